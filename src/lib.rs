@@ -1,0 +1,1 @@
+//! skytie engine: typed dataflow DAG with content-addressed caching, workflows, CLI support.
