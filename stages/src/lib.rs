@@ -6,6 +6,10 @@
 //! root crate wraps the stages built from these as cached DAG nodes.
 
 pub mod campaign;
+pub mod estimators;
+pub mod features;
+pub mod fsutil;
 pub mod geometry;
 pub mod imaging;
+pub mod matching;
 pub mod synth;

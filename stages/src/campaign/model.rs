@@ -1,0 +1,108 @@
+//! In-memory model of a campaign (shared/docs/campaign-format.md): one struct per CSV row kind.
+//!
+//! Units: world coordinates in metres (f64, projected frame X = east, Y = north, Z = up), angles in degrees,
+//! pixels in continuous pixel coordinates. Field names carry units where the CSV column name does not.
+
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// One panorama row of `mm/recordings.csv` (also the row type of `truth/recordings.csv`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Recording {
+    pub image_id: String,
+    /// Path relative to `mm/panoramas/`.
+    pub file: String,
+    /// Acquisition time exactly as written (ISO 8601).
+    pub time: String,
+    /// Acquisition time in seconds since 1970-01-01T00:00:00Z (parsed from `time`); orders the trajectory.
+    pub time_s: f64,
+    /// Projection centre, world frame, metres.
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+    /// Driving direction, degrees clockwise from grid north.
+    pub heading_deg: f64,
+    /// Height of the projection centre above the road surface below it, metres.
+    pub camera_height_m: f64,
+    /// A-priori standard deviation of x and of y each, metres (optional column `sigma_xy`).
+    pub sigma_xy_m: Option<f64>,
+    /// A-priori standard deviation of z, metres (optional column `sigma_z`).
+    pub sigma_z_m: Option<f64>,
+    /// Residual rotation of the panorama frame, degrees (optional columns, default 0).
+    pub yaw_deg: f64,
+    pub pitch_deg: f64,
+    pub roll_deg: f64,
+}
+
+/// One row of `aerial/{nadir,oblique}/cameras.csv`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AerialImage {
+    pub image_id: String,
+    /// Path relative to the folder of the CSV.
+    pub file: String,
+    /// Projection centre, world frame, metres.
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+    /// Attitude, degrees, R = Rx(ω)·Ry(φ)·Rz(κ) maps camera-frame vectors to world-frame vectors.
+    pub omega_deg: f64,
+    pub phi_deg: f64,
+    pub kappa_deg: f64,
+    pub focal_px: f64,
+    pub cx_px: f64,
+    pub cy_px: f64,
+    pub width_px: u32,
+    pub height_px: u32,
+    /// Brown distortion (optional columns, default 0); normalised image y points up.
+    pub k1: f64,
+    pub k2: f64,
+    pub p1: f64,
+    pub p2: f64,
+    /// Image measurement precision, pixels (optional, default 0.5).
+    pub sigma_px: f64,
+}
+
+/// Which aerial folder an image came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum AerialKind {
+    Nadir,
+    Oblique,
+}
+
+/// One row of `control/checkpoints.csv`: a surveyed point used only for evaluation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CheckPoint {
+    pub point_id: String,
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+    pub sigma_xy_m: Option<f64>,
+    pub sigma_z_m: Option<f64>,
+}
+
+/// One row of `control/observations.csv`: where a check point was measured in a panorama.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Observation {
+    pub point_id: String,
+    pub image_id: String,
+    /// Continuous pixel coordinates in the panorama.
+    pub u_px: f64,
+    pub v_px: f64,
+}
+
+/// A whole campaign as read from disk (only rows that passed validation).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Campaign {
+    /// The campaign folder.
+    pub root: PathBuf,
+    /// `campaign.toml`: `name`.
+    pub name: String,
+    /// `campaign.toml`: `crs` (informative, never reprojected).
+    pub crs: String,
+    /// Recordings sorted by `time_s`.
+    pub recordings: Vec<Recording>,
+    pub nadir: Vec<AerialImage>,
+    pub oblique: Vec<AerialImage>,
+    pub checkpoints: Vec<CheckPoint>,
+    pub observations: Vec<Observation>,
+}

@@ -1,0 +1,129 @@
+//! Reading and writing image files (JPEG, PNG, TIFF via the `image` crate) as [`GrayImage`]/[`RgbImage`].
+//!
+//! 8-bit files map to 0..1 (value / 255); 16-bit files to 0..1 (value / 65535). Writing clamps to 0..1 and
+//! rounds to 8 bits. Writes are atomic (see [`crate::fsutil`]).
+
+use super::{GrayImage, RgbImage};
+use std::path::Path;
+
+/// An image file that could not be read or written; the message names the file and what to do.
+#[derive(Debug, thiserror::Error)]
+#[error("{path}: {message}")]
+pub struct ImageIoError {
+    pub path: String,
+    pub message: String,
+}
+
+fn err(path: &Path, message: impl Into<String>) -> ImageIoError {
+    ImageIoError { path: path.display().to_string(), message: message.into() }
+}
+
+fn open(path: &Path) -> Result<image::DynamicImage, ImageIoError> {
+    let reader = image::ImageReader::open(path)
+        .map_err(|e| err(path, format!("cannot open ({e}); check that the file exists and is readable")))?
+        .with_guessed_format()
+        .map_err(|e| err(path, format!("cannot read ({e})")))?;
+    reader
+        .decode()
+        .map_err(|e| err(path, format!("does not decode as an image ({e}); is it truncated or not JPEG/PNG/TIFF?")))
+}
+
+/// Load any supported image as a single-channel image (luminance for colour files).
+pub fn load_gray(path: &Path) -> Result<GrayImage, ImageIoError> {
+    let img = open(path)?;
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let data = match img {
+        image::DynamicImage::ImageLuma16(b) => b.into_raw().into_iter().map(|v| v as f32 / 65535.0).collect(),
+        other => {
+            let rgb = other.to_rgb32f();
+            rgb.into_raw().chunks_exact(3).map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]).collect()
+        }
+    };
+    Ok(GrayImage { width: w, height: h, data })
+}
+
+/// Load any supported image as RGB.
+pub fn load_rgb(path: &Path) -> Result<RgbImage, ImageIoError> {
+    let img = open(path)?;
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    Ok(RgbImage { width: w, height: h, data: img.to_rgb32f().into_raw() })
+}
+
+/// Only the dimensions (width, height) of an image file, without decoding the pixels.
+pub fn dimensions(path: &Path) -> Result<(u32, u32), ImageIoError> {
+    image::image_dimensions(path).map_err(|e| err(path, format!("cannot read image header ({e})")))
+}
+
+#[inline]
+fn to_u8(v: f32) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+}
+
+fn format_for(path: &Path) -> Result<image::ImageFormat, ImageIoError> {
+    image::ImageFormat::from_path(path).map_err(|_| err(path, "unknown image extension; use .png, .jpg or .tif"))
+}
+
+fn save_dynamic(path: &Path, img: image::DynamicImage, jpeg_quality: u8) -> Result<(), ImageIoError> {
+    let format = format_for(path)?;
+    crate::fsutil::atomic_write_with(path, |w| {
+        let res = if format == image::ImageFormat::Jpeg {
+            let enc = image::codecs::jpeg::JpegEncoder::new_with_quality(w, jpeg_quality);
+            img.write_with_encoder(enc)
+        } else {
+            let mut buf = std::io::Cursor::new(Vec::new());
+            img.write_to(&mut buf, format).map(|_| {
+                use std::io::Write;
+                let _ = w.write_all(buf.get_ref());
+            })
+        };
+        res.map_err(std::io::Error::other)
+    })
+    .map_err(|e| err(path, format!("cannot write ({e})")))
+}
+
+/// Save as 8-bit RGB (format from the extension; JPEG at `jpeg_quality`).
+pub fn save_rgb(path: &Path, img: &RgbImage, jpeg_quality: u8) -> Result<(), ImageIoError> {
+    let raw: Vec<u8> = img.data.iter().map(|&v| to_u8(v)).collect();
+    let buf = image::RgbImage::from_raw(img.width as u32, img.height as u32, raw)
+        .ok_or_else(|| err(path, "internal: RGB buffer size does not match its dimensions"))?;
+    save_dynamic(path, image::DynamicImage::ImageRgb8(buf), jpeg_quality)
+}
+
+/// Save as 8-bit grey (format from the extension; JPEG at quality 95).
+pub fn save_gray(path: &Path, img: &GrayImage) -> Result<(), ImageIoError> {
+    let raw: Vec<u8> = img.data.iter().map(|&v| to_u8(v)).collect();
+    let buf = image::GrayImage::from_raw(img.width as u32, img.height as u32, raw)
+        .ok_or_else(|| err(path, "internal: grey buffer size does not match its dimensions"))?;
+    save_dynamic(path, image::DynamicImage::ImageLuma8(buf), 95)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn png_round_trip_is_exact_at_8_bits() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut img = RgbImage::filled(4, 3, [0.0, 0.5, 1.0]);
+        img.set(1, 2, [1.0, 0.0, 0.2]);
+        let p = dir.path().join("a.png");
+        save_rgb(&p, &img, 95).unwrap();
+        let back = load_rgb(&p).unwrap();
+        assert_eq!((back.width, back.height), (4, 3));
+        for (a, b) in img.data.iter().zip(&back.data) {
+            assert!((a - b).abs() <= 0.5 / 255.0 + 1e-6);
+        }
+        assert_eq!(dimensions(&p).unwrap(), (4, 3));
+    }
+
+    #[test]
+    fn truncated_file_is_an_error_naming_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.jpg");
+        save_rgb(&p, &RgbImage::filled(64, 64, [0.3, 0.4, 0.5]), 90).unwrap();
+        let bytes = std::fs::read(&p).unwrap();
+        std::fs::write(&p, &bytes[..bytes.len() / 3]).unwrap();
+        let e = load_gray(&p).unwrap_err();
+        assert!(e.to_string().contains("t.jpg"), "{e}");
+    }
+}
