@@ -1,5 +1,13 @@
 //! The campaign contract (shared/docs/campaign-format.md): model, reading with validation, writers.
 
 pub mod model;
+pub mod time;
+pub mod write;
 
 pub use model::{AerialImage, AerialKind, Campaign, CheckPoint, Observation, Recording};
+pub use time::{format_time_iso, parse_time_s};
+pub use write::{
+    write_aerial_cameras_csv, write_campaign_toml, write_checkpoints_csv, write_observations_csv,
+    write_ply, write_recordings_csv, write_trajectory_adjusted_csv, write_trajectory_geojson,
+    GeoJsonLayer, GeoJsonPoint, PlyPoint,
+};
