@@ -1,0 +1,238 @@
+//! Bodies of the `skytie cache stats | verify | gc` commands (the CLI wires them in): human-readable tables
+//! built from [`Store::stats`], [`Store::verify`] and [`Store::gc`], and size parsing for `--max-size`.
+
+use std::fmt::Write;
+
+use crate::store::Store;
+
+/// Parses a size such as `10G`, `500M`, `1.5GiB`, `64k`, `0` or `123456` (bytes). Suffixes K, M, G, T are
+/// binary multiples (1K = 1024 bytes); an optional `B`/`iB` after them is accepted; case does not matter.
+pub fn parse_size(text: &str) -> Result<u64, String> {
+    let err = |why: &str| {
+        format!("invalid size `{text}`: {why}; write a number with an optional unit K, M, G or T (e.g. 10G, 500M, 0)")
+    };
+    let t = text.trim();
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (number, unit) = t.split_at(split);
+    if number.is_empty() {
+        return Err(err("no number"));
+    }
+    let unit = unit.trim().to_ascii_uppercase();
+    let unit = unit
+        .strip_suffix("IB")
+        .or_else(|| unit.strip_suffix('B'))
+        .unwrap_or(&unit);
+    let shift = match unit {
+        "" => 0,
+        "K" => 10,
+        "M" => 20,
+        "G" => 30,
+        "T" => 40,
+        _ => return Err(err("unknown unit")),
+    };
+    let multiplier = (1u64 << shift) as f64;
+    let value: f64 = number.parse().map_err(|_| err("not a number"))?;
+    let bytes = (value * multiplier).round();
+    if !bytes.is_finite() || bytes >= u64::MAX as f64 {
+        return Err(err("too large"));
+    }
+    if shift == 0 && number.contains('.') {
+        return Err(err("a byte count must be a whole number"));
+    }
+    Ok(bytes as u64)
+}
+
+/// `1536` → `1.5 KiB`; exact byte counts below 1 KiB.
+pub fn format_bytes(bytes: u64) -> String {
+    const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut value = bytes as f64;
+    let mut unit = 0;
+    while value >= 1024.0 && unit < UNITS.len() - 1 {
+        value /= 1024.0;
+        unit += 1;
+    }
+    if unit == 0 {
+        format!("{bytes} B")
+    } else {
+        format!("{value:.1} {}", UNITS[unit])
+    }
+}
+
+/// `skytie cache stats`: totals and a per-stage table.
+pub fn stats(store: &Store) -> String {
+    let stats = match store.stats() {
+        Ok(s) => s,
+        Err(e) => return format!("{e}\n"),
+    };
+    let mut out = String::new();
+    let _ = writeln!(out, "cache {}", store.root().display());
+    let _ = writeln!(out, "{:<28} {:>10} {:>12}", "stage", "entries", "size");
+    for (stage, s) in &stats.per_stage {
+        let _ = writeln!(
+            out,
+            "{:<28} {:>10} {:>12}",
+            stage,
+            s.entries,
+            format_bytes(s.bytes)
+        );
+    }
+    if stats.unreadable.entries > 0 {
+        let _ = writeln!(
+            out,
+            "{:<28} {:>10} {:>12}",
+            "(unreadable or old format)",
+            stats.unreadable.entries,
+            format_bytes(stats.unreadable.bytes)
+        );
+    }
+    let _ = writeln!(
+        out,
+        "{:<28} {:>10} {:>12}",
+        "total",
+        stats.entries,
+        format_bytes(stats.bytes)
+    );
+    let _ = writeln!(
+        out,
+        "{:<28} {:>10} {:>12}",
+        "records",
+        stats.records.entries,
+        format_bytes(stats.records.bytes)
+    );
+    let _ = writeln!(out, "live runs: {}", stats.live_runs);
+    out
+}
+
+/// `skytie cache verify`: re-hashes every entry; the flag is false if any entry was bad (exit status 1).
+pub fn verify(store: &Store) -> (String, bool) {
+    let report = match store.verify() {
+        Ok(r) => r,
+        Err(e) => return (format!("{e}\n"), false),
+    };
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "checked {} entries ({}): {} ok, {} bad",
+        report.checked,
+        format_bytes(report.bytes_checked),
+        report.ok,
+        report.bad.len()
+    );
+    for bad in &report.bad {
+        let action = if bad.removed {
+            "removed"
+        } else {
+            "could NOT be removed"
+        };
+        let _ = writeln!(out, "  {}  {} — {action}", bad.path.display(), bad.reason);
+    }
+    if report.temp_files_removed > 0 {
+        let _ = writeln!(
+            out,
+            "removed {} left-over temporary files of crashed writes",
+            report.temp_files_removed
+        );
+    }
+    if !report.all_ok() {
+        let _ = writeln!(
+            out,
+            "bad entries will be recomputed by the next `skytie run`"
+        );
+    }
+    (out, report.all_ok())
+}
+
+/// `skytie cache gc --max-size SIZE`: removes least-recently-used entries until the cache fits in SIZE.
+pub fn gc(store: &Store, max_size: &str) -> Result<String, String> {
+    let max_bytes = parse_size(max_size)?;
+    let report = store.gc(max_bytes).map_err(|e| e.to_string())?;
+    let mut out = String::new();
+    let _ = writeln!(out, "{:<22} {:>10} {:>12}", "", "entries", "size");
+    let row = |out: &mut String, label: &str, n: u64, b: u64| {
+        let _ = writeln!(out, "{:<22} {:>10} {:>12}", label, n, format_bytes(b));
+    };
+    row(
+        &mut out,
+        "before",
+        report.entries_before,
+        report.bytes_before,
+    );
+    row(
+        &mut out,
+        "removed (LRU first)",
+        report.removed_entries,
+        report.removed_bytes,
+    );
+    row(
+        &mut out,
+        "kept in use by runs",
+        report.protected_entries,
+        report.protected_bytes,
+    );
+    row(&mut out, "after", report.kept_entries, report.kept_bytes);
+    let _ = writeln!(
+        out,
+        "limit {} ({} bytes); live runs: {}",
+        format_bytes(max_bytes),
+        max_bytes,
+        report.live_runs
+    );
+    if report.stale_leases_removed > 0 {
+        let _ = writeln!(
+            out,
+            "removed {} stale lease(s) of crashed runs",
+            report.stale_leases_removed
+        );
+    }
+    if report.temp_files_removed > 0 {
+        let _ = writeln!(
+            out,
+            "removed {} left-over temporary files of crashed writes",
+            report.temp_files_removed
+        );
+    }
+    if report.kept_bytes > max_bytes {
+        let _ = writeln!(
+            out,
+            "the cache is still above the limit because live runs use the kept entries"
+        );
+    }
+    for failure in &report.failures {
+        let _ = writeln!(out, "warning: {failure}");
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse_with_binary_units_and_clear_errors() {
+        assert_eq!(parse_size("0"), Ok(0));
+        assert_eq!(parse_size("123"), Ok(123));
+        assert_eq!(parse_size("10G"), Ok(10 << 30));
+        assert_eq!(parse_size("500M"), Ok(500 << 20));
+        assert_eq!(parse_size("500mb"), Ok(500 << 20));
+        assert_eq!(parse_size("1.5GiB"), Ok(3 << 29));
+        assert_eq!(parse_size("64k"), Ok(64 << 10));
+        assert_eq!(parse_size(" 2T "), Ok(2 << 40));
+        for bad in ["", "G", "10X", "-5M", "1.2.3G", "1.5", "99999999999T"] {
+            let e = parse_size(bad).unwrap_err();
+            assert!(
+                e.contains("invalid size") && e.contains("10G"),
+                "{bad}: {e}"
+            );
+        }
+    }
+
+    #[test]
+    fn bytes_format_readably() {
+        assert_eq!(format_bytes(0), "0 B");
+        assert_eq!(format_bytes(1023), "1023 B");
+        assert_eq!(format_bytes(1536), "1.5 KiB");
+        assert_eq!(format_bytes(10 << 30), "10.0 GiB");
+    }
+}

@@ -1,0 +1,226 @@
+//! The content-addressed artifact store: one file per DAG node result under `<root>/objects/`, named by the
+//! node key, written atomically and verified on every read.
+//!
+//! Safe for many threads (`&self` methods, `Store: Send + Sync`) and many processes sharing one folder: entries
+//! are immutable once renamed into place, and two processes saving the same key write identical bytes. A
+//! damaged entry is reported once, deleted and recomputed by the caller — never trusted. Last use of an entry
+//! is its file modification time (set on every load hit and save), which `gc` sorts by; live runs hold a
+//! [`RunLease`] so `gc` never removes what they used.
+
+mod entry;
+mod error;
+mod gc;
+mod lease;
+mod objects;
+mod records;
+mod stats;
+mod verify;
+
+use std::collections::HashSet;
+use std::fs::{self, File};
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
+use std::time::SystemTime;
+
+pub use entry::{EntryMeta, STORE_FORMAT_VERSION};
+pub use error::StoreError;
+pub use gc::GcReport;
+pub use lease::{LiveRun, RunLease};
+pub use stats::{StageStats, StoreStats};
+pub use verify::{BadEntry, VerifyReport};
+
+use crate::hashing::{hash_bytes, ContentHash, NodeKey};
+use entry::EntryFault;
+
+/// A verified cache entry.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Entry {
+    pub meta: EntryMeta,
+    pub payload: Vec<u8>,
+    /// blake3 of `payload` (verified).
+    pub content_hash: ContentHash,
+}
+
+/// Result of [`Store::load`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Lookup {
+    /// A verified entry.
+    Hit(Entry),
+    /// No entry: compute the node.
+    Miss,
+    /// The entry was damaged or unreadable: it has been deleted; show `message` once and compute the node.
+    Corrupt { message: String },
+}
+
+/// Handle on a cache folder.
+pub struct Store {
+    root: PathBuf,
+    objects: PathBuf,
+    records: PathBuf,
+    runs: PathBuf,
+    /// An entry of another store format has been reported by this handle (later ones are silent misses).
+    other_format_noticed: AtomicBool,
+    /// Keys already reported as corrupt whose file could not be deleted (reported only once).
+    reported: Mutex<HashSet<NodeKey>>,
+}
+
+impl Store {
+    /// Opens (creating as needed) the store at `root`, with its `objects/`, `records/` and `runs/` folders.
+    pub fn open(root: &Path) -> Result<Store, StoreError> {
+        let store = Store {
+            root: root.to_path_buf(),
+            objects: root.join("objects"),
+            records: root.join("records"),
+            runs: root.join("runs"),
+            other_format_noticed: AtomicBool::new(false),
+            reported: Mutex::new(HashSet::new()),
+        };
+        for dir in [&store.root, &store.objects, &store.records, &store.runs] {
+            fs::create_dir_all(dir).map_err(StoreError::io("create cache folder", dir))?;
+        }
+        Ok(store)
+    }
+
+    /// The cache folder.
+    pub fn root(&self) -> &Path {
+        &self.root
+    }
+
+    /// Path of the entry file of `key`.
+    pub fn object_path(&self, key: &NodeKey) -> PathBuf {
+        objects::object_path(&self.objects, key)
+    }
+
+    /// Looks up the artifact of `key`, verifying header, format version and payload hash. A damaged, truncated
+    /// or unreadable entry is returned once as [`Lookup::Corrupt`] (message names key, path and reason) and
+    /// deleted; the next load is a [`Lookup::Miss`]. An entry of another store format is deleted too; the first
+    /// one per handle is reported, later ones are plain misses. A hit marks the entry as used now.
+    pub fn load(&self, key: &NodeKey) -> Result<Lookup, StoreError> {
+        let path = self.object_path(key);
+        let mut file = match File::open(&path) {
+            Ok(f) => f,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Lookup::Miss),
+            Err(e) => return Ok(self.corrupt(key, &path, None, &format!("cannot open: {e}"))),
+        };
+        match entry::read_entry(&mut file, key) {
+            Ok((header, payload)) => {
+                // Last-use time for LRU gc and live-run protection; failure only weakens gc ordering.
+                let _ = file.set_modified(SystemTime::now());
+                Ok(Lookup::Hit(Entry {
+                    meta: header.meta,
+                    payload,
+                    content_hash: header.payload_hash,
+                }))
+            }
+            Err(EntryFault::OtherFormat(version)) => {
+                objects::remove_if_same(&path, &file);
+                if self.other_format_noticed.swap(true, Ordering::Relaxed) {
+                    Ok(Lookup::Miss)
+                } else {
+                    Ok(Lookup::Corrupt {
+                        message: format!(
+                            "cache entry {key} ({}) was written by store format version {version}, this skytie uses \
+                             version {STORE_FORMAT_VERSION}: entries of the old format are discarded and recomputed \
+                             (reported once; `skytie cache gc --max-size 0` clears them all)",
+                            path.display()
+                        ),
+                    })
+                }
+            }
+            Err(EntryFault::Damaged(reason)) => Ok(self.corrupt(key, &path, Some(&file), &reason)),
+            Err(EntryFault::Unreadable(e)) => {
+                Ok(self.corrupt(key, &path, Some(&file), &format!("read error: {e}")))
+            }
+        }
+    }
+
+    fn corrupt(&self, key: &NodeKey, path: &Path, opened: Option<&File>, reason: &str) -> Lookup {
+        let removed = match opened {
+            Some(file) => objects::remove_if_same(path, file),
+            None => fs::remove_file(path).is_ok(),
+        };
+        let mut reported = self.reported.lock().unwrap_or_else(|p| p.into_inner());
+        if !removed && !reported.insert(*key) {
+            return Lookup::Miss;
+        }
+        let action = if removed {
+            "deleted"
+        } else {
+            "could not be deleted, ignored"
+        };
+        Lookup::Corrupt {
+            message: format!(
+                "cache entry {key} ({}) is corrupt: {reason}; {action}, the node will be recomputed",
+                path.display()
+            ),
+        }
+    }
+
+    /// Atomically stores `payload` as the entry of `key` (temporary file in the same folder, fsync, rename).
+    /// Returns the payload's content hash. Concurrent saves of one key are safe (identical bytes, atomic rename).
+    pub fn save(
+        &self,
+        key: &NodeKey,
+        meta: &EntryMeta,
+        payload: &[u8],
+    ) -> Result<ContentHash, StoreError> {
+        let meta_block = entry::encode_meta(meta).map_err(|len| StoreError::MetaTooLarge {
+            key: key.to_string(),
+            len,
+            max: entry::MAX_META_BYTES,
+        })?;
+        let content_hash = hash_bytes(payload);
+        let header = entry::encode_header(key, &meta_block, payload.len() as u64, &content_hash);
+        let path = self.object_path(key);
+        skytie_stages::fsutil::atomic_write_with(&path, |w| {
+            w.write_all(&header)?;
+            w.write_all(payload)
+        })
+        .map_err(StoreError::io("write cache entry", &path))?;
+        Ok(content_hash)
+    }
+
+    /// Whether an entry file for `key` exists (no verification; for planning).
+    pub fn contains(&self, key: &NodeKey) -> bool {
+        self.object_path(key).is_file()
+    }
+
+    /// Atomically stores a small side record `bytes` under `<root>/records/<namespace>/<blake3(name)>`.
+    pub fn put_record(&self, namespace: &str, name: &str, bytes: &[u8]) -> Result<(), StoreError> {
+        records::put(&self.records, namespace, name, bytes)
+    }
+
+    /// The record stored under (`namespace`, `name`); `None` if absent, unreadable or corrupt.
+    pub fn get_record(&self, namespace: &str, name: &str) -> Option<Vec<u8>> {
+        records::get(&self.records, namespace, name)
+    }
+
+    /// Registers this process as a live run until the returned lease is dropped. Entries it loads or saves are
+    /// protected from `gc` meanwhile; a crashed run's lease is detected as stale and never blocks anything.
+    pub fn begin_run(&self) -> Result<RunLease, StoreError> {
+        lease::acquire(&self.runs)
+    }
+
+    /// Live runs using this cache (leases of dead runs are removed on the way).
+    pub fn live_runs(&self) -> Result<Vec<LiveRun>, StoreError> {
+        Ok(lease::scan(&self.runs)?.0)
+    }
+
+    /// Entry and byte counts, in total and per stage.
+    pub fn stats(&self) -> Result<StoreStats, StoreError> {
+        stats::collect(self)
+    }
+
+    /// Re-reads and re-hashes every entry; removes and lists the bad ones.
+    pub fn verify(&self) -> Result<VerifyReport, StoreError> {
+        verify::run(self)
+    }
+
+    /// Removes least-recently-used entries until the entries total at most `max_bytes`, never removing an entry
+    /// used since the start of a live run.
+    pub fn gc(&self, max_bytes: u64) -> Result<GcReport, StoreError> {
+        gc::run(self, max_bytes)
+    }
+}

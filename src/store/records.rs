@@ -1,0 +1,77 @@
+//! Small side records (node identity → last key, provenance, run logs): atomic put/get of bytes by name under
+//! `<root>/records/<namespace>/<blake3(name) hex>`.
+//!
+//! Layout: `"SKYREC\0"` · version (u8) · name length (u32) · name · payload length (u64) · payload blake3 (32)
+//! · payload. A record that fails any check reads as absent (and is replaced by the next `put`).
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use super::error::StoreError;
+use crate::hashing::hash_bytes;
+
+const MAGIC: &[u8; 7] = b"SKYREC\0";
+const VERSION: u8 = 1;
+
+fn valid_namespace(namespace: &str) -> bool {
+    !namespace.is_empty()
+        && namespace.len() <= 64
+        && !namespace.starts_with('.')
+        && namespace
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-' || b == b'.')
+}
+
+fn record_path(records: &Path, namespace: &str, name: &str) -> Result<PathBuf, StoreError> {
+    if !valid_namespace(namespace) {
+        return Err(StoreError::InvalidNamespace(namespace.to_string()));
+    }
+    Ok(records
+        .join(namespace)
+        .join(blake3::hash(name.as_bytes()).to_hex().as_str()))
+}
+
+pub(crate) fn put(
+    records: &Path,
+    namespace: &str,
+    name: &str,
+    bytes: &[u8],
+) -> Result<(), StoreError> {
+    let path = record_path(records, namespace, name)?;
+    let mut out = Vec::with_capacity(MAGIC.len() + 1 + 4 + name.len() + 8 + 32 + bytes.len());
+    out.extend_from_slice(MAGIC);
+    out.push(VERSION);
+    out.extend_from_slice(&(name.len() as u32).to_le_bytes());
+    out.extend_from_slice(name.as_bytes());
+    out.extend_from_slice(&(bytes.len() as u64).to_le_bytes());
+    out.extend_from_slice(hash_bytes(bytes).as_bytes());
+    out.extend_from_slice(bytes);
+    skytie_stages::fsutil::atomic_write(&path, &out).map_err(StoreError::io("write record", &path))
+}
+
+fn parse<'a>(file: &'a [u8], name: &str) -> Option<&'a [u8]> {
+    let rest = file.strip_prefix(MAGIC.as_slice())?;
+    let (&version, rest) = rest.split_first()?;
+    if version != VERSION {
+        return None;
+    }
+    let name_len = u32::from_le_bytes(rest.get(..4)?.try_into().ok()?) as usize;
+    let rest = &rest[4..];
+    if rest.get(..name_len)? != name.as_bytes() {
+        return None;
+    }
+    let rest = &rest[name_len..];
+    let payload_len = u64::from_le_bytes(rest.get(..8)?.try_into().ok()?);
+    let hash = rest.get(8..40)?;
+    let payload = &rest[40..];
+    (payload.len() as u64 == payload_len && hash_bytes(payload).as_bytes() == hash)
+        .then_some(payload)
+}
+
+pub(crate) fn get(records: &Path, namespace: &str, name: &str) -> Option<Vec<u8>> {
+    let path = record_path(records, namespace, name).ok()?;
+    let file = fs::read(&path).ok()?;
+    // A corrupt record is left in place (a concurrent `put` may be replacing it right now); the next `put`
+    // overwrites it.
+    parse(&file, name).map(<[u8]>::to_vec)
+}
