@@ -1,0 +1,106 @@
+//! Reading `aerial/{nadir,oblique}/cameras.csv` row by row with validation (campaign-format.md,
+//! "Aerial frame images").
+
+use super::model::AerialImage;
+use super::problem::Problem;
+use super::read_recordings::check_file_exists;
+use super::table::read_table;
+use super::unique::Sourced;
+use std::path::Path;
+
+const AERIAL_COLUMNS: &[&str] = &[
+    "image_id", "file", "x", "y", "z", "omega", "phi", "kappa", "focal_px", "cx", "cy", "width",
+    "height",
+];
+
+/// Valid rows of `root/rel` in file order; `file` must exist next to the CSV. Id uniqueness is checked by
+/// the caller across nadir and oblique together.
+pub(crate) fn read_aerial_rows(
+    root: &Path,
+    rel: &Path,
+    problems: &mut Vec<Problem>,
+) -> Vec<Sourced<AerialImage>> {
+    let Some(table) = read_table(root, rel, AERIAL_COLUMNS, problems) else {
+        return Vec::new();
+    };
+    let dir = rel.parent().unwrap_or(Path::new(""));
+    let mut rows = Vec::with_capacity(table.records.len());
+    for record in &table.records {
+        let mut f = table.fields(record, problems);
+        let image_id = f.text("image_id");
+        let file = f.text("file");
+        let (x, y, z) = (f.number("x"), f.number("y"), f.number("z"));
+        let (omega_deg, phi_deg, kappa_deg) =
+            (f.number("omega"), f.number("phi"), f.number("kappa"));
+        let focal_px = f.number("focal_px");
+        let (cx_px, cy_px) = (f.number("cx"), f.number("cy"));
+        let (width_px, height_px) = (f.pixel_count("width"), f.pixel_count("height"));
+        let (k1, k2, p1, p2) = (
+            f.number_or("k1", 0.0),
+            f.number_or("k2", 0.0),
+            f.number_or("p1", 0.0),
+            f.number_or("p2", 0.0),
+        );
+        let sigma_px = f.number_or("sigma_px", 0.5);
+        // thesis/format: ω and φ are tilts from the nadir; beyond ±90° the camera would look upwards.
+        for (column, angle) in [("omega", omega_deg), ("phi", phi_deg)] {
+            if angle.abs() > 90.0 {
+                f.error(
+                    column,
+                    format!("{angle}° is beyond ±90° (the camera would look upwards)"),
+                    "check the angle convention (ω-φ-κ, degrees; 0,0,0 looks straight down)",
+                );
+            }
+        }
+        if focal_px <= 0.0 {
+            f.error(
+                "focal_px",
+                format!("{focal_px} is not a principal distance"),
+                "give the principal distance in pixels, > 0",
+            );
+        }
+        for (column, c, size) in [("cx", cx_px, width_px), ("cy", cy_px, height_px)] {
+            if size > 0 && !(0.0..=f64::from(size)).contains(&c) {
+                f.error(column, format!("principal point {c} px lies outside the image (0..{size} px)"), "give the principal point in continuous pixel coordinates of this image (centre = size/2)");
+            }
+        }
+        if sigma_px <= 0.0 {
+            f.error(
+                "sigma_px",
+                format!("{sigma_px} is not a standard deviation"),
+                "write a value > 0 px, or leave the cell empty for the default 0.5",
+            );
+        }
+        if !file.is_empty() {
+            check_file_exists(&mut f, root, dir, &file);
+        }
+        if f.ok {
+            let item = AerialImage {
+                image_id,
+                file,
+                x,
+                y,
+                z,
+                omega_deg,
+                phi_deg,
+                kappa_deg,
+                focal_px,
+                cx_px,
+                cy_px,
+                width_px,
+                height_px,
+                k1,
+                k2,
+                p1,
+                p2,
+                sigma_px,
+            };
+            rows.push(Sourced {
+                item,
+                file: rel.to_path_buf(),
+                row: record.row,
+            });
+        }
+    }
+    rows
+}
