@@ -1,1 +1,15 @@
-//! (module under construction)
+//! Robust estimation: a deterministic PRNG ([`rng`]), generic RANSAC ([`ransac`]) and the [`Model`]
+//! implementations of the 2-D transforms of [`crate::geometry`] ([`models`]).
+
+// `!(x > t)` is used on purpose throughout: it also rejects NaN, which `x <= t` would let through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod models;
+pub mod ransac;
+pub mod rng;
+
+#[cfg(test)]
+mod tests;
+
+pub use ransac::{ransac, required_iterations, Model, RansacParams, RansacResult};
+pub use rng::{mix64, mix_seed, SplitMix64};

@@ -1,0 +1,113 @@
+//! RANSAC similarity (ALGORITHMS.md §11 KAT): 50 % outliers, noisy inliers, determinism.
+
+use crate::estimators::{ransac, RansacParams, SplitMix64};
+use crate::geometry::{PointPair, Similarity2};
+use nalgebra::Vector2;
+
+fn truth() -> Similarity2 {
+    Similarity2 {
+        scale: 0.93,
+        rotation_rad: -0.35,
+        tx: 57.0,
+        ty: -21.5,
+    }
+}
+
+/// `n_in` correspondences of `truth()` with N(0, noise) in dst, then `n_out` random ones over the image.
+fn contaminated(n_in: usize, n_out: usize, noise: f64, seed: u64) -> Vec<PointPair> {
+    let mut rng = SplitMix64::new(seed);
+    let sim = truth();
+    let mut pairs: Vec<PointPair> = (0..n_in)
+        .map(|_| {
+            let src = Vector2::new(600.0 * rng.next_f64(), 600.0 * rng.next_f64());
+            let dst =
+                sim.apply(&src) + Vector2::new(rng.next_gaussian(), rng.next_gaussian()) * noise;
+            PointPair { src, dst }
+        })
+        .collect();
+    pairs.extend((0..n_out).map(|_| {
+        PointPair::new(
+            600.0 * rng.next_f64(),
+            600.0 * rng.next_f64(),
+            600.0 * rng.next_f64(),
+            600.0 * rng.next_f64(),
+        )
+    }));
+    pairs
+}
+
+#[test]
+fn exact_inliers_with_50_percent_outliers() {
+    let pairs = contaminated(100, 100, 0.0, 21);
+    let params = RansacParams {
+        threshold: 1.0,
+        confidence: 0.99,
+        max_iterations: 2000,
+        seed: 7,
+    };
+    let r = ransac::<Similarity2>(&pairs, &params).unwrap();
+    let t = truth();
+    assert!((r.model.scale - t.scale).abs() < 1e-9 * t.scale);
+    assert!((r.model.rotation_rad - t.rotation_rad).abs() < 1e-9);
+    assert!((r.model.tx - t.tx).abs() < 1e-9 * 600.0 && (r.model.ty - t.ty).abs() < 1e-9 * 600.0);
+    // All true inliers found; an outlier is only accepted if it happens to fall within the threshold.
+    assert!((0..100).all(|i| r.inliers.contains(&i)));
+    for &i in r.inliers.iter().filter(|&&i| i >= 100) {
+        assert!(t.transfer_error(&pairs[i]) <= 1.0);
+    }
+    // Adaptive stopping: far fewer than the cap (17 trials suffice at w = 0.5, p = 0.99).
+    assert!(r.iterations < 100, "{} iterations", r.iterations);
+}
+
+#[test]
+fn noisy_inliers_match_least_squares_on_true_inliers() {
+    let noise = 0.5;
+    let pairs = contaminated(120, 120, noise, 22);
+    let params = RansacParams {
+        threshold: 3.0 * noise * 2f64.sqrt(),
+        confidence: 0.99,
+        max_iterations: 2000,
+        seed: 8,
+    };
+    let r = ransac::<Similarity2>(&pairs, &params).unwrap();
+    let recall = (0..120).filter(|i| r.inliers.contains(i)).count() as f64 / 120.0;
+    assert!(recall > 0.98, "recall {recall}");
+    let reference = Similarity2::least_squares(&pairs[..120]).unwrap();
+    // Compare where it matters: transferred positions over the image differ far less than the noise.
+    for &(x, y) in &[
+        (0.0, 0.0),
+        (600.0, 0.0),
+        (0.0, 600.0),
+        (600.0, 600.0),
+        (300.0, 300.0),
+    ] {
+        let p = Vector2::new(x, y);
+        let d = (r.model.apply(&p) - reference.apply(&p)).norm();
+        assert!(d < 0.3 * noise, "corner ({x},{y}) differs by {d} px");
+    }
+}
+
+#[test]
+fn deterministic_for_a_seed() {
+    let pairs = contaminated(80, 80, 0.3, 23);
+    let params = RansacParams {
+        threshold: 1.5,
+        confidence: 0.995,
+        max_iterations: 2000,
+        seed: 99,
+    };
+    let a = ransac::<Similarity2>(&pairs, &params).unwrap();
+    let b = ransac::<Similarity2>(&pairs, &params).unwrap();
+    assert_eq!(a, b);
+    assert_eq!(a.model.scale.to_bits(), b.model.scale.to_bits());
+    // Another seed reaches the same consensus here.
+    let c = ransac::<Similarity2>(
+        &pairs,
+        &RansacParams {
+            seed: 100,
+            ..params
+        },
+    )
+    .unwrap();
+    assert_eq!(a.inliers, c.inliers);
+}

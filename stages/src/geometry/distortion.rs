@@ -1,0 +1,109 @@
+//! Brown lens distortion in the convention of campaign-format.md (normalised image y points up):
+//! `r² = x² + y²`, `x_d = x(1 + k1 r² + k2 r⁴) + 2 p1 x y + p2 (r² + 2x²)`,
+//! `y_d = y(1 + k1 r² + k2 r⁴) + p1 (r² + 2y²) + 2 p2 x y`.
+
+use serde::{Deserialize, Serialize};
+
+/// Brown radial (k1, k2) and tangential (p1, p2) distortion coefficients; all zero = no distortion.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct BrownDistortion {
+    pub k1: f64,
+    pub k2: f64,
+    pub p1: f64,
+    pub p2: f64,
+}
+
+/// Largest residual ‖distort(x, y) − (x_d, y_d)‖ (normalised units) accepted as converged by `undistort`.
+pub const UNDISTORT_TOLERANCE: f64 = 1e-12;
+
+const MAX_UNDISTORT_ITERATIONS: usize = 100;
+
+impl BrownDistortion {
+    /// No distortion.
+    pub const NONE: Self = Self {
+        k1: 0.0,
+        k2: 0.0,
+        p1: 0.0,
+        p2: 0.0,
+    };
+
+    /// True when all coefficients are zero.
+    pub fn is_zero(&self) -> bool {
+        self.k1 == 0.0 && self.k2 == 0.0 && self.p1 == 0.0 && self.p2 == 0.0
+    }
+
+    /// Ideal normalised coordinates → distorted normalised coordinates.
+    pub fn distort(&self, x: f64, y: f64) -> (f64, f64) {
+        let r2 = x * x + y * y;
+        let radial = 1.0 + self.k1 * r2 + self.k2 * r2 * r2;
+        let xd = x * radial + 2.0 * self.p1 * x * y + self.p2 * (r2 + 2.0 * x * x);
+        let yd = y * radial + self.p1 * (r2 + 2.0 * y * y) + 2.0 * self.p2 * x * y;
+        (xd, yd)
+    }
+
+    /// Jacobian of [`Self::distort`]: `[[∂xd/∂x, ∂xd/∂y], [∂yd/∂x, ∂yd/∂y]]`.
+    pub fn distort_jacobian(&self, x: f64, y: f64) -> [[f64; 2]; 2] {
+        let r2 = x * x + y * y;
+        let radial = 1.0 + self.k1 * r2 + self.k2 * r2 * r2;
+        // d(radial)/dx = 2x·g, d(radial)/dy = 2y·g
+        let g = self.k1 + 2.0 * self.k2 * r2;
+        let dxd_dx = radial + 2.0 * x * x * g + 2.0 * self.p1 * y + 6.0 * self.p2 * x;
+        let dxd_dy = 2.0 * x * y * g + 2.0 * self.p1 * x + 2.0 * self.p2 * y;
+        let dyd_dx = 2.0 * x * y * g + 2.0 * self.p1 * x + 2.0 * self.p2 * y;
+        let dyd_dy = radial + 2.0 * y * y * g + 6.0 * self.p1 * y + 2.0 * self.p2 * x;
+        [[dxd_dx, dxd_dy], [dyd_dx, dyd_dy]]
+    }
+
+    /// Distorted → ideal normalised coordinates by Newton iteration on [`Self::distort`], converged to
+    /// [`UNDISTORT_TOLERANCE`]. Outside the region where the distortion is invertible (far beyond any real
+    /// image) it returns the best iterate found; use [`Self::try_undistort`] to detect that.
+    pub fn undistort(&self, xd: f64, yd: f64) -> (f64, f64) {
+        let (x, y, _) = self.undistort_iterate(xd, yd);
+        (x, y)
+    }
+
+    /// Like [`Self::undistort`], but `None` when the iteration did not reach [`UNDISTORT_TOLERANCE`].
+    pub fn try_undistort(&self, xd: f64, yd: f64) -> Option<(f64, f64)> {
+        let (x, y, residual) = self.undistort_iterate(xd, yd);
+        (residual <= UNDISTORT_TOLERANCE).then_some((x, y))
+    }
+
+    /// Newton iteration; returns the best (x, y) and its residual norm.
+    fn undistort_iterate(&self, xd: f64, yd: f64) -> (f64, f64, f64) {
+        if self.is_zero() {
+            return (xd, yd, 0.0);
+        }
+        let (mut x, mut y) = (xd, yd);
+        let mut best = (x, y, f64::INFINITY);
+        for _ in 0..MAX_UNDISTORT_ITERATIONS {
+            let (fx, fy) = self.distort(x, y);
+            let (ex, ey) = (fx - xd, fy - yd);
+            let residual = ex.hypot(ey);
+            if residual < best.2 {
+                best = (x, y, residual);
+            }
+            // Stop once the residual is at the rounding level of the coordinates.
+            if residual <= 1e-16 * (1.0 + xd.abs() + yd.abs()) || !residual.is_finite() {
+                break;
+            }
+            let [[a, b], [c, d]] = self.distort_jacobian(x, y);
+            let det = a * d - b * c;
+            if det.abs() < 1e-300 || !det.is_finite() {
+                break;
+            }
+            let dx = (d * ex - b * ey) / det;
+            let dy = (a * ey - c * ex) / det;
+            x -= dx;
+            y -= dy;
+            if dx.abs() + dy.abs() <= 1e-17 * (1.0 + x.abs() + y.abs()) {
+                let (fx, fy) = self.distort(x, y);
+                let residual = (fx - xd).hypot(fy - yd);
+                if residual < best.2 {
+                    best = (x, y, residual);
+                }
+                break;
+            }
+        }
+        best
+    }
+}

@@ -1,0 +1,119 @@
+//! Homography: normalised DLT recovery, degeneracy, inverse, normalisation invariance.
+
+use crate::estimators::SplitMix64;
+use crate::geometry::{Homography, PointPair};
+use nalgebra::{Matrix3, Vector2};
+
+pub(crate) fn truth() -> Homography {
+    Homography(Matrix3::new(
+        1.1, 0.05, -30.0, -0.08, 0.95, 12.0, 2e-4, -1e-4, 1.0,
+    ))
+    .normalized()
+}
+
+fn pairs_for(h: &Homography, n: usize, seed: u64, offset: f64) -> Vec<PointPair> {
+    let mut rng = SplitMix64::new(seed);
+    (0..n)
+        .map(|_| {
+            let src = Vector2::new(
+                offset + 1000.0 * rng.next_f64(),
+                offset + 1000.0 * rng.next_f64(),
+            );
+            PointPair {
+                src,
+                dst: h.apply(&src).unwrap(),
+            }
+        })
+        .collect()
+}
+
+fn assert_h_close(a: &Homography, b: &Homography, tol: f64) {
+    let (a, b) = (a.normalized(), b.normalized());
+    assert!((a.0 - b.0).norm() <= tol, "{:?} vs {:?}", a.0, b.0);
+}
+
+#[test]
+fn exact_recovery_from_four_and_many_pairs() {
+    let t = truth();
+    let four = pairs_for(&t, 4, 11, 0.0);
+    assert_h_close(&Homography::from_pairs(&four).unwrap(), &t, 1e-9);
+    let many = pairs_for(&t, 50, 12, 0.0);
+    let fit = Homography::from_pairs(&many).unwrap();
+    assert_h_close(&fit, &t, 1e-10);
+    for p in &many {
+        assert!(fit.transfer_error(p) < 1e-8);
+    }
+}
+
+#[test]
+fn apply_by_hand() {
+    let h = Homography(Matrix3::new(2.0, 0.0, 1.0, 0.0, 2.0, -1.0, 0.0, 0.0, 2.0));
+    assert_eq!(
+        h.apply(&Vector2::new(1.0, 1.0)),
+        Some(Vector2::new(1.5, 0.5))
+    );
+    // A point on the line at infinity maps nowhere.
+    let p = Homography(Matrix3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, -1.0));
+    assert_eq!(p.apply(&Vector2::new(1.0, 5.0)), None);
+}
+
+#[test]
+fn degenerate_samples_give_none() {
+    let t = truth();
+    // Three of four source points collinear.
+    let src = [
+        Vector2::new(0.0, 0.0),
+        Vector2::new(1.0, 1.0),
+        Vector2::new(2.0, 2.0),
+        Vector2::new(0.0, 5.0),
+    ];
+    let pairs: Vec<PointPair> = src
+        .iter()
+        .map(|s| PointPair {
+            src: *s,
+            dst: t.apply(s).unwrap(),
+        })
+        .collect();
+    assert_eq!(Homography::from_pairs(&pairs), None);
+    // Many points all on one line (a road marking): rank test.
+    let line: Vec<PointPair> = (0..20)
+        .map(|i| {
+            let s = Vector2::new(f64::from(i) * 10.0, 3.0 + f64::from(i) * 5.0);
+            PointPair {
+                src: s,
+                dst: t.apply(&s).unwrap(),
+            }
+        })
+        .collect();
+    assert_eq!(Homography::from_pairs(&line), None);
+    assert_eq!(Homography::from_pairs(&pairs[..3]), None);
+}
+
+#[test]
+fn inverse_and_compose() {
+    let t = truth();
+    let inv = t.inverse().unwrap();
+    for p in pairs_for(&t, 10, 13, 0.0) {
+        assert!((inv.apply(&p.dst).unwrap() - p.src).norm() < 1e-9);
+    }
+    assert_h_close(&t.compose(&inv), &Homography::identity(), 1e-12);
+    assert_eq!(Homography(Matrix3::zeros()).inverse(), None);
+}
+
+#[test]
+fn normalisation_invariance() {
+    // Translating all inputs by (1e5, 1e5) and scaling by 10 gives the conjugated transform.
+    let t = truth();
+    let pairs = pairs_for(&t, 30, 14, 0.0);
+    let g = Homography(Matrix3::new(10.0, 0.0, 1e5, 0.0, 10.0, 1e5, 0.0, 0.0, 1.0));
+    let moved: Vec<PointPair> = pairs
+        .iter()
+        .map(|p| PointPair {
+            src: g.apply(&p.src).unwrap(),
+            dst: g.apply(&p.dst).unwrap(),
+        })
+        .collect();
+    let fit_moved = Homography::from_pairs(&moved).unwrap();
+    let back = g.inverse().unwrap().compose(&fit_moved).compose(&g);
+    assert_h_close(&back, &t, 1e-9);
+}

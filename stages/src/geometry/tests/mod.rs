@@ -1,0 +1,9 @@
+//! Known-answer tests of the geometry core (campaign-format.md conventions, ALGORITHMS.md §10–11).
+
+mod frame_tests;
+mod homography_tests;
+mod panorama_tests;
+mod ray_tests;
+mod rotation_tests;
+mod similarity_tests;
+mod triangulation_tests;
