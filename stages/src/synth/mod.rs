@@ -1,1 +1,29 @@
-//! (module under construction)
+//! The synthetic urban campaign: a procedural street scene (by "scene": [`scene`], [`noise`], [`texture`])
+//! rendered into mobile-mapping panoramas and aerial nadir/oblique frames, with deteriorated recorded positions,
+//! true poses, check points and their observations, written in the campaign format
+//! (shared/docs/campaign-format.md). It is skytie's embedded default data and the judge of every stage.
+//!
+//! Entry points: [`generate`] / [`generate_preset`]; the pieces ([`render`], [`aerial_plan`], [`trajectory`],
+//! [`deteriorate`], [`control`], [`postprocess`], [`vehicle`]) are public for tests and benchmarks.
+
+pub mod noise;
+pub mod scene;
+pub mod texture;
+
+pub mod aerial_plan;
+pub mod control;
+pub mod deteriorate;
+pub mod error;
+pub mod generate;
+pub mod postprocess;
+pub mod preset;
+pub mod render;
+pub mod rng;
+pub mod trajectory;
+pub mod vehicle;
+
+pub use deteriorate::{Deterioration, DeteriorationModel, DriftProfile};
+pub use error::SynthError;
+pub use generate::{generate, generate_preset, SynthOptions, SynthSummary};
+pub use preset::{Preset, PresetParams};
+pub use render::{render_frame, render_panorama, render_panorama_with_vehicle};
