@@ -6,4 +6,12 @@
 pub mod image;
 pub mod io;
 
+pub mod border;
+pub mod convolve;
+pub mod gaussian;
+pub mod gradient;
+pub mod sample;
+
+pub use border::Border;
+pub use gaussian::gaussian_blur;
 pub use image::{GrayImage, RgbImage};
