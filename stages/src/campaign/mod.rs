@@ -1,5 +1,6 @@
 //! The campaign contract (shared/docs/campaign-format.md): model, reading with validation, writers.
 
+pub mod check;
 pub mod model;
 pub mod problem;
 pub mod read;
@@ -11,6 +12,7 @@ pub mod time;
 mod unique;
 pub mod write;
 
+pub use check::{check_campaign, CheckReport};
 pub use model::{AerialImage, AerialKind, Campaign, CheckPoint, Observation, Recording};
 pub use problem::{Problem, Severity};
 pub use read::{read_campaign, CampaignError};

@@ -195,6 +195,7 @@ pub(crate) fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>
         checkpoints: checkpoints.into_iter().map(|r| r.item).collect(),
         observations,
     };
+    sort_problems(&mut problems);
     let sourced = SourcedCampaign {
         campaign,
         recording_rows,
@@ -203,6 +204,18 @@ pub(crate) fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>
         observation_rows,
     };
     Ok((sourced, problems))
+}
+
+/// Order problems by file (in reading order) and row, keeping the order of problems on the same row.
+pub(crate) fn sort_problems(problems: &mut [Problem]) {
+    const ORDER: [&str; 6] = [TOML, RECORDINGS, NADIR, OBLIQUE, CHECKPOINTS, OBSERVATIONS];
+    problems.sort_by_key(|p| {
+        let rank = ORDER
+            .iter()
+            .position(|f| p.file == Path::new(f))
+            .unwrap_or(ORDER.len());
+        (rank, p.row.unwrap_or(0))
+    });
 }
 
 /// `name` and `crs` of `campaign.toml` (empty strings when missing, with a problem).
