@@ -15,3 +15,6 @@ pub mod sample;
 pub use border::Border;
 pub use gaussian::gaussian_blur;
 pub use image::{GrayImage, RgbImage};
+pub mod resample;
+pub mod wallis;
+pub mod window;
