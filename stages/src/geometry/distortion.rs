@@ -32,6 +32,30 @@ impl BrownDistortion {
         self.k1 == 0.0 && self.k2 == 0.0 && self.p1 == 0.0 && self.p2 == 0.0
     }
 
+    /// Largest squared ideal radius r² = x² + y² up to which the radial part `r·(1 + k1 r² + k2 r⁴)` keeps
+    /// increasing (infinite if it always does). Beyond it the polynomial folds back, so far-away points would
+    /// land inside the image: [`super::FrameCamera::project_world`] rejects them.
+    ///
+    /// `d r_d / d r = 1 + 3 k1 s + 5 k2 s²` with `s = r²`; the limit is its smallest positive root.
+    pub fn max_monotonic_r2(&self) -> f64 {
+        let (a, b, c) = (5.0 * self.k2, 3.0 * self.k1, 1.0);
+        if a == 0.0 {
+            return if b < 0.0 { -c / b } else { f64::INFINITY };
+        }
+        let disc = b * b - 4.0 * a * c;
+        if disc < 0.0 {
+            return f64::INFINITY;
+        }
+        // Numerically stable roots q/a and c/q.
+        let q = -0.5 * (b + b.signum() * disc.sqrt());
+        let roots = [if q != 0.0 { c / q } else { f64::NAN }, q / a];
+        roots
+            .iter()
+            .copied()
+            .filter(|&s| s > 0.0)
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// Ideal normalised coordinates → distorted normalised coordinates.
     pub fn distort(&self, x: f64, y: f64) -> (f64, f64) {
         let r2 = x * x + y * y;

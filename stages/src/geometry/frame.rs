@@ -80,7 +80,9 @@ impl FrameCamera {
     }
 
     /// Continuous pixel of a world point (with distortion), whether or not it falls inside the image
-    /// (see [`Self::contains`]); `None` if the point is not in front of the camera (p_cam.z ≥ 0).
+    /// (see [`Self::contains`]); `None` if the point is not in front of the camera (p_cam.z ≥ 0), or so far
+    /// off-axis that the distortion polynomial folds back ([`BrownDistortion::max_monotonic_r2`]; such a
+    /// point would otherwise appear at a wrong place inside the image).
     pub fn project_world(&self, p_world: &Vector3<f64>) -> Option<(f64, f64)> {
         let p = self.world_to_cam(p_world);
         if !(p.z < 0.0) {
@@ -88,6 +90,9 @@ impl FrameCamera {
         }
         let x = p.x / -p.z;
         let y = p.y / -p.z;
+        if !self.distortion.is_zero() && !(x * x + y * y < self.distortion.max_monotonic_r2()) {
+            return None;
+        }
         let (xd, yd) = self.distortion.distort(x, y);
         Some((
             self.cx_px + self.focal_px * xd,

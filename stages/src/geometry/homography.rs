@@ -2,12 +2,19 @@
 //! ALGORITHMS.md §11); used between adjacent MM ortho-images (thesis 3.4.4).
 
 use super::point_pair::PointPair;
+use super::similarity2::Similarity2;
 use nalgebra::{Matrix3, SMatrix, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// A homography `x' ~ H·x` on homogeneous 2-D points (defined up to scale).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Homography(pub Matrix3<f64>);
+
+impl From<Similarity2> for Homography {
+    fn from(sim: Similarity2) -> Self {
+        Self(sim.to_matrix())
+    }
+}
 
 /// Rows of the DLT design matrix are reduced into this 9×9 triangle (Givens QR), so any number of
 /// correspondences is handled without allocation and without squaring the condition number.

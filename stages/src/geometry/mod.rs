@@ -7,6 +7,7 @@
 // `!(x > t)` is used on purpose throughout: it also rejects NaN, which `x <= t` would let through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod closest_approach;
 pub mod distortion;
 pub mod frame;
 pub mod homography;
@@ -21,6 +22,7 @@ pub mod triangulation;
 #[cfg(test)]
 mod tests;
 
+pub use closest_approach::{closest_approach, ClosestApproach};
 pub use distortion::BrownDistortion;
 pub use frame::FrameCamera;
 pub use homography::Homography;

@@ -325,3 +325,61 @@ fn from_aerial_matches_from_opk() {
     );
     assert_eq!(cam, expected);
 }
+
+#[test]
+fn monotonic_limit_of_the_distortion() {
+    assert_eq!(BrownDistortion::NONE.max_monotonic_r2(), f64::INFINITY);
+    assert_eq!(
+        BrownDistortion {
+            k1: 0.1,
+            ..BrownDistortion::NONE
+        }
+        .max_monotonic_r2(),
+        f64::INFINITY
+    );
+    // k2 = 0: 1 + 3 k1 s = 0 ⇒ s = −1/(3 k1).
+    let k1 = BrownDistortion {
+        k1: -0.5,
+        ..BrownDistortion::NONE
+    };
+    assert!((k1.max_monotonic_r2() - 2.0 / 3.0).abs() < 1e-15);
+    // k1 = 0, k2 < 0: 1 + 5 k2 s² = 0 ⇒ s = sqrt(−1/(5 k2)).
+    let k2 = BrownDistortion {
+        k2: -0.2,
+        ..BrownDistortion::NONE
+    };
+    assert!((k2.max_monotonic_r2() - 1.0).abs() < 1e-15);
+    // General case: the derivative vanishes at the limit.
+    let d = BrownDistortion {
+        k1: -0.3,
+        k2: 0.02,
+        p1: 0.0,
+        p2: 0.0,
+    };
+    let s = d.max_monotonic_r2();
+    assert!(s.is_finite() && (1.0 + 3.0 * d.k1 * s + 5.0 * d.k2 * s * s).abs() < 1e-12);
+}
+
+#[test]
+fn points_beyond_the_fold_do_not_project_into_the_image() {
+    // k1 = −0.5 folds at r = 0.816: a point at r = 1.5 would map to r_d = 1.5·(1 − 0.5·2.25) < 0, i.e. near
+    // the principal point, although it is far outside the field of view.
+    let cam = camera(
+        0.0,
+        0.0,
+        0.0,
+        BrownDistortion {
+            k1: -0.5,
+            ..BrownDistortion::NONE
+        },
+    );
+    let c = centre();
+    assert_eq!(
+        cam.project_world(&Vector3::new(c.x + 1500.0, c.y, 0.0)),
+        None
+    );
+    let (u, v) = cam
+        .project_world(&Vector3::new(c.x + 500.0, c.y, 0.0))
+        .unwrap();
+    assert!((u - (CX + F * 0.5 * (1.0 - 0.5 * 0.25))).abs() < 1e-9 && (v - CY).abs() < 1e-9);
+}

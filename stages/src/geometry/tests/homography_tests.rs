@@ -117,3 +117,16 @@ fn normalisation_invariance() {
     let back = g.inverse().unwrap().compose(&fit_moved).compose(&g);
     assert_h_close(&back, &t, 1e-9);
 }
+
+#[test]
+fn similarity_converts_to_an_equal_homography() {
+    let sim = crate::geometry::Similarity2 {
+        scale: 1.2,
+        rotation_rad: 0.4,
+        tx: 3.0,
+        ty: -9.0,
+    };
+    let h = Homography::from(sim);
+    let p = Vector2::new(17.0, -4.0);
+    assert!((h.apply(&p).unwrap() - sim.apply(&p)).norm() < 1e-12);
+}

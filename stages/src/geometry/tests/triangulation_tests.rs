@@ -218,3 +218,29 @@ fn errors_name_the_problem() {
         TriangulationError::BehindRay { index: 1, .. }
     ));
 }
+
+#[test]
+fn thin_intersection_angle_is_still_exact_but_uncertain_along_the_ray() {
+    // Two panoramas 5 m apart seeing a point 60 m away (≈ 4.8°): exact rays still give the point to 1e-9 m;
+    // the covariance is elongated along the viewing direction.
+    let x = rd_point();
+    let centres = [
+        x + Vector3::new(-2.5, -60.0, -2.0),
+        x + Vector3::new(2.5, -60.0, -2.0),
+    ];
+    let t = triangulate_rays(&rays_to(&x, &centres), &[1e-3, 1e-3]).unwrap();
+    assert!((t.point_world - x).norm() < 1e-9);
+    assert!(
+        t.max_angle_deg > 4.0 && t.max_angle_deg < 5.0,
+        "{}",
+        t.max_angle_deg
+    );
+    let along = Vector3::new(0.0, 1.0, 0.0);
+    let across = Vector3::new(1.0, 0.0, 0.0);
+    let var_along = (along.transpose() * t.covariance_m2 * along)[(0, 0)];
+    let var_across = (across.transpose() * t.covariance_m2 * across)[(0, 0)];
+    assert!(
+        var_along > 100.0 * var_across,
+        "along {var_along} across {var_across}"
+    );
+}
