@@ -243,6 +243,22 @@ impl Artifact for serde_json::Value {
 }
 
 /// Appends `samples` as little-endian `f32` bytes.
+#[cfg(target_endian = "little")]
+fn put_f32_le(out: &mut Vec<u8>, samples: &[f32]) {
+    // SAFETY: `f32` has no padding and every bit pattern is a valid `u8` sequence; `u8` needs no alignment;
+    // the byte slice covers exactly the samples' memory and lives as long as `samples`. On a little-endian
+    // target the in-memory bytes of an `f32` are its little-endian encoding, so this is a plain memcpy.
+    let raw = unsafe {
+        std::slice::from_raw_parts(
+            samples.as_ptr().cast::<u8>(),
+            std::mem::size_of_val(samples),
+        )
+    };
+    out.extend_from_slice(raw);
+}
+
+/// Appends `samples` as little-endian `f32` bytes (portable path for big-endian targets).
+#[cfg(not(target_endian = "little"))]
 fn put_f32_le(out: &mut Vec<u8>, samples: &[f32]) {
     let start = out.len();
     out.resize(start + samples.len() * 4, 0);
@@ -252,6 +268,22 @@ fn put_f32_le(out: &mut Vec<u8>, samples: &[f32]) {
 }
 
 /// Reads little-endian `f32` samples (`bytes.len()` is a multiple of 4, checked by the caller).
+#[cfg(target_endian = "little")]
+fn get_f32_le(bytes: &[u8]) -> Vec<f32> {
+    let n = bytes.len() / 4;
+    let mut samples: Vec<f32> = Vec::with_capacity(n);
+    // SAFETY: the destination has capacity for `n` f32 = `4 n` bytes and does not overlap `bytes`; any 4 bytes
+    // are a valid `f32`; on a little-endian target the little-endian encoding is the in-memory layout. The
+    // length is set only after all `n` samples are initialised.
+    unsafe {
+        std::ptr::copy_nonoverlapping(bytes.as_ptr(), samples.as_mut_ptr().cast::<u8>(), n * 4);
+        samples.set_len(n);
+    }
+    samples
+}
+
+/// Reads little-endian `f32` samples (portable path for big-endian targets).
+#[cfg(not(target_endian = "little"))]
 fn get_f32_le(bytes: &[u8]) -> Vec<f32> {
     bytes
         .chunks_exact(4)

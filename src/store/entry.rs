@@ -185,7 +185,7 @@ pub(crate) fn read_header(file: &mut File, file_len: u64) -> Result<Header, Entr
     let mut hasher = blake3::Hasher::new();
     hasher.update(&fixed);
     hasher.update(&rest[..check_at]);
-    if &hasher.finalize().as_bytes()[..8] != &rest[check_at..] {
+    if hasher.finalize().as_bytes()[..8] != rest[check_at..] {
         return Err(EntryFault::Damaged(
             "header check mismatch (header bytes damaged)".into(),
         ));

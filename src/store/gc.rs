@@ -46,7 +46,7 @@ pub(crate) fn run(store: &Store, max_bytes: u64) -> Result<GcReport, StoreError>
     let listing = objects::list(&store.objects)?;
     let mut candidates = listing.objects;
     // Least recently used first; ties by key so the order is deterministic.
-    candidates.sort_by(|a, b| (a.last_used, a.key).cmp(&(b.last_used, b.key)));
+    candidates.sort_by_key(|o| (o.last_used, o.key));
 
     let mut report = GcReport {
         max_bytes,

@@ -87,7 +87,7 @@ pub(crate) fn list(objects: &Path) -> Result<Listing, StoreError> {
             });
         }
     }
-    out.sort_by(|a, b| a.key.cmp(&b.key));
+    out.sort_by_key(|o| o.key);
     Ok(Listing {
         objects: out,
         temp_files_removed,
