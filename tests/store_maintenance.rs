@@ -316,3 +316,42 @@ fn verify_rehashes_everything_and_removes_bad_entries() {
         "{text}"
     );
 }
+
+#[test]
+fn contains_marks_entries_used_only_while_this_handle_runs() {
+    if std::env::var(CHILD_ENV).is_ok() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let store = Store::open(dir.path()).unwrap();
+    let meta = EntryMeta::new("s", "1", "i");
+    for n in 0..3 {
+        store.save(&key(n), &meta, b"x").unwrap();
+        age(&store, &key(n), Duration::from_secs(3600));
+    }
+    let mtime = |n| {
+        fs::metadata(store.object_path(&key(n)))
+            .unwrap()
+            .modified()
+            .unwrap()
+    };
+    let old = mtime(0);
+    // Planning (no lease): contains changes nothing.
+    assert!(store.contains(&key(0)));
+    assert_eq!(mtime(0), old);
+    // A run that finds key 0 cached without loading it still uses it: gc keeps it.
+    let lease = store.begin_run().unwrap();
+    assert!(store.contains(&key(0)));
+    assert!(!store.contains(&key(99)));
+    assert!(mtime(0) > old);
+    assert!(store.mark_used(&key(1)));
+    assert!(!store.mark_used(&key(98)));
+    let report = store.gc(0).unwrap();
+    assert_eq!(report.removed_keys, vec![key(2)]);
+    drop(lease);
+    // After the run ended, contains is read-only again.
+    age(&store, &key(0), Duration::from_secs(60));
+    let before = mtime(0);
+    assert!(store.contains(&key(0)));
+    assert_eq!(mtime(0), before);
+}

@@ -8,7 +8,8 @@
 use std::fs::{self, File, TryLockError};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use super::error::StoreError;
@@ -25,6 +26,8 @@ pub struct RunLease {
     file: Option<File>,
     path: PathBuf,
     started: SystemTime,
+    /// The issuing store handle's count of live leases (decremented on drop).
+    active: Arc<AtomicUsize>,
 }
 
 impl RunLease {
@@ -44,6 +47,7 @@ impl Drop for RunLease {
         // Remove while still holding the lock, then close (which releases it).
         let _ = fs::remove_file(&self.path);
         drop(self.file.take());
+        self.active.fetch_sub(1, Ordering::Relaxed);
     }
 }
 
@@ -57,7 +61,8 @@ pub struct LiveRun {
 
 /// Creates and locks a new lease in `runs_dir`. The file is locked before it gets its `.lease` name, so nobody
 /// can ever see an unlocked lease of a live run.
-pub(crate) fn acquire(runs_dir: &Path) -> Result<RunLease, StoreError> {
+/// `active` counts the live leases of the issuing store handle.
+pub(crate) fn acquire(runs_dir: &Path, active: Arc<AtomicUsize>) -> Result<RunLease, StoreError> {
     fs::create_dir_all(runs_dir).map_err(StoreError::io("create folder", runs_dir))?;
     let started = SystemTime::now();
     let pid = std::process::id();
@@ -78,11 +83,15 @@ pub(crate) fn acquire(runs_dir: &Path) -> Result<RunLease, StoreError> {
         Ok(file)
     })();
     match result {
-        Ok(file) => Ok(RunLease {
-            file: Some(file),
-            path,
-            started,
-        }),
+        Ok(file) => {
+            active.fetch_add(1, Ordering::Relaxed);
+            Ok(RunLease {
+                file: Some(file),
+                path,
+                started,
+                active,
+            })
+        }
         Err(e) => {
             let _ = fs::remove_file(&tmp);
             Err(e)

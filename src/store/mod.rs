@@ -4,8 +4,8 @@
 //! Safe for many threads (`&self` methods, `Store: Send + Sync`) and many processes sharing one folder: entries
 //! are immutable once renamed into place, and two processes saving the same key write identical bytes. A
 //! damaged entry is reported once, deleted and recomputed by the caller — never trusted. Last use of an entry
-//! is its file modification time (set on every load hit and save), which `gc` sorts by; live runs hold a
-//! [`RunLease`] so `gc` never removes what they used.
+//! is its file modification time (set on every load hit and save, and by `contains` during a run), which
+//! `gc` sorts by; live runs hold a [`RunLease`] so `gc` never removes what they used.
 
 mod entry;
 mod error;
@@ -20,8 +20,8 @@ use std::collections::HashSet;
 use std::fs::{self, File};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::SystemTime;
 
 pub use entry::{EntryMeta, STORE_FORMAT_VERSION};
@@ -64,6 +64,8 @@ pub struct Store {
     other_format_noticed: AtomicBool,
     /// Keys already reported as corrupt whose file could not be deleted (reported only once).
     reported: Mutex<HashSet<NodeKey>>,
+    /// Leases taken through this handle and not yet dropped.
+    active_leases: Arc<AtomicUsize>,
 }
 
 impl Store {
@@ -76,6 +78,7 @@ impl Store {
             runs: root.join("runs"),
             other_format_noticed: AtomicBool::new(false),
             reported: Mutex::new(HashSet::new()),
+            active_leases: Arc::new(AtomicUsize::new(0)),
         };
         for dir in [&store.root, &store.objects, &store.records, &store.runs] {
             fs::create_dir_all(dir).map_err(StoreError::io("create cache folder", dir))?;
@@ -182,9 +185,27 @@ impl Store {
         Ok(content_hash)
     }
 
-    /// Whether an entry file for `key` exists (no verification; for planning).
+    /// Whether an entry file for `key` exists (no verification). While a run holds a lease from this handle,
+    /// an existing entry is also marked used (a run that finds a node cached uses its entry even if it never
+    /// loads it); without a lease (e.g. `skytie plan`) nothing is modified.
     pub fn contains(&self, key: &NodeKey) -> bool {
-        self.object_path(key).is_file()
+        if self.active_leases.load(Ordering::Relaxed) > 0 {
+            self.mark_used(key)
+        } else {
+            self.object_path(key).is_file()
+        }
+    }
+
+    /// Marks the entry of `key` as used now (for LRU `gc` and live-run protection); returns whether it exists.
+    pub fn mark_used(&self, key: &NodeKey) -> bool {
+        match File::open(self.object_path(key)) {
+            Ok(file) => {
+                // Failure (e.g. a cache folder owned by another user) only weakens gc ordering.
+                let _ = file.set_modified(SystemTime::now());
+                file.metadata().is_ok_and(|m| m.is_file())
+            }
+            Err(_) => false,
+        }
     }
 
     /// Atomically stores a small side record `bytes` under `<root>/records/<namespace>/<blake3(name)>`.
@@ -200,7 +221,7 @@ impl Store {
     /// Registers this process as a live run until the returned lease is dropped. Entries it loads or saves are
     /// protected from `gc` meanwhile; a crashed run's lease is detected as stale and never blocks anything.
     pub fn begin_run(&self) -> Result<RunLease, StoreError> {
-        lease::acquire(&self.runs)
+        lease::acquire(&self.runs, Arc::clone(&self.active_leases))
     }
 
     /// Live runs using this cache (leases of dead runs are removed on the way).
