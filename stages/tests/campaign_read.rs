@@ -538,3 +538,142 @@ fn trajectory_adjusted_round_trips_through_the_reader() {
         .collect();
     assert_eq!(read, expected);
 }
+
+#[test]
+fn more_broken_cases_toml_types_cross_file_ids_cell_counts_encoding() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path();
+    write_valid_campaign(root);
+    std::fs::write(
+        root.join("campaign.toml"),
+        "# campaign\nname = \"x\"\ncrs = 28992\n",
+    )
+    .unwrap();
+    // The oblique image reuses the nadir id.
+    let oblique = root.join("aerial/oblique/cameras.csv");
+    let text = std::fs::read_to_string(&oblique)
+        .unwrap()
+        .replace("o0,", "n0,");
+    std::fs::write(&oblique, text).unwrap();
+    // Row 3: one cell too many (unquoted comma); row 4: not UTF-8. Observations row 6: c1 again in pano_0.
+    let rec = root.join("mm/recordings.csv");
+    let mut bytes = std::fs::read(&rec).unwrap();
+    let lines: Vec<&[u8]> = bytes.split(|&b| b == b'\n').collect();
+    let mut out = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        out.extend_from_slice(line);
+        if i == 2 {
+            out.extend_from_slice(b",surplus");
+        }
+        if i == 3 {
+            out.extend_from_slice(b",\xff");
+        }
+        if i + 1 < lines.len() {
+            out.push(b'\n');
+        }
+    }
+    bytes = out;
+    std::fs::write(&rec, &bytes).unwrap();
+    let obs = root.join("control/observations.csv");
+    let mut text = std::fs::read_to_string(&obs).unwrap();
+    text.push_str("# remeasured\nc1,pano_0,33.0,20.0\n");
+    std::fs::write(&obs, text).unwrap();
+
+    let (campaign, problems) = read_campaign(root).unwrap();
+    let expected = vec![
+        (
+            String::from("campaign.toml"),
+            None,
+            Some(String::from("crs")),
+            Severity::Error,
+        ),
+        (
+            String::from("mm/recordings.csv"),
+            Some(3),
+            None,
+            Severity::Error,
+        ),
+        (
+            String::from("mm/recordings.csv"),
+            Some(4),
+            None,
+            Severity::Error,
+        ),
+        key("aerial/oblique/cameras.csv", 2, "image_id", Severity::Error),
+        key("control/observations.csv", 3, "image_id", Severity::Error),
+        key("control/observations.csv", 4, "image_id", Severity::Error),
+        key("control/observations.csv", 6, "point_id", Severity::Error),
+    ];
+    assert_eq!(keys(&problems), expected, "{problems:#?}");
+    assert!(
+        problems[0]
+            .message
+            .contains("is of type integer, not a string"),
+        "{}",
+        problems[0]
+    );
+    assert!(
+        problems[1]
+            .message
+            .contains("has 14 cells but the header has 13 columns"),
+        "{}",
+        problems[1]
+    );
+    assert!(
+        problems[2].message.contains("not valid UTF-8"),
+        "{}",
+        problems[2]
+    );
+    assert!(
+        problems[3]
+            .message
+            .contains("'n0' is also used on aerial/nadir/cameras.csv:2"),
+        "{}",
+        problems[3]
+    );
+    assert!(
+        problems[6]
+            .message
+            .contains("'c1' in image 'pano_0' is also used on row 2"),
+        "{}",
+        problems[6]
+    );
+    let ids: Vec<&str> = campaign
+        .recordings
+        .iter()
+        .map(|r| r.image_id.as_str())
+        .collect();
+    assert_eq!(ids, ["pano_0", "pano_3"]);
+    assert!(campaign.nadir.is_empty() && campaign.oblique.is_empty());
+    // pano_1 and pano_2 were unusable; of the two pano_0 measurements of c1 neither is kept.
+    assert_eq!(campaign.observations.len(), 0);
+
+    std::fs::write(
+        root.join("campaign.toml"),
+        "name = \"x\"\n\ncrs = \"EPSG:28992\n",
+    )
+    .unwrap();
+    let (_, problems) = read_campaign(root).unwrap();
+    assert_eq!(
+        (problems[0].file.to_str(), problems[0].row),
+        (Some("campaign.toml"), Some(3))
+    );
+    assert!(
+        problems[0].message.starts_with("is not valid TOML"),
+        "{}",
+        problems[0]
+    );
+}
+
+#[test]
+fn check_is_deterministic() {
+    let dir = tempfile::tempdir().unwrap();
+    write_valid_campaign(dir.path());
+    std::fs::write(dir.path().join("mm/panoramas/sub/pano_1.png"), b"not a png").unwrap();
+    std::fs::write(dir.path().join("aerial/nadir/n0.png"), b"").unwrap();
+    let first = check_campaign(dir.path());
+    assert_eq!(first.error_count(), 2, "{}", first.render());
+    for _ in 0..3 {
+        assert_eq!(check_campaign(dir.path()), first);
+    }
+}

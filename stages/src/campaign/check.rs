@@ -16,7 +16,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// Outcome of [`check_campaign`]: all problems (grouped by file, rows ascending) and the usable item counts.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct CheckReport {
     pub problems: Vec<Problem>,
     pub recordings: usize,
@@ -193,7 +193,7 @@ fn inspect_image(root: &Path, job: &ImageJob) -> (Option<(u32, u32)>, Option<Pro
     let image = match load_gray(&root.join(&job.rel_path)) {
         Ok(img) => img,
         Err(e) => {
-            let message = format!("{shown} does not decode ({})", e.message);
+            let message = format!("{shown} {}", e.message);
             return (
                 None,
                 problem(message, "replace it with a complete JPEG, PNG or TIFF file"),

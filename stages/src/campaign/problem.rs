@@ -6,7 +6,9 @@ use std::fmt;
 use std::path::PathBuf;
 
 /// Errors make the item unusable (it is skipped); warnings are suspicious but the item is kept.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize,
+)]
 pub enum Severity {
     Error,
     Warning,
@@ -14,7 +16,7 @@ pub enum Severity {
 
 /// One finding, e.g. `mm/recordings.csv:14: field 'x': 'abc' is not a number — write a decimal number with
 /// '.' as decimal mark`.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Problem {
     pub severity: Severity,
     /// Relative to the campaign root, e.g. `mm/recordings.csv`.

@@ -109,6 +109,7 @@ pub(crate) fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>
         aerial,
         |(_, a)| a.image_id.clone(),
         "image_id",
+        "give every aerial image its own image_id (nadir and oblique together)",
         &mut problems,
     );
     let (mut nadir, mut oblique) = (Vec::new(), Vec::new());
@@ -242,9 +243,13 @@ fn read_toml(root: &Path, problems: &mut Vec<Problem>) -> (String, String) {
     let table: toml::Table = match toml::from_str(text) {
         Ok(t) => t,
         Err(e) => {
-            let row = e
-                .span()
-                .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+            let row = e.span().map(|s| {
+                text.as_bytes()[..s.start.min(text.len())]
+                    .iter()
+                    .filter(|&&b| b == b'\n')
+                    .count()
+                    + 1
+            });
             problems.push(Problem::error(
                 TOML,
                 row,
@@ -267,7 +272,7 @@ fn read_toml(root: &Path, problems: &mut Vec<Problem>) -> (String, String) {
                     TOML,
                     None,
                     Some(k),
-                    format!("is a {}, not a string", other.type_str()),
+                    format!("is of type {}, not a string", other.type_str()),
                     format!("write {k} = \"...\" (quoted)"),
                 ));
                 String::new()

@@ -49,7 +49,13 @@ pub(crate) fn read_checkpoint_rows(
             });
         }
     }
-    keep_unique(rows, |c| c.point_id.clone(), "point_id", problems)
+    keep_unique(
+        rows,
+        |c| c.point_id.clone(),
+        "point_id",
+        "give every check point its own point_id",
+        problems,
+    )
 }
 
 /// Valid observations of `root/rel` in file order: `point_id` among `points`, `image_id` among `images`
@@ -108,6 +114,7 @@ pub(crate) fn read_observation_rows(
         rows,
         |o| format!("{}' in image '{}", o.point_id, o.image_id),
         "point_id",
+        "measure each point at most once per panorama: delete the extra row",
         problems,
     )
 }

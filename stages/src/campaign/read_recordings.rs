@@ -114,7 +114,13 @@ pub(crate) fn read_recording_rows(
             });
         }
     }
-    let rows = keep_unique(rows, |r| r.image_id.clone(), "image_id", problems);
+    let rows = keep_unique(
+        rows,
+        |r| r.image_id.clone(),
+        "image_id",
+        "give every panorama its own image_id",
+        problems,
+    );
     for pair in rows.windows(2) {
         let (a, b) = (&pair[0], &pair[1]);
         if b.item.time_s <= a.item.time_s {

@@ -14,11 +14,12 @@ pub(crate) struct Sourced<T> {
 }
 
 /// Keep only rows whose `id` occurs once; report each later occurrence (naming the first) as an error on
-/// `column`. Order of the kept rows is unchanged.
+/// `column` with `hint` saying what to do. Order of the kept rows is unchanged.
 pub(crate) fn keep_unique<T>(
     rows: Vec<Sourced<T>>,
     id: impl Fn(&T) -> String,
     column: &str,
+    hint: &str,
     problems: &mut Vec<Problem>,
 ) -> Vec<Sourced<T>> {
     let mut first: HashMap<String, usize> = HashMap::new();
@@ -40,7 +41,7 @@ pub(crate) fn keep_unique<T>(
                     Some(r.row),
                     Some(column),
                     format!("'{key}' is also used on {place}; both rows skipped"),
-                    format!("give every row its own {column}"),
+                    hint,
                 ));
             }
             None => {
