@@ -1,0 +1,155 @@
+//! Acceleration structure: a uniform 2-D grid over the objects' XY extent (street scenes are flat and
+//! wide), each cell listing the objects whose bounds overlap it; rays are clipped to the objects' 3-D
+//! bounds and walked cell by cell (2-D DDA, Amanatides–Woo) in front-to-back order.
+
+use super::objects::Object;
+use super::shapes::Aabb;
+use nalgebra::Vector3;
+
+#[derive(Clone, Debug)]
+pub struct Grid {
+    bounds: Aabb,
+    cell_m: f64,
+    nx: usize,
+    ny: usize,
+    /// Offsets into `items` per cell (len nx·ny + 1).
+    starts: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Grid {
+    /// Build over `objects` with cells of about `cell_m` (at most 512 per axis).
+    pub fn build(objects: &[Object], cell_m: f64) -> Self {
+        if objects.is_empty() {
+            return Self {
+                bounds: Aabb::new(Vector3::zeros(), Vector3::zeros()),
+                cell_m: 1.0,
+                nx: 0,
+                ny: 0,
+                starts: vec![0],
+                items: Vec::new(),
+            };
+        }
+        let mut bounds = objects[0].bounds;
+        for o in &objects[1..] {
+            bounds = bounds.union(&o.bounds);
+        }
+        // pad slightly so objects on the boundary are inside
+        let pad = Vector3::repeat(1e-6);
+        bounds = Aabb::new(bounds.min - pad, bounds.max + pad);
+        let ext = bounds.max - bounds.min;
+        let cell_m = cell_m.max(ext.x / 512.0).max(ext.y / 512.0).max(1e-3);
+        let nx = ((ext.x / cell_m).ceil() as usize).max(1);
+        let ny = ((ext.y / cell_m).ceil() as usize).max(1);
+        let cell_range = |lo: f64, hi: f64, min: f64, n: usize| -> (usize, usize) {
+            let a = (((lo - min) / cell_m).floor().max(0.0) as usize).min(n - 1);
+            let b = (((hi - min) / cell_m).floor().max(0.0) as usize).min(n - 1);
+            (a, b)
+        };
+        let mut counts = vec![0u32; nx * ny];
+        for o in objects {
+            let (x0, x1) = cell_range(o.bounds.min.x, o.bounds.max.x, bounds.min.x, nx);
+            let (y0, y1) = cell_range(o.bounds.min.y, o.bounds.max.y, bounds.min.y, ny);
+            for iy in y0..=y1 {
+                for ix in x0..=x1 {
+                    counts[iy * nx + ix] += 1;
+                }
+            }
+        }
+        let mut starts = vec![0u32; nx * ny + 1];
+        for i in 0..nx * ny {
+            starts[i + 1] = starts[i] + counts[i];
+        }
+        let mut fill = starts.clone();
+        let mut items = vec![0u32; starts[nx * ny] as usize];
+        for (k, o) in objects.iter().enumerate() {
+            let (x0, x1) = cell_range(o.bounds.min.x, o.bounds.max.x, bounds.min.x, nx);
+            let (y0, y1) = cell_range(o.bounds.min.y, o.bounds.max.y, bounds.min.y, ny);
+            for iy in y0..=y1 {
+                for ix in x0..=x1 {
+                    let c = iy * nx + ix;
+                    items[fill[c] as usize] = k as u32;
+                    fill[c] += 1;
+                }
+            }
+        }
+        Self {
+            bounds,
+            cell_m,
+            nx,
+            ny,
+            starts,
+            items,
+        }
+    }
+
+    /// Walk the cells pierced by the ray within (t_min, t_max), front to back. `visit(items, t_cell_exit)`
+    /// returns `true` to stop.
+    #[inline]
+    pub fn walk(
+        &self,
+        o: &Vector3<f64>,
+        d: &Vector3<f64>,
+        inv_d: &Vector3<f64>,
+        t_min: f64,
+        t_max: f64,
+        mut visit: impl FnMut(&[u32], f64) -> bool,
+    ) {
+        if self.nx == 0 {
+            return;
+        }
+        let Some((t0, t1)) = self.bounds.clip(o, inv_d, t_min, t_max) else {
+            return;
+        };
+        let px = o.x + t0 * d.x;
+        let py = o.y + t0 * d.y;
+        let mut ix =
+            (((px - self.bounds.min.x) / self.cell_m).floor().max(0.0) as usize).min(self.nx - 1);
+        let mut iy =
+            (((py - self.bounds.min.y) / self.cell_m).floor().max(0.0) as usize).min(self.ny - 1);
+        let (step_x, mut t_next_x, dt_x) = if d.x > 0.0 {
+            let bx = self.bounds.min.x + (ix + 1) as f64 * self.cell_m;
+            (1isize, (bx - o.x) * inv_d.x, self.cell_m * inv_d.x)
+        } else if d.x < 0.0 {
+            let bx = self.bounds.min.x + ix as f64 * self.cell_m;
+            (-1isize, (bx - o.x) * inv_d.x, -self.cell_m * inv_d.x)
+        } else {
+            (0, f64::INFINITY, f64::INFINITY)
+        };
+        let (step_y, mut t_next_y, dt_y) = if d.y > 0.0 {
+            let by = self.bounds.min.y + (iy + 1) as f64 * self.cell_m;
+            (1isize, (by - o.y) * inv_d.y, self.cell_m * inv_d.y)
+        } else if d.y < 0.0 {
+            let by = self.bounds.min.y + iy as f64 * self.cell_m;
+            (-1isize, (by - o.y) * inv_d.y, -self.cell_m * inv_d.y)
+        } else {
+            (0, f64::INFINITY, f64::INFINITY)
+        };
+        loop {
+            let c = iy * self.nx + ix;
+            let t_exit = t_next_x.min(t_next_y).min(t1);
+            let cell = &self.items[self.starts[c] as usize..self.starts[c + 1] as usize];
+            if !cell.is_empty() && visit(cell, t_exit) {
+                return;
+            }
+            if t_exit >= t1 {
+                return;
+            }
+            if t_next_x < t_next_y {
+                let n = ix as isize + step_x;
+                if n < 0 || n >= self.nx as isize {
+                    return;
+                }
+                ix = n as usize;
+                t_next_x += dt_x;
+            } else {
+                let n = iy as isize + step_y;
+                if n < 0 || n >= self.ny as isize {
+                    return;
+                }
+                iy = n as usize;
+                t_next_y += dt_y;
+            }
+        }
+    }
+}
