@@ -12,4 +12,5 @@ pub mod fsutil;
 pub mod geometry;
 pub mod imaging;
 pub mod matching;
+pub mod nadir;
 pub mod synth;

@@ -1,0 +1,8 @@
+//! The nadir pipeline (thesis chapter 3): ortho-projection of panoramas, MM-to-MM matching, the initial KAZE
+//! transform to aerial nadir patches, phase-correlation refinement and aerial control points.
+
+pub mod ortho;
+pub mod vehicle_mask;
+
+pub use ortho::{ortho_project, OrthoGeoref, OrthoImage, OrthoParams};
+pub use vehicle_mask::VehicleMask;

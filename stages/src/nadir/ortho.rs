@@ -1,0 +1,244 @@
+//! Ortho-projection (inverse perspective mapping) of a panorama onto a horizontal ground plane — thesis 3.4.3.
+//!
+//! A horizontal plane `camera_height` below the projection centre, centred at the perpendicular foot of the
+//! camera, `diagonal_m` across (30 m in the thesis), is discretised into a square pixel grid of spacing `gsd_m`
+//! (3 cm for MM↔MM matching, 10 cm or the aerial GSD for MM↔aerial), rotated so that the image's "up" points at
+//! azimuth `rotation_deg` (0 = grid north; the aerial image's κ direction to align with it). Every ortho pixel is
+//! filled by back-projection: its ground point is projected into the panorama and the grey value interpolated
+//! bilinearly — so there are no gaps. Ground points hidden by the recording vehicle are masked (`valid = 0`).
+//!
+//! Ortho images are for matching only: [`OrthoGeoref::ortho_to_panorama_pixel`] is the exact inverse that turns an
+//! ortho-image measurement back into the panorama's spherical geometry, where all measuring happens (3.4.3, last
+//! paragraph).
+
+use super::vehicle_mask::VehicleMask;
+use crate::campaign::Recording;
+use crate::geometry::PanoramaCamera;
+use crate::imaging::border::Border;
+use crate::imaging::sample::sample_bilinear;
+use crate::imaging::GrayImage;
+use nalgebra::Vector3;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Parameters of one ortho-projection.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OrthoParams {
+    /// Pixel spacing on the ground, m.
+    pub gsd_m: f64,
+    /// Diagonal of the square ground plane, m (thesis: 30 m).
+    pub diagonal_m: f64,
+    /// Azimuth (degrees clockwise from grid north) that the image's "up" direction points at.
+    pub rotation_deg: f64,
+    /// The recording vehicle's body, masked out.
+    pub vehicle: VehicleMask,
+}
+
+impl Default for OrthoParams {
+    fn default() -> Self {
+        Self {
+            gsd_m: 0.03,
+            diagonal_m: 30.0,
+            rotation_deg: 0.0,
+            vehicle: VehicleMask::default(),
+        }
+    }
+}
+
+impl OrthoParams {
+    /// Check ranges; each error is (field, message with the allowed range).
+    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
+        let mut errs = Vec::new();
+        if !(self.gsd_m.is_finite() && self.gsd_m >= 0.001 && self.gsd_m <= 1.0) {
+            errs.push((
+                "gsd_m".into(),
+                format!("must be in [0.001, 1] m, got {}", self.gsd_m),
+            ));
+        }
+        if !(self.diagonal_m.is_finite() && self.diagonal_m >= 1.0 && self.diagonal_m <= 200.0) {
+            errs.push((
+                "diagonal_m".into(),
+                format!("must be in [1, 200] m, got {}", self.diagonal_m),
+            ));
+        }
+        if !self.rotation_deg.is_finite() {
+            errs.push((
+                "rotation_deg".into(),
+                "must be a finite angle in degrees".into(),
+            ));
+        }
+        if self.gsd_m.is_finite()
+            && self.diagonal_m.is_finite()
+            && self.diagonal_m / self.gsd_m > 20_000.0
+        {
+            errs.push((
+                "gsd_m".into(),
+                "diagonal_m / gsd_m exceeds 20000 px: the ortho image would be too large".into(),
+            ));
+        }
+        if let Err(v) = self.vehicle.validate() {
+            errs.extend(v.into_iter().map(|(f, m)| (format!("vehicle.{f}"), m)));
+        }
+        if errs.is_empty() {
+            Ok(())
+        } else {
+            Err(errs)
+        }
+    }
+}
+
+/// Where an ortho image lies in the world: the plane's centre (foot point), spacing, rotation and size.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OrthoGeoref {
+    /// Centre of the plane: the perpendicular foot of the projection centre (x, y, z − camera_height), world.
+    pub foot_world: [f64; 3],
+    pub gsd_m: f64,
+    /// Azimuth of the image's "up" direction, degrees clockwise from grid north.
+    pub rotation_deg: f64,
+    pub width_px: usize,
+    pub height_px: usize,
+}
+
+impl OrthoGeoref {
+    /// The square grid for `params` centred at `foot_world`.
+    pub fn new(foot_world: [f64; 3], params: &OrthoParams) -> Self {
+        let side_m = params.diagonal_m / std::f64::consts::SQRT_2;
+        let n = (side_m / params.gsd_m).round().max(1.0) as usize;
+        Self {
+            foot_world,
+            gsd_m: params.gsd_m,
+            rotation_deg: params.rotation_deg,
+            width_px: n,
+            height_px: n,
+        }
+    }
+
+    /// Unit vectors (east, north) of the image's right and up directions.
+    fn axes(&self) -> ([f64; 2], [f64; 2]) {
+        let r = self.rotation_deg.to_radians();
+        let up = [r.sin(), r.cos()];
+        let right = [r.cos(), -r.sin()];
+        (right, up)
+    }
+
+    /// World point on the plane at continuous ortho pixel (u, v).
+    pub fn pixel_to_world(&self, u_px: f64, v_px: f64) -> Vector3<f64> {
+        let (right, up) = self.axes();
+        let a = (u_px - self.width_px as f64 / 2.0) * self.gsd_m;
+        let b = (self.height_px as f64 / 2.0 - v_px) * self.gsd_m;
+        Vector3::new(
+            self.foot_world[0] + a * right[0] + b * up[0],
+            self.foot_world[1] + a * right[1] + b * up[1],
+            self.foot_world[2],
+        )
+    }
+
+    /// Continuous ortho pixel of the vertical projection of `p_world` onto the plane (its z is ignored).
+    pub fn world_to_pixel(&self, p_world: &Vector3<f64>) -> (f64, f64) {
+        let (right, up) = self.axes();
+        let dx = p_world.x - self.foot_world[0];
+        let dy = p_world.y - self.foot_world[1];
+        let a = dx * right[0] + dy * right[1];
+        let b = dx * up[0] + dy * up[1];
+        (
+            a / self.gsd_m + self.width_px as f64 / 2.0,
+            self.height_px as f64 / 2.0 - b / self.gsd_m,
+        )
+    }
+
+    /// The exact inverse of the ortho-projection: the panorama pixel an ortho pixel was sampled from.
+    pub fn ortho_to_panorama_pixel(
+        &self,
+        camera: &PanoramaCamera,
+        u_px: f64,
+        v_px: f64,
+    ) -> Option<(f64, f64)> {
+        camera.project_world(&self.pixel_to_world(u_px, v_px))
+    }
+}
+
+/// An ortho-projected panorama: grey values, validity mask (1 = filled, 0 = hidden by the vehicle) and georeference.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OrthoImage {
+    pub image: GrayImage,
+    /// Row-major, one byte per pixel: 1 where the pixel holds ground seen by the panorama, 0 where masked.
+    pub valid: Vec<u8>,
+    pub georef: OrthoGeoref,
+}
+
+/// A panorama padded by one wrapped column on each side, so bilinear sampling is continuous across the seam
+/// at azimuth ±180° (u = 0 / W).
+struct WrappedPanorama {
+    padded: GrayImage,
+}
+
+impl WrappedPanorama {
+    fn new(pano: &GrayImage) -> Self {
+        let (w, h) = (pano.width, pano.height);
+        let mut data = Vec::with_capacity((w + 2) * h);
+        for row in 0..h {
+            let r = pano.row(row);
+            data.push(r[w - 1]);
+            data.extend_from_slice(r);
+            data.push(r[0]);
+        }
+        Self {
+            padded: GrayImage {
+                width: w + 2,
+                height: h,
+                data,
+            },
+        }
+    }
+
+    #[inline]
+    fn sample(&self, u_px: f64, v_px: f64) -> f32 {
+        sample_bilinear(&self.padded, u_px + 1.0, v_px, Border::Clamp)
+    }
+}
+
+/// Ortho-project `panorama` (grey, W = 2H) of `recording` with `params`. Thesis 3.4.3.
+pub fn ortho_project(
+    panorama: &GrayImage,
+    recording: &Recording,
+    params: &OrthoParams,
+) -> OrthoImage {
+    let camera =
+        PanoramaCamera::from_recording(recording, panorama.width as u32, panorama.height as u32);
+    let foot = [
+        recording.x,
+        recording.y,
+        recording.z - recording.camera_height_m,
+    ];
+    let georef = OrthoGeoref::new(foot, params);
+    let wrapped = WrappedPanorama::new(panorama);
+    let (w, h) = (georef.width_px, georef.height_px);
+    let mut image = GrayImage::filled(w, h, 0.0);
+    let mut valid = vec![0u8; w * h];
+    image
+        .data
+        .par_chunks_mut(w)
+        .zip(valid.par_chunks_mut(w))
+        .enumerate()
+        .for_each(|(row, (out, ok))| {
+            for col in 0..w {
+                let p = georef.pixel_to_world(col as f64 + 0.5, row as f64 + 0.5);
+                if params
+                    .vehicle
+                    .hides(&camera.center_world, recording.heading_deg, &p)
+                {
+                    continue;
+                }
+                if let Some((u, v)) = camera.project_world(&p) {
+                    out[col] = wrapped.sample(u, v);
+                    ok[col] = 1;
+                }
+            }
+        });
+    OrthoImage {
+        image,
+        valid,
+        georef,
+    }
+}
