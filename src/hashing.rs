@@ -327,10 +327,13 @@ impl StatCache {
         self.len() == 0
     }
 
-    /// Writes the cache atomically to `<root>/stat-cache.bin` (entries in path order, so the file is deterministic).
+    /// Writes the cache atomically to `<root>/stat-cache.bin` (entries in path order, so the file is
+    /// deterministic), forgetting files that no longer exist.
     pub fn save(&self) -> io::Result<()> {
         let bytes = {
-            let entries = self.lock();
+            let mut entries = self.lock();
+            // Forget files that no longer exist, so the cache does not grow forever.
+            entries.retain(|path, _| fs::symlink_metadata(path).is_ok());
             let mut records: Vec<StatRecord> = entries
                 .iter()
                 .map(|(path, (stamp, hash))| StatRecord {

@@ -271,3 +271,12 @@ fn opening_a_store_on_a_file_names_the_path() {
         .expect("opening a file as cache must fail");
     assert!(err.to_string().contains("not-a-dir"), "{err}");
 }
+
+#[test]
+fn store_and_keys_can_be_shared_across_threads() {
+    fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<Store>();
+    assert_send_sync::<skytie::hashing::StatCache>();
+    assert_send_sync::<skytie::store::RunLease>();
+    assert_send_sync::<NodeKey>();
+}

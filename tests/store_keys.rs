@@ -274,3 +274,21 @@ fn corrupt_or_foreign_stat_cache_files_start_empty_and_are_rebuilt() {
         assert_eq!(fs::read(&bin).unwrap(), good, "rebuilt file differs");
     }
 }
+
+#[test]
+fn stat_cache_forgets_deleted_files_on_save() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    for p in [&a, &b] {
+        fs::write(p, p.to_string_lossy().as_bytes()).unwrap();
+        set_mtime(p, Duration::from_secs(3600));
+    }
+    let cache = StatCache::open(dir.path());
+    cache.hash_file(&a).unwrap();
+    cache.hash_file(&b).unwrap();
+    assert_eq!(cache.len(), 2);
+    fs::remove_file(&a).unwrap();
+    cache.save().unwrap();
+    assert_eq!(cache.len(), 1);
+    assert_eq!(StatCache::open(dir.path()).len(), 1);
+}
