@@ -24,6 +24,11 @@ const KIND_RGB: &[u8; 4] = b"RGB3";
 const KIND_BYTES: &[u8; 4] = b"BYTE";
 const KIND_JSON: &[u8; 4] = b"JSON";
 
+/// Advice appended to decoding errors. Payloads reaching the codec from the store have passed its hash
+/// check, so a decoding failure means bytes written by an incompatible skytie build, not disk damage.
+const INCOMPATIBLE: &str =
+    "the cached bytes come from an incompatible skytie build; run `skytie cache gc --max-size 0` (or delete the cache folder)";
+
 /// Bytes before an artifact's body: version byte + kind magic.
 const FRAME_LEN: usize = 5;
 
@@ -71,7 +76,7 @@ fn open_frame<'a>(
 ) -> Result<&'a [u8], CodecError> {
     if bytes.len() < FRAME_LEN {
         return Err(CodecError::new(format!(
-            "cached {type_name} is truncated ({} bytes, shorter than its 5-byte header): run `skytie cache verify`",
+            "cached {type_name} is truncated ({} bytes, shorter than its 5-byte header); {INCOMPATIBLE}",
             bytes.len()
         )));
     }
@@ -85,7 +90,7 @@ fn open_frame<'a>(
     if &bytes[1..FRAME_LEN] != kind {
         return Err(CodecError::new(format!(
             "cached artifact is a {} value, not a {type_name} ({}): the cache entry does not belong to this node; \
-             run `skytie cache verify`",
+             {INCOMPATIBLE}",
             kind_name(&bytes[1..FRAME_LEN]),
             kind_name(kind)
         )));
@@ -141,11 +146,11 @@ pub fn decode_serde_exact<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, CodecE
         Ok((value, used)) if used == bytes.len() => Ok(value),
         Ok((_, used)) => Err(CodecError::new(format!(
             "cached {type_name} has {} unexpected trailing bytes after {used}: the entry holds another type; \
-             run `skytie cache verify`",
+             {INCOMPATIBLE}",
             bytes.len() - used
         ))),
         Err(e) => Err(CodecError::new(format!(
-            "cannot decode cached {type_name}: {e}; the entry is damaged or holds another type, run `skytie cache verify`"
+            "cannot decode cached {type_name}: {e}; the entry is damaged or holds another type; {INCOMPATIBLE}"
         ))),
     }
 }
@@ -217,7 +222,7 @@ impl Artifact for Vec<u8> {
         match declared {
             Some(n) if n == (body.len() - 8) as u64 => Ok(body[8..].to_vec()),
             _ => Err(CodecError::new(format!(
-                "cached byte buffer is damaged: its length header does not match its {} bytes; run `skytie cache verify`",
+                "cached byte buffer is damaged: its length header does not match its {} bytes; {INCOMPATIBLE}",
                 body.len()
             ))),
         }
@@ -236,7 +241,7 @@ impl Artifact for serde_json::Value {
         let body = open_frame(bytes, KIND_JSON, "JSON value")?;
         serde_json::from_slice(body).map_err(|e| {
             CodecError::new(format!(
-                "cached JSON value is damaged ({e}): run `skytie cache verify`"
+                "cached JSON value is damaged ({e}); {INCOMPATIBLE}"
             ))
         })
     }
@@ -309,7 +314,7 @@ fn decode_image(
     let body = open_frame(bytes, kind, type_name)?;
     if body.len() < 16 {
         return Err(CodecError::new(format!(
-            "cached {type_name} is truncated: its size header needs 16 bytes, found {}; run `skytie cache verify`",
+            "cached {type_name} is truncated: its size header needs 16 bytes, found {}; {INCOMPATIBLE}",
             body.len()
         )));
     }
@@ -325,7 +330,7 @@ fn decode_image(
     else {
         return Err(CodecError::new(format!(
             "cached {type_name} of {width}×{height} px should hold {width}×{height}×{channels} f32 samples but has \
-             {} bytes of samples: the entry is damaged, run `skytie cache verify`",
+             {} bytes of samples: the entry is damaged; {INCOMPATIBLE}",
             samples.len()
         )));
     };

@@ -280,3 +280,21 @@ fn store_and_keys_can_be_shared_across_threads() {
     assert_send_sync::<skytie::store::RunLease>();
     assert_send_sync::<NodeKey>();
 }
+
+#[test]
+fn an_unreadable_entry_is_reported_once_and_never_panics() {
+    // A folder where the entry file should be: cannot be read (nor deleted as a file).
+    let dir = tempfile::tempdir().unwrap();
+    let store = Store::open(dir.path()).unwrap();
+    let k = key(3);
+    fs::create_dir_all(store.object_path(&k)).unwrap();
+    let message = corrupt_message(store.load(&k).unwrap());
+    assert!(message.contains(&k.to_string()), "{message}");
+    assert_eq!(store.load(&k).unwrap(), Lookup::Miss, "reported twice");
+    // Saving over it fails with an error naming the file, not a panic.
+    let err = store.save(&k, &meta("m"), b"x").unwrap_err();
+    assert!(err.to_string().contains(&k.to_string()[2..]), "{err}");
+    // verify and stats look at entry files only.
+    let report = store.verify().unwrap();
+    assert_eq!(report.checked, 0, "a folder is not an entry file");
+}

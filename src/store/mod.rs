@@ -99,13 +99,24 @@ impl Store {
     /// Looks up the artifact of `key`, verifying header, format version and payload hash. A damaged, truncated
     /// or unreadable entry is returned once as [`Lookup::Corrupt`] (message names key, path and reason) and
     /// deleted; the next load is a [`Lookup::Miss`]. An entry of another store format is deleted too; the first
-    /// one per handle is reported, later ones are plain misses. A hit marks the entry as used now.
+    /// one per handle is reported, later ones are plain misses. A hit marks the entry as used now. `Err` only
+    /// when the entry cannot even be opened for a reason that is not its own (e.g. too many open files).
     pub fn load(&self, key: &NodeKey) -> Result<Lookup, StoreError> {
         let path = self.object_path(key);
         let mut file = match File::open(&path) {
             Ok(f) => f,
             Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Lookup::Miss),
-            Err(e) => return Ok(self.corrupt(key, &path, None, &format!("cannot open: {e}"))),
+            // The entry itself is unusable: report and remove it.
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    io::ErrorKind::PermissionDenied | io::ErrorKind::IsADirectory
+                ) =>
+            {
+                return Ok(self.corrupt(key, &path, None, &format!("cannot open: {e}")));
+            }
+            // Not the entry's fault (e.g. too many open files): keep it, report the failure.
+            Err(e) => return Err(StoreError::io("open cache entry", &path)(e)),
         };
         match entry::read_entry(&mut file, key) {
             Ok((header, payload)) => {
