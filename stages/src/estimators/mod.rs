@@ -11,5 +11,5 @@ pub mod rng;
 #[cfg(test)]
 mod tests;
 
-pub use ransac::{ransac, required_iterations, Model, RansacParams, RansacResult};
+pub use ransac::{ransac, ransac_filtered, required_iterations, Model, RansacParams, RansacResult};
 pub use rng::{mix64, mix_seed, SplitMix64};

@@ -102,6 +102,17 @@ const MAX_REFITS: usize = 10;
 /// Robustly fits `M` to `data`; `None` if the parameters are invalid ([`RansacParams::validate`]), there are
 /// fewer than `M::MIN_SAMPLES` data, or no non-degenerate sample was found.
 pub fn ransac<M: Model>(data: &[M::Datum], p: &RansacParams) -> Option<RansacResult<M>> {
+    ransac_filtered(data, p, |_: &M| true)
+}
+
+/// [`ransac`] where every hypothesis (sampled or refitted) must also pass `accept`, e.g. "the transformed
+/// patch centre lies within the expected localisation error" (thesis 3.4.5.2). Rejected samples count as
+/// iterations like degenerate ones; a refit that is rejected ends the refinement.
+pub fn ransac_filtered<M: Model>(
+    data: &[M::Datum],
+    p: &RansacParams,
+    accept: impl Fn(&M) -> bool,
+) -> Option<RansacResult<M>> {
     if p.validate().is_err() || data.len() < M::MIN_SAMPLES || M::MIN_SAMPLES == 0 {
         return None;
     }
@@ -118,7 +129,7 @@ pub fn ransac<M: Model>(data: &[M::Datum], p: &RansacParams) -> Option<RansacRes
         rng.sample_distinct(n, &mut sample_idx);
         sample.clear();
         sample.extend(sample_idx.iter().map(|&i| &data[i]));
-        let Some(model) = M::fit(&sample) else {
+        let Some(model) = M::fit(&sample).filter(|m| accept(m)) else {
             continue;
         };
         let score = Score::of(&model, data, p.threshold);
@@ -137,7 +148,9 @@ pub fn ransac<M: Model>(data: &[M::Datum], p: &RansacParams) -> Option<RansacRes
     for pass in 0..MAX_REFITS {
         refs.clear();
         refs.extend(inliers.iter().map(|&i| &data[i]));
-        let Some(refit) = M::fit(&refs) else { break };
+        let Some(refit) = M::fit(&refs).filter(|m| accept(m)) else {
+            break;
+        };
         let refit_score = Score::of(&refit, data, p.threshold);
         let accept = refit_score.inliers > score.inliers
             || (pass == 0 && refit_score.inliers == score.inliers);

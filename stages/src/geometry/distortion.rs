@@ -98,16 +98,17 @@ impl BrownDistortion {
             return (xd, yd, 0.0);
         }
         let (mut x, mut y) = (xd, yd);
+        // Squared residuals (no hypot in the per-pixel path); stop at the rounding level of the coordinates.
+        let stop_sq = (1e-16 * (1.0 + xd.abs() + yd.abs())).powi(2);
         let mut best = (x, y, f64::INFINITY);
         for _ in 0..MAX_UNDISTORT_ITERATIONS {
             let (fx, fy) = self.distort(x, y);
             let (ex, ey) = (fx - xd, fy - yd);
-            let residual = ex.hypot(ey);
-            if residual < best.2 {
-                best = (x, y, residual);
+            let residual_sq = ex * ex + ey * ey;
+            if residual_sq < best.2 {
+                best = (x, y, residual_sq);
             }
-            // Stop once the residual is at the rounding level of the coordinates.
-            if residual <= 1e-16 * (1.0 + xd.abs() + yd.abs()) || !residual.is_finite() {
+            if residual_sq <= stop_sq || !residual_sq.is_finite() {
                 break;
             }
             let [[a, b], [c, d]] = self.distort_jacobian(x, y);
@@ -121,13 +122,13 @@ impl BrownDistortion {
             y -= dy;
             if dx.abs() + dy.abs() <= 1e-17 * (1.0 + x.abs() + y.abs()) {
                 let (fx, fy) = self.distort(x, y);
-                let residual = (fx - xd).hypot(fy - yd);
-                if residual < best.2 {
-                    best = (x, y, residual);
+                let residual_sq = (fx - xd).powi(2) + (fy - yd).powi(2);
+                if residual_sq < best.2 {
+                    best = (x, y, residual_sq);
                 }
                 break;
             }
         }
-        best
+        (best.0, best.1, best.2.sqrt())
     }
 }

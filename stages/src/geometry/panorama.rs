@@ -67,14 +67,16 @@ impl PanoramaCamera {
         Vector3::new(cos_e * sin_a, cos_e * cos_a, sin_e)
     }
 
-    /// Continuous pixel of a panorama-frame direction (need not be unit); u wrapped into [0, W).
+    /// Continuous pixel of a panorama-frame direction (need not be unit, but finite and not astronomically
+    /// large: its squared norm must not overflow); u wrapped into [0, W).
     ///
     /// At the poles (horizontal part zero) the azimuth is undefined and u is whatever `atan2(0, 0)` gives.
     pub fn ray_pano_to_pixel(&self, dir_pano: &Vector3<f64>) -> (f64, f64) {
         let w = f64::from(self.width_px);
         let h = f64::from(self.height_px);
         let azimuth_rad = dir_pano.x.atan2(dir_pano.y);
-        let elevation_rad = dir_pano.z.atan2(dir_pano.x.hypot(dir_pano.y));
+        let horizontal = (dir_pano.x * dir_pano.x + dir_pano.y * dir_pano.y).sqrt();
+        let elevation_rad = dir_pano.z.atan2(horizontal);
         let mut u_px = (w * (azimuth_rad + PI) / TAU).rem_euclid(w);
         if u_px >= w {
             // rem_euclid of a tiny negative number can round up to exactly w.
@@ -99,10 +101,11 @@ impl PanoramaCamera {
     /// (or is not finite).
     pub fn project_world(&self, p_world: &Vector3<f64>) -> Option<(f64, f64)> {
         let d = p_world - self.center_world;
-        let norm = d.norm();
-        if !(norm > 0.0 && norm.is_finite()) {
+        let norm_sq = d.norm_squared();
+        if !(norm_sq > 0.0 && norm_sq.is_finite()) {
             return None;
         }
-        Some(self.ray_world_to_pixel(&(d / norm)))
+        // atan2 is scale-invariant: no normalisation needed.
+        Some(self.ray_world_to_pixel(&d))
     }
 }

@@ -1,6 +1,6 @@
 //! RANSAC similarity (ALGORITHMS.md §11 KAT): 50 % outliers, noisy inliers, determinism.
 
-use crate::estimators::{ransac, RansacParams, SplitMix64};
+use crate::estimators::{ransac, ransac_filtered, RansacParams, SplitMix64};
 use crate::geometry::{PointPair, Similarity2};
 use nalgebra::Vector2;
 
@@ -110,4 +110,41 @@ fn deterministic_for_a_seed() {
     )
     .unwrap();
     assert_eq!(a.inliers, c.inliers);
+}
+
+#[test]
+fn acceptance_test_rejects_implausible_hypotheses() {
+    // Two consistent groups: 60 pairs of truth() and 40 pairs of a far-shifted copy. Plain RANSAC takes
+    // the majority; with "the image centre may move at most 20 px from where truth() puts it" it still does,
+    // and requiring a position near the shifted copy selects the minority group instead.
+    let mut pairs = contaminated(60, 0, 0.0, 24);
+    let shifted = Similarity2 {
+        tx: truth().tx + 150.0,
+        ..truth()
+    };
+    let mut rng = SplitMix64::new(25);
+    pairs.extend((0..40).map(|_| {
+        let src = Vector2::new(600.0 * rng.next_f64(), 600.0 * rng.next_f64());
+        PointPair {
+            src,
+            dst: shifted.apply(&src),
+        }
+    }));
+    let params = RansacParams {
+        threshold: 1.0,
+        confidence: 0.999,
+        max_iterations: 2000,
+        seed: 4,
+    };
+    let centre = Vector2::new(300.0, 300.0);
+    let plain = ransac::<Similarity2>(&pairs, &params).unwrap();
+    assert_eq!(plain.inliers, (0..60).collect::<Vec<_>>());
+    let near_truth = |m: &Similarity2| (m.apply(&centre) - truth().apply(&centre)).norm() < 20.0;
+    let r = ransac_filtered::<Similarity2>(&pairs, &params, near_truth).unwrap();
+    assert_eq!(r.inliers, (0..60).collect::<Vec<_>>());
+    let near_shifted = |m: &Similarity2| (m.apply(&centre) - shifted.apply(&centre)).norm() < 20.0;
+    let r = ransac_filtered::<Similarity2>(&pairs, &params, near_shifted).unwrap();
+    assert_eq!(r.inliers, (60..100).collect::<Vec<_>>());
+    assert!((r.model.tx - shifted.tx).abs() < 1e-9);
+    assert!(ransac_filtered::<Similarity2>(&pairs, &params, |_: &Similarity2| false).is_none());
 }
