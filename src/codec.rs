@@ -114,8 +114,10 @@ pub fn encode_serde_into<T: Serialize + ?Sized>(
 
 /// Decodes plain bincode produced by [`encode_serde_into`]; every byte must be consumed.
 ///
-/// Garbage can announce huge lengths; bincode's byte limit is set to a bound proportional to the input
-/// (at least 256 bytes of claimed memory per input byte) so such input fails instead of allocating gigabytes.
+/// Garbage can announce huge lengths. bincode's byte limit (which also bounds the memory it reserves for
+/// containers: length × element size) is set to the smallest power-of-16 tier of at least 4096 bytes per
+/// input byte, capped at 8 GiB, so such input fails instead of allocating without bound. Legitimate values
+/// reserve far less than 4096 bytes per encoded byte; values needing more than 8 GiB are not supported.
 pub fn decode_serde_exact<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, CodecError> {
     use bincode::config::Config;
     fn run<T: DeserializeOwned, C: Config>(
@@ -124,7 +126,7 @@ pub fn decode_serde_exact<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, CodecE
     ) -> Result<(T, usize), bincode::error::DecodeError> {
         bincode::serde::decode_from_slice(bytes, config)
     }
-    let claim_bound = (bytes.len() as u64).saturating_mul(256);
+    let claim_bound = (bytes.len() as u64).saturating_mul(4096);
     let base = bincode_config();
     let result = if claim_bound <= 1 << 16 {
         run(bytes, base.with_limit::<{ 1 << 16 }>())
@@ -136,10 +138,8 @@ pub fn decode_serde_exact<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, CodecE
         run(bytes, base.with_limit::<{ 1 << 28 }>())
     } else if claim_bound <= 1 << 32 {
         run(bytes, base.with_limit::<{ 1 << 32 }>())
-    } else if claim_bound <= 1 << 36 {
-        run(bytes, base.with_limit::<{ 1 << 36 }>())
     } else {
-        run(bytes, base)
+        run(bytes, base.with_limit::<{ 1 << 33 }>())
     };
     let type_name = std::any::type_name::<T>();
     match result {
@@ -471,6 +471,21 @@ mod tests {
         7u64.encode(&mut two);
         two.push(0);
         assert!(u64::decode(&two).unwrap_err().0.contains("trailing"));
+    }
+
+    #[test]
+    fn sparse_values_of_large_types_decode_despite_the_garbage_limit() {
+        // 50 000 `None`s of a 520-byte type encode in ~50 kB but reserve 26 MB while decoding (more than a
+        // 256-bytes-per-input-byte bound would allow).
+        let sparse: Vec<Option<[[f64; 32]; 2]>> = vec![None; 50_000];
+        let bytes = encode_serde(&sparse).unwrap();
+        assert!(bytes.len() < 50_100);
+        assert_eq!(
+            decode_serde::<Vec<Option<[[f64; 32]; 2]>>>(&bytes)
+                .unwrap()
+                .len(),
+            50_000
+        );
     }
 
     #[test]
