@@ -136,7 +136,7 @@ impl Store {
                     Ok(Lookup::Corrupt {
                         message: format!(
                             "cache entry {key} ({}) was written by store format version {version}, this skytie uses \
-                             version {STORE_FORMAT_VERSION}: entries of the old format are discarded and recomputed \
+                             version {STORE_FORMAT_VERSION}: entries of other formats are discarded and recomputed \
                              (reported once; `skytie cache gc --max-size 0` clears them all)",
                             path.display()
                         ),
