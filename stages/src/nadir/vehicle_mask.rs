@@ -3,7 +3,8 @@
 //! The car is modelled as a box under the camera, aligned with `heading`: its top face lies `roof_drop_m` below the
 //! projection centre and spans `rear_m` behind to `front_m` ahead of it and `half_width_m` to each side. A ground
 //! point is hidden when its ray to the camera pierces that top face. Real campaigns set these from the vehicle;
-//! the defaults cover a typical mobile-mapping car with a mast-mounted camera.
+//! the defaults are the silhouette of the synthetic campaign's car (camera 0.4 m above the roof; bonnet and boot
+//! projected onto the roof plane, plus a 5 cm margin) — set them for your vehicle.
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -28,10 +29,10 @@ impl Default for VehicleMask {
     fn default() -> Self {
         Self {
             enabled: true,
-            roof_drop_m: 0.8,
-            front_m: 3.0,
-            rear_m: 1.2,
-            half_width_m: 0.95,
+            roof_drop_m: 0.4,
+            front_m: 0.75,
+            rear_m: 1.25,
+            half_width_m: 0.75,
         }
     }
 }
@@ -90,11 +91,11 @@ mod tests {
     fn points_under_the_bonnet_are_hidden_and_points_beside_are_not() {
         let m = VehicleMask::default();
         let cam = Vector3::new(100.0, 200.0, 2.2);
-        // Heading east: 2 m ahead of the camera on the ground, the ray meets the roof plane at 0.73 m ahead.
+        // Heading east: 2 m ahead of the camera on the ground, the ray meets the roof plane at 0.36 m ahead.
         assert!(m.hides(&cam, 90.0, &Vector3::new(102.0, 200.0, 0.0)));
         // 8 m to the north (left of an east-bound car) is far outside the body's side.
         assert!(!m.hides(&cam, 90.0, &Vector3::new(100.0, 208.0, 0.0)));
-        // 20 m ahead: the ray meets the roof plane at 7.3 m ahead, beyond the bonnet.
+        // 20 m ahead: the ray meets the roof plane at 3.6 m ahead, beyond the bonnet.
         assert!(!m.hides(&cam, 90.0, &Vector3::new(120.0, 200.0, 0.0)));
         // Same geometry heading north: now (0, +2) is ahead.
         assert!(m.hides(&cam, 0.0, &Vector3::new(100.0, 202.0, 0.0)));
