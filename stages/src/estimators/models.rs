@@ -18,13 +18,21 @@ impl Model for Similarity2 {
     }
 }
 
-/// Homography from 4 pairs (exact; rejected if 3 are collinear) or more (normalised DLT).
+/// Levenberg–Marquardt iterations of the least-squares refit on more than 4 pairs.
+pub const HOMOGRAPHY_REFINE_ITERATIONS: usize = 10;
+
+/// Homography from 4 pairs (exact; rejected if 3 are collinear) or more (normalised DLT, then LM on the
+/// transfer error, as OpenCV's `findHomography` does on its inliers).
 impl Model for Homography {
     const MIN_SAMPLES: usize = 4;
     type Datum = PointPair;
 
     fn fit(data: &[&PointPair]) -> Option<Self> {
-        Homography::from_pairs_iter(data.iter().copied())
+        let dlt = Homography::from_pairs_iter(data.iter().copied())?;
+        if data.len() == Self::MIN_SAMPLES {
+            return Some(dlt);
+        }
+        Some(dlt.refine_transfer_error(data.iter().copied(), HOMOGRAPHY_REFINE_ITERATIONS))
     }
 
     fn residual(&self, d: &PointPair) -> f64 {

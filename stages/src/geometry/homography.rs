@@ -183,7 +183,7 @@ impl Homography {
 
 /// Hartley normalisation: translate the centroid to 0 and scale the mean distance to √2.
 /// `None` if the points (numerically) coincide.
-fn hartley_normalisation<'a, I>(points: I) -> Option<Matrix3<f64>>
+pub(super) fn hartley_normalisation<'a, I>(points: I) -> Option<Matrix3<f64>>
 where
     I: Iterator<Item = &'a Vector2<f64>> + Clone,
 {

@@ -11,6 +11,7 @@ pub mod closest_approach;
 pub mod distortion;
 pub mod frame;
 pub mod homography;
+pub mod homography_refine;
 pub mod local_frame;
 pub mod panorama;
 pub mod point_pair;

@@ -130,3 +130,59 @@ fn similarity_converts_to_an_equal_homography() {
     let p = Vector2::new(17.0, -4.0);
     assert!((h.apply(&p).unwrap() - sim.apply(&p)).norm() < 1e-12);
 }
+
+fn transfer_cost(h: &Homography, pairs: &[PointPair]) -> f64 {
+    pairs.iter().map(|p| h.transfer_error(p).powi(2)).sum()
+}
+
+#[test]
+fn lm_refinement_lowers_transfer_error_to_a_local_minimum() {
+    let t = truth();
+    let mut rng = SplitMix64::new(15);
+    // World-scale source coordinates, 0.7 px noise in the destination.
+    let pairs: Vec<PointPair> = (0..80)
+        .map(|_| {
+            let src = Vector2::new(1000.0 * rng.next_f64(), 1000.0 * rng.next_f64());
+            let dst = t.apply(&src).unwrap()
+                + Vector2::new(rng.next_gaussian(), rng.next_gaussian()) * 0.7;
+            PointPair { src, dst }
+        })
+        .collect();
+    let dlt = Homography::from_pairs(&pairs).unwrap();
+    let refined = dlt.refine_transfer_error(pairs.iter(), 50);
+    let (c_dlt, c_ref) = (transfer_cost(&dlt, &pairs), transfer_cost(&refined, &pairs));
+    assert!(c_ref <= c_dlt, "refined {c_ref} > dlt {c_dlt}");
+    // Local minimum: perturbing any entry (relative 1e-6) does not lower the cost.
+    for i in 0..3 {
+        for j in 0..3 {
+            for sign in [-1.0, 1.0] {
+                let mut m = refined.0;
+                m[(i, j)] += sign * 1e-6 * m.norm();
+                let c = transfer_cost(&Homography(m), &pairs);
+                assert!(
+                    c >= c_ref * (1.0 - 1e-9),
+                    "entry ({i},{j}) {sign}: {c} < {c_ref}"
+                );
+            }
+        }
+    }
+    // Expected cost at the optimum ≈ (2n − 8)·σ²: a loose sanity check of the noise model.
+    let expected = (2.0 * 80.0 - 8.0) * 0.49;
+    assert!(
+        c_ref > 0.7 * expected && c_ref < 1.3 * expected,
+        "cost {c_ref}, expected ≈ {expected}"
+    );
+}
+
+#[test]
+fn lm_refinement_keeps_exact_solutions() {
+    let t = truth();
+    let pairs = pairs_for(&t, 20, 16, 0.0);
+    let refined = Homography::from_pairs(&pairs)
+        .unwrap()
+        .refine_transfer_error(pairs.iter(), 10);
+    assert_h_close(&refined, &t, 1e-10);
+    // Fewer than 5 pairs: returned unchanged.
+    let four = Homography::from_pairs(&pairs[..4]).unwrap();
+    assert_eq!(four.refine_transfer_error(pairs[..4].iter(), 10), four);
+}
