@@ -1,0 +1,207 @@
+//! Loading a workflow file together with the files it includes (`include = ["base.toml"]`): each file is parsed
+//! into a located tree, included files are merged first (in the order listed) and the including file is merged
+//! on top. Relative include paths are resolved against the including file's folder; cycles are errors that show
+//! the chain. Keys that belong to one file only (`include`, `name`) are not inherited; sweep variants accumulate.
+
+use std::path::{Path, PathBuf};
+
+use super::error::WorkflowError;
+use super::source::{parse_source, SourceFile};
+use super::tree::{Entry, Loc, Node, Table, Value};
+
+/// Deepest include nesting accepted (a guard against runaway chains that are not cycles).
+const MAX_INCLUDE_DEPTH: usize = 32;
+
+/// The merged tree of a workflow and all files read for it (index 0 = the workflow file, then includes in the
+/// order they were read).
+#[derive(Debug, Clone)]
+pub(crate) struct Loaded {
+    pub sources: Vec<SourceFile>,
+    pub document: Table,
+}
+
+/// Loads the workflow whose text is `text` and which lives at `path` (includes are read from disk).
+pub(crate) fn load_document(text: &str, path: &Path) -> Result<Loaded, WorkflowError> {
+    let mut loader = Loader {
+        sources: Vec::new(),
+        stack: Vec::new(),
+    };
+    let canonical = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    let document = loader.load(text, path, canonical)?;
+    Ok(Loaded {
+        sources: loader.sources,
+        document,
+    })
+}
+
+struct Loader {
+    sources: Vec<SourceFile>,
+    /// The chain of files being loaded: (canonical path, path as shown).
+    stack: Vec<(PathBuf, PathBuf)>,
+}
+
+impl Loader {
+    fn load(
+        &mut self,
+        text: &str,
+        shown: &Path,
+        canonical: PathBuf,
+    ) -> Result<Table, WorkflowError> {
+        let file_index = self.sources.len();
+        self.sources.push(SourceFile {
+            path: shown.to_path_buf(),
+            bytes: text.as_bytes().to_vec(),
+        });
+        let mut own = parse_source(text, shown, file_index)?;
+        let includes = match own.remove("include") {
+            Some(entry) => include_list(entry, shown)?,
+            None => Vec::new(),
+        };
+        self.stack.push((canonical, shown.to_path_buf()));
+        let mut merged = Table::default();
+        for (include, at) in includes {
+            let mut included = self.load_include(&include, at, shown)?;
+            included.remove("name");
+            merge_layer(&mut merged, included);
+        }
+        self.stack.pop();
+        merge_layer(&mut merged, own);
+        Ok(merged)
+    }
+
+    fn load_include(
+        &mut self,
+        include: &str,
+        at: Loc,
+        from: &Path,
+    ) -> Result<Table, WorkflowError> {
+        let error = |message: String| WorkflowError::at(from, at.line, at.column, message);
+        let shown = from.parent().unwrap_or(Path::new("")).join(include);
+        let canonical = std::fs::canonicalize(&shown).map_err(|e| {
+            error(format!(
+                "cannot read included file '{include}' (looked for {}): {e}",
+                shown.display()
+            ))
+        })?;
+        if let Some(start) = self.stack.iter().position(|(c, _)| *c == canonical) {
+            let mut chain: Vec<String> = self.stack[start..]
+                .iter()
+                .map(|(_, s)| s.display().to_string())
+                .collect();
+            chain.push(shown.display().to_string());
+            return Err(error(format!(
+                "include cycle: {}; remove one of these includes",
+                chain.join(" -> ")
+            )));
+        }
+        if self.stack.len() >= MAX_INCLUDE_DEPTH {
+            return Err(error(format!(
+                "includes nested deeper than {MAX_INCLUDE_DEPTH} files"
+            )));
+        }
+        let bytes = std::fs::read(&canonical).map_err(|e| {
+            error(format!(
+                "cannot read included file '{include}' ({}): {e}",
+                shown.display()
+            ))
+        })?;
+        let text = String::from_utf8(bytes).map_err(|_| {
+            error(format!(
+                "included file '{include}' is not UTF-8 text ({})",
+                shown.display()
+            ))
+        })?;
+        self.load(&text, &shown, canonical)
+    }
+}
+
+/// The entries of `include = "a.toml"` or `include = ["a.toml", "b.toml"]` with their positions.
+fn include_list(entry: Entry, file: &Path) -> Result<Vec<(String, Loc)>, WorkflowError> {
+    let wrong = |at: Loc, found: &str| {
+        WorkflowError::at(
+            file,
+            at.line,
+            at.column,
+            format!(
+                "include must be a file path or an array of file paths (strings), found {found}"
+            ),
+        )
+    };
+    match entry.node.value {
+        Value::String(s) => Ok(vec![(s, entry.node.at)]),
+        Value::Array(items) => items
+            .into_iter()
+            .map(|n| match n.value {
+                Value::String(s) => Ok((s, n.at)),
+                other => Err(wrong(n.at, other.type_name())),
+            })
+            .collect(),
+        other => Err(wrong(entry.node.at, other.type_name())),
+    }
+}
+
+/// Merges one layer on top of `base` (see `Table::merge_from`), except that `[[sweep.variant]]` arrays of both
+/// sides are concatenated (base first) so that files can add variants to the ones they include.
+pub(crate) fn merge_layer(base: &mut Table, mut over: Table) {
+    let base_variants = take_variants(base);
+    let over_variants = take_variants(&mut over);
+    base.merge_from(over);
+    let combined = match (base_variants, over_variants) {
+        (Some((mut b, _, _)), Some((o, key_at, at))) => {
+            b.extend(o);
+            Some((b, key_at, at))
+        }
+        (one, None) | (None, one) => one,
+    };
+    if let Some((nodes, key_at, at)) = combined {
+        if let Some(Entry {
+            node:
+                Node {
+                    value: Value::Table(sweep),
+                    ..
+                },
+            ..
+        }) = base.get_mut("sweep")
+        {
+            sweep.set(Entry {
+                key: "variant".into(),
+                key_at,
+                node: Node {
+                    value: Value::Array(nodes),
+                    at,
+                },
+            });
+        }
+    }
+}
+
+/// Removes `sweep.variant` when it is an array, returning its items and positions.
+fn take_variants(table: &mut Table) -> Option<(Vec<Node>, Loc, Loc)> {
+    let Some(Entry {
+        node: Node {
+            value: Value::Table(sweep),
+            ..
+        },
+        ..
+    }) = table.get_mut("sweep")
+    else {
+        return None;
+    };
+    if !matches!(
+        sweep.get("variant"),
+        Some(Entry {
+            node: Node {
+                value: Value::Array(_),
+                ..
+            },
+            ..
+        })
+    ) {
+        return None;
+    }
+    let entry = sweep.remove("variant")?;
+    match entry.node.value {
+        Value::Array(nodes) => Some((nodes, entry.key_at, entry.node.at)),
+        _ => None,
+    }
+}
