@@ -298,3 +298,22 @@ fn an_unreadable_entry_is_reported_once_and_never_panics() {
     let report = store.verify().unwrap();
     assert_eq!(report.checked, 0, "a folder is not an entry file");
 }
+
+#[test]
+fn entry_files_are_byte_identical_for_identical_saves() {
+    // Two processes saving one key write the same bytes, so whichever rename wins, the entry is the same.
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let payload: Vec<u8> = (0..2_000_000u32).map(|i| (i % 253) as u8).collect();
+    let (sa, sb) = (
+        Store::open(a.path()).unwrap(),
+        Store::open(b.path()).unwrap(),
+    );
+    sa.save(&key(5), &meta("same"), &payload).unwrap();
+    sb.save(&key(5), &meta("same"), &payload).unwrap();
+    let (fa, fb) = (
+        fs::read(sa.object_path(&key(5))).unwrap(),
+        fs::read(sb.object_path(&key(5))).unwrap(),
+    );
+    assert!(fa == fb);
+    assert!(fa.ends_with(&payload));
+}
