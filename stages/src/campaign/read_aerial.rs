@@ -42,7 +42,7 @@ pub(crate) fn read_aerial_rows(
             f.number_or("p2", 0.0),
         );
         let sigma_px = f.number_or("sigma_px", 0.5);
-        // thesis/format: ω and φ are tilts from the nadir; beyond ±90° the camera would look upwards.
+        // campaign-format.md: ω and φ tilt the view axis away from the nadir; beyond ±90° it looks up.
         for (column, angle) in [("omega", omega_deg), ("phi", phi_deg)] {
             if angle.abs() > 90.0 {
                 f.error(
