@@ -4,6 +4,7 @@
 //! `v = cy − f·y_d`.
 
 pub use super::distortion::BrownDistortion;
+use super::ray::Ray;
 use super::rotation::opk_to_matrix;
 use crate::campaign::AerialImage;
 use nalgebra::{Matrix3, Vector3};
@@ -106,6 +107,20 @@ impl FrameCamera {
         let yd = (self.cy_px - v_px) / self.focal_px;
         let (x, y) = self.distortion.undistort(xd, yd);
         (self.rotation_cam_to_world * Vector3::new(x, y, -1.0)).normalize()
+    }
+
+    /// The ray from the projection centre through a continuous pixel (world frame, distortion removed).
+    pub fn pixel_ray(&self, u_px: f64, v_px: f64) -> Ray {
+        Ray {
+            origin_world: self.center_world,
+            dir_world: self.pixel_to_ray_world(u_px, v_px),
+        }
+    }
+
+    /// Angular standard deviation (radians) of a pixel measurement with standard deviation `sigma_px` at the
+    /// principal point (σ_px / f; off-axis pixels subtend slightly smaller angles, so this is conservative).
+    pub fn angular_sigma_rad(&self, sigma_px: f64) -> f64 {
+        sigma_px / self.focal_px
     }
 
     /// True if the continuous pixel lies in the image: 0 ≤ u < W and 0 ≤ v < H.

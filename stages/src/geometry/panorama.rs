@@ -6,6 +6,7 @@
 //! `d_pano = (cos E sin A, cos E cos A, sin E)` (east, north, up); the world direction is
 //! `d_world = R·d_pano` with `R = Rz(−yaw)·Rx(pitch)·Ry(roll)` ([`panorama_rotation`]).
 
+use super::ray::Ray;
 use super::rotation::panorama_rotation;
 use crate::campaign::Recording;
 use nalgebra::{Matrix3, Vector3};
@@ -56,6 +57,20 @@ impl PanoramaCamera {
     /// Angular size of one pixel, radians (2π/W; equal in both directions when W = 2H).
     pub fn pixel_angle_rad(&self) -> f64 {
         TAU / f64::from(self.width_px)
+    }
+
+    /// Angular standard deviation (radians) of a pixel measurement with standard deviation `sigma_px`
+    /// (ALGORITHMS.md §10: σ_θ = σ_px·2π/W), e.g. for [`super::triangulate_rays`].
+    pub fn angular_sigma_rad(&self, sigma_px: f64) -> f64 {
+        sigma_px * self.pixel_angle_rad()
+    }
+
+    /// The ray from the projection centre through a continuous pixel (world frame).
+    pub fn pixel_ray(&self, u_px: f64, v_px: f64) -> Ray {
+        Ray {
+            origin_world: self.center_world,
+            dir_world: self.pixel_to_ray_world(u_px, v_px),
+        }
     }
 
     /// Unit direction in the panorama frame (before the residual rotation) of a continuous pixel.

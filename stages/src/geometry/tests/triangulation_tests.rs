@@ -244,3 +244,88 @@ fn thin_intersection_angle_is_still_exact_but_uncertain_along_the_ray() {
         "along {var_along} across {var_across}"
     );
 }
+
+#[test]
+fn panorama_and_aerial_pixels_triangulate_a_ground_point() {
+    // End to end through the cameras: a road point seen by two panoramas and two nadir images.
+    use crate::geometry::{BrownDistortion, FrameCamera, PanoramaCamera};
+    let x = Vector3::new(92_031.25, 437_118.5, 0.42);
+    let panos = [
+        PanoramaCamera::new(
+            4800,
+            2400,
+            x + Vector3::new(-3.0, -6.0, 2.5),
+            2.0,
+            0.5,
+            -0.3,
+        ),
+        PanoramaCamera::new(
+            4800,
+            2400,
+            x + Vector3::new(-2.0, -1.0, 2.4),
+            -1.0,
+            0.0,
+            0.4,
+        ),
+    ];
+    let distortion = BrownDistortion {
+        k1: -0.05,
+        k2: 0.01,
+        p1: 1e-4,
+        p2: -2e-4,
+    };
+    let aerial = [
+        FrameCamera::from_opk(
+            x + Vector3::new(-120.0, 80.0, 1000.0),
+            0.5,
+            -0.3,
+            2.0,
+            10_000.0,
+            6_000.0,
+            4_000.0,
+            12_000,
+            8_000,
+            distortion,
+        ),
+        FrameCamera::from_opk(
+            x + Vector3::new(150.0, -60.0, 1010.0),
+            -0.4,
+            0.2,
+            -1.0,
+            10_000.0,
+            6_010.0,
+            3_990.0,
+            12_000,
+            8_000,
+            distortion,
+        ),
+    ];
+    let mut rays = Vec::new();
+    let mut sigmas = Vec::new();
+    for cam in &panos {
+        let (u, v) = cam.project_world(&x).unwrap();
+        rays.push(cam.pixel_ray(u, v));
+        sigmas.push(cam.angular_sigma_rad(0.5));
+    }
+    for cam in &aerial {
+        let (u, v) = cam.project_world(&x).unwrap();
+        assert!(cam.contains(u, v));
+        rays.push(cam.pixel_ray(u, v));
+        sigmas.push(cam.angular_sigma_rad(0.5));
+    }
+    assert!((sigmas[0] - 0.5 * 0.075f64.to_radians()).abs() < 1e-15);
+    assert!((sigmas[2] - 0.5 / 10_000.0).abs() < 1e-18);
+    let t = triangulate_rays(&rays, &sigmas).unwrap();
+    assert!(
+        (t.point_world - x).norm() < 1e-8,
+        "error {}",
+        (t.point_world - x).norm()
+    );
+    // The aerial rays are ≈ 1 km long, the panorama rays a few metres: the panoramas dominate the height,
+    // and every standard deviation is millimetric.
+    assert!(t
+        .covariance_m2
+        .diagonal()
+        .iter()
+        .all(|&v| v > 0.0 && v.sqrt() < 0.01));
+}
