@@ -1,6 +1,19 @@
 //! skytie engine: typed dataflow DAG with content-addressed caching, workflows, CLI support.
-pub mod codec;
-pub mod hashing;
-pub mod workflow;
-pub mod store;
+//!
+//! Layers: [`hashing`] / [`codec`] / [`store`] (content-addressed artifacts), [`workflow`] (TOML workflows
+//! and sweeps), [`dag`] (typed stages, graph building, keys, executor, sessions and pipelines),
+//! [`progress`] / [`metrics`] / [`provenance`] / [`plan`] / [`explain`] (what a run reports), [`cli`] (the
+//! `skytie` command), [`testing`] (toy stages and the `toy` pipeline used by tests and benchmarks).
 pub mod cache_cmd;
+pub mod cli;
+pub mod codec;
+pub mod dag;
+pub mod explain;
+pub mod hashing;
+pub mod metrics;
+pub mod plan;
+pub mod progress;
+pub mod provenance;
+pub mod store;
+pub mod testing;
+pub mod workflow;

@@ -1,1 +1,5 @@
-fn main() {}
+//! The `skytie` binary: see `skytie --help` and `skytie::cli`.
+
+fn main() {
+    std::process::exit(skytie::cli::main());
+}

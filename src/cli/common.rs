@@ -1,0 +1,78 @@
+//! Options and setup shared by subcommands: cache location, thread pool, workflow loading.
+
+use crate::dag::{pipeline_by_name, Pipeline};
+use crate::store::Store;
+use crate::workflow::Workflow;
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+/// Default workflow file.
+pub const DEFAULT_WORKFLOW: &str = "workflows/default.toml";
+
+/// `--cache DIR` (default: `$SKYTIE_CACHE`, else `cache/` in the working directory).
+#[derive(Args, Debug, Clone, Default)]
+pub struct CacheOpt {
+    /// Cache folder (default: $SKYTIE_CACHE, else ./cache).
+    #[arg(long, value_name = "DIR")]
+    pub cache: Option<PathBuf>,
+}
+
+impl CacheOpt {
+    /// The cache root to use.
+    pub fn root(&self) -> PathBuf {
+        if let Some(c) = &self.cache {
+            return c.clone();
+        }
+        match std::env::var_os("SKYTIE_CACHE") {
+            Some(v) if !v.is_empty() => PathBuf::from(v),
+            _ => PathBuf::from("cache"),
+        }
+    }
+
+    /// Open the store, or print why not.
+    pub fn open(&self) -> Result<Store, String> {
+        let root = self.root();
+        Store::open(&root).map_err(|e| {
+            format!(
+                "cannot open the cache at {}: {e} (use --cache DIR)",
+                root.display()
+            )
+        })
+    }
+}
+
+/// `--threads N` (0 = all cores).
+#[derive(Args, Debug, Clone, Default)]
+pub struct ThreadsOpt {
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub threads: usize,
+}
+
+impl ThreadsOpt {
+    /// Run `f` in a rayon pool of the requested size.
+    pub fn install<R: Send>(&self, f: impl FnOnce() -> R + Send) -> Result<R, String> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(self.threads)
+            .build()
+            .map_err(|e| format!("cannot start {} worker threads: {e}", self.threads))?;
+        Ok(pool.install(f))
+    }
+}
+
+/// Load a workflow, applying `--campaign`, and find its pipeline (checking the stage names against it).
+pub fn load_workflow(
+    path: &Path,
+    campaign: Option<&Path>,
+) -> Result<(Workflow, &'static dyn Pipeline), String> {
+    let mut wf = Workflow::load(path).map_err(|e| e.to_string())?;
+    if let Some(c) = campaign {
+        wf.override_campaign(c.to_path_buf());
+    }
+    let pipeline =
+        pipeline_by_name(&wf.pipeline).map_err(|e| format!("{}: {e}", wf.path.display()))?;
+    wf.check_stage_names(&pipeline.stage_names())
+        .map_err(|e| e.to_string())?;
+    pipeline.validate(&wf)?;
+    Ok((wf, pipeline))
+}

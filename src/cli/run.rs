@@ -1,0 +1,235 @@
+//! `skytie run [WORKFLOW] [--campaign DIR] [--cache DIR] [--out DIR] [--threads N] [--quiet]`.
+//!
+//! Runs the workflow's pipeline, then writes `OUT/metrics.json`, `OUT/provenance.json` and, for a sweep,
+//! `OUT/variants/<name>/metrics.json` and `OUT/sweep.csv` (default OUT: `out/<workflow name>/`), and prints
+//! a summary table (stage, executed, cached, failed, skipped, seconds) plus the failed and skipped nodes.
+//!
+//! Exit code rule: **0** when the run produced something useful — at least one requested output of the
+//! last phase (e.g. the final report/metrics node of one variant) was produced, or, if the pipeline
+//! requests no outputs, at least one node succeeded — even when other nodes failed (they are listed and
+//! counted in `engine.nodes_failed` / `engine.nodes_skipped`). **1** when nothing useful was produced:
+//! the pipeline stopped with an error (e.g. the campaign could not be generated or read) or every
+//! requested output failed or was skipped. **2** for usage/setup errors before anything ran (workflow does
+//! not load, unknown pipeline, cache cannot be opened) or when the output files cannot be written.
+
+use crate::cli::common::{load_workflow, CacheOpt, ThreadsOpt, DEFAULT_WORKFLOW};
+use crate::dag::{Mode, NodeStatus, PipelineError, Session};
+use crate::hashing::StatCache;
+use crate::metrics::{add_sections, sweep_csv, write_json, Summary};
+use crate::progress::{Progress, ProgressMode};
+use crate::workflow::Workflow;
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::time::{Instant, SystemTime, UNIX_EPOCH};
+
+#[derive(Args, Debug, Clone)]
+pub struct RunArgs {
+    /// Workflow file.
+    #[arg(default_value = DEFAULT_WORKFLOW)]
+    pub workflow: PathBuf,
+    /// Use this campaign folder instead of the workflow's `campaign`.
+    #[arg(long, value_name = "DIR")]
+    pub campaign: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: CacheOpt,
+    /// Output folder (default: out/<workflow name>/).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub threads: ThreadsOpt,
+    /// Print only errors and the final summary.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// What a finished run reports back (for the exit code and for tests).
+pub struct RunResult {
+    pub exit_code: i32,
+    pub out_dir: PathBuf,
+    pub summary: Summary,
+}
+
+pub fn main(args: &RunArgs) -> i32 {
+    match run(args) {
+        Ok(r) => r.exit_code,
+        Err((code, msg)) => {
+            eprintln!("error: {msg}");
+            code
+        }
+    }
+}
+
+/// Run a workflow as the CLI does. Err = (exit code, message).
+pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
+    let (wf, pipeline) =
+        load_workflow(&args.workflow, args.campaign.as_deref()).map_err(|e| (2, e))?;
+    let store = args.cache.open().map_err(|e| (2, e))?;
+    let _lease = store
+        .begin_run()
+        .map_err(|e| (2, format!("cannot register the run in the cache: {e}")))?;
+    let stat_cache = StatCache::open(store.root());
+    let progress = Progress::new(if args.quiet {
+        ProgressMode::Quiet
+    } else {
+        ProgressMode::Auto
+    });
+    let out_dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| Path::new("out").join(&wf.name));
+    let started_unix_s = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map(|d| d.as_secs())
+        .unwrap_or(0);
+    let start = Instant::now();
+    let mut session = Session::new(&store, &stat_cache, &progress, Mode::Run);
+    let result = args
+        .threads
+        .install(|| pipeline.run(&wf, &mut session))
+        .map_err(|e| (2, e))?;
+    if let Err(PipelineError::Workflow(m)) = &result {
+        return Err((2, m.clone()));
+    }
+    let wall = start.elapsed().as_secs_f64();
+    if let Err(e) = stat_cache.save() {
+        progress.warn(&format!("could not save the stat cache: {e}"));
+    }
+    let summary = Summary::of(session.reports());
+    write_outputs(&wf, &session, &out_dir, started_unix_s, wall).map_err(|e| {
+        (
+            2,
+            format!("cannot write outputs to {}: {e}", out_dir.display()),
+        )
+    })?;
+    print!("{}", summary.table(wall));
+    print_problems(&session);
+    let useful = produced_something(&session);
+    if let Err(e) = &result {
+        eprintln!("error: {e}");
+    }
+    let exit_code = if result.is_ok() && useful { 0 } else { 1 };
+    if !args.quiet {
+        println!("outputs in {}", out_dir.display());
+    }
+    Ok(RunResult {
+        exit_code,
+        out_dir,
+        summary,
+    })
+}
+
+/// The exit-code rule (see the module documentation).
+pub fn produced_something(session: &Session<'_>) -> bool {
+    let Some(last) = session.phases.last() else {
+        return false;
+    };
+    if last.requested.is_empty() {
+        return session.reports().any(|r| r.status.is_ok());
+    }
+    last.requested
+        .iter()
+        .any(|&id| last.reports[id].status.is_ok())
+}
+
+fn print_problems(session: &Session<'_>) {
+    const MAX: usize = 30;
+    let failed: Vec<_> = session
+        .reports()
+        .filter(|r| matches!(r.status, NodeStatus::Failed(_)))
+        .collect();
+    let skipped: Vec<_> = session
+        .reports()
+        .filter(|r| matches!(r.status, NodeStatus::Skipped { .. }))
+        .collect();
+    if !failed.is_empty() {
+        println!("failed ({}):", failed.len());
+        for r in failed.iter().take(MAX) {
+            if let NodeStatus::Failed(m) = &r.status {
+                println!("  {}: {m}", r.identity);
+            }
+        }
+        if failed.len() > MAX {
+            println!("  … and {} more", failed.len() - MAX);
+        }
+    }
+    if !skipped.is_empty() {
+        println!("skipped (upstream failed) ({}):", skipped.len());
+        for r in skipped.iter().take(MAX) {
+            if let NodeStatus::Skipped { upstream } = &r.status {
+                println!("  {} (upstream {upstream})", r.identity);
+            }
+        }
+        if skipped.len() > MAX {
+            println!("  … and {} more", skipped.len() - MAX);
+        }
+    }
+}
+
+/// Write metrics.json, provenance.json and, for sweeps, per-variant metrics and sweep.csv.
+pub fn write_outputs(
+    wf: &Workflow,
+    session: &Session<'_>,
+    out_dir: &Path,
+    started_unix_s: u64,
+    wall_seconds: f64,
+) -> std::io::Result<()> {
+    let warnings: usize = session.phases.iter().map(|p| p.warnings.len()).sum();
+    let summary = Summary::of(session.reports());
+    let mut doc = summary.to_json(wall_seconds, warnings);
+    let variants = wf.variants();
+    if wf.is_sweep() {
+        if let serde_json::Value::Object(m) = &mut doc {
+            m.insert("variants".into(), serde_json::json!(variants));
+        }
+        let mut rows = Vec::new();
+        for v in &variants {
+            let vs = Summary::of(session.reports().filter(|r| r.variants.contains(v)));
+            let mut vdoc = vs.to_json(wall_seconds, warnings);
+            add_sections(
+                &mut vdoc,
+                session
+                    .metrics()
+                    .filter(|(var, _, _)| var == v)
+                    .map(|(_, ns, val)| (ns.as_str(), val)),
+            );
+            write_json(
+                &out_dir.join("variants").join(v).join("metrics.json"),
+                &vdoc,
+            )?;
+            // sweep.csv: the contributed sections plus the variant's engine counters.
+            let mut row = serde_json::json!({});
+            add_sections(
+                &mut row,
+                session
+                    .metrics()
+                    .filter(|(var, _, _)| var == v)
+                    .map(|(_, ns, val)| (ns.as_str(), val)),
+            );
+            rows.push((v.clone(), row));
+        }
+        skytie_stages::fsutil::atomic_write(
+            &out_dir.join("sweep.csv"),
+            sweep_csv(&rows).as_bytes(),
+        )?;
+    } else {
+        add_sections(
+            &mut doc,
+            session.metrics().map(|(_, ns, val)| (ns.as_str(), val)),
+        );
+    }
+    write_json(&out_dir.join("metrics.json"), &doc)?;
+    let prov = crate::provenance::provenance(wf, session, started_unix_s, wall_seconds);
+    write_json(&out_dir.join("provenance.json"), &prov)?;
+    Ok(())
+}
+
+/// Turn a pipeline error of a plan into "planning stopped here" (not an error) or a real error.
+pub fn plan_stop(
+    result: Result<(), PipelineError>,
+) -> Result<Option<PipelineError>, PipelineError> {
+    match result {
+        Ok(()) => Ok(None),
+        Err(e @ PipelineError::NotYetAvailable(_)) => Ok(Some(e)),
+        Err(e) => Err(e),
+    }
+}

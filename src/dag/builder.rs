@@ -1,0 +1,280 @@
+//! Building a DAG in Rust code: `DagBuilder::add` returns a typed `Handle` to the node's output.
+//!
+//! Nodes are deduplicated at build time: adding a node whose stage, version, params, item and inputs equal
+//! those of an existing node returns the existing handle (this is how the variants of a sweep share their
+//! common prefix: built bottom-up, shared nodes merge and run once). The graph itself is a petgraph
+//! `DiGraph` (edge upstream → consumer); handles only refer to existing nodes, so insertion order is a
+//! topological order.
+
+use crate::codec::encode_params;
+use crate::dag::inputs::{Handle, InputRef, InputSet, NodeId};
+use crate::dag::node::{Node, TypedNode};
+use crate::dag::stage::Stage;
+use petgraph::graph::{DiGraph, NodeIndex};
+use std::collections::HashMap;
+use std::fmt;
+use std::sync::Arc;
+
+/// A wiring mistake found while building the graph.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct BuildError {
+    pub message: String,
+}
+
+impl fmt::Display for BuildError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+impl std::error::Error for BuildError {}
+
+/// Turns a node's output into a JSON object contributed to `metrics.json` under `namespace`.
+pub(crate) type MetricsFn =
+    Arc<dyn Fn(&(dyn std::any::Any + Send + Sync)) -> Option<serde_json::Value> + Send + Sync>;
+
+/// A metrics contribution registered with [`DagBuilder::metrics`].
+#[derive(Clone)]
+pub(crate) struct MetricsSink {
+    pub node: NodeId,
+    pub variant: String,
+    pub namespace: String,
+    pub to_json: MetricsFn,
+}
+
+/// Collects nodes; see the module documentation.
+pub struct DagBuilder {
+    nodes: Vec<Node>,
+    graph: DiGraph<NodeId, ()>,
+    by_structure: HashMap<[u8; 32], NodeId>,
+    variant: String,
+    sinks: Vec<MetricsSink>,
+}
+
+impl Default for DagBuilder {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl DagBuilder {
+    pub fn new() -> Self {
+        DagBuilder {
+            nodes: Vec::new(),
+            graph: DiGraph::new(),
+            by_structure: HashMap::new(),
+            variant: "default".to_string(),
+            sinks: Vec::new(),
+        }
+    }
+
+    /// Nodes added from now on belong to `variant` (sweeps build each variant in turn into one builder).
+    pub fn set_variant(&mut self, variant: &str) {
+        self.variant = variant.to_string();
+    }
+
+    /// Add a node of stage `S` for `item` (empty for a global node) with `params` reading `inputs`.
+    pub fn add<S: Stage>(
+        &mut self,
+        stage: S,
+        item: &str,
+        params: S::Params,
+        inputs: S::Inputs,
+    ) -> Result<Handle<S::Output>, BuildError> {
+        let params_bytes = encode_params(&params).map_err(|e| BuildError {
+            message: format!("stage {}: cannot encode params: {e}", S::NAME),
+        })?;
+        let params_json = serde_json::to_value(&params).map_err(|e| BuildError {
+            message: format!("stage {}: cannot describe params: {e}", S::NAME),
+        })?;
+        let mut refs = Vec::new();
+        inputs.collect_refs("", &mut refs);
+        for (label, r) in &refs {
+            if let InputRef::Node(id) = r {
+                if *id >= self.nodes.len() {
+                    return Err(BuildError {
+                        message: format!(
+                            "stage {} input {label}: handle {id} does not belong to this graph",
+                            S::NAME
+                        ),
+                    });
+                }
+            }
+        }
+        let structure = structural_hash(S::NAME, S::VERSION, item, &params_bytes, &refs);
+        if let Some(&id) = self.by_structure.get(&structure) {
+            let node = &mut self.nodes[id];
+            if !node.variants.contains(&self.variant) {
+                node.variants.push(self.variant.clone());
+            }
+            return Ok(Handle::new(id));
+        }
+        let id = self.nodes.len();
+        let gid = self.graph.add_node(id);
+        debug_assert_eq!(gid.index(), id);
+        let mut upstream: Vec<NodeId> = refs
+            .iter()
+            .filter_map(|(_, r)| match r {
+                InputRef::Node(u) => Some(*u),
+                InputRef::File(_) => None,
+            })
+            .collect();
+        upstream.sort_unstable();
+        upstream.dedup();
+        for u in upstream {
+            self.graph.add_edge(NodeIndex::new(u), gid, ());
+        }
+        self.nodes.push(Node {
+            stage: S::NAME,
+            version: S::VERSION,
+            item: item.to_string(),
+            variants: vec![self.variant.clone()],
+            params_bytes,
+            params_json,
+            inputs: refs,
+            erased: Box::new(TypedNode {
+                stage,
+                params,
+                inputs,
+            }),
+            requested: false,
+        });
+        self.by_structure.insert(structure, id);
+        Ok(Handle::new(id))
+    }
+
+    /// Keep this node's value after the run so `Outcome::get` can return it (it is loaded from the cache
+    /// when the node is cached).
+    pub fn request<T>(&mut self, handle: Handle<T>) {
+        if let Some(n) = self.nodes.get_mut(handle.id) {
+            n.requested = true;
+        }
+    }
+
+    /// Contribute `to_json(output)` to the metrics of the current variant under `namespace` (e.g. the
+    /// adjustment's statistics under `adjust`). The node is requested.
+    pub fn metrics<T, F>(&mut self, handle: Handle<T>, namespace: &str, to_json: F)
+    where
+        T: Send + Sync + 'static,
+        F: Fn(&T) -> serde_json::Value + Send + Sync + 'static,
+    {
+        self.request(handle);
+        let f: MetricsFn = Arc::new(move |v| v.downcast_ref::<T>().map(&to_json));
+        self.sinks.push(MetricsSink {
+            node: handle.id,
+            variant: self.variant.clone(),
+            namespace: namespace.to_string(),
+            to_json: f,
+        });
+    }
+
+    /// Number of nodes so far.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// Finish building.
+    pub fn build(self) -> Dag {
+        Dag {
+            nodes: self.nodes,
+            graph: self.graph,
+            sinks: self.sinks,
+        }
+    }
+}
+
+fn structural_hash(
+    stage: &str,
+    version: &str,
+    item: &str,
+    params: &[u8],
+    refs: &[(String, InputRef)],
+) -> [u8; 32] {
+    let mut h = blake3::Hasher::new();
+    let mut field = |b: &[u8]| {
+        h.update(&(b.len() as u64).to_le_bytes());
+        h.update(b);
+    };
+    field(stage.as_bytes());
+    field(version.as_bytes());
+    field(item.as_bytes());
+    field(params);
+    for (label, r) in refs {
+        field(label.as_bytes());
+        match r {
+            InputRef::Node(id) => {
+                field(b"node");
+                field(&(*id as u64).to_le_bytes());
+            }
+            InputRef::File(p) => {
+                field(b"file");
+                field(p.as_os_str().as_encoded_bytes());
+            }
+        }
+    }
+    *h.finalize().as_bytes()
+}
+
+/// A finished graph, ready for `plan` or `execute`.
+pub struct Dag {
+    pub(crate) nodes: Vec<Node>,
+    pub(crate) graph: DiGraph<NodeId, ()>,
+    pub(crate) sinks: Vec<MetricsSink>,
+}
+
+impl Dag {
+    pub fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+    /// Ids of the nodes that read node `id`.
+    pub fn consumers(&self, id: NodeId) -> Vec<NodeId> {
+        let mut c: Vec<NodeId> = self
+            .graph
+            .neighbors_directed(NodeIndex::new(id), petgraph::Direction::Outgoing)
+            .map(|n| n.index())
+            .collect();
+        c.sort_unstable();
+        c
+    }
+    /// Topological waves: wave k holds the nodes whose longest upstream chain has k nodes. Nodes of one
+    /// wave are independent and run in parallel.
+    pub fn waves(&self) -> Vec<Vec<NodeId>> {
+        let mut depth = vec![0usize; self.nodes.len()];
+        let mut waves: Vec<Vec<NodeId>> = Vec::new();
+        for (id, node) in self.nodes.iter().enumerate() {
+            let d = node
+                .upstream_ids()
+                .iter()
+                .map(|&u| depth[u] + 1)
+                .max()
+                .unwrap_or(0);
+            depth[id] = d;
+            if waves.len() <= d {
+                waves.resize_with(d + 1, Vec::new);
+            }
+            waves[d].push(id);
+        }
+        waves
+    }
+    /// Find nodes by identity (`stage[item]`), exact match first, else all nodes whose identity starts
+    /// with `query`.
+    pub fn find(&self, query: &str) -> Vec<NodeId> {
+        let exact: Vec<NodeId> = (0..self.nodes.len())
+            .filter(|&i| self.nodes[i].identity() == query)
+            .collect();
+        if !exact.is_empty() {
+            return exact;
+        }
+        (0..self.nodes.len())
+            .filter(|&i| self.nodes[i].identity().starts_with(query))
+            .collect()
+    }
+}

@@ -1,0 +1,797 @@
+//! Executes (or plans) a DAG against the content-addressed store.
+//!
+//! Nodes run in topological waves on the rayon pool; every parallel step collects in node order, so results
+//! and records are identical for 1 or N threads. For each wave:
+//! 1. check (parallel): skip nodes whose upstream failed; hash raw-file inputs (stat cache); compute the key
+//!    from the inputs' content hashes (early cutoff); a key whose output hash is known (node record or
+//!    output record) and whose entry exists is CACHED without reading the artifact; otherwise `Store::load`
+//!    (Hit ⇒ cached; Corrupt ⇒ one warning, recompute; Miss ⇒ run).
+//! 2. load (parallel, each value once) the inputs the nodes to run need; an input that turns out corrupt or
+//!    missing is recomputed first (recursively).
+//! 3. run (parallel) inside `catch_unwind`: an error or panic marks the node FAILED and nothing is stored;
+//!    success is encoded, saved, then recorded (output record, node record).
+//! 4. account (sequential): statuses, progress, release values no consumer needs any more.
+//!
+//! No lock is ever held while a stage runs or the store is called (rayon work stealing could otherwise
+//! re-enter the lock on the same thread).
+
+use crate::dag::builder::Dag;
+use crate::dag::inputs::{InputRef, InputValue, NodeId, RawFileValue};
+use crate::dag::key::node_key;
+use crate::dag::node::{AnyValue, Node};
+use crate::dag::record::{self, NodeRecord, RecordedInput};
+use crate::dag::stage::{dirs_root, tmp_dir_for, NodeCtx};
+use crate::hashing::{ContentHash, NodeKey, StatCache};
+use crate::progress::Progress;
+use crate::store::{EntryMeta, Lookup, Store};
+use rayon::prelude::*;
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::Mutex;
+use std::time::{Instant, SystemTime, UNIX_EPOCH};
+
+/// Run the stages, or only say what would run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    Run,
+    Plan,
+}
+
+/// What happened to a node.
+#[derive(Clone, Debug, PartialEq)]
+pub enum NodeStatus {
+    /// The stage ran (or was recomputed because its cached artifact was corrupt or missing).
+    Executed,
+    /// The output came from the cache.
+    Cached,
+    /// The stage returned an error or panicked; nothing was stored.
+    Failed(String),
+    /// Not run because an upstream node failed (identity of that node).
+    Skipped { upstream: String },
+    /// Plan mode: the node will run, with the reasons.
+    WillRun { reasons: Vec<String> },
+}
+
+impl NodeStatus {
+    pub fn is_ok(&self) -> bool {
+        matches!(self, NodeStatus::Executed | NodeStatus::Cached)
+    }
+}
+
+/// The outcome of one node.
+#[derive(Clone, Debug)]
+pub struct NodeReport {
+    pub id: NodeId,
+    pub identity: String,
+    pub stage: &'static str,
+    pub stage_version: &'static str,
+    pub variants: Vec<String>,
+    pub status: NodeStatus,
+    pub key: Option<NodeKey>,
+    pub output_hash: Option<ContentHash>,
+    /// Seconds the stage ran in this run (0 when cached).
+    pub seconds: f64,
+    /// The node's inputs with their sources and hashes (empty hash: not known yet, plan mode).
+    pub inputs: Vec<RecordedInput>,
+}
+
+/// Everything an execution produced.
+pub struct Outcome {
+    pub reports: Vec<NodeReport>,
+    pub(crate) values: HashMap<NodeId, AnyValue>,
+    /// Warnings (corrupt cache entries …), each once.
+    pub warnings: Vec<String>,
+    /// Metrics contributed by nodes: (variant, namespace, object).
+    pub metrics: Vec<(String, String, serde_json::Value)>,
+    pub seconds: f64,
+}
+
+impl Outcome {
+    /// The value of a requested node (`DagBuilder::request`), if it was produced.
+    pub fn get<T: Send + Sync + 'static>(
+        &self,
+        handle: crate::dag::Handle<T>,
+    ) -> Option<std::sync::Arc<T>> {
+        self.values.get(&handle.id)?.clone().downcast::<T>().ok()
+    }
+    pub fn count(&self, pred: impl Fn(&NodeStatus) -> bool) -> usize {
+        self.reports.iter().filter(|r| pred(&r.status)).count()
+    }
+    pub fn executed(&self) -> usize {
+        self.count(|s| matches!(s, NodeStatus::Executed))
+    }
+    pub fn cached(&self) -> usize {
+        self.count(|s| matches!(s, NodeStatus::Cached))
+    }
+    pub fn failed(&self) -> usize {
+        self.count(|s| matches!(s, NodeStatus::Failed(_)))
+    }
+    pub fn skipped(&self) -> usize {
+        self.count(|s| matches!(s, NodeStatus::Skipped { .. }))
+    }
+    pub fn will_run(&self) -> usize {
+        self.count(|s| matches!(s, NodeStatus::WillRun { .. }))
+    }
+    /// Executed count of one stage.
+    pub fn executed_of(&self, stage: &str) -> usize {
+        self.reports
+            .iter()
+            .filter(|r| r.stage == stage && r.status == NodeStatus::Executed)
+            .count()
+    }
+}
+
+/// Where an execution reads and writes.
+pub struct Env<'a> {
+    pub store: &'a Store,
+    pub stat_cache: &'a StatCache,
+    pub progress: &'a Progress,
+}
+
+#[derive(Default)]
+struct Slot {
+    status: Option<NodeStatus>,
+    key: Option<NodeKey>,
+    hash: Option<ContentHash>,
+    value: Option<AnyValue>,
+    seconds: f64,
+    inputs: Vec<RecordedInput>,
+    consumers_left: usize,
+}
+
+enum Check {
+    Cached {
+        key: NodeKey,
+        hash: ContentHash,
+        value: Option<AnyValue>,
+        record_stale: bool,
+    },
+    Run {
+        key: NodeKey,
+    },
+    WillRun(Vec<String>),
+    Failed(String),
+    Skipped(String),
+}
+
+struct Exec<'a> {
+    dag: &'a Dag,
+    env: &'a Env<'a>,
+    mode: Mode,
+    slots: Vec<Mutex<Slot>>,
+    warnings: Mutex<(Vec<String>, BTreeSet<String>)>,
+}
+
+/// Execute (or plan) `dag`. Never panics on stage errors/panics or store trouble; those become node
+/// statuses and warnings.
+pub fn execute(dag: &Dag, env: &Env<'_>, mode: Mode) -> Outcome {
+    let start = Instant::now();
+    let mut slots: Vec<Mutex<Slot>> = (0..dag.nodes.len())
+        .map(|_| Mutex::new(Slot::default()))
+        .collect();
+    for (id, node) in dag.nodes.iter().enumerate() {
+        for u in node.upstream_ids() {
+            lock(&mut slots, u).consumers_left += 1;
+        }
+        let _ = id;
+    }
+    let ex = Exec {
+        dag,
+        env,
+        mode,
+        slots,
+        warnings: Mutex::new((Vec::new(), BTreeSet::new())),
+    };
+    let mut totals: BTreeMap<&'static str, usize> = BTreeMap::new();
+    for n in &dag.nodes {
+        *totals.entry(n.stage).or_default() += 1;
+    }
+    if mode == Mode::Run {
+        env.progress.begin(&totals);
+    }
+    for wave in dag.waves() {
+        ex.run_wave(&wave);
+    }
+    // Values the caller asked for (loaded from the cache if the node was cached).
+    let requested: Vec<NodeId> = (0..dag.nodes.len())
+        .filter(|&i| {
+            dag.nodes[i].requested && ex.slot(i).status.as_ref().is_some_and(|s| s.is_ok())
+        })
+        .collect();
+    let failures = ex.ensure_values(&requested);
+    for (id, msg) in failures {
+        ex.set_status(id, NodeStatus::Failed(msg));
+    }
+    if mode == Mode::Run {
+        env.progress.end();
+    }
+    let mut values = HashMap::new();
+    let mut reports = Vec::with_capacity(dag.nodes.len());
+    for (id, node) in dag.nodes.iter().enumerate() {
+        let mut s = ex.slot(id);
+        if node.requested {
+            if let Some(v) = s.value.take() {
+                values.insert(id, v);
+            }
+        }
+        reports.push(NodeReport {
+            id,
+            identity: node.identity(),
+            stage: node.stage,
+            stage_version: node.version,
+            variants: node.variants.clone(),
+            status: s.status.take().unwrap_or(NodeStatus::Failed(
+                "internal error: node was not processed".into(),
+            )),
+            key: s.key,
+            output_hash: s.hash,
+            seconds: s.seconds,
+            inputs: std::mem::take(&mut s.inputs),
+        });
+    }
+    let mut metrics = Vec::new();
+    for sink in &dag.sinks {
+        if let Some(v) = values.get(&sink.node) {
+            if let Some(json) = (sink.to_json)(v.as_ref()) {
+                metrics.push((sink.variant.clone(), sink.namespace.clone(), json));
+            }
+        }
+    }
+    let warnings = ex
+        .warnings
+        .into_inner()
+        .unwrap_or_else(|e| e.into_inner())
+        .0;
+    Outcome {
+        reports,
+        values,
+        warnings,
+        metrics,
+        seconds: start.elapsed().as_secs_f64(),
+    }
+}
+
+fn lock(slots: &mut [Mutex<Slot>], id: NodeId) -> &mut Slot {
+    slots[id].get_mut().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Whether the entry of `key` exists; if so mark it as used now (like `Store::load` does), so `cache gc`
+/// sees it as recently used and a live run protects it, without reading the artifact.
+fn touch_entry(store: &Store, key: &NodeKey) -> bool {
+    match std::fs::File::open(store.object_path(key)) {
+        Ok(f) => {
+            let _ = f.set_modified(SystemTime::now());
+            true
+        }
+        Err(_) => false,
+    }
+}
+
+fn now_unix_s() -> u64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map(|d| d.as_secs())
+        .unwrap_or(0)
+}
+
+fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
+    if let Some(s) = p.downcast_ref::<&str>() {
+        (*s).to_string()
+    } else if let Some(s) = p.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "(non-text panic payload)".to_string()
+    }
+}
+
+impl<'a> Exec<'a> {
+    fn slot(&self, id: NodeId) -> std::sync::MutexGuard<'_, Slot> {
+        self.slots[id].lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    fn warn(&self, message: String) {
+        let mut w = self.warnings.lock().unwrap_or_else(|e| e.into_inner());
+        if w.1.insert(message.clone()) {
+            self.env.progress.warn(&message);
+            w.0.push(message);
+        }
+    }
+
+    fn set_status(&self, id: NodeId, status: NodeStatus) {
+        self.slot(id).status = Some(status);
+    }
+
+    fn ctx(&self, node: &Node, key: NodeKey) -> NodeCtx {
+        NodeCtx {
+            stage: node.stage,
+            item: node.item.clone(),
+            key,
+            cache_root: self.env.store.root().to_path_buf(),
+        }
+    }
+
+    fn run_wave(&self, wave: &[NodeId]) {
+        // 1. check
+        let checks: Vec<Check> = wave.par_iter().map(|&id| self.check(id)).collect();
+        let mut to_run: Vec<(NodeId, NodeKey)> = Vec::new();
+        for (&id, check) in wave.iter().zip(checks) {
+            let node = &self.dag.nodes[id];
+            match check {
+                Check::Cached {
+                    key,
+                    hash,
+                    value,
+                    record_stale,
+                } => {
+                    if record_stale && self.mode == Mode::Run {
+                        let inputs = self.slot(id).inputs.clone();
+                        self.write_records(node, key, hash, 0.0, inputs);
+                    }
+                    let mut s = self.slot(id);
+                    s.key = Some(key);
+                    s.hash = Some(hash);
+                    s.value = value;
+                    s.status = Some(NodeStatus::Cached);
+                    drop(s);
+                    self.done(node, &NodeStatus::Cached);
+                }
+                Check::Run { key } => {
+                    self.slot(id).key = Some(key);
+                    to_run.push((id, key));
+                }
+                Check::WillRun(reasons) => self.set_status(id, NodeStatus::WillRun { reasons }),
+                Check::Failed(msg) => {
+                    let st = NodeStatus::Failed(msg);
+                    self.done(node, &st);
+                    self.set_status(id, st);
+                }
+                Check::Skipped(upstream) => {
+                    let st = NodeStatus::Skipped { upstream };
+                    self.done(node, &st);
+                    self.set_status(id, st);
+                }
+            }
+        }
+        // 2. load inputs of the nodes to run
+        if !to_run.is_empty() {
+            let mut needed: Vec<NodeId> = to_run
+                .iter()
+                .flat_map(|(id, _)| self.dag.nodes[*id].upstream_ids())
+                .collect();
+            needed.sort_unstable();
+            needed.dedup();
+            let failures: HashMap<NodeId, String> =
+                self.ensure_values(&needed).into_iter().collect();
+            // 3. run
+            let results: Vec<(NodeId, Result<f64, String>)> = to_run
+                .par_iter()
+                .map(|&(id, _)| {
+                    let node = &self.dag.nodes[id];
+                    let blocked = node
+                        .upstream_ids()
+                        .into_iter()
+                        .find_map(|u| failures.get(&u).map(|m| (u, m.clone())));
+                    let r = match blocked {
+                        Some((u, m)) => Err(format!(
+                            "upstream {} could not be loaded or recomputed: {m}",
+                            self.dag.nodes[u].identity()
+                        )),
+                        None => self.execute_node(id),
+                    };
+                    let st = match &r {
+                        Ok(_) => NodeStatus::Executed,
+                        Err(m) => NodeStatus::Failed(m.clone()),
+                    };
+                    self.done(node, &st);
+                    (id, r)
+                })
+                .collect();
+            for (id, r) in results {
+                let mut s = self.slot(id);
+                match r {
+                    Ok(secs) => {
+                        s.seconds = secs;
+                        s.status = Some(NodeStatus::Executed);
+                    }
+                    Err(m) => s.status = Some(NodeStatus::Failed(m)),
+                }
+            }
+        }
+        // 4. release values nobody needs any more
+        for &id in wave {
+            for u in self.dag.nodes[id].upstream_ids() {
+                let mut s = self.slot(u);
+                s.consumers_left = s.consumers_left.saturating_sub(1);
+                if s.consumers_left == 0 && !self.dag.nodes[u].requested {
+                    s.value = None;
+                }
+            }
+        }
+    }
+
+    fn done(&self, node: &Node, status: &NodeStatus) {
+        if self.mode == Mode::Run {
+            self.env.progress.node_done(node.stage, status);
+        }
+    }
+
+    /// Step 1 for one node.
+    fn check(&self, id: NodeId) -> Check {
+        let node = &self.dag.nodes[id];
+        let mut hashes = Vec::with_capacity(node.inputs.len());
+        let mut recorded = Vec::with_capacity(node.inputs.len());
+        let mut upstream_running = Vec::new();
+        for (label, r) in &node.inputs {
+            match r {
+                InputRef::Node(u) => {
+                    let s = self.slot(*u);
+                    let source = self.dag.nodes[*u].identity();
+                    match &s.status {
+                        Some(NodeStatus::Failed(_)) => return Check::Skipped(source),
+                        Some(NodeStatus::Skipped { upstream }) => return Check::Skipped(upstream.clone()),
+                        Some(NodeStatus::WillRun { .. }) => {
+                            if !upstream_running.contains(&source) {
+                                upstream_running.push(source.clone());
+                            }
+                            hashes.push(ContentHash([0; 32]));
+                            recorded.push(RecordedInput { label: label.clone(), source, hash: String::new() });
+                        }
+                        _ => match s.hash {
+                            Some(h) => {
+                                hashes.push(h);
+                                recorded.push(RecordedInput { label: label.clone(), source, hash: h.to_string() });
+                            }
+                            None => return Check::Failed(format!("internal error: upstream {source} has no output")),
+                        },
+                    }
+                }
+                InputRef::File(p) => match self.env.stat_cache.hash_file(p) {
+                    Ok(h) => {
+                        hashes.push(h);
+                        recorded.push(RecordedInput {
+                            label: label.clone(),
+                            source: format!("file {}", p.display()),
+                            hash: h.to_string(),
+                        });
+                    }
+                    Err(e) => {
+                        return Check::Failed(format!(
+                            "cannot read input file {}: {e} (check that the campaign folder is complete)",
+                            p.display()
+                        ))
+                    }
+                },
+            }
+        }
+        let variant = node
+            .variants
+            .first()
+            .map(String::as_str)
+            .unwrap_or("default");
+        let identity = node.identity();
+        if !upstream_running.is_empty() {
+            let prev = record::load_record(self.env.store, &identity, variant);
+            let mut why =
+                record::reasons(prev.as_ref(), node.version, &node.params_json, &recorded);
+            why.retain(|w| {
+                !w.starts_with("same ingredients") && !w.starts_with("upstream will run")
+            });
+            if prev.is_some() {
+                const SHOWN: usize = 5;
+                let mut list = upstream_running
+                    .iter()
+                    .take(SHOWN)
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                if upstream_running.len() > SHOWN {
+                    list.push_str(&format!(" and {} more", upstream_running.len() - SHOWN));
+                }
+                why.push(format!("upstream will run: {list}"));
+            }
+            self.slot(id).inputs = recorded;
+            return Check::WillRun(why);
+        }
+        let key = node_key(node, &hashes);
+        let key_hex = key.to_string();
+        let prev = record::load_record(self.env.store, &identity, variant);
+        let known_hash = match &prev {
+            Some(r) if r.key == key_hex => ContentHash::from_hex(&r.output_hash).ok(),
+            _ => record::load_output_hash(self.env.store, &key),
+        };
+        let record_stale = prev.as_ref().is_none_or(|r| r.key != key_hex);
+        self.slot(id).inputs = recorded;
+        if let Some(hash) = known_hash {
+            if touch_entry(self.env.store, &key) {
+                return Check::Cached {
+                    key,
+                    hash,
+                    value: None,
+                    record_stale,
+                };
+            }
+        }
+        match self.load_verified(id, key, None) {
+            Ok(Some((value, hash))) => Check::Cached {
+                key,
+                hash,
+                value: Some(value),
+                record_stale: true,
+            },
+            _ if self.mode == Mode::Plan => {
+                let inputs = self.slot(id).inputs.clone();
+                Check::WillRun(record::reasons(
+                    prev.as_ref(),
+                    node.version,
+                    &node.params_json,
+                    &inputs,
+                ))
+            }
+            _ => Check::Run { key },
+        }
+    }
+
+    /// Load and decode node `id`'s artifact under `key`. Ok(None) = miss; Err = corrupt/unusable (warned).
+    fn load_verified(
+        &self,
+        id: NodeId,
+        key: NodeKey,
+        expected: Option<ContentHash>,
+    ) -> Result<Option<(AnyValue, ContentHash)>, ()> {
+        let node = &self.dag.nodes[id];
+        match self.env.store.load(&key) {
+            Ok(Lookup::Hit(entry)) => {
+                if expected.is_some_and(|h| h != entry.content_hash) {
+                    self.warn(format!(
+                        "{}: cached artifact {key} differs from the recorded output; recomputing",
+                        node.identity()
+                    ));
+                    return Err(());
+                }
+                match node.erased.decode(&entry.payload) {
+                    Ok(v) => {
+                        if node.erased.cached_output_ok(&v, &self.ctx(node, key)) {
+                            Ok(Some((v, entry.content_hash)))
+                        } else {
+                            self.warn(format!(
+                                "{}: cached output refers to files that are gone; recomputing",
+                                node.identity()
+                            ));
+                            Err(())
+                        }
+                    }
+                    Err(e) => {
+                        self.warn(format!(
+                            "{}: cached artifact {key} cannot be decoded ({e}); recomputing",
+                            node.identity()
+                        ));
+                        Err(())
+                    }
+                }
+            }
+            Ok(Lookup::Miss) => Ok(None),
+            Ok(Lookup::Corrupt { message }) => {
+                self.warn(format!("{}: {message}; recomputing", node.identity()));
+                Err(())
+            }
+            Err(e) => {
+                self.warn(format!(
+                    "{}: cache read failed ({e}); recomputing",
+                    node.identity()
+                ));
+                Err(())
+            }
+        }
+    }
+
+    /// Make sure the values of `ids` (all processed successfully) are in memory: load them (parallel), and
+    /// recompute those whose artifact is gone or corrupt (after ensuring their own inputs). Returns the ids
+    /// that could not be provided, with the reason.
+    fn ensure_values(&self, ids: &[NodeId]) -> Vec<(NodeId, String)> {
+        let missing: Vec<NodeId> = ids
+            .iter()
+            .copied()
+            .filter(|&id| self.slot(id).value.is_none())
+            .collect();
+        if missing.is_empty() {
+            return Vec::new();
+        }
+        let loaded: Vec<(NodeId, Option<(AnyValue, ContentHash)>)> = missing
+            .par_iter()
+            .map(|&id| {
+                let (key, hash) = {
+                    let s = self.slot(id);
+                    (s.key, s.hash)
+                };
+                let r = match key {
+                    Some(k) => self.load_verified(id, k, hash).ok().flatten(),
+                    None => None,
+                };
+                (id, r)
+            })
+            .collect();
+        let mut recompute = Vec::new();
+        for (id, r) in loaded {
+            match r {
+                Some((v, _)) => self.slot(id).value = Some(v),
+                None => recompute.push(id),
+            }
+        }
+        if recompute.is_empty() {
+            return Vec::new();
+        }
+        let mut upstream: Vec<NodeId> = recompute
+            .iter()
+            .flat_map(|&id| self.dag.nodes[id].upstream_ids())
+            .collect();
+        upstream.sort_unstable();
+        upstream.dedup();
+        let upstream_failures: HashMap<NodeId, String> =
+            self.ensure_values(&upstream).into_iter().collect();
+        let results: Vec<(NodeId, Result<f64, String>)> = recompute
+            .par_iter()
+            .map(|&id| {
+                let node = &self.dag.nodes[id];
+                if let Some((u, m)) = node
+                    .upstream_ids()
+                    .into_iter()
+                    .find_map(|u| upstream_failures.get(&u).map(|m| (u, m)))
+                {
+                    return (
+                        id,
+                        Err(format!(
+                            "upstream {} unavailable: {m}",
+                            self.dag.nodes[u].identity()
+                        )),
+                    );
+                }
+                (id, self.execute_node(id))
+            })
+            .collect();
+        let mut failures = Vec::new();
+        for (id, r) in results {
+            match r {
+                Ok(secs) => {
+                    let mut s = self.slot(id);
+                    s.seconds += secs;
+                    if s.status == Some(NodeStatus::Cached) {
+                        s.status = Some(NodeStatus::Executed);
+                    }
+                }
+                Err(m) => failures.push((id, m)),
+            }
+        }
+        // Release recomputed upstream values nobody will read again.
+        for &u in &upstream {
+            let mut s = self.slot(u);
+            if s.consumers_left == 0 && !self.dag.nodes[u].requested {
+                s.value = None;
+            }
+        }
+        failures
+    }
+
+    /// Run node `id` (its input values are in memory), store and record its output. Returns seconds.
+    fn execute_node(&self, id: NodeId) -> Result<f64, String> {
+        let node = &self.dag.nodes[id];
+        let mut values = Vec::with_capacity(node.inputs.len());
+        let mut hashes = Vec::with_capacity(node.inputs.len());
+        for (_, r) in &node.inputs {
+            match r {
+                InputRef::Node(u) => {
+                    let s = self.slot(*u);
+                    match (&s.value, s.hash) {
+                        (Some(v), Some(h)) => {
+                            values.push(InputValue::Node(v.clone()));
+                            hashes.push(h);
+                        }
+                        _ => {
+                            return Err(format!(
+                                "internal error: input {} not loaded",
+                                self.dag.nodes[*u].identity()
+                            ))
+                        }
+                    }
+                }
+                InputRef::File(p) => {
+                    let h = self
+                        .env
+                        .stat_cache
+                        .hash_file(p)
+                        .map_err(|e| format!("cannot read input file {}: {e}", p.display()))?;
+                    values.push(InputValue::File(RawFileValue {
+                        path: p.clone(),
+                        hash: h,
+                    }));
+                    hashes.push(h);
+                }
+            }
+        }
+        let key = node_key(node, &hashes);
+        let ctx = self.ctx(node, key);
+        let start = Instant::now();
+        let result = catch_unwind(AssertUnwindSafe(|| {
+            let value = node.erased.run(&values, &ctx)?;
+            let mut payload = Vec::new();
+            node.erased.encode(&value, &mut payload)?;
+            Ok::<_, crate::dag::StageError>((value, payload))
+        }));
+        drop(values);
+        let seconds = start.elapsed().as_secs_f64();
+        let tmp = tmp_dir_for(self.env.store.root(), &key);
+        let (value, payload) = match result {
+            Ok(Ok(v)) => v,
+            Ok(Err(e)) => {
+                let _ = std::fs::remove_dir_all(&tmp);
+                return Err(e.message);
+            }
+            Err(p) => {
+                let _ = std::fs::remove_dir_all(&tmp);
+                return Err(format!("panicked: {}", panic_message(p.as_ref())));
+            }
+        };
+        if tmp.exists() {
+            let fin = dirs_root(self.env.store.root()).join(key.to_string());
+            if fin.exists() || std::fs::rename(&tmp, &fin).is_err() {
+                let _ = std::fs::remove_dir_all(&tmp);
+            }
+            if !fin.exists() {
+                return Err(format!(
+                    "could not move the output folder into place at {}",
+                    fin.display()
+                ));
+            }
+        }
+        let meta = EntryMeta {
+            stage: node.stage.to_string(),
+            stage_version: node.version.to_string(),
+            item: node.identity(),
+        };
+        let hash = self
+            .env
+            .store
+            .save(&key, &meta, &payload)
+            .map_err(|e| format!("could not store the result: {e}"))?;
+        drop(payload);
+        let inputs = self.slot(id).inputs.clone();
+        self.write_records(node, key, hash, seconds, inputs);
+        let mut s = self.slot(id);
+        s.key = Some(key);
+        s.hash = Some(hash);
+        s.value = Some(value);
+        Ok(seconds)
+    }
+
+    fn write_records(
+        &self,
+        node: &Node,
+        key: NodeKey,
+        hash: ContentHash,
+        seconds: f64,
+        inputs: Vec<RecordedInput>,
+    ) {
+        let store = self.env.store;
+        if let Err(e) = record::save_output_hash(store, &key, &hash) {
+            self.warn(format!("could not write a cache record: {e}"));
+            return;
+        }
+        let identity = node.identity();
+        for variant in &node.variants {
+            let rec = NodeRecord {
+                identity: identity.clone(),
+                variant: variant.clone(),
+                key: key.to_string(),
+                stage_version: node.version.to_string(),
+                params: node.params_json.clone(),
+                inputs: inputs.clone(),
+                output_hash: hash.to_string(),
+                seconds,
+                recorded_unix_s: now_unix_s(),
+                skytie_version: env!("CARGO_PKG_VERSION").to_string(),
+            };
+            if let Err(e) = record::save_record(store, &rec) {
+                self.warn(format!("could not write a cache record: {e}"));
+            }
+        }
+    }
+}

@@ -1,0 +1,179 @@
+//! Typed node inputs: `Handle<T>` (the output of another node), `RawFile` (a file hashed by content), and
+//! collections/tuples of those. Wiring a handle of the wrong type into a stage is a compile error.
+
+use crate::dag::stage::StageError;
+use crate::hashing::ContentHash;
+use std::any::Any;
+use std::marker::PhantomData;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// Index of a node in its DAG.
+pub type NodeId = usize;
+
+/// A typed reference to the output of a node added to a [`crate::dag::DagBuilder`].
+pub struct Handle<T> {
+    pub(crate) id: NodeId,
+    _type: PhantomData<fn() -> T>,
+}
+
+impl<T> Handle<T> {
+    pub(crate) fn new(id: NodeId) -> Self {
+        Handle {
+            id,
+            _type: PhantomData,
+        }
+    }
+    /// The node's index in its DAG.
+    pub fn id(&self) -> NodeId {
+        self.id
+    }
+}
+
+impl<T> Clone for Handle<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T> Copy for Handle<T> {}
+impl<T> std::fmt::Debug for Handle<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Handle({})", self.id)
+    }
+}
+
+/// An input file outside the cache, keyed by its content (hashed through the stat cache).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RawFile(pub PathBuf);
+
+impl RawFile {
+    pub fn new(path: impl Into<PathBuf>) -> Self {
+        RawFile(path.into())
+    }
+}
+
+/// What a stage receives for a `RawFile` input: the path and its content hash.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RawFileValue {
+    pub path: PathBuf,
+    pub hash: ContentHash,
+}
+
+/// One input edge, as the builder records it.
+#[derive(Clone, Debug)]
+pub enum InputRef {
+    Node(NodeId),
+    File(PathBuf),
+}
+
+/// One input value, as the executor hands it over.
+#[derive(Clone)]
+pub enum InputValue {
+    Node(Arc<dyn Any + Send + Sync>),
+    File(RawFileValue),
+}
+
+/// A set of typed inputs. Implemented for `()`, `Handle<T>`, `RawFile`, `Vec<I>` and tuples (up to 6).
+pub trait InputSet: Send + Sync + 'static {
+    /// What the stage's `run` receives.
+    type Values;
+    /// Append this set's edges with their labels (labels name the position: `0`, `1.2`, …).
+    fn collect_refs(&self, label: &str, out: &mut Vec<(String, InputRef)>);
+    /// Rebuild the typed values from the executor's values, in `collect_refs` order.
+    fn take_values(
+        &self,
+        values: &mut std::slice::Iter<'_, InputValue>,
+    ) -> Result<Self::Values, StageError>;
+}
+
+fn missing() -> StageError {
+    StageError::new("internal error: input values do not match the node's inputs (please report)")
+}
+
+fn join_label(prefix: &str, part: &str) -> String {
+    if prefix.is_empty() {
+        part.to_string()
+    } else {
+        format!("{prefix}.{part}")
+    }
+}
+
+impl InputSet for () {
+    type Values = ();
+    fn collect_refs(&self, _label: &str, _out: &mut Vec<(String, InputRef)>) {}
+    fn take_values(
+        &self,
+        _values: &mut std::slice::Iter<'_, InputValue>,
+    ) -> Result<(), StageError> {
+        Ok(())
+    }
+}
+
+impl<T: Send + Sync + 'static> InputSet for Handle<T> {
+    type Values = Arc<T>;
+    fn collect_refs(&self, label: &str, out: &mut Vec<(String, InputRef)>) {
+        out.push((label.to_string(), InputRef::Node(self.id)));
+    }
+    fn take_values(
+        &self,
+        values: &mut std::slice::Iter<'_, InputValue>,
+    ) -> Result<Arc<T>, StageError> {
+        match values.next() {
+            Some(InputValue::Node(v)) => v.clone().downcast::<T>().map_err(|_| missing()),
+            _ => Err(missing()),
+        }
+    }
+}
+
+impl InputSet for RawFile {
+    type Values = RawFileValue;
+    fn collect_refs(&self, label: &str, out: &mut Vec<(String, InputRef)>) {
+        out.push((label.to_string(), InputRef::File(self.0.clone())));
+    }
+    fn take_values(
+        &self,
+        values: &mut std::slice::Iter<'_, InputValue>,
+    ) -> Result<RawFileValue, StageError> {
+        match values.next() {
+            Some(InputValue::File(v)) => Ok(v.clone()),
+            _ => Err(missing()),
+        }
+    }
+}
+
+/// A collection input: each element is labelled by its index, so adding an element changes the key of the
+/// consuming node.
+impl<I: InputSet> InputSet for Vec<I> {
+    type Values = Vec<I::Values>;
+    fn collect_refs(&self, label: &str, out: &mut Vec<(String, InputRef)>) {
+        for (i, item) in self.iter().enumerate() {
+            item.collect_refs(&join_label(label, &format!("[{i}]")), out);
+        }
+    }
+    fn take_values(
+        &self,
+        values: &mut std::slice::Iter<'_, InputValue>,
+    ) -> Result<Self::Values, StageError> {
+        self.iter().map(|item| item.take_values(values)).collect()
+    }
+}
+
+macro_rules! tuple_inputs {
+    ($($name:ident $idx:tt),+) => {
+        impl<$($name: InputSet),+> InputSet for ($($name,)+) {
+            type Values = ($($name::Values,)+);
+            fn collect_refs(&self, label: &str, out: &mut Vec<(String, InputRef)>) {
+                $( self.$idx.collect_refs(&join_label(label, stringify!($idx)), out); )+
+            }
+            fn take_values(&self, values: &mut std::slice::Iter<'_, InputValue>) -> Result<Self::Values, StageError> {
+                Ok(($(self.$idx.take_values(values)?,)+))
+            }
+        }
+    };
+}
+tuple_inputs!(A 0);
+tuple_inputs!(A 0, B 1);
+tuple_inputs!(A 0, B 1, C 2);
+tuple_inputs!(A 0, B 1, C 2, D 3);
+tuple_inputs!(A 0, B 1, C 2, D 3, E 4);
+tuple_inputs!(A 0, B 1, C 2, D 3, E 4, F 5);

@@ -1,0 +1,101 @@
+//! A node of the DAG with its stage type erased, so nodes of many stage types live in one graph.
+
+use crate::codec::{Artifact, CodecError};
+use crate::dag::inputs::{InputRef, InputSet, InputValue};
+use crate::dag::stage::{NodeCtx, Stage, StageError};
+use std::any::Any;
+use std::sync::Arc;
+
+/// A node's output value, type-erased.
+pub type AnyValue = Arc<dyn Any + Send + Sync>;
+
+/// The operations the executor needs on a node, independent of its stage type.
+pub(crate) trait ErasedStage: Send + Sync {
+    fn run(&self, inputs: &[InputValue], ctx: &NodeCtx) -> Result<AnyValue, StageError>;
+    fn encode(&self, value: &AnyValue, out: &mut Vec<u8>) -> Result<(), StageError>;
+    fn decode(&self, bytes: &[u8]) -> Result<AnyValue, CodecError>;
+    fn cached_output_ok(&self, value: &AnyValue, ctx: &NodeCtx) -> bool;
+}
+
+/// A stage together with its params and input handles.
+pub(crate) struct TypedNode<S: Stage> {
+    pub stage: S,
+    pub params: S::Params,
+    pub inputs: S::Inputs,
+}
+
+fn wrong_type<S: Stage>() -> StageError {
+    StageError::new(format!(
+        "internal error: value of the wrong type for stage {} (please report)",
+        S::NAME
+    ))
+}
+
+impl<S: Stage> ErasedStage for TypedNode<S> {
+    fn run(&self, inputs: &[InputValue], ctx: &NodeCtx) -> Result<AnyValue, StageError> {
+        let mut it = inputs.iter();
+        let values = self.inputs.take_values(&mut it)?;
+        let out = self.stage.run(&self.params, values, ctx)?;
+        Ok(Arc::new(out))
+    }
+    fn encode(&self, value: &AnyValue, out: &mut Vec<u8>) -> Result<(), StageError> {
+        let v = value
+            .downcast_ref::<S::Output>()
+            .ok_or_else(wrong_type::<S>)?;
+        v.encode(out);
+        Ok(())
+    }
+    fn decode(&self, bytes: &[u8]) -> Result<AnyValue, CodecError> {
+        Ok(Arc::new(S::Output::decode(bytes)?))
+    }
+    fn cached_output_ok(&self, value: &AnyValue, ctx: &NodeCtx) -> bool {
+        match value.downcast_ref::<S::Output>() {
+            Some(v) => self.stage.cached_output_ok(v, ctx),
+            None => false,
+        }
+    }
+}
+
+/// Everything the engine knows about one node.
+pub struct Node {
+    pub stage: &'static str,
+    pub version: &'static str,
+    /// Item label (`rec 0012`, `pair 3-4`), empty for global nodes.
+    pub item: String,
+    /// Variants of a sweep that use this node (a node shared by variants lists all of them).
+    pub variants: Vec<String>,
+    /// Canonical params bytes (part of the key).
+    pub params_bytes: Vec<u8>,
+    /// The same params as JSON, to tell which field changed.
+    pub params_json: serde_json::Value,
+    /// Labelled input edges, in the order the stage receives them.
+    pub inputs: Vec<(String, InputRef)>,
+    pub(crate) erased: Box<dyn ErasedStage>,
+    /// The caller wants this node's value after the run.
+    pub requested: bool,
+}
+
+impl Node {
+    /// Human identity, independent of variant and key: `stage[item]` or `stage` for global nodes.
+    pub fn identity(&self) -> String {
+        if self.item.is_empty() {
+            self.stage.to_string()
+        } else {
+            format!("{}[{}]", self.stage, self.item)
+        }
+    }
+    /// Ids of the nodes this node reads (each once, ascending).
+    pub fn upstream_ids(&self) -> Vec<usize> {
+        let mut ids: Vec<usize> = self
+            .inputs
+            .iter()
+            .filter_map(|(_, r)| match r {
+                InputRef::Node(id) => Some(*id),
+                InputRef::File(_) => None,
+            })
+            .collect();
+        ids.sort_unstable();
+        ids.dedup();
+        ids
+    }
+}

@@ -1,0 +1,217 @@
+//! Per-node run records kept in the store: for each node identity (`stage[item]`) and variant, the key and
+//! ingredients of its last successful run. `plan` compares a node's current ingredients with its record to
+//! say WHY it will run (new node, stage version bump, which param field changed, which input changed);
+//! `explain` prints the record as the node's provenance. A second record maps an output key to its content
+//! hash so an all-cached run need not read artifacts it does not use.
+
+use crate::hashing::{ContentHash, NodeKey};
+use crate::store::Store;
+use serde::{Deserialize, Serialize};
+
+/// Record namespace: node identity@variant → [`NodeRecord`] (JSON).
+pub const NODES_NS: &str = "nodes";
+/// Record namespace: key hex → output content hash (32 raw bytes).
+pub const OUTPUT_NS: &str = "outputs";
+
+/// One input as recorded: its label, where it came from (upstream identity or file path) and its hash.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RecordedInput {
+    pub label: String,
+    pub source: String,
+    pub hash: String,
+}
+
+/// The ingredients and provenance of a node's last successful run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NodeRecord {
+    pub identity: String,
+    pub variant: String,
+    pub key: String,
+    pub stage_version: String,
+    pub params: serde_json::Value,
+    pub inputs: Vec<RecordedInput>,
+    pub output_hash: String,
+    /// Seconds the stage ran when it was computed (0 if it was found in the cache by this run).
+    pub seconds: f64,
+    /// When the record was written, seconds since the Unix epoch.
+    pub recorded_unix_s: u64,
+    pub skytie_version: String,
+}
+
+/// Record name of a node identity in a variant.
+pub fn record_name(identity: &str, variant: &str) -> String {
+    format!("{identity}@{variant}")
+}
+
+pub fn load_record(store: &Store, identity: &str, variant: &str) -> Option<NodeRecord> {
+    let bytes = store.get_record(NODES_NS, &record_name(identity, variant))?;
+    serde_json::from_slice(&bytes).ok()
+}
+
+pub fn save_record(store: &Store, record: &NodeRecord) -> Result<(), String> {
+    let bytes = serde_json::to_vec(record).map_err(|e| e.to_string())?;
+    store
+        .put_record(
+            NODES_NS,
+            &record_name(&record.identity, &record.variant),
+            &bytes,
+        )
+        .map_err(|e| e.to_string())
+}
+
+pub fn load_output_hash(store: &Store, key: &NodeKey) -> Option<ContentHash> {
+    let bytes = store.get_record(OUTPUT_NS, &key.to_string())?;
+    let arr: [u8; 32] = bytes.as_slice().try_into().ok()?;
+    Some(ContentHash(arr))
+}
+
+pub fn save_output_hash(store: &Store, key: &NodeKey, hash: &ContentHash) -> Result<(), String> {
+    store
+        .put_record(OUTPUT_NS, &key.to_string(), &hash.0)
+        .map_err(|e| e.to_string())
+}
+
+/// Why a node whose key is not in the cache will run, compared with its last record. `upstream_changed`
+/// lists the identities of upstream nodes that will run or whose output changed.
+pub fn reasons(
+    previous: Option<&NodeRecord>,
+    stage_version: &str,
+    params: &serde_json::Value,
+    inputs: &[RecordedInput],
+) -> Vec<String> {
+    let Some(prev) = previous else {
+        return vec![
+            "new node (no earlier run of this item: new input item or first run)".to_string(),
+        ];
+    };
+    let mut why = Vec::new();
+    if prev.stage_version != stage_version {
+        why.push(format!(
+            "stage version changed: {} -> {}",
+            prev.stage_version, stage_version
+        ));
+    }
+    let mut changes = Vec::new();
+    diff_json("", &prev.params, params, &mut changes);
+    for c in changes {
+        why.push(format!("param changed: {c}"));
+    }
+    for input in inputs {
+        match prev.inputs.iter().find(|p| p.label == input.label) {
+            None => why.push(format!("new input {} ({})", input.label, input.source)),
+            Some(p) if p.hash != input.hash => {
+                if input.hash.is_empty() {
+                    why.push(format!("upstream will run: {}", input.source));
+                } else if input.source.starts_with("file ") {
+                    why.push(format!("input changed: {}", input.source));
+                } else {
+                    why.push(format!("upstream changed: {}", input.source));
+                }
+            }
+            Some(_) => {}
+        }
+    }
+    for p in &prev.inputs {
+        if !inputs.iter().any(|i| i.label == p.label) {
+            why.push(format!("input removed: {} ({})", p.label, p.source));
+        }
+    }
+    if why.is_empty() {
+        why.push(
+            "same ingredients as its last run, but the artifact is no longer in the cache"
+                .to_string(),
+        );
+    }
+    why
+}
+
+/// Dotted paths of the fields that differ between two JSON values, as `path: old -> new`.
+pub fn diff_json(
+    path: &str,
+    old: &serde_json::Value,
+    new: &serde_json::Value,
+    out: &mut Vec<String>,
+) {
+    use serde_json::Value;
+    match (old, new) {
+        (Value::Object(a), Value::Object(b)) => {
+            let mut keys: Vec<&String> = a.keys().chain(b.keys()).collect();
+            keys.sort();
+            keys.dedup();
+            for k in keys {
+                let p = if path.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{path}.{k}")
+                };
+                match (a.get(k), b.get(k)) {
+                    (Some(x), Some(y)) => diff_json(&p, x, y, out),
+                    (None, Some(y)) => out.push(format!("{p}: (absent) -> {y}")),
+                    (Some(x), None) => out.push(format!("{p}: {x} -> (absent)")),
+                    (None, None) => {}
+                }
+            }
+        }
+        _ if old != new => {
+            let p = if path.is_empty() { "(params)" } else { path };
+            out.push(format!("{p}: {old} -> {new}"));
+        }
+        _ => {}
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn diff_names_nested_changed_fields() {
+        let mut out = Vec::new();
+        diff_json(
+            "",
+            &json!({"a": 1, "b": {"c": 2, "d": 3}}),
+            &json!({"a": 1, "b": {"c": 5, "d": 3}, "e": true}),
+            &mut out,
+        );
+        assert_eq!(
+            out,
+            vec!["b.c: 2 -> 5".to_string(), "e: (absent) -> true".to_string()]
+        );
+    }
+
+    #[test]
+    fn reasons_name_version_param_and_input() {
+        let prev = NodeRecord {
+            identity: "s[i]".into(),
+            variant: "default".into(),
+            key: "k".into(),
+            stage_version: "1".into(),
+            params: json!({"gain": 2}),
+            inputs: vec![RecordedInput {
+                label: "0".into(),
+                source: "file a.txt".into(),
+                hash: "h1".into(),
+            }],
+            output_hash: "o".into(),
+            seconds: 0.0,
+            recorded_unix_s: 0,
+            skytie_version: "0".into(),
+        };
+        let inputs = vec![RecordedInput {
+            label: "0".into(),
+            source: "file a.txt".into(),
+            hash: "h2".into(),
+        }];
+        let why = reasons(Some(&prev), "2", &json!({"gain": 3}), &inputs);
+        assert_eq!(
+            why,
+            vec![
+                "stage version changed: 1 -> 2".to_string(),
+                "param changed: gain: 2 -> 3".to_string(),
+                "input changed: file a.txt".to_string()
+            ]
+        );
+        assert!(reasons(None, "1", &json!({}), &[])[0].starts_with("new node"));
+    }
+}

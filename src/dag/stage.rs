@@ -1,0 +1,128 @@
+//! The `Stage` trait: one typed, cacheable computation of the dataflow DAG, and the context a node runs in.
+//!
+//! A stage is a plain Rust type. Its cache identity is `NAME` + `VERSION` + the canonical encoding of its
+//! `Params` + the content hashes of its inputs (see `dag::key`). Bump `VERSION` whenever the code changes
+//! what the stage computes: that re-runs exactly this stage's nodes (and dependents whose inputs change).
+
+use crate::codec::Artifact;
+use crate::dag::inputs::InputSet;
+use crate::hashing::NodeKey;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// A typed DAG computation. See the module documentation.
+pub trait Stage: Send + Sync + 'static {
+    /// Stable stage name (used in keys, workflows, metrics: keep it snake_case).
+    const NAME: &'static str;
+    /// Version of the stage's semantics; part of every key of this stage.
+    const VERSION: &'static str;
+    /// Parameters, deserialised from the workflow and canonically encoded into the key.
+    type Params: Serialize + DeserializeOwned + Clone + Send + Sync + 'static;
+    /// The artifact this stage produces (stored in the cache).
+    type Output: Artifact;
+    /// The typed inputs: a `Handle<T>`, `RawFile`, `Vec<…>` of those, tuples of those, or `()`.
+    type Inputs: InputSet;
+
+    /// Compute the output. Errors (and panics, which the executor catches) mark the node failed; a failed
+    /// node is never stored, its dependents are skipped.
+    fn run(
+        &self,
+        params: &Self::Params,
+        inputs: <Self::Inputs as InputSet>::Values,
+        ctx: &NodeCtx,
+    ) -> Result<Self::Output, StageError>;
+
+    /// Called on a cache hit of an output that is needed: return false if the output refers to something
+    /// outside the store that is gone (e.g. a generated folder was deleted), and the node is recomputed.
+    fn cached_output_ok(&self, _output: &Self::Output, _ctx: &NodeCtx) -> bool {
+        true
+    }
+}
+
+/// Why a stage failed; the message should say what is wrong and what to do.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StageError {
+    pub message: String,
+}
+
+impl StageError {
+    pub fn new(message: impl Into<String>) -> Self {
+        StageError {
+            message: message.into(),
+        }
+    }
+}
+
+impl fmt::Display for StageError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for StageError {}
+
+impl From<std::io::Error> for StageError {
+    fn from(e: std::io::Error) -> Self {
+        StageError::new(e.to_string())
+    }
+}
+
+/// What a running node may know about itself.
+pub struct NodeCtx {
+    pub(crate) stage: &'static str,
+    pub(crate) item: String,
+    pub(crate) key: NodeKey,
+    pub(crate) cache_root: PathBuf,
+}
+
+impl NodeCtx {
+    /// Stage name.
+    pub fn stage(&self) -> &'static str {
+        self.stage
+    }
+    /// The node's item label (e.g. `rec 0012`), empty for global nodes.
+    pub fn item(&self) -> &str {
+        &self.item
+    }
+    /// The node's cache key.
+    pub fn key(&self) -> NodeKey {
+        self.key
+    }
+    /// A deterministic per-node seed derived from a base seed and the item label (never from thread
+    /// order), for stages that draw random numbers.
+    pub fn item_seed(&self, base_seed: u64) -> u64 {
+        let mut h = blake3::Hasher::new();
+        h.update(b"skytie item seed\0");
+        h.update(&base_seed.to_le_bytes());
+        h.update(self.stage.as_bytes());
+        h.update(&[0]);
+        h.update(self.item.as_bytes());
+        let b = h.finalize();
+        u64::from_le_bytes(b.as_bytes()[..8].try_into().expect("8 bytes"))
+    }
+    /// The folder a node producing files owns: `<cache root>/dirs/<key hex>/`. The stage writes into
+    /// [`NodeCtx::output_dir_tmp`]; the executor renames it here only after the stage succeeded, so a folder
+    /// at this path is always complete. Record this path (not the temporary one) in the output artifact.
+    pub fn output_dir(&self) -> PathBuf {
+        dirs_root(&self.cache_root).join(self.key.to_string())
+    }
+    /// A fresh, empty temporary folder (created on first call) the stage writes its files into.
+    pub fn output_dir_tmp(&self) -> std::io::Result<PathBuf> {
+        let p = tmp_dir_for(&self.cache_root, &self.key);
+        if p.exists() {
+            std::fs::remove_dir_all(&p)?;
+        }
+        std::fs::create_dir_all(&p)?;
+        Ok(p)
+    }
+}
+
+pub(crate) fn dirs_root(cache_root: &Path) -> PathBuf {
+    cache_root.join("dirs")
+}
+
+pub(crate) fn tmp_dir_for(cache_root: &Path, key: &NodeKey) -> PathBuf {
+    dirs_root(cache_root).join(format!(".tmp-{}-{}", key, std::process::id()))
+}

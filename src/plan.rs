@@ -1,0 +1,101 @@
+//! `skytie plan`: for each phase and stage, how many nodes are cached and how many will run, and WHY each
+//! node will run (new item, stage version bump, the param field that changed, the input that changed).
+
+use crate::dag::{NodeStatus, PipelineError, Session};
+use std::collections::BTreeMap;
+use std::fmt::Write;
+
+/// At most this many nodes are listed per stage (the rest are counted).
+pub const MAX_LISTED_PER_STAGE: usize = 50;
+
+/// Counts of a plan.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct PlanCounts {
+    pub cached: usize,
+    pub will_run: usize,
+    pub failed: usize,
+}
+
+/// Count the planned statuses of a session run in plan mode.
+pub fn plan_counts(session: &Session<'_>) -> PlanCounts {
+    let mut c = PlanCounts::default();
+    for r in session.reports() {
+        match r.status {
+            NodeStatus::Cached | NodeStatus::Executed => c.cached += 1,
+            NodeStatus::WillRun { .. } => c.will_run += 1,
+            NodeStatus::Failed(_) | NodeStatus::Skipped { .. } => c.failed += 1,
+        }
+    }
+    c
+}
+
+/// The human-readable plan. `stopped` is the reason planning could not continue past the last phase.
+pub fn plan_text(session: &Session<'_>, stopped: Option<&PipelineError>) -> String {
+    let mut out = String::new();
+    for phase in &session.phases {
+        let _ = writeln!(out, "phase '{}': {} nodes", phase.name, phase.reports.len());
+        let mut by_stage: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
+        for (i, r) in phase.reports.iter().enumerate() {
+            by_stage.entry(r.stage).or_default().push(i);
+        }
+        for (stage, ids) in by_stage {
+            let reports: Vec<_> = ids.iter().map(|&i| &phase.reports[i]).collect();
+            let cached = reports.iter().filter(|r| r.status.is_ok()).count();
+            let will_run: Vec<_> = reports
+                .iter()
+                .filter(|r| matches!(r.status, NodeStatus::WillRun { .. }))
+                .collect();
+            let bad: Vec<_> = reports
+                .iter()
+                .filter(|r| matches!(r.status, NodeStatus::Failed(_) | NodeStatus::Skipped { .. }))
+                .collect();
+            let _ = writeln!(
+                out,
+                "  {stage:<20} {cached:>6} cached  {:>6} will run{}",
+                will_run.len(),
+                if bad.is_empty() {
+                    String::new()
+                } else {
+                    format!("  {:>6} cannot run", bad.len())
+                }
+            );
+            for r in will_run.iter().take(MAX_LISTED_PER_STAGE) {
+                if let NodeStatus::WillRun { reasons } = &r.status {
+                    let _ = writeln!(out, "    {}: {}", r.identity, reasons.join("; "));
+                }
+            }
+            if will_run.len() > MAX_LISTED_PER_STAGE {
+                let _ = writeln!(
+                    out,
+                    "    … and {} more",
+                    will_run.len() - MAX_LISTED_PER_STAGE
+                );
+            }
+            for r in bad.iter().take(MAX_LISTED_PER_STAGE) {
+                match &r.status {
+                    NodeStatus::Failed(m) => {
+                        let _ = writeln!(out, "    {}: cannot run: {m}", r.identity);
+                    }
+                    NodeStatus::Skipped { upstream } => {
+                        let _ = writeln!(
+                            out,
+                            "    {}: cannot run: upstream {upstream} cannot run",
+                            r.identity
+                        );
+                    }
+                    _ => {}
+                }
+            }
+        }
+    }
+    let c = plan_counts(session);
+    let _ = writeln!(
+        out,
+        "total: {} cached, {} will run, {} cannot run",
+        c.cached, c.will_run, c.failed
+    );
+    if let Some(e) = stopped {
+        let _ = writeln!(out, "note: {e}");
+    }
+    out
+}

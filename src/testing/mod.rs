@@ -1,0 +1,6 @@
+//! Toy stages and the `toy` pipeline, used by the engine's tests, the benchmark and the CLI tests (a
+//! workflow with `pipeline = "toy"`). They exercise every engine feature (raw-file inputs, per-item and
+//! global nodes, collections, generated folders, failures, panics, sleeps) without photogrammetry.
+
+pub mod toy;
+pub mod toy_pipeline;

@@ -1,0 +1,316 @@
+//! Engine caching behaviour with toy stages: no-op reruns, param changes, early cutoff, version bumps, new
+//! items, sweeps sharing a prefix, corrupt artifacts, failures and panics, thread-count independence.
+
+mod support;
+
+use skytie::dag::{DagBuilder, Mode, NodeStatus};
+use skytie::testing::toy::{Faults, ToyScaleParams, ToySumParams, ToySummary};
+use support::*;
+
+const VALUES: [f64; 4] = [1.0, 2.0, 3.0, 4.0];
+
+fn setup() -> (
+    tempfile::TempDir,
+    std::path::PathBuf,
+    Vec<std::path::PathBuf>,
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let items = make_items(dir.path(), &VALUES);
+    let cache = dir.path().join("cache");
+    (dir, cache, items)
+}
+
+#[test]
+fn first_run_executes_all_and_second_identical_run_executes_nothing() {
+    let (_d, cache, items) = setup();
+    let cfg = ToyConfig::default();
+    let (dag, h) = toy_dag(&items, &cfg);
+    let o1 = run(&cache, &dag, Mode::Run);
+    assert_eq!(executed(&o1), (4, 4, 1));
+    assert_eq!(o1.cached(), 0);
+    assert_eq!(
+        *o1.get(h).unwrap(),
+        ToySummary {
+            sum: 20.0,
+            count: 4
+        }
+    );
+    let (dag, h) = toy_dag(&items, &cfg);
+    let o2 = run(&cache, &dag, Mode::Run);
+    assert_eq!(o2.executed(), 0);
+    assert_eq!(o2.cached(), 9);
+    assert!(o2.warnings.is_empty(), "{:?}", o2.warnings);
+    // The requested output is loaded from the cache.
+    assert_eq!(
+        *o2.get(h).unwrap(),
+        ToySummary {
+            sum: 20.0,
+            count: 4
+        }
+    );
+}
+
+#[test]
+fn changing_one_param_reruns_that_stage_and_its_dependents_only() {
+    let (_d, cache, items) = setup();
+    let mut cfg = ToyConfig::default();
+    run(&cache, &toy_dag(&items, &cfg).0, Mode::Run);
+    cfg.scale.factor = 3.0;
+    let (dag, h) = toy_dag(&items, &cfg);
+    let o = run(&cache, &dag, Mode::Run);
+    assert_eq!(executed(&o), (0, 4, 1));
+    assert_eq!(o.cached(), 4);
+    assert_eq!(o.get(h).unwrap().sum, 30.0);
+    // Only the sum's param: only the sum.
+    cfg.sum.offset = 1.5;
+    let (dag, h) = toy_dag(&items, &cfg);
+    let o = run(&cache, &dag, Mode::Run);
+    assert_eq!(executed(&o), (0, 0, 1));
+    assert_eq!(o.get(h).unwrap().sum, 31.5);
+}
+
+#[test]
+fn early_cutoff_keeps_dependents_cached_when_output_is_identical() {
+    let (_d, cache, items) = setup();
+    let mut cfg = ToyConfig::default();
+    cfg.scale = ToyScaleParams {
+        factor: 2.0,
+        quantum: 1.0,
+        faults: Faults::default(),
+    };
+    run(&cache, &toy_dag(&items, &cfg).0, Mode::Run);
+    // 2.001 * v rounds to the same integers: toy_scale re-runs, its outputs are identical, toy_sum is cached.
+    cfg.scale.factor = 2.001;
+    let (dag, h) = toy_dag(&items, &cfg);
+    let o = run(&cache, &dag, Mode::Run);
+    assert_eq!(executed(&o), (0, 4, 0));
+    assert_eq!(o.cached(), 5);
+    assert_eq!(o.get(h).unwrap().sum, 20.0);
+}
+
+#[test]
+fn stage_version_bump_reruns_that_stage() {
+    let (_d, cache, items) = setup();
+    let mut cfg = ToyConfig::default();
+    run(&cache, &toy_dag(&items, &cfg).0, Mode::Run);
+    cfg.scale_v2 = true;
+    let (dag, h) = toy_dag(&items, &cfg);
+    let o = run(&cache, &dag, Mode::Run);
+    // The twin computes the same values, so the sum is cut off early.
+    assert_eq!(executed(&o), (0, 4, 0));
+    assert_eq!(o.get(h).unwrap().sum, 20.0);
+    let plan = run(
+        &cache,
+        &toy_dag(&items, &ToyConfig::default()).0,
+        Mode::Plan,
+    );
+    assert_eq!(plan.will_run(), 0, "version 1 results are still cached");
+}
+
+#[test]
+fn adding_one_item_reruns_only_the_nodes_that_involve_it() {
+    let (d, cache, items) = setup();
+    let cfg = ToyConfig::default();
+    run(&cache, &toy_dag(&items, &cfg).0, Mode::Run);
+    let items5 = make_items(d.path(), &[1.0, 2.0, 3.0, 4.0, 10.0]);
+    let (dag, h) = toy_dag(&items5, &cfg);
+    let o = run(&cache, &dag, Mode::Run);
+    assert_eq!(executed(&o), (1, 1, 1));
+    assert_eq!(o.cached(), 8);
+    assert_eq!(
+        *o.get(h).unwrap(),
+        ToySummary {
+            sum: 40.0,
+            count: 5
+        }
+    );
+    let new: Vec<_> = o
+        .reports
+        .iter()
+        .filter(|r| r.status == NodeStatus::Executed)
+        .map(|r| r.identity.clone())
+        .collect();
+    assert_eq!(
+        new,
+        vec!["toy_parse[item_004]", "toy_scale[item_004]", "toy_sum"]
+    );
+}
+
+#[test]
+fn sweep_variants_sharing_a_prefix_execute_shared_nodes_once() {
+    let (_d, cache, items) = setup();
+    let mut b = DagBuilder::new();
+    let mut handles = Vec::new();
+    for (name, offset) in [("a", 0.0), ("b", 100.0), ("c", 200.0)] {
+        b.set_variant(name);
+        let cfg = ToyConfig {
+            sum: ToySumParams {
+                offset,
+                faults: Faults::default(),
+            },
+            ..Default::default()
+        };
+        handles.push(add_toy(&mut b, &items, &cfg));
+    }
+    let dag = b.build();
+    assert_eq!(
+        dag.len(),
+        4 + 4 + 3,
+        "parse and scale nodes are shared by the three variants"
+    );
+    let o = run(&cache, &dag, Mode::Run);
+    assert_eq!(executed(&o), (4, 4, 3));
+    let sums: Vec<f64> = handles.iter().map(|h| o.get(*h).unwrap().sum).collect();
+    assert_eq!(sums, vec![20.0, 120.0, 220.0]);
+    let shared = o
+        .reports
+        .iter()
+        .find(|r| r.identity == "toy_scale[item_000]")
+        .unwrap();
+    assert_eq!(shared.variants, vec!["a", "b", "c"]);
+}
+
+#[test]
+fn corrupt_or_truncated_artifacts_warn_once_and_are_recomputed() {
+    let (_d, cache, items) = setup();
+    let mut cfg = ToyConfig::default();
+    let (dag, _) = toy_dag(&items, &cfg);
+    let o1 = run(&cache, &dag, Mode::Run);
+    let store = skytie::store::Store::open(&cache).unwrap();
+    let key_of = |identity: &str| {
+        o1.reports
+            .iter()
+            .find(|r| r.identity == identity)
+            .unwrap()
+            .key
+            .unwrap()
+    };
+    // Flip the last byte of the sum's payload.
+    let sum_path = store.object_path(&key_of("toy_sum"));
+    let mut bytes = std::fs::read(&sum_path).unwrap();
+    *bytes.last_mut().unwrap() ^= 0x55;
+    std::fs::write(&sum_path, &bytes).unwrap();
+    let (dag, h) = toy_dag(&items, &cfg);
+    let o2 = run(&cache, &dag, Mode::Run);
+    assert_eq!(o2.warnings.len(), 1, "{:?}", o2.warnings);
+    assert!(o2.warnings[0].contains("toy_sum"), "{}", o2.warnings[0]);
+    assert_eq!(executed(&o2), (0, 0, 1));
+    assert_eq!(
+        *o2.get(h).unwrap(),
+        ToySummary {
+            sum: 20.0,
+            count: 4
+        }
+    );
+    // Truncate one scale artifact, then change the sum so it needs the scale values: the truncated one is
+    // recomputed (with a warning), the others are loaded.
+    let scale_path = store.object_path(&key_of("toy_scale[item_002]"));
+    let len = std::fs::metadata(&scale_path).unwrap().len();
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(&scale_path)
+        .unwrap()
+        .set_len(len / 2)
+        .unwrap();
+    cfg.sum.offset = 1.0;
+    let (dag, h) = toy_dag(&items, &cfg);
+    let o3 = run(&cache, &dag, Mode::Run);
+    assert_eq!(o3.warnings.len(), 1, "{:?}", o3.warnings);
+    assert!(
+        o3.warnings[0].contains("toy_scale[item_002]"),
+        "{}",
+        o3.warnings[0]
+    );
+    assert_eq!(executed(&o3), (0, 1, 1));
+    assert_eq!(o3.get(h).unwrap().sum, 21.0);
+    // And everything is healthy again.
+    let o4 = run(&cache, &toy_dag(&items, &cfg).0, Mode::Run);
+    assert_eq!((o4.executed(), o4.warnings.len()), (0, 0));
+}
+
+#[test]
+fn failing_and_panicking_nodes_are_not_recorded_and_dependents_are_skipped() {
+    for panic in [false, true] {
+        let (_d, cache, items) = setup();
+        let mut cfg = ToyConfig::default();
+        if panic {
+            cfg.scale.faults.panic_item = "item_001".into();
+        } else {
+            cfg.scale.faults.fail_item = "item_001".into();
+        }
+        let (dag, h) = toy_dag(&items, &cfg);
+        let o = run(&cache, &dag, Mode::Run);
+        let bad = o
+            .reports
+            .iter()
+            .find(|r| r.identity == "toy_scale[item_001]")
+            .unwrap();
+        match &bad.status {
+            NodeStatus::Failed(m) => assert!(
+                m.contains(if panic {
+                    "panicked"
+                } else {
+                    "failure injected"
+                }),
+                "{m}"
+            ),
+            s => panic!("expected failure, got {s:?}"),
+        }
+        let store = skytie::store::Store::open(&cache).unwrap();
+        assert!(
+            !store.contains(&bad.key.unwrap()),
+            "a failed node must never be stored"
+        );
+        let sum = o.reports.iter().find(|r| r.identity == "toy_sum").unwrap();
+        assert_eq!(
+            sum.status,
+            NodeStatus::Skipped {
+                upstream: "toy_scale[item_001]".into()
+            }
+        );
+        assert_eq!((o.executed(), o.failed(), o.skipped()), (7, 1, 1));
+        assert!(o.get(h).is_none());
+        // Same failure again: the failure was not cached as a success.
+        let o = run(&cache, &toy_dag(&items, &cfg).0, Mode::Run);
+        assert_eq!(
+            (o.executed(), o.cached(), o.failed(), o.skipped()),
+            (0, 7, 1, 1)
+        );
+        // Fix it: only the failed node and its dependent run.
+        cfg.scale.faults = Faults::default();
+        let (dag, h) = toy_dag(&items, &cfg);
+        let o = run(&cache, &dag, Mode::Run);
+        // The fault params are part of the key, so all scale nodes re-run; their outputs are unchanged.
+        assert_eq!(executed(&o), (0, 4, 1));
+        assert_eq!(o.get(h).unwrap().sum, 20.0);
+    }
+}
+
+#[test]
+fn results_are_identical_for_one_or_many_threads() {
+    let (d, _, items) = setup();
+    let cfg = ToyConfig {
+        scale: ToyScaleParams {
+            factor: 0.1,
+            quantum: 0.0,
+            faults: Faults::default(),
+        },
+        ..Default::default()
+    };
+    let mut hashes = Vec::new();
+    for threads in [1, 4] {
+        let cache = d.path().join(format!("cache{threads}"));
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let o = pool.install(|| run(&cache, &toy_dag(&items, &cfg).0, Mode::Run));
+        let h: Vec<_> = o
+            .reports
+            .iter()
+            .map(|r| (r.identity.clone(), r.key.unwrap(), r.output_hash.unwrap()))
+            .collect();
+        hashes.push(h);
+    }
+    assert_eq!(hashes[0], hashes[1]);
+}
