@@ -26,7 +26,7 @@ const NADIR_MARGIN_M: f64 = 15.0;
 /// Nadir strips over `route_points` (world XY), ground at `ground_z_m`. Strips run along the longer side of the
 /// route's bounding box (serpentine), the image top pointing in the flight direction (κ = −flight azimuth);
 /// at least two strips, so route points typically lie in the side overlap and are seen by 4+ images; the
-/// exposures extend a full base beyond the route so every route point is in ≥ 2 images of a strip.
+/// exposures extend half a base beyond the covered extent so every route point is in ≥ 2 images of a strip.
 pub fn plan_nadir(
     route_points: &[[f64; 2]],
     ground_z_m: f64,
@@ -55,7 +55,7 @@ pub fn plan_nadir(
         .max(0.0) as usize
         + 1)
     .max(2);
-    let n_exposures = (extent[along_axis] / base_m).ceil() as usize + 3;
+    let n_exposures = (extent[along_axis] / base_m).ceil() as usize + 2;
     let focal_px = plan.altitude_m / plan.gsd_m;
     let clamp_deg = 0.9;
     let mut out = Vec::with_capacity(n_strips * n_exposures);

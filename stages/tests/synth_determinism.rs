@@ -1,0 +1,161 @@
+//! The synthetic campaign is deterministic: `tiny` with seed 1 generated twice, and with 1 vs 2 rayon
+//! threads, gives byte-identical folders (every file compared); the folder follows the campaign format;
+//! regenerating over a previous synthetic campaign replaces it, while a foreign folder is refused.
+
+use skytie_stages::synth::{generate, Preset, SynthError, SynthOptions, SynthSummary};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Every file below `root` (relative path → bytes).
+fn read_tree(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.insert(
+                    p.strip_prefix(root).unwrap().to_path_buf(),
+                    std::fs::read(&p).unwrap(),
+                );
+            }
+        }
+    }
+    out
+}
+
+fn generate_with_threads(threads: usize, out: &Path) -> SynthSummary {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| generate(&SynthOptions::new(Preset::Tiny, 1), out).unwrap())
+}
+
+fn assert_same_tree(a: &BTreeMap<PathBuf, Vec<u8>>, b: &BTreeMap<PathBuf, Vec<u8>>, what: &str) {
+    assert_eq!(
+        a.keys().collect::<Vec<_>>(),
+        b.keys().collect::<Vec<_>>(),
+        "{what}: different file sets"
+    );
+    for (k, v) in a {
+        assert!(v == &b[k], "{what}: {} differs", k.display());
+    }
+}
+
+#[test]
+fn tiny_is_byte_identical_across_runs_and_thread_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let (one, two) = (dir.path().join("one"), dir.path().join("two"));
+    let s1 = generate_with_threads(1, &one);
+    eprintln!(
+        "tiny (1 thread): {s1:?}, {:.2e} primary rays/s",
+        s1.rays_per_second()
+    );
+    let s2 = generate_with_threads(2, &two);
+    eprintln!(
+        "tiny (2 threads): {:.2} s, {:.2e} primary rays/s",
+        s2.seconds,
+        s2.rays_per_second()
+    );
+    let t1 = read_tree(&one);
+    assert_same_tree(&t1, &read_tree(&two), "1 vs 2 threads");
+    // A second 2-thread run, generated over the previous synthetic campaign (which it replaces).
+    let s3 = generate_with_threads(2, &two);
+    assert_same_tree(
+        &t1,
+        &read_tree(&two),
+        "second run, replacing the previous folder",
+    );
+
+    // Counts and layout (campaign-format.md).
+    assert_eq!(
+        (s1.recordings, s1.nadir_images, s1.oblique_images),
+        (s3.recordings, s3.nadir_images, s3.oblique_images)
+    );
+    assert!(
+        (4..=8).contains(&s1.recordings),
+        "tiny has ~6 panoramas: {}",
+        s1.recordings
+    );
+    assert!(
+        s1.nadir_images >= 2
+            && s1.oblique_images >= 8
+            && s1.checkpoints >= 1
+            && s1.observations >= 2,
+        "{s1:?}"
+    );
+    let toml = String::from_utf8(t1[Path::new("campaign.toml")].clone()).unwrap();
+    assert!(
+        toml.contains("name = \"synth-tiny-seed1\"") && toml.contains("crs = \"EPSG:28992\""),
+        "{toml}"
+    );
+    let panos = t1
+        .keys()
+        .filter(|k| k.starts_with("mm/panoramas") && k.extension().is_some_and(|e| e == "jpg"))
+        .count();
+    assert_eq!(panos, s1.recordings);
+    for f in [
+        "mm/recordings.csv",
+        "truth/recordings.csv",
+        "truth/README.md",
+        "aerial/nadir/cameras.csv",
+        "aerial/oblique/cameras.csv",
+        "control/checkpoints.csv",
+        "control/observations.csv",
+    ] {
+        assert!(t1.contains_key(Path::new(f)), "missing {f}");
+    }
+    assert!(
+        !t1.keys().any(|k| k.starts_with("truth/aerial")),
+        "aerial poses are not perturbed by default"
+    );
+    let header = String::from_utf8(t1[Path::new("mm/recordings.csv")].clone()).unwrap();
+    let first = header.lines().next().unwrap();
+    for col in [
+        "image_id",
+        "file",
+        "time",
+        "x",
+        "y",
+        "z",
+        "heading",
+        "camera_height",
+        "sigma_xy",
+        "sigma_z",
+    ] {
+        assert!(
+            first.split(',').any(|c| c == col),
+            "column {col} missing in {first}"
+        );
+    }
+    let pano = image::image_dimensions(one.join("mm/panoramas").join("pano_0_000.jpg")).unwrap();
+    assert_eq!(pano, (1024, 512));
+    // No temporary folders left next to the outputs.
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 2, "{names:?}");
+
+    // A foreign folder is refused and left alone.
+    let foreign = dir.path().join("foreign");
+    std::fs::create_dir_all(&foreign).unwrap();
+    std::fs::write(foreign.join("notes.txt"), b"mine").unwrap();
+    let e = generate(&SynthOptions::new(Preset::Tiny, 1), &foreign).unwrap_err();
+    assert!(matches!(e, SynthError::OutputExists { .. }), "{e}");
+    assert_eq!(std::fs::read(foreign.join("notes.txt")).unwrap(), b"mine");
+}
+
+#[test]
+fn seeds_change_the_campaign() {
+    // Different seeds give different deteriorations (cheap: no rendering needed to see it).
+    let a =
+        skytie_stages::synth::generate::plan_campaign(&SynthOptions::new(Preset::Tiny, 1)).unwrap();
+    let b =
+        skytie_stages::synth::generate::plan_campaign(&SynthOptions::new(Preset::Tiny, 2)).unwrap();
+    assert_ne!(a.recorded[0].x, b.recorded[0].x);
+    assert_eq!(a.name, "synth-tiny-seed1");
+}
