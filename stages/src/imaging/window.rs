@@ -14,22 +14,26 @@ pub enum WindowKind {
     Blackman,
 }
 
+/// Value of the length-`n` window at continuous sample position `x` (sample k of [`window_1d`] is at x = k);
+/// 0 outside `[0, n − 1]`. Used to place a window at a sub-pixel offset.
+pub fn window_value(kind: WindowKind, n: usize, x: f64) -> f64 {
+    if n == 0 || !(x >= 0.0 && x <= (n - 1) as f64) {
+        return 0.0;
+    }
+    if n == 1 {
+        return 1.0;
+    }
+    let t = 2.0 * std::f64::consts::PI * x / (n - 1) as f64;
+    match kind {
+        WindowKind::Rectangular => 1.0,
+        WindowKind::Hann => 0.5 * (1.0 - t.cos()),
+        WindowKind::Blackman => (0.42 - 0.5 * t.cos() + 0.08 * (2.0 * t).cos()).max(0.0),
+    }
+}
+
 /// The 1-D window of length `n` (f64). Length 1 gives `[1.0]`, length 0 an empty vector.
 pub fn window_1d(kind: WindowKind, n: usize) -> Vec<f64> {
-    if n <= 1 {
-        return vec![1.0; n];
-    }
-    let d = (n - 1) as f64;
-    (0..n)
-        .map(|i| {
-            let x = 2.0 * std::f64::consts::PI * i as f64 / d;
-            match kind {
-                WindowKind::Rectangular => 1.0,
-                WindowKind::Hann => 0.5 * (1.0 - x.cos()),
-                WindowKind::Blackman => (0.42 - 0.5 * x.cos() + 0.08 * (2.0 * x).cos()).max(0.0),
-            }
-        })
-        .collect()
+    (0..n).map(|i| window_value(kind, n, i as f64)).collect()
 }
 
 /// Separable 2-D window `w(col)·w(row)` of size `width × height` (row-major, f64).
@@ -77,6 +81,14 @@ mod tests {
         }
         assert_eq!(window_1d(WindowKind::Hann, 1), vec![1.0]);
         assert!(window_1d(WindowKind::Hann, 0).is_empty());
+        assert!(
+            (window_value(WindowKind::Hann, 5, 1.5)
+                - 0.5 * (1.0 - (0.75 * std::f64::consts::PI).cos()))
+            .abs()
+                < 1e-12
+        );
+        assert_eq!(window_value(WindowKind::Hann, 5, -0.1), 0.0);
+        assert_eq!(window_value(WindowKind::Rectangular, 5, 4.1), 0.0);
     }
 
     #[test]
