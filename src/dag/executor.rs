@@ -256,9 +256,28 @@ fn lock(slots: &mut [Mutex<Slot>], id: NodeId) -> &mut Slot {
 }
 
 /// Whether the entry of `key` exists; if so mark it as used now (like `Store::load` does), so `cache gc`
-/// sees it as recently used and a live run protects it, without reading the artifact.
+/// sees it as recently used and a live run protects it, without reading the artifact. One `utimensat`
+/// system call on Unix (it fails with ENOENT when the entry is absent).
 fn touch_entry(store: &Store, key: &NodeKey) -> bool {
-    match std::fs::File::open(store.object_path(key)) {
+    let path = store.object_path(key);
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let Ok(c_path) = std::ffi::CString::new(path.as_os_str().as_bytes()) else {
+            return false;
+        };
+        // SAFETY: `c_path` is a valid NUL-terminated string; a null `times` pointer means "now" for both
+        // access and modification time (POSIX utimensat).
+        let rc = unsafe { libc::utimensat(libc::AT_FDCWD, c_path.as_ptr(), std::ptr::null(), 0) };
+        if rc == 0 {
+            return true;
+        }
+        // Not ours to touch (e.g. a read-only shared cache): fall back to an existence check.
+        return std::io::Error::last_os_error().kind() != std::io::ErrorKind::NotFound
+            && path.is_file();
+    }
+    #[cfg(not(unix))]
+    match std::fs::File::open(&path) {
         Ok(f) => {
             let _ = f.set_modified(SystemTime::now());
             true
