@@ -79,7 +79,10 @@ fn main() {
         return;
     }
 
-    let dir = tempfile::tempdir().expect("temp dir");
+    // SKYTIE_BENCH_KEEP=DIR keeps the generated campaigns in DIR (for inspection) instead of a temp folder.
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let keep = std::env::var_os("SKYTIE_BENCH_KEEP").map(std::path::PathBuf::from);
+    let dir_path = keep.as_deref().unwrap_or(tmp.path());
     let skip_demo = std::env::var_os("SKYTIE_BENCH_SKIP_DEMO").is_some();
     let presets: &[Preset] = if skip_demo {
         &[Preset::Tiny]
@@ -87,7 +90,7 @@ fn main() {
         &[Preset::Tiny, Preset::Demo]
     };
     for &preset in presets {
-        let out = dir.path().join(preset.name());
+        let out = dir_path.join(preset.name());
         let s = generate(&SynthOptions::new(preset, 1), &out).expect("generate");
         println!(
             "generate {:5}: {:7.2} s wall ({:.2} s rendering), {} panoramas + {} nadir + {} oblique, \

@@ -4,7 +4,7 @@
 //! Aerial geometry follows the thesis data: nadir at ≈ 4470 m above ground with ≈ 10 cm GSD and 60 % / 40 %
 //! overlap (thesis 3.5.1.1, 5.5), pentacam obliques tilted 45° at ≈ 450 m (thesis 4.5).
 
-use super::scene::SceneSpec;
+use super::scene::{RouteSpec, SceneSpec};
 use super::SynthError;
 use serde::{Deserialize, Serialize};
 
@@ -20,7 +20,10 @@ pub enum Preset {
 }
 
 /// Distance between the origins of the four `paper` areas along world X, m.
-pub const PAPER_AREA_SPACING_M: f64 = 1500.0;
+pub const PAPER_AREA_SPACING_M: f64 = 2000.0;
+
+/// Length of each (straight) `paper` route, m: 100 panoramas at 5 m.
+pub const PAPER_ROUTE_LENGTH_M: f64 = 495.0;
 
 /// Valid preset names, in the order shown in messages.
 pub const PRESET_NAMES: [&str; 3] = ["tiny", "demo", "paper"];
@@ -54,7 +57,7 @@ impl Preset {
             Preset::Tiny => vec![SceneSpec::tiny()],
             Preset::Demo => vec![SceneSpec::demo()],
             // The areas share one origin in their specs; they are placed side by side, far enough apart that
-            // no aerial footprint of one area reaches another.
+            // no aerial footprint of one area reaches another, and lengthened to ~100 panoramas each.
             Preset::Paper => (0..4)
                 .map(|i| {
                     let spec = SceneSpec::paper_area(i);
@@ -62,8 +65,14 @@ impl Preset {
                         spec.origin_world[0] + PAPER_AREA_SPACING_M * i as f64,
                         spec.origin_world[1],
                     ];
+                    let route = RouteSpec {
+                        end_x_m: spec.route.start_x_m + PAPER_ROUTE_LENGTH_M,
+                        ..spec.route
+                    };
                     SceneSpec {
                         origin_world: origin,
+                        street_length_m: route.end_x_m + 10.0,
+                        route,
                         ..spec
                     }
                 })
@@ -80,7 +89,7 @@ impl Preset {
             height_px,
             forward_overlap: 0.60,
             side_overlap: 0.40,
-            attitude_sigma_deg: 0.3,
+            attitude_sigma_deg: 0.15,
         };
         let oblique = |width_px, height_px| ObliquePlan {
             altitude_m: 450.0,
@@ -216,7 +225,7 @@ impl PresetParams {
                 height_px: 480,
                 forward_overlap: 0.6,
                 side_overlap: 0.4,
-                attitude_sigma_deg: 0.3,
+                attitude_sigma_deg: 0.15,
             },
             oblique: ObliquePlan {
                 altitude_m: 450.0,
