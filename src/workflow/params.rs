@@ -25,7 +25,7 @@ pub trait StageParams: DeserializeOwned + Serialize + Default + Clone {
     }
 }
 
-/// The keys of `P::default()` serialised to a TOML table (empty if it does not serialise to a table).
+/// The keys of `P::default()` serialised to a TOML table, sorted (empty if it does not serialise to a table).
 pub fn default_field_names<P: Serialize + Default>() -> Vec<String> {
     match toml::Value::try_from(P::default()) {
         Ok(toml::Value::Table(t)) => t.keys().cloned().collect(),
