@@ -5,7 +5,7 @@
 //! All functions are pure in (position, parameters, seed). Detail is band-limited: the finest structure is
 //! ~1 cm (asphalt grain), well above the ~2 mm limit, so supersampled renders do not alias badly.
 
-use crate::synth::noise::{fbm2, gradient2, hash2, unit_f32, value2, value3};
+use crate::synth::noise::{fbm2, floor_f64, gradient2, hash2, unit_f32, value2, value3};
 
 #[inline]
 fn scale(c: [f32; 3], k: f32) -> [f32; 3] {
@@ -32,15 +32,15 @@ fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
 pub fn asphalt(x: f64, y: f64, seed: u64) -> [f32; 3] {
     let grain = value2(x * 90.0, y * 90.0, seed) * 0.035;
     let stone = unit_f32(hash2(
-        (x * 70.0).floor() as i64,
-        (y * 70.0).floor() as i64,
+        floor_f64(x * 70.0) as i64,
+        floor_f64(y * 70.0) as i64,
         seed ^ 0xA66,
     ));
     let stone = if stone > 0.93 { 0.06 } else { 0.0 };
     let blotch = fbm2(x, y, seed ^ 0xB10, 0.35, 3, 0.55) * 0.045;
     let mut v = 0.17 + grain + stone + blotch;
     // repair patches
-    let (cx, cy) = ((x / 7.0).floor() as i64, (y / 7.0).floor() as i64);
+    let (cx, cy) = (floor_f64(x / 7.0) as i64, floor_f64(y / 7.0) as i64);
     let h = hash2(cx, cy, seed ^ 0x9A7C);
     if unit_f32(h) < 0.22 {
         let fx = x - cx as f64 * 7.0;
@@ -84,7 +84,7 @@ pub fn manhole(ds: f64, dq: f64, r: f64, seed: u64) -> [f32; 3] {
     let mut v = 0.10 + value2(ds * 40.0, dq * 40.0, seed) * 0.02;
     if rho > r - 0.04 {
         v = 0.22; // steel rim
-    } else if ((rho / 0.05).floor() as i64) % 2 == 0 && rho > 0.06 {
+    } else if (floor_f64(rho / 0.05) as i64) % 2 == 0 && rho > 0.06 {
         v += 0.06; // concentric ribs
     }
     [v, v * 0.98, v * 0.95]
@@ -93,7 +93,7 @@ pub fn manhole(ds: f64, dq: f64, r: f64, seed: u64) -> [f32; 3] {
 /// Concrete paving tiles (0.30 m) with dark joints and per-tile brightness; (s, q) street coordinates.
 pub fn paving(s: f64, q: f64, seed: u64) -> [f32; 3] {
     const TILE: f64 = 0.30;
-    let (is, iq) = ((s / TILE).floor(), (q / TILE).floor());
+    let (is, iq) = (floor_f64(s / TILE), floor_f64(q / TILE));
     let (fs, fq) = (s - is * TILE, q - iq * TILE);
     let joint = fs.min(TILE - fs).min(fq).min(TILE - fq);
     let h = hash2(is as i64, iq as i64, seed ^ 0x7A1E);
@@ -173,13 +173,13 @@ pub fn facade(u: f64, v: f64, look: &FacadeLook) -> [f32; 3] {
     let wall = if look.brick {
         const BRICK_W: f64 = 0.22;
         const BRICK_H: f64 = 0.0625;
-        let row = (v / BRICK_H).floor();
+        let row = floor_f64(v / BRICK_H);
         let off = if (row as i64) % 2 == 0 {
             0.0
         } else {
             0.5 * BRICK_W
         };
-        let col = ((u + off) / BRICK_W).floor();
+        let col = floor_f64((u + off) / BRICK_W);
         let fu = u + off - col * BRICK_W;
         let fv = v - row * BRICK_H;
         let mortar = fu < 0.010 || fv < 0.010;
@@ -198,11 +198,11 @@ pub fn facade(u: f64, v: f64, look: &FacadeLook) -> [f32; 3] {
     if v < 0.0 {
         return scale(wall, 0.7); // plinth
     }
-    let storey = (v / look.storey_height_m).floor();
+    let storey = floor_f64(v / look.storey_height_m);
     if storey as u32 >= look.storeys {
         return wall; // parapet / attic wall
     }
-    let bay = (u / look.bay_m).floor();
+    let bay = floor_f64(u / look.bay_m);
     let bu = u - bay * look.bay_m - 0.5 * look.bay_m; // relative to bay centre
     let sv = v - storey * look.storey_height_m; // height within storey
     let frame_w = 0.07;
@@ -249,7 +249,7 @@ pub fn facade(u: f64, v: f64, look: &FacadeLook) -> [f32; 3] {
 /// Roof albedo: `tiles` for gable roofs (rows along the slope), else gravel/bitumen for flat roofs.
 pub fn roof(rgb: [f32; 3], along: f64, across: f64, tiles: bool, seed: u64) -> [f32; 3] {
     if tiles {
-        let row = (across / 0.33).floor();
+        let row = floor_f64(across / 0.33);
         let f = (across - row * 0.33) as f32 / 0.33;
         let col = ((along + if (row as i64) % 2 == 0 { 0.0 } else { 0.1 }) / 0.2).floor();
         let k = 0.85 + 0.2 * unit_f32(hash2(col as i64, row as i64, seed))

@@ -15,12 +15,15 @@ pub struct Grid {
     /// Offsets into `items` per cell (len nx·ny + 1).
     starts: Vec<u32>,
     items: Vec<u32>,
+    /// Highest and lowest object z per cell (rays passing above/below a cell skip it).
+    cell_z: Vec<(f64, f64)>,
 }
 
 impl Grid {
     /// Build over `objects` with cells of about `cell_m` (at most 512 per axis).
     pub fn build(objects: &[Object], cell_m: f64) -> Self {
-        if objects.is_empty() {
+        let top = objects.iter().filter(|o| !o.is_child).count();
+        if top == 0 {
             return Self {
                 bounds: Aabb::new(Vector3::zeros(), Vector3::zeros()),
                 cell_m: 1.0,
@@ -28,10 +31,15 @@ impl Grid {
                 ny: 0,
                 starts: vec![0],
                 items: Vec::new(),
+                cell_z: Vec::new(),
             };
         }
-        let mut bounds = objects[0].bounds;
-        for o in &objects[1..] {
+        let mut tops = objects.iter().filter(|o| !o.is_child);
+        let mut bounds = tops
+            .next()
+            .map(|o| o.bounds)
+            .unwrap_or(Aabb::new(Vector3::zeros(), Vector3::zeros()));
+        for o in tops {
             bounds = bounds.union(&o.bounds);
         }
         // pad slightly so objects on the boundary are inside
@@ -47,12 +55,16 @@ impl Grid {
             (a, b)
         };
         let mut counts = vec![0u32; nx * ny];
-        for o in objects {
+        let mut cell_z = vec![(f64::INFINITY, f64::NEG_INFINITY); nx * ny];
+        for o in objects.iter().filter(|o| !o.is_child) {
             let (x0, x1) = cell_range(o.bounds.min.x, o.bounds.max.x, bounds.min.x, nx);
             let (y0, y1) = cell_range(o.bounds.min.y, o.bounds.max.y, bounds.min.y, ny);
             for iy in y0..=y1 {
                 for ix in x0..=x1 {
                     counts[iy * nx + ix] += 1;
+                    let z = &mut cell_z[iy * nx + ix];
+                    z.0 = z.0.min(o.bounds.min.z);
+                    z.1 = z.1.max(o.bounds.max.z);
                 }
             }
         }
@@ -62,7 +74,7 @@ impl Grid {
         }
         let mut fill = starts.clone();
         let mut items = vec![0u32; starts[nx * ny] as usize];
-        for (k, o) in objects.iter().enumerate() {
+        for (k, o) in objects.iter().enumerate().filter(|(_, o)| !o.is_child) {
             let (x0, x1) = cell_range(o.bounds.min.x, o.bounds.max.x, bounds.min.x, nx);
             let (y0, y1) = cell_range(o.bounds.min.y, o.bounds.max.y, bounds.min.y, ny);
             for iy in y0..=y1 {
@@ -80,6 +92,7 @@ impl Grid {
             ny,
             starts,
             items,
+            cell_z,
         }
     }
 
@@ -125,13 +138,20 @@ impl Grid {
         } else {
             (0, f64::INFINITY, f64::INFINITY)
         };
+        let mut t_enter = t0;
         loop {
             let c = iy * self.nx + ix;
             let t_exit = t_next_x.min(t_next_y).min(t1);
-            let cell = &self.items[self.starts[c] as usize..self.starts[c + 1] as usize];
-            if !cell.is_empty() && visit(cell, t_exit) {
-                return;
+            let (z_lo, z_hi) = self.cell_z[c];
+            let za = o.z + t_enter * d.z;
+            let zb = o.z + t_exit * d.z;
+            if za.min(zb) <= z_hi && za.max(zb) >= z_lo {
+                let cell = &self.items[self.starts[c] as usize..self.starts[c + 1] as usize];
+                if !cell.is_empty() && visit(cell, t_exit) {
+                    return;
+                }
             }
+            t_enter = t_exit;
             if t_exit >= t1 {
                 return;
             }

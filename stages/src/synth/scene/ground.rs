@@ -77,6 +77,10 @@ pub struct Ground {
     flat: bool,
     lines: [Line; MAX_LINES],
     n_lines: usize,
+    /// Bounds of `h − base` over the whole plane (relief above/below the sloped base plane), m.
+    relief_max_m: f64,
+    /// |∇base|, the base plane's slope.
+    base_slope: f64,
 }
 
 impl Ground {
@@ -108,6 +112,8 @@ impl Ground {
                 c: 0.0,
             }; MAX_LINES],
             n_lines: 0,
+            relief_max_m: (kerb_m - crossfall * half_width_m).max(0.0),
+            base_slope: (gx * gx + gy * gy).sqrt(),
         };
         let mut push = |nx: f64, ny: f64, c: f64| {
             let n = (nx * nx + ny * ny).sqrt();
@@ -279,6 +285,24 @@ impl Ground {
         t_min: f64,
         t_max: f64,
     ) -> Option<GroundHit> {
+        // Cull with the bound h(p) ≤ base(o) + relief_max + |∇base|·|p − o|_xy: a hit needs
+        // t·(d_z − |∇base|·|d_xy|) ≤ base(o) + relief_max − o_z.
+        let (mut t_min, mut t_max) = (t_min, t_max);
+        let num = self.z0 + self.gx * o.x + self.gy * o.y + self.relief_max_m - o.z;
+        let denom = d.z - self.base_slope * (d.x * d.x + d.y * d.y).sqrt();
+        if denom >= 0.0 {
+            if num < 0.0 {
+                return None;
+            }
+            if denom > 0.0 {
+                t_max = t_max.min(num / denom + 1e-9);
+            }
+        } else {
+            t_min = t_min.max(num / denom - 1e-9);
+        }
+        if t_min >= t_max {
+            return None;
+        }
         let mut ts = [0.0f64; MAX_LINES];
         let mut idx = [0usize; MAX_LINES];
         let mut n = 0;

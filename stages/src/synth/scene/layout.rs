@@ -274,6 +274,7 @@ fn add_building(
         Vector3::new(min[0], min[1], base),
         Vector3::new(max[0], max[1], eave),
     );
+    let parent = objects.len();
     objects.push(Object::new(
         Shape::Box(body),
         Material::Building { building: id },
@@ -285,12 +286,15 @@ fn add_building(
             Vector3::new(min[0], min[1], eave),
             Vector3::new(max[0], max[1], rz),
         );
-        objects.push(Object::with_bounds(
-            Shape::Prism(prism),
-            bounds,
-            Material::GableRoof { building: id },
-            IN_BOTH,
-        ));
+        objects.push(
+            Object::with_bounds(
+                Shape::Prism(prism),
+                bounds,
+                Material::GableRoof { building: id },
+                IN_BOTH,
+            )
+            .as_child(),
+        );
     }
     // balconies (one per bay on alternating or all floors) or oriels spanning the upper floors
     if storeys >= 2 && rng.chance(spec.balcony_probability) {
@@ -320,14 +324,24 @@ fn add_building(
                 let pb = f.xy(bs1, q_front - f.side * proj);
                 let bmin = Vector3::new(pa[0].min(pb[0]), pa[1].min(pb[1]), z0);
                 let bmax = Vector3::new(pa[0].max(pb[0]), pa[1].max(pb[1]), z1);
-                objects.push(Object::new(
-                    Shape::Box(Aabb::new(bmin, bmax)),
-                    Material::Balcony { building: id },
-                    IN_BOTH,
-                ));
+                objects.push(
+                    Object::new(
+                        Shape::Box(Aabb::new(bmin, bmax)),
+                        Material::Balcony { building: id },
+                        IN_BOTH,
+                    )
+                    .as_child(),
+                );
             }
         }
     }
+    // the body is a compound enclosing its roof and protrusions
+    let mut env = objects[parent].bounds;
+    for o in &objects[parent + 1..] {
+        env = env.union(&o.bounds);
+    }
+    objects[parent].bounds = env;
+    objects[parent].children_end = objects.len() as u32;
     buildings.push(Building {
         id,
         footprint_min_local: min,

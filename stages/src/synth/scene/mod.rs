@@ -366,9 +366,16 @@ impl Scene {
                 if obj.epochs & bit == 0 {
                     continue;
                 }
-                if let Some((t, n)) = obj.hit(o, d, &inv_d, 0.0, best_t) {
-                    best_t = t;
-                    best_obj = Some((k, t, n));
+                let end = obj.children_end.max(k + 1);
+                if end > k + 1 && obj.bounds.clip(o, &inv_d, 0.0, best_t).is_none() {
+                    continue; // misses the compound's envelope
+                }
+                for j in k..end {
+                    let part = &self.objects[j as usize];
+                    if let Some((t, n)) = part.hit(o, d, &inv_d, 0.0, best_t) {
+                        best_t = t;
+                        best_obj = Some((j, t, n));
+                    }
                 }
             }
             best_t <= t_exit
@@ -399,9 +406,18 @@ impl Scene {
                 if obj.epochs & bit == 0 || matches!(obj.material, Material::Marker { .. }) {
                     continue;
                 }
-                if obj.hit(o, d, &inv_d, 0.0, f64::INFINITY).is_some() {
-                    blocked = true;
-                    return true;
+                let end = obj.children_end.max(k + 1);
+                if end > k + 1 && obj.bounds.clip(o, &inv_d, 0.0, f64::INFINITY).is_none() {
+                    continue;
+                }
+                for j in k..end {
+                    if self.objects[j as usize]
+                        .hit(o, d, &inv_d, 0.0, f64::INFINITY)
+                        .is_some()
+                    {
+                        blocked = true;
+                        return true;
+                    }
                 }
             }
             false

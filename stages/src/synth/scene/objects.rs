@@ -74,6 +74,11 @@ pub struct Object {
     pub bounds: Aabb,
     pub material: Material,
     pub epochs: u8,
+    /// Parts of a compound (a building's roof, balconies) are the objects at indices
+    /// `self_index + 1 .. children_end`; `bounds` then encloses them all. 0 = no parts.
+    pub children_end: u32,
+    /// This object is a part of a compound (not entered into the acceleration grid itself).
+    pub is_child: bool,
 }
 
 /// Fraction of a crown's surface that is a see-through hole is set by this threshold on 3-D value noise.
@@ -108,6 +113,8 @@ impl Object {
             bounds,
             material,
             epochs,
+            children_end: 0,
+            is_child: false,
         }
     }
 
@@ -117,7 +124,15 @@ impl Object {
             bounds,
             material,
             epochs,
+            children_end: 0,
+            is_child: false,
         }
+    }
+
+    /// Mark as a part of a compound.
+    pub fn as_child(mut self) -> Self {
+        self.is_child = true;
+        self
     }
 
     /// Is the crown surface at p a hole?
