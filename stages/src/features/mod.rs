@@ -1,1 +1,3 @@
-//! (module under construction)
+//! Feature detection: Förstner interest points (and, from the "kaze" engineer, KAZE features).
+
+pub mod forstner;
