@@ -1,3 +1,4 @@
 //! Feature detection: Förstner interest points (and, from the "kaze" engineer, KAZE features).
 
 pub mod forstner;
+pub mod kaze;

@@ -4,3 +4,4 @@
 pub mod ncc;
 pub mod phase_correlation;
 pub mod subpixel;
+pub mod descriptor_match;
