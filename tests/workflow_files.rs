@@ -511,6 +511,10 @@ fn variants_merge_over_stage_tables() {
     assert_eq!(table["threshold"].as_float(), Some(0.3));
     assert_eq!(table["patch"]["extent_m"].as_float(), Some(20.0));
 
+    // "default" is the workflow without overrides, also in a sweep.
+    let base: ObliqueParams = w.params("oblique", "default").unwrap();
+    assert_eq!((base.threshold, base.patch.bins, base.seed), (0.8, 16, 7));
+
     let e = w.params::<ObliqueParams>("oblique", "tigth").unwrap_err();
     assert_error(
         &e,

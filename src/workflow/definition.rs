@@ -158,14 +158,19 @@ impl Workflow {
         WorkflowError::combine(errors).map_or(Ok(()), Err)
     }
 
-    /// The variant named `variant`: `None` for the default variant of a workflow without sweep.
+    /// The variant named `variant`: `None` for "default" (the workflow without overrides; in a sweep too, unless
+    /// the sweep declares a variant of that name).
     pub(crate) fn variant(
         &self,
         variant: &str,
     ) -> Result<Option<&super::sweep::Variant>, WorkflowError> {
         match &self.sweep {
             Some(sweep) if !sweep.variants.is_empty() => {
-                sweep.variants.iter().find(|v| v.name == variant).map(Some).ok_or_else(|| {
+                let found = sweep.variants.iter().find(|v| v.name == variant);
+                if found.is_none() && variant == DEFAULT_VARIANT {
+                    return Ok(None); // the unvaried workflow, also available in a sweep
+                }
+                found.map(Some).ok_or_else(|| {
                     let names: Vec<&str> = sweep.variants.iter().map(|v| v.name.as_str()).collect();
                     self.error(
                         sweep.at,

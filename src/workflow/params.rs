@@ -37,7 +37,8 @@ impl Workflow {
     /// The parameters of `stage` for `variant`: the stage table with the variant's overrides merged in (deep
     /// merge: an override replaces one parameter, untouched parameters keep the table's value or the default),
     /// deserialised into `P`, then `P::validate()`. If `P` has a top-level integer field `seed` that neither the
-    /// table nor the variant sets, it gets the workflow's `seed`.
+    /// table nor the variant sets, it gets the workflow's `seed`. `variant` "default" is the workflow without
+    /// overrides, also in a sweep that does not declare a variant of that name (e.g. for stages no variant varies).
     pub fn params<P: StageParams>(&self, stage: &str, variant: &str) -> Result<P, WorkflowError> {
         let variant_def = self.variant(variant)?;
         let mut node = self.merged_stage_table(stage, variant_def)?;
