@@ -72,11 +72,13 @@ fn changing_one_param_reruns_that_stage_and_its_dependents_only() {
 #[test]
 fn early_cutoff_keeps_dependents_cached_when_output_is_identical() {
     let (_d, cache, items) = setup();
-    let mut cfg = ToyConfig::default();
-    cfg.scale = ToyScaleParams {
-        factor: 2.0,
-        quantum: 1.0,
-        faults: Faults::default(),
+    let mut cfg = ToyConfig {
+        scale: ToyScaleParams {
+            factor: 2.0,
+            quantum: 1.0,
+            faults: Faults::default(),
+        },
+        ..Default::default()
     };
     run(&cache, &toy_dag(&items, &cfg).0, Mode::Run);
     // 2.001 * v rounds to the same integers: toy_scale re-runs, its outputs are identical, toy_sum is cached.

@@ -13,7 +13,7 @@ pub const DEFAULT_WORKFLOW: &str = "workflows/default.toml";
 #[derive(Args, Debug, Clone, Default)]
 pub struct CacheOpt {
     /// Cache folder (default: $SKYTIE_CACHE, else ./cache).
-    #[arg(long, value_name = "DIR")]
+    #[arg(long, value_name = "DIR", global = true)]
     pub cache: Option<PathBuf>,
 }
 

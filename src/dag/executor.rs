@@ -169,11 +169,10 @@ pub fn execute(dag: &Dag, env: &Env<'_>, mode: Mode) -> Outcome {
     let mut slots: Vec<Mutex<Slot>> = (0..dag.nodes.len())
         .map(|_| Mutex::new(Slot::default()))
         .collect();
-    for (id, node) in dag.nodes.iter().enumerate() {
+    for node in &dag.nodes {
         for u in node.upstream_ids() {
             lock(&mut slots, u).consumers_left += 1;
         }
-        let _ = id;
     }
     let ex = Exec {
         dag,
@@ -273,8 +272,7 @@ fn touch_entry(store: &Store, key: &NodeKey) -> bool {
             return true;
         }
         // Not ours to touch (e.g. a read-only shared cache): fall back to an existence check.
-        return std::io::Error::last_os_error().kind() != std::io::ErrorKind::NotFound
-            && path.is_file();
+        std::io::Error::last_os_error().kind() != std::io::ErrorKind::NotFound && path.is_file()
     }
     #[cfg(not(unix))]
     match std::fs::File::open(&path) {
