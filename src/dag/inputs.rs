@@ -1,5 +1,13 @@
 //! Typed node inputs: `Handle<T>` (the output of another node), `RawFile` (a file hashed by content), and
-//! collections/tuples of those. Wiring a handle of the wrong type into a stage is a compile error.
+//! collections/tuples of those. Wiring a handle of the wrong type into a stage is a compile error:
+//!
+//! ```compile_fail
+//! use skytie::dag::DagBuilder;
+//! use skytie::testing::toy::{ToyGen, ToyScale};
+//! let mut b = DagBuilder::new();
+//! let folder = b.add(ToyGen, "g", Default::default(), ()).unwrap(); // Handle<ToyDir>
+//! b.add(ToyScale, "x", Default::default(), folder).unwrap(); // ToyScale reads a Handle<f64>
+//! ```
 
 use crate::dag::stage::StageError;
 use crate::hashing::ContentHash;
