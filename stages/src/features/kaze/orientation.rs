@@ -2,9 +2,11 @@
 //!
 //! With s = round(σ): derivative samples (Lx, Ly) of the keypoint's level at the pixels containing
 //! (u + i·s, v + j·s), integer i, j with i² + j² < 36 (109 samples), Gaussian-weighted (σ = 2.5·s) by the
-//! distance of the sampled pixel's centre from the keypoint. A π/3 sector slides in steps of 0.15 rad; the
+//! distance of the sampled pixel's centre from the keypoint. A π/3 sector slides around the circle; the
 //! sector with the longest summed vector gives θ = atan2(ΣLy, ΣLx) ∈ [0, 2π). Samples outside the image are
-//! skipped. θ is measured in the image frame (+x right, +y down), i.e. clockwise on screen.
+//! skipped. Deviation from OpenCV (which steps the sector start by 0.15 rad): the sector starts at every
+//! sample angle, i.e. the exact maximum over all sector positions, which also makes θ follow image
+//! rotations exactly (OpenCV's fixed 0.15 rad grid does not rotate with the image). θ is measured in the image frame (+x right, +y down), i.e. clockwise on screen.
 
 use std::f32::consts::PI;
 
@@ -12,7 +14,6 @@ use super::scale_space::Level;
 
 const SAMPLE_RADIUS: i32 = 6;
 const SECTOR_WIDTH_RAD: f32 = PI / 3.0;
-const SECTOR_STEP_RAD: f32 = 0.15;
 const MAX_SAMPLES: usize = 109;
 
 /// Angle of (x, y) in [0, 2π).
@@ -55,31 +56,42 @@ pub fn dominant_orientation(level: &Level, u_px: f32, v_px: f32, sigma_px: f32) 
             n += 1;
         }
     }
+    // Sectors anchored at every sample angle: the exact maximum over all sector positions (the 0.15 rad
+    // sweep of OpenCV samples these positions coarsely), and equivariant under image rotations.
+    let mut order = [0usize; MAX_SAMPLES];
+    for (k, o) in order.iter_mut().enumerate().take(n) {
+        *o = k;
+    }
+    let order = &mut order[..n];
+    order.sort_by(|&a, &b| angles[a].total_cmp(&angles[b]).then(a.cmp(&b)));
+    let angle_at = |j: usize| {
+        let a = angles[order[j % n]];
+        if j >= n {
+            a + 2.0 * PI
+        } else {
+            a
+        }
+    };
     let mut best_norm = 0.0f32;
     let mut best_angle = 0.0f32;
-    let mut start = 0.0f32;
-    while start < 2.0 * PI {
-        let end = start + SECTOR_WIDTH_RAD;
+    let mut end = 0usize;
+    for start in 0..n {
+        end = end.max(start);
+        while end < start + n && angle_at(end) < angle_at(start) + SECTOR_WIDTH_RAD {
+            end += 1;
+        }
+        // Sum in a fixed order (start..end) so the result does not depend on earlier windows.
         let (mut sx, mut sy) = (0.0f32, 0.0f32);
-        for k in 0..n {
-            let a = angles[k];
-            // Sector [start, end) wrapping past 2π.
-            let inside = if end <= 2.0 * PI {
-                a >= start && a < end
-            } else {
-                a >= start || a < end - 2.0 * PI
-            };
-            if inside {
-                sx += xs[k];
-                sy += ys[k];
-            }
+        for j in start..end {
+            let k = order[j % n];
+            sx += xs[k];
+            sy += ys[k];
         }
         let norm = sx * sx + sy * sy;
         if norm > best_norm {
             best_norm = norm;
             best_angle = angle_0_2pi(sx, sy);
         }
-        start += SECTOR_STEP_RAD;
     }
     best_angle
 }
