@@ -29,8 +29,17 @@ pub fn convolve_rows(img: &GrayImage, kernel: &[f32]) -> GrayImage {
         || vec![0.0f32; w + kernel.len() - 1],
         |padded, (row, out_row)| {
             let src = img.row(row);
-            for (k, p) in padded.iter_mut().enumerate() {
-                *p = src[reflect_index(k as isize - r as isize, w)];
+            out_row.fill(0.0);
+            // Interior copied as a block; only the 2r border samples need the reflection.
+            if r + tail <= w {
+                padded[r..r + w].copy_from_slice(src);
+                for k in (0..r).chain(r + w..padded.len()) {
+                    padded[k] = src[reflect_index(k as isize - r as isize, w)];
+                }
+            } else {
+                for (k, p) in padded.iter_mut().enumerate() {
+                    *p = src[reflect_index(k as isize - r as isize, w)];
+                }
             }
             debug_assert_eq!(padded.len(), w + r + tail);
             for (i, &kv) in kernel.iter().enumerate() {
