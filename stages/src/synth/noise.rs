@@ -14,16 +14,25 @@ pub fn mix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// Hash of a 2-D integer lattice point and a seed.
+/// Hash of a 2-D integer lattice point and a seed (one mixing round over a linear combination).
 #[inline]
 pub fn hash2(ix: i64, iy: i64, seed: u64) -> u64 {
-    mix64(seed ^ mix64((ix as u64).wrapping_mul(0x9E37_79B1) ^ mix64(iy as u64)))
+    mix64(
+        (ix as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ (iy as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
+            ^ seed,
+    )
 }
 
 /// Hash of a 3-D integer lattice point and a seed.
 #[inline]
 pub fn hash3(ix: i64, iy: i64, iz: i64, seed: u64) -> u64 {
-    mix64(hash2(ix, iy, seed) ^ (iz as u64).wrapping_mul(0xD6E8_FEB8_6659_FD93))
+    mix64(
+        (ix as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ (iy as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
+            ^ (iz as u64).wrapping_mul(0x1656_67B1_9E37_79F9)
+            ^ seed,
+    )
 }
 
 /// Map a hash to a uniform f32 in [0, 1).
@@ -156,19 +165,22 @@ pub fn value3(x: f64, y: f64, z: f64, seed: u64) -> f32 {
     lerp(a, b, sz)
 }
 
+/// The 8 gradient directions of [`gradient2`] (axes scaled by √2 so all have the same length).
+const GRADIENTS: [(f32, f32); 8] = [
+    (1.0, 1.0),
+    (1.0, -1.0),
+    (-1.0, 1.0),
+    (-1.0, -1.0),
+    (std::f32::consts::SQRT_2, 0.0),
+    (-std::f32::consts::SQRT_2, 0.0),
+    (0.0, std::f32::consts::SQRT_2),
+    (0.0, -std::f32::consts::SQRT_2),
+];
+
 #[inline]
 fn grad2(h: u64, fx: f32, fy: f32) -> f32 {
-    // 8 gradient directions
-    match h >> 61 {
-        0 => fx + fy,
-        1 => fx - fy,
-        2 => -fx + fy,
-        3 => -fx - fy,
-        4 => fx * std::f32::consts::SQRT_2,
-        5 => -fx * std::f32::consts::SQRT_2,
-        6 => fy * std::f32::consts::SQRT_2,
-        _ => -fy * std::f32::consts::SQRT_2,
-    }
+    let (gx, gy) = GRADIENTS[(h >> 61) as usize];
+    gx * fx + gy * fy
 }
 
 /// 2-D gradient (Perlin-style) noise, roughly in [-1, 1], zero at lattice points, unit lattice spacing.

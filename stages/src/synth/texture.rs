@@ -37,7 +37,7 @@ pub fn asphalt(x: f64, y: f64, seed: u64) -> [f32; 3] {
         seed ^ 0xA66,
     ));
     let stone = if stone > 0.93 { 0.06 } else { 0.0 };
-    let blotch = fbm2(x, y, seed ^ 0xB10, 0.35, 3, 0.55) * 0.045;
+    let blotch = fbm2(x, y, seed ^ 0xB10, 0.35, 2, 0.55) * 0.045;
     let mut v = 0.17 + grain + stone + blotch;
     // repair patches
     let (cx, cy) = (floor_f64(x / 7.0) as i64, floor_f64(y / 7.0) as i64);

@@ -116,10 +116,8 @@ impl Grid {
         };
         let px = o.x + t0 * d.x;
         let py = o.y + t0 * d.y;
-        let mut ix =
-            (((px - self.bounds.min.x) / self.cell_m).floor().max(0.0) as usize).min(self.nx - 1);
-        let mut iy =
-            (((py - self.bounds.min.y) / self.cell_m).floor().max(0.0) as usize).min(self.ny - 1);
+        let mut ix = (((px - self.bounds.min.x) / self.cell_m).max(0.0) as usize).min(self.nx - 1);
+        let mut iy = (((py - self.bounds.min.y) / self.cell_m).max(0.0) as usize).min(self.ny - 1);
         let (step_x, mut t_next_x, dt_x) = if d.x > 0.0 {
             let bx = self.bounds.min.x + (ix + 1) as f64 * self.cell_m;
             (1isize, (bx - o.x) * inv_d.x, self.cell_m * inv_d.x)
