@@ -183,6 +183,30 @@ impl Converter<'_, '_> {
     }
 }
 
+/// An error at `at`, naming the source file `at` points into.
+pub(crate) fn error_at(
+    sources: &[SourceFile],
+    at: Loc,
+    message: impl Into<String>,
+) -> WorkflowError {
+    let path = sources
+        .get(at.file)
+        .map_or_else(PathBuf::new, |s| s.path.clone());
+    WorkflowError::at(path, at.line, at.column, message)
+}
+
+/// "line 12" for a position in `file`, "other.toml:12" for one in another file.
+pub(crate) fn describe_position(sources: &[SourceFile], at: Loc, file: usize) -> String {
+    if at.file == file {
+        format!("line {}", at.line)
+    } else {
+        let path = sources
+            .get(at.file)
+            .map_or_else(PathBuf::new, |s| s.path.clone());
+        format!("{}:{}", path.display(), at.line)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -228,29 +252,5 @@ mod tests {
         let e = parse_source("a = 1\nb = = 2\n", Path::new("w.toml"), 0).unwrap_err();
         assert_eq!((e.line, e.column), (2, 5), "{e}");
         assert!(e.message.starts_with("TOML syntax error"), "{e}");
-    }
-}
-
-/// An error at `at`, naming the source file `at` points into.
-pub(crate) fn error_at(
-    sources: &[SourceFile],
-    at: Loc,
-    message: impl Into<String>,
-) -> WorkflowError {
-    let path = sources
-        .get(at.file)
-        .map_or_else(PathBuf::new, |s| s.path.clone());
-    WorkflowError::at(path, at.line, at.column, message)
-}
-
-/// "line 12" for a position in `file`, "other.toml:12" for one in another file.
-pub(crate) fn describe_position(sources: &[SourceFile], at: Loc, file: usize) -> String {
-    if at.file == file {
-        format!("line {}", at.line)
-    } else {
-        let path = sources
-            .get(at.file)
-            .map_or_else(PathBuf::new, |s| s.path.clone());
-        format!("{}:{}", path.display(), at.line)
     }
 }
