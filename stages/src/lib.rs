@@ -14,3 +14,4 @@ pub mod imaging;
 pub mod matching;
 pub mod nadir;
 pub mod synth;
+pub mod adjustment;

@@ -1,0 +1,252 @@
+//! The adjustment driver (thesis 5.4, 5.7; issue 6 "robust estimation"): solve with LM, reject observations
+//! whose |normalised residual| exceeds k (per tie
+//! point only the worst one per round), re-solve from the current estimate, repeat until nothing is
+//! rejected (or the round limit); then posterior σ per recording.
+//!
+//! Normalised residual: the residual divided by its a-priori σ (σ0 = 1), per component — the angular
+//! components of a panorama observation in units of its σ_θ (without the 5.7 weighting factor, so the test is
+//! the same for every weighting method) and the whitened coordinate residual `L⁻¹·e` of a control point. We do
+//! not divide by σ̂0 (exact synthetic data would make it 0) nor by the redundancy numbers (they would need the
+//! full inverse). Priors and relative constraints are never rejected.
+
+use super::covariance::recording_covariances;
+use super::prepared::Prepared;
+use super::problem::{AdjustError, AdjustOptions, Block};
+use super::residuals::{pano_residual, State};
+use super::solver::{solve, SolveReport, Termination};
+use crate::geometry::LocalOrigin;
+use nalgebra::Vector3;
+
+/// One adjusted recording.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AdjustedRecording {
+    /// Adjusted projection centre, world frame, metres.
+    pub position_world: Vector3<f64>,
+    /// Yaw correction added to the recorded yaw, degrees (0 unless estimated).
+    pub yaw_correction_deg: f64,
+    /// A-priori σ (σ0 = 1) of x, y, z, metres (0 for fixed coordinates).
+    pub sigma_a_priori_m: Vector3<f64>,
+    /// A-posteriori σ (scaled by σ̂0) of x, y, z, metres; `None` without redundancy.
+    pub sigma_a_posteriori_m: Option<Vector3<f64>>,
+    /// A-priori σ of the yaw correction, degrees (0 if not estimated).
+    pub sigma_yaw_a_priori_deg: f64,
+}
+
+/// Observation counts per type.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ObservationCounts {
+    pub pano: usize,
+    pub control: usize,
+    pub priors: usize,
+    pub relative: usize,
+}
+
+/// One solve and the rejections that followed it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoundReport {
+    pub solve: SolveReport,
+    pub rejected_pano: usize,
+    pub rejected_control: usize,
+}
+
+/// The result of [`adjust`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Adjustment {
+    pub recordings: Vec<AdjustedRecording>,
+    /// Adjusted tie points, world frame, metres (undetermined points keep their initial value).
+    pub points_world: Vec<Vector3<f64>>,
+    /// Whether each tie point was determined in the final solve (≥ 2 rays or a control point).
+    pub point_determined: Vec<bool>,
+    pub rounds: Vec<RoundReport>,
+    /// Accepted LM steps over all rounds.
+    pub iterations: usize,
+    /// Cost ½Σρ of the final solve.
+    pub final_cost: f64,
+    pub termination: Termination,
+    /// σ̂0² of the final solve (`None` without redundancy).
+    pub variance_factor: Option<f64>,
+    pub redundancy: i64,
+    /// Input observations per type.
+    pub observations: ObservationCounts,
+    /// Rejected observations per type (priors and relative constraints are never rejected).
+    pub rejected: ObservationCounts,
+    /// Indices of rejected panorama observations / control points, ascending.
+    pub rejected_pano: Vec<usize>,
+    pub rejected_control: Vec<usize>,
+    /// Panorama observations unused in the final solve although not rejected (undetermined point, or
+    /// weight 0 under weighting method 2).
+    pub unused_pano: usize,
+}
+
+/// Adjusts `block` with `options`.
+pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, AdjustError> {
+    block.validate()?;
+    options.validate()?;
+    let origin = LocalOrigin::at_mean(block.recordings.iter().map(|r| &r.camera.center_world))
+        .ok_or(AdjustError::NoRecordings)?;
+    let mut state = State {
+        origin,
+        centers_local: block
+            .recordings
+            .iter()
+            .map(|r| origin.to_local(&r.camera.center_world))
+            .collect(),
+        yaw_correction_rad: vec![0.0; block.recordings.len()],
+        points_local: block
+            .points_initial_world
+            .iter()
+            .map(|p| origin.to_local(p))
+            .collect(),
+    };
+    let mut pano_rejected = vec![false; block.pano_observations.len()];
+    let mut control_rejected = vec![false; block.control_points.len()];
+    let mut rounds = Vec::new();
+    let max_rounds = if options.rejection_threshold.is_some() {
+        options.max_rejection_rounds + 1
+    } else {
+        1
+    };
+    let mut prep;
+    loop {
+        prep = Prepared::new(block, options, &state, &pano_rejected, &control_rejected)?;
+        let report = solve(&prep, &mut state, &options.lm)?;
+        let mut round = RoundReport {
+            solve: report,
+            rejected_pano: 0,
+            rejected_control: 0,
+        };
+        if let Some(k) = options
+            .rejection_threshold
+            .filter(|_| rounds.len() + 1 < max_rounds)
+        {
+            // Per tie point, only its worst observation above k is rejected per round (one gross error at a
+            // time, as in data snooping): a gross error also inflates the residuals of the other rays of
+            // its point, which must not be rejected with it.
+            let mut worst: Vec<Option<(f64, Candidate)>> = vec![None; prep.point_active.len()];
+            let mut offer = |point: usize, value: f64, candidate: Candidate| {
+                if value > k && worst[point].is_none_or(|(w, _)| value > w) {
+                    worst[point] = Some((value, candidate));
+                }
+            };
+            for (i, o) in prep.pano.iter().enumerate() {
+                if o.active {
+                    offer(
+                        o.point,
+                        pano_normalised(&prep, i, &state),
+                        Candidate::Pano(i),
+                    );
+                }
+            }
+            for (i, c) in prep.control.iter().enumerate() {
+                if c.active {
+                    offer(
+                        c.point,
+                        prep.control_whitened(i, &state).amax(),
+                        Candidate::Control(i),
+                    );
+                }
+            }
+            for (_, candidate) in worst.into_iter().flatten() {
+                match candidate {
+                    Candidate::Pano(i) => {
+                        pano_rejected[i] = true;
+                        round.rejected_pano += 1;
+                    }
+                    Candidate::Control(i) => {
+                        control_rejected[i] = true;
+                        round.rejected_control += 1;
+                    }
+                }
+            }
+        }
+        let done = round.rejected_pano + round.rejected_control == 0;
+        rounds.push(round);
+        if done {
+            break;
+        }
+    }
+    let cov = recording_covariances(&prep, &state)?;
+    let recordings = (0..block.recordings.len())
+        .map(|c| {
+            let m = &cov.a_priori[c];
+            let sigma = Vector3::new(m[(0, 0)], m[(1, 1)], m[(2, 2)]).map(|v| v.max(0.0).sqrt());
+            AdjustedRecording {
+                position_world: origin.to_world(&state.centers_local[c]),
+                yaw_correction_deg: state.yaw_correction_rad[c].to_degrees(),
+                sigma_a_priori_m: sigma,
+                sigma_a_posteriori_m: cov.variance_factor.map(|f| sigma * f.sqrt()),
+                sigma_yaw_a_priori_deg: m[(3, 3)].max(0.0).sqrt().to_degrees(),
+            }
+        })
+        .collect();
+    let last = rounds.last().copied().expect("at least one round");
+    let rejected_pano: Vec<usize> = (0..pano_rejected.len())
+        .filter(|&i| pano_rejected[i])
+        .collect();
+    let rejected_control: Vec<usize> = (0..control_rejected.len())
+        .filter(|&i| control_rejected[i])
+        .collect();
+    let priors = block
+        .recordings
+        .iter()
+        .map(|r| {
+            usize::from(r.prior_sigma_xy_m.is_some()) * 2
+                + usize::from(r.prior_sigma_z_m.is_some() && !options.horizontal_only)
+        })
+        .sum();
+    Ok(Adjustment {
+        recordings,
+        points_world: state
+            .points_local
+            .iter()
+            .map(|p| origin.to_world(p))
+            .collect(),
+        point_determined: prep.point_active.clone(),
+        iterations: rounds.iter().map(|r| r.solve.iterations).sum(),
+        final_cost: last.solve.final_cost,
+        termination: last.solve.termination,
+        variance_factor: cov.variance_factor,
+        redundancy: cov.redundancy,
+        observations: ObservationCounts {
+            pano: block.pano_observations.len(),
+            control: block.control_points.len(),
+            priors,
+            relative: block.relative_constraints.len(),
+        },
+        rejected: ObservationCounts {
+            pano: rejected_pano.len(),
+            control: rejected_control.len(),
+            priors: 0,
+            relative: 0,
+        },
+        unused_pano: prep
+            .pano
+            .iter()
+            .zip(&pano_rejected)
+            .filter(|(o, &rej)| !o.active && !rej)
+            .count(),
+        rejected_pano,
+        rejected_control,
+        rounds,
+    })
+}
+
+/// An observation that may be rejected.
+#[derive(Clone, Copy, Debug)]
+enum Candidate {
+    Pano(usize),
+    Control(usize),
+}
+
+/// Largest |component| of a panorama observation's residual in units of its σ_θ (no 5.7 factor).
+fn pano_normalised(prep: &Prepared, i: usize, state: &State) -> f64 {
+    let o = &prep.pano[i];
+    pano_residual(
+        o.observed_rad,
+        &prep.rotations0[o.recording],
+        state.yaw_correction_rad[o.recording],
+        &state.centers_local[o.recording],
+        &state.points_local[o.point],
+    )
+    .map_or(f64::INFINITY, |(r, _, _)| r.amax() * o.whitening)
+}

@@ -1,0 +1,36 @@
+//! Bundle adjustment core (thesis 3.5.3 and chapter 5): corrects mobile-mapping recording positions (and,
+//! optionally, a yaw correction per recording) from panorama observations of tie points, aerial control
+//! points, weak priors on the recorded positions and optional relative constraints along the trajectory.
+//!
+//! Layers: [`problem`] (the block and the options), [`weighting`] (residual weighting methods 1–4 of thesis
+//! 5.7), [`robust`] (Huber/Cauchy losses), [`residuals`] (residuals and analytic Jacobians), [`skyline`]
+//! (envelope Cholesky of the reduced camera matrix), [`solver`] (Levenberg–Marquardt with the points
+//! eliminated by a Schur complement), [`covariance`] (posterior σ per recording), [`adjust`] (solve, reject
+//! by normalised residuals, re-solve), [`evaluate`] (check-point triangulation and RMSE), [`synthetic_block`]
+//! (known-answer test blocks).
+
+pub mod adjust;
+pub mod covariance;
+pub mod evaluate;
+pub mod prepared;
+pub mod problem;
+pub mod residuals;
+pub mod robust;
+pub mod skyline;
+pub mod solver;
+pub mod synthetic_block;
+pub mod weighting;
+
+pub use adjust::{adjust, AdjustedRecording, Adjustment, ObservationCounts, RoundReport};
+pub use evaluate::{
+    evaluate_checkpoints, CheckObservation, CheckPointError, CheckPointEvaluation, RmseSummary,
+    ViewSelection,
+};
+pub use problem::{
+    AdjustError, AdjustOptions, Block, BlockRecording, ControlPoint, LmOptions, PanoObservation,
+    RelativeConstraint,
+};
+pub use robust::RobustLoss;
+pub use solver::Termination;
+pub use synthetic_block::{SyntheticBlock, SyntheticBlockSpec};
+pub use weighting::{ResidualWeighting, WeightingMethod};

@@ -1,0 +1,425 @@
+//! One solve's fixed setup (local frame, active observations, weights, whitening) and the evaluation of its
+//! cost and its linearisation (thesis 5.4: the adjustment model; 5.7: residual weighting).
+//!
+//! Whitening: every residual is divided by its a-priori standard deviation, so the cost is
+//! `½·Σ ρ(‖r_obs‖²)` over panorama and control-point observations (robust loss ρ) plus `½·Σ ‖r‖²` over the
+//! priors and relative constraints. Panorama residuals are additionally multiplied by the thesis 5.7 weighting
+//! factor, fixed per solve from the distances at the start of the solve.
+
+use super::problem::{AdjustError, AdjustOptions, Block};
+use super::residuals::{observed_angles_rad, pano_residual, Parameterization, State};
+use super::robust::RobustLoss;
+use nalgebra::{Matrix3, Matrix4, SMatrix, Vector3, Vector4};
+
+/// 4 × 3 coupling block Jᵀ_camera·J_point of one panorama observation.
+pub type Coupling = SMatrix<f64, 4, 3>;
+
+/// A panorama observation ready for evaluation.
+#[derive(Clone, Copy, Debug)]
+pub struct PreparedPano {
+    pub recording: usize,
+    pub point: usize,
+    /// Observed (azimuth, elevation), radians.
+    pub observed_rad: (f64, f64),
+    /// 1 / σ_θ (radians⁻¹): whitens the angular residual.
+    pub whitening: f64,
+    /// Thesis 5.7 weighting factor (1 for method 1).
+    pub weight_factor: f64,
+    pub active: bool,
+}
+
+/// A control point ready for evaluation.
+#[derive(Clone, Copy, Debug)]
+pub struct PreparedControl {
+    pub point: usize,
+    pub position_local: Vector3<f64>,
+    /// L⁻¹ with covariance = L·Lᵀ: whitens the coordinate residual.
+    pub whitening: Matrix3<f64>,
+    pub active: bool,
+}
+
+/// The fixed setup of one solve.
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    pub parameterization: Parameterization,
+    pub loss: RobustLoss,
+    pub horizontal_only: bool,
+    /// Recorded pano→world rotations R0.
+    pub rotations0: Vec<Matrix3<f64>>,
+    /// Recorded centres, local frame (priors and relative constraints refer to them).
+    pub recorded_local: Vec<Vector3<f64>>,
+    pub prior_sigma_xy_m: Vec<Option<f64>>,
+    pub prior_sigma_z_m: Vec<Option<f64>>,
+    pub yaw_prior_sigma_rad: Option<f64>,
+    pub pano: Vec<PreparedPano>,
+    pub control: Vec<PreparedControl>,
+    /// (from, to, σ) with from ≠ to.
+    pub relative: Vec<(usize, usize, f64)>,
+    /// Points with enough active observations to be determined.
+    pub point_active: Vec<bool>,
+    /// Active panorama observations per point.
+    pub point_observations: Vec<Vec<usize>>,
+    /// Envelope of the reduced camera matrix: first coupled recording per recording.
+    pub first_recording: Vec<usize>,
+}
+
+/// Gradient and Gauss–Newton blocks at one state (robust weights included).
+#[derive(Clone, Debug)]
+pub struct Linearization {
+    /// Per recording: Jᵀ·J over (x, y, z, ψ).
+    pub camera_diag: Vec<Matrix4<f64>>,
+    /// (row recording, column recording < row, block) from relative constraints.
+    pub camera_off: Vec<(usize, usize, Matrix4<f64>)>,
+    /// Per recording: −Jᵀ·r.
+    pub camera_rhs: Vec<Vector4<f64>>,
+    /// Per point: Jᵀ·J.
+    pub point_diag: Vec<Matrix3<f64>>,
+    /// Per point: −Jᵀ·r.
+    pub point_rhs: Vec<Vector3<f64>>,
+    /// Per panorama observation: Jᵀ_camera·J_point (zero when inactive).
+    pub couplings: Vec<Coupling>,
+}
+
+impl Prepared {
+    /// Sets up a solve at `state`; `pano_rejected` / `control_rejected` flag observations removed by
+    /// earlier rejection rounds.
+    pub fn new(
+        block: &Block,
+        options: &AdjustOptions,
+        state: &State,
+        pano_rejected: &[bool],
+        control_rejected: &[bool],
+    ) -> Result<Self, AdjustError> {
+        let n_rec = block.recordings.len();
+        let n_pts = block.points_initial_world.len();
+        let rotations0: Vec<Matrix3<f64>> = block
+            .recordings
+            .iter()
+            .map(|r| r.camera.rotation_pano_to_world)
+            .collect();
+        let recorded_local = block
+            .recordings
+            .iter()
+            .map(|r| state.origin.to_local(&r.camera.center_world))
+            .collect();
+        let mut pano = Vec::with_capacity(block.pano_observations.len());
+        for (index, o) in block.pano_observations.iter().enumerate() {
+            let cam = &block.recordings[o.recording].camera;
+            let observed_rad = observed_angles_rad(o.u_px, o.v_px, cam.width_px, cam.height_px);
+            let distance_m =
+                (state.points_local[o.point] - state.centers_local[o.recording]).norm();
+            let weight_factor = options
+                .weighting
+                .factor(distance_m, cam.pixel_angle_rad().to_degrees());
+            if pano_residual(
+                observed_rad,
+                &rotations0[o.recording],
+                state.yaw_correction_rad[o.recording],
+                &state.centers_local[o.recording],
+                &state.points_local[o.point],
+            )
+            .is_none()
+            {
+                return Err(AdjustError::InvalidPanoObservation {
+                    index,
+                    problem: "the tie point lies at or straight above/below the recording centre; \
+                              check its initial coordinates"
+                        .to_string(),
+                });
+            }
+            pano.push(PreparedPano {
+                recording: o.recording,
+                point: o.point,
+                observed_rad,
+                whitening: 1.0 / cam.angular_sigma_rad(o.sigma_px),
+                weight_factor,
+                active: !pano_rejected[index] && weight_factor > 0.0,
+            });
+        }
+        let mut control = Vec::with_capacity(block.control_points.len());
+        for (index, cp) in block.control_points.iter().enumerate() {
+            let chol =
+                cp.covariance_m2
+                    .cholesky()
+                    .ok_or_else(|| AdjustError::InvalidControlPoint {
+                        index,
+                        problem: "covariance is not symmetric positive definite".to_string(),
+                    })?;
+            let whitening =
+                chol.l()
+                    .try_inverse()
+                    .ok_or_else(|| AdjustError::InvalidControlPoint {
+                        index,
+                        problem: "covariance is singular".to_string(),
+                    })?;
+            control.push(PreparedControl {
+                point: cp.point,
+                position_local: state.origin.to_local(&cp.position_world),
+                whitening,
+                active: !control_rejected[index],
+            });
+        }
+        // A point is determined by ≥ 2 active panorama rays or an active control point.
+        let mut rays = vec![0usize; n_pts];
+        for o in pano.iter().filter(|o| o.active) {
+            rays[o.point] += 1;
+        }
+        let mut controlled = vec![false; n_pts];
+        for c in control.iter().filter(|c| c.active) {
+            controlled[c.point] = true;
+        }
+        let point_active: Vec<bool> = (0..n_pts).map(|p| rays[p] >= 2 || controlled[p]).collect();
+        for o in pano.iter_mut() {
+            o.active &= point_active[o.point];
+        }
+        let mut point_observations = vec![Vec::new(); n_pts];
+        for (i, o) in pano.iter().enumerate().filter(|(_, o)| o.active) {
+            point_observations[o.point].push(i);
+        }
+        let relative: Vec<(usize, usize, f64)> = block
+            .relative_constraints
+            .iter()
+            .map(|r| (r.from, r.to, r.sigma_m))
+            .collect();
+        let mut first_recording: Vec<usize> = (0..n_rec).collect();
+        for obs in &point_observations {
+            if let Some(min) = obs.iter().map(|&i| pano[i].recording).min() {
+                for &i in obs {
+                    let r = pano[i].recording;
+                    first_recording[r] = first_recording[r].min(min);
+                }
+            }
+        }
+        for &(a, b, _) in &relative {
+            let (lo, hi) = (a.min(b), a.max(b));
+            first_recording[hi] = first_recording[hi].min(lo);
+        }
+        Ok(Self {
+            parameterization: Parameterization::from_options(options),
+            loss: options.loss,
+            horizontal_only: options.horizontal_only,
+            rotations0,
+            recorded_local,
+            prior_sigma_xy_m: block
+                .recordings
+                .iter()
+                .map(|r| r.prior_sigma_xy_m)
+                .collect(),
+            prior_sigma_z_m: block.recordings.iter().map(|r| r.prior_sigma_z_m).collect(),
+            yaw_prior_sigma_rad: options
+                .estimate_yaw
+                .then_some(options.yaw_prior_sigma_deg.map(f64::to_radians))
+                .flatten(),
+            pano,
+            control,
+            relative,
+            point_active,
+            point_observations,
+            first_recording,
+        })
+    }
+
+    /// Number of axes (of x, y, z) that are free: 2 horizontal-only, else 3.
+    fn position_axes(&self) -> usize {
+        if self.horizontal_only {
+            2
+        } else {
+            3
+        }
+    }
+
+    /// Whitened, weighted residual of panorama observation `i` and its Jacobians (before the robust scaling);
+    /// `None` for a degenerate geometry.
+    pub fn pano_whitened(
+        &self,
+        i: usize,
+        state: &State,
+    ) -> Option<(
+        nalgebra::Vector2<f64>,
+        super::residuals::CameraJacobian2,
+        nalgebra::Matrix2x3<f64>,
+    )> {
+        let o = &self.pano[i];
+        let (r, jc, jp) = pano_residual(
+            o.observed_rad,
+            &self.rotations0[o.recording],
+            state.yaw_correction_rad[o.recording],
+            &state.centers_local[o.recording],
+            &state.points_local[o.point],
+        )?;
+        let s = o.whitening * o.weight_factor;
+        Some((r * s, jc * s, jp * s))
+    }
+
+    /// Whitened residual of control point `i`.
+    pub fn control_whitened(&self, i: usize, state: &State) -> Vector3<f64> {
+        let c = &self.control[i];
+        c.whitening * (state.points_local[c.point] - c.position_local)
+    }
+
+    /// Whitened prior residuals of recording `c`: (axis, residual, 1/σ) for each prior axis.
+    fn prior_terms(&self, c: usize, state: &State) -> [(usize, f64, f64); 3] {
+        let d = state.centers_local[c] - self.recorded_local[c];
+        let mut out = [(0, 0.0, 0.0); 3];
+        if let Some(s) = self.prior_sigma_xy_m[c] {
+            out[0] = (0, d.x / s, 1.0 / s);
+            out[1] = (1, d.y / s, 1.0 / s);
+        }
+        if let (Some(s), false) = (self.prior_sigma_z_m[c], self.horizontal_only) {
+            out[2] = (2, d.z / s, 1.0 / s);
+        }
+        out
+    }
+
+    /// Relative-constraint residual (whitened) of constraint `i`, per free axis.
+    fn relative_residual(&self, i: usize, state: &State) -> Vector3<f64> {
+        let (a, b, sigma) = self.relative[i];
+        let kept = self.recorded_local[b] - self.recorded_local[a];
+        let mut r = (state.centers_local[b] - state.centers_local[a] - kept) / sigma;
+        if self.horizontal_only {
+            r.z = 0.0;
+        }
+        r
+    }
+
+    /// The cost ½·Σρ at `state`; +∞ if some observation is geometrically degenerate there.
+    pub fn cost(&self, state: &State) -> f64 {
+        let mut total = 0.0;
+        for (i, o) in self.pano.iter().enumerate() {
+            if !o.active {
+                continue;
+            }
+            match self.pano_whitened(i, state) {
+                Some((r, _, _)) => total += self.loss.rho(r.norm_squared()),
+                None => return f64::INFINITY,
+            }
+        }
+        for (i, c) in self.control.iter().enumerate() {
+            if c.active {
+                total += self
+                    .loss
+                    .rho(self.control_whitened(i, state).norm_squared());
+            }
+        }
+        total += self.gaussian_terms(state);
+        0.5 * total
+    }
+
+    /// Σ‖r‖² of the priors, yaw priors and relative constraints (never robustified).
+    fn gaussian_terms(&self, state: &State) -> f64 {
+        let mut total = 0.0;
+        for c in 0..self.recorded_local.len() {
+            for (_, r, _) in self.prior_terms(c, state) {
+                total += r * r;
+            }
+            if let Some(s) = self.yaw_prior_sigma_rad {
+                total += (state.yaw_correction_rad[c] / s).powi(2);
+            }
+        }
+        for i in 0..self.relative.len() {
+            total += self.relative_residual(i, state).norm_squared();
+        }
+        total
+    }
+
+    /// Normal-equation blocks at `state`; degenerate observations (rare, only far from the solution)
+    /// contribute nothing.
+    pub fn linearize(&self, state: &State) -> Linearization {
+        let n_rec = self.recorded_local.len();
+        let n_pts = self.point_active.len();
+        let mut lin = Linearization {
+            camera_diag: vec![Matrix4::zeros(); n_rec],
+            camera_off: Vec::with_capacity(self.relative.len()),
+            camera_rhs: vec![Vector4::zeros(); n_rec],
+            point_diag: vec![Matrix3::zeros(); n_pts],
+            point_rhs: vec![Vector3::zeros(); n_pts],
+            couplings: vec![Coupling::zeros(); self.pano.len()],
+        };
+        for (i, o) in self.pano.iter().enumerate() {
+            if !o.active {
+                continue;
+            }
+            let Some((r, jc, jp)) = self.pano_whitened(i, state) else {
+                continue;
+            };
+            let w = self.loss.weight(r.norm_squared());
+            lin.camera_diag[o.recording] += w * jc.transpose() * jc;
+            lin.camera_rhs[o.recording] -= w * jc.transpose() * r;
+            lin.point_diag[o.point] += w * jp.transpose() * jp;
+            lin.point_rhs[o.point] -= w * jp.transpose() * r;
+            lin.couplings[i] = w * jc.transpose() * jp;
+        }
+        for (i, c) in self.control.iter().enumerate() {
+            if !c.active {
+                continue;
+            }
+            let r = self.control_whitened(i, state);
+            let w = self.loss.weight(r.norm_squared());
+            let j = c.whitening;
+            lin.point_diag[c.point] += w * j.transpose() * j;
+            lin.point_rhs[c.point] -= w * j.transpose() * r;
+        }
+        for c in 0..n_rec {
+            for (axis, r, inv_sigma) in self.prior_terms(c, state) {
+                if inv_sigma > 0.0 {
+                    lin.camera_diag[c][(axis, axis)] += inv_sigma * inv_sigma;
+                    lin.camera_rhs[c][axis] -= inv_sigma * r;
+                }
+            }
+            if let Some(s) = self.yaw_prior_sigma_rad {
+                lin.camera_diag[c][(3, 3)] += 1.0 / (s * s);
+                lin.camera_rhs[c][3] -= state.yaw_correction_rad[c] / (s * s);
+            }
+        }
+        for i in 0..self.relative.len() {
+            let (a, b, sigma) = self.relative[i];
+            let r = self.relative_residual(i, state);
+            let inv2 = 1.0 / (sigma * sigma);
+            let mut block = Matrix4::zeros();
+            for axis in 0..self.position_axes() {
+                lin.camera_diag[a][(axis, axis)] += inv2;
+                lin.camera_diag[b][(axis, axis)] += inv2;
+                block[(axis, axis)] = -inv2;
+                // J_a = −I/σ, J_b = I/σ.
+                lin.camera_rhs[a][axis] += r[axis] / sigma;
+                lin.camera_rhs[b][axis] -= r[axis] / sigma;
+            }
+            let (row, col) = if a > b { (a, b) } else { (b, a) };
+            lin.camera_off.push((row, col, block));
+        }
+        lin
+    }
+
+    /// Squared-residual sum Σ‖r‖² of the active observations without robust loss (for σ̂0²), and the number of
+    /// residual components.
+    pub fn plain_sum_of_squares(&self, state: &State) -> (f64, usize) {
+        let mut total = self.gaussian_terms(state);
+        let mut count = 0usize;
+        for (i, o) in self.pano.iter().enumerate() {
+            if o.active {
+                if let Some((r, _, _)) = self.pano_whitened(i, state) {
+                    total += r.norm_squared();
+                    count += 2;
+                }
+            }
+        }
+        for (i, c) in self.control.iter().enumerate() {
+            if c.active {
+                total += self.control_whitened(i, state).norm_squared();
+                count += 3;
+            }
+        }
+        for c in 0..self.recorded_local.len() {
+            count += self
+                .prior_terms(c, state)
+                .iter()
+                .filter(|t| t.2 > 0.0)
+                .count();
+            if self.yaw_prior_sigma_rad.is_some() {
+                count += 1;
+            }
+        }
+        count += self.relative.len() * self.position_axes();
+        (total, count)
+    }
+}

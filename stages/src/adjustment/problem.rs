@@ -1,0 +1,327 @@
+//! The adjustment block (unknowns and observations) and the options of one adjustment configuration
+//! (thesis 5.4 and 5.7), with validation that names the offending item.
+//!
+//! Frames and units: world coordinates are f64 metres (X east, Y north, Z up); the solver works in a local
+//! frame shifted to the mean recording centre. Pixel coordinates follow campaign-format.md (continuous, first
+//! pixel centre at 0.5). Angles carry their unit in the name.
+
+use super::robust::RobustLoss;
+use super::weighting::ResidualWeighting;
+use crate::geometry::PanoramaCamera;
+use nalgebra::{Matrix3, Vector3};
+
+/// Default σ of an aerial control point, metres (thesis 5.4.3).
+pub const DEFAULT_CONTROL_SIGMA_M: f64 = 0.10;
+
+/// One mobile-mapping recording: its recorded pose (the initial value and the prior) and prior weights.
+#[derive(Clone, Debug)]
+pub struct BlockRecording {
+    /// Recorded pose: projection centre (world, m), residual rotation and image size.
+    pub camera: PanoramaCamera,
+    /// σ of the recorded X and Y as a weak prior, metres; `None` = no horizontal prior.
+    pub prior_sigma_xy_m: Option<f64>,
+    /// σ of the recorded Z as a weak prior, metres; `None` = no vertical prior.
+    pub prior_sigma_z_m: Option<f64>,
+}
+
+/// A panorama observation of a tie point: continuous pixel (u, v) in recording `recording`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PanoObservation {
+    pub recording: usize,
+    pub point: usize,
+    pub u_px: f64,
+    pub v_px: f64,
+    /// Standard deviation of the pixel measurement, pixels (both directions).
+    pub sigma_px: f64,
+}
+
+/// An aerial control point: tie point `point` is tied to a known 3-D position (triangulated from ≥ 2 aerial
+/// images) with the given covariance (thesis 5.4.3: σ = 0.10 m isotropic by default).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ControlPoint {
+    pub point: usize,
+    /// Known position, world frame, metres.
+    pub position_world: Vector3<f64>,
+    /// Covariance of the known position, m² (symmetric positive definite).
+    pub covariance_m2: Matrix3<f64>,
+}
+
+impl ControlPoint {
+    /// A control point with isotropic standard deviation `sigma_m` in X, Y and Z.
+    pub fn isotropic(point: usize, position_world: Vector3<f64>, sigma_m: f64) -> Self {
+        Self {
+            point,
+            position_world,
+            covariance_m2: Matrix3::identity() * (sigma_m * sigma_m),
+        }
+    }
+}
+
+/// A relative constraint between two recordings (thesis 3.4.2: the trajectory's high relative accuracy):
+/// the difference of their recorded positions is kept with standard deviation `sigma_m` per axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RelativeConstraint {
+    pub from: usize,
+    pub to: usize,
+    pub sigma_m: f64,
+}
+
+/// Everything the adjustment estimates from: recordings (initial poses and priors), initial tie-point
+/// coordinates and the observations.
+#[derive(Clone, Debug, Default)]
+pub struct Block {
+    pub recordings: Vec<BlockRecording>,
+    /// Initial tie-point coordinates, world frame, metres (e.g. triangulated with the recorded poses).
+    pub points_initial_world: Vec<Vector3<f64>>,
+    pub pano_observations: Vec<PanoObservation>,
+    pub control_points: Vec<ControlPoint>,
+    pub relative_constraints: Vec<RelativeConstraint>,
+}
+
+/// Levenberg–Marquardt settings and convergence criteria.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LmOptions {
+    /// Largest number of accepted linearisations per solve.
+    pub max_iterations: usize,
+    /// Converged when an accepted step lowers the cost by less than this fraction of it.
+    pub relative_cost_tolerance: f64,
+    /// Converged when the largest parameter update is below this (metres / radians).
+    pub step_tolerance: f64,
+    /// Initial Marquardt damping λ (the normal matrix diagonal is scaled by 1 + λ).
+    pub initial_lambda: f64,
+}
+
+impl Default for LmOptions {
+    fn default() -> Self {
+        Self {
+            max_iterations: 100,
+            relative_cost_tolerance: 1e-12,
+            step_tolerance: 1e-10,
+            initial_lambda: 1e-4,
+        }
+    }
+}
+
+/// One adjustment configuration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdjustOptions {
+    /// Horizontal-only adjustment (thesis 5.7): recording Z is fixed at its recorded value.
+    pub horizontal_only: bool,
+    /// Estimate a yaw correction per recording (added to the recorded yaw).
+    pub estimate_yaw: bool,
+    /// σ of a zero prior on each yaw correction, degrees (`None` = no prior).
+    pub yaw_prior_sigma_deg: Option<f64>,
+    /// Residual weighting of panorama observations (thesis 5.7 methods 1–4).
+    pub weighting: ResidualWeighting,
+    /// Loss on panorama and control-point residuals (IRLS inside LM).
+    pub loss: RobustLoss,
+    /// Reject observations whose |normalised residual| exceeds this and re-solve (`None` = no rejection).
+    pub rejection_threshold: Option<f64>,
+    /// Largest number of rejection rounds (re-solves after rejections).
+    pub max_rejection_rounds: usize,
+    pub lm: LmOptions,
+}
+
+impl Default for AdjustOptions {
+    fn default() -> Self {
+        Self {
+            horizontal_only: false,
+            estimate_yaw: false,
+            yaw_prior_sigma_deg: None,
+            weighting: ResidualWeighting::default(),
+            loss: RobustLoss::Squared,
+            rejection_threshold: None,
+            max_rejection_rounds: 10,
+            lm: LmOptions::default(),
+        }
+    }
+}
+
+impl AdjustOptions {
+    /// The robust variant: Huber loss (threshold 2σ) and rejection of |normalised residual| > 3.
+    pub fn robust() -> Self {
+        Self {
+            loss: RobustLoss::Huber { threshold: 2.0 },
+            rejection_threshold: Some(3.0),
+            ..Self::default()
+        }
+    }
+}
+
+/// Why an adjustment could not be set up or solved.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum AdjustError {
+    #[error("the block has no recordings; add at least one recording")]
+    NoRecordings,
+    #[error("recording {index}: {field} = {value} is not valid ({hint})")]
+    InvalidRecording {
+        index: usize,
+        field: &'static str,
+        value: f64,
+        hint: &'static str,
+    },
+    #[error(
+        "tie point {index}: initial coordinates are not finite; triangulate it first or drop it"
+    )]
+    InvalidPoint { index: usize },
+    #[error("panorama observation {index}: {problem}")]
+    InvalidPanoObservation { index: usize, problem: String },
+    #[error("control point {index}: {problem}")]
+    InvalidControlPoint { index: usize, problem: String },
+    #[error("relative constraint {index}: {problem}")]
+    InvalidRelativeConstraint { index: usize, problem: String },
+    #[error("option {field} = {value} is not valid ({hint})")]
+    InvalidOption {
+        field: &'static str,
+        value: f64,
+        hint: &'static str,
+    },
+    #[error(
+        "the reduced normal matrix is singular at recording {recording} (parameter {parameter}): the block does \
+         not determine it; add priors (sigma_xy/sigma_z), control points or observations of that recording"
+    )]
+    Singular { recording: usize, parameter: usize },
+}
+
+fn positive_finite(x: f64) -> bool {
+    x.is_finite() && x > 0.0
+}
+
+impl Block {
+    /// Checks indices, finiteness and positivity of all inputs; the error names the first bad item.
+    pub fn validate(&self) -> Result<(), AdjustError> {
+        if self.recordings.is_empty() {
+            return Err(AdjustError::NoRecordings);
+        }
+        for (index, rec) in self.recordings.iter().enumerate() {
+            let c = &rec.camera.center_world;
+            for (field, value) in [("x", c.x), ("y", c.y), ("z", c.z)] {
+                if !value.is_finite() {
+                    return Err(AdjustError::InvalidRecording {
+                        index,
+                        field,
+                        value,
+                        hint: "coordinates must be finite metres",
+                    });
+                }
+            }
+            if rec.camera.width_px == 0 || rec.camera.height_px == 0 {
+                return Err(AdjustError::InvalidRecording {
+                    index,
+                    field: "width_px",
+                    value: f64::from(rec.camera.width_px),
+                    hint: "image size must be positive",
+                });
+            }
+            for (field, sigma) in [
+                ("sigma_xy_m", rec.prior_sigma_xy_m),
+                ("sigma_z_m", rec.prior_sigma_z_m),
+            ] {
+                if let Some(s) = sigma {
+                    if !positive_finite(s) {
+                        return Err(AdjustError::InvalidRecording {
+                            index,
+                            field,
+                            value: s,
+                            hint: "a prior sigma must be finite and > 0, or absent",
+                        });
+                    }
+                }
+            }
+        }
+        for (index, p) in self.points_initial_world.iter().enumerate() {
+            if !p.iter().all(|v| v.is_finite()) {
+                return Err(AdjustError::InvalidPoint { index });
+            }
+        }
+        let n_rec = self.recordings.len();
+        let n_pts = self.points_initial_world.len();
+        for (index, o) in self.pano_observations.iter().enumerate() {
+            let problem = if o.recording >= n_rec {
+                Some(format!(
+                    "recording index {} ≥ {n_rec} recordings",
+                    o.recording
+                ))
+            } else if o.point >= n_pts {
+                Some(format!("point index {} ≥ {n_pts} points", o.point))
+            } else if !(o.u_px.is_finite() && o.v_px.is_finite()) {
+                Some("pixel coordinates are not finite".to_string())
+            } else if !positive_finite(o.sigma_px) {
+                Some(format!("sigma_px = {} must be finite and > 0", o.sigma_px))
+            } else {
+                let cam = &self.recordings[o.recording].camera;
+                let v_max = f64::from(cam.height_px);
+                (!(o.v_px > 0.0 && o.v_px < v_max)).then(|| {
+                    format!(
+                        "v_px = {} outside (0, {v_max}) (the poles have no azimuth)",
+                        o.v_px
+                    )
+                })
+            };
+            if let Some(problem) = problem {
+                return Err(AdjustError::InvalidPanoObservation { index, problem });
+            }
+        }
+        for (index, cp) in self.control_points.iter().enumerate() {
+            let problem = if cp.point >= n_pts {
+                Some(format!("point index {} ≥ {n_pts} points", cp.point))
+            } else if !cp.position_world.iter().all(|v| v.is_finite()) {
+                Some("position is not finite".to_string())
+            } else if cp.covariance_m2.cholesky().is_none()
+                || !cp.covariance_m2.iter().all(|v| v.is_finite())
+            {
+                Some("covariance is not symmetric positive definite".to_string())
+            } else {
+                None
+            };
+            if let Some(problem) = problem {
+                return Err(AdjustError::InvalidControlPoint { index, problem });
+            }
+        }
+        for (index, rc) in self.relative_constraints.iter().enumerate() {
+            let problem = if rc.from >= n_rec || rc.to >= n_rec {
+                Some(format!(
+                    "recording indices {} / {} must be < {n_rec}",
+                    rc.from, rc.to
+                ))
+            } else if rc.from == rc.to {
+                Some("from and to are the same recording".to_string())
+            } else if !positive_finite(rc.sigma_m) {
+                Some(format!("sigma_m = {} must be finite and > 0", rc.sigma_m))
+            } else {
+                None
+            };
+            if let Some(problem) = problem {
+                return Err(AdjustError::InvalidRelativeConstraint { index, problem });
+            }
+        }
+        Ok(())
+    }
+}
+
+impl AdjustOptions {
+    /// Checks the numeric options.
+    pub fn validate(&self) -> Result<(), AdjustError> {
+        if let Some(s) = self.yaw_prior_sigma_deg {
+            if !positive_finite(s) {
+                return Err(AdjustError::InvalidOption {
+                    field: "yaw_prior_sigma_deg",
+                    value: s,
+                    hint: "must be finite and > 0, or absent",
+                });
+            }
+        }
+        if let Some(k) = self.rejection_threshold {
+            if !positive_finite(k) {
+                return Err(AdjustError::InvalidOption {
+                    field: "rejection_threshold",
+                    value: k,
+                    hint: "must be finite and > 0 (e.g. 3), or absent",
+                });
+            }
+        }
+        self.weighting.validate()?;
+        self.loss.validate()?;
+        Ok(())
+    }
+}

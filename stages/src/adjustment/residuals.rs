@@ -1,0 +1,211 @@
+//! Residuals and analytic Jacobians of the adjustment's observations, and the parameterisation of the
+//! unknowns (thesis 5.4: recording positions, optional yaw, tie-point coordinates).
+//!
+//! Unknowns per recording (local frame, see [`State`]): centre x, y, z (metres) and a yaw correction ψ
+//! (radians); horizontal-only fixes z, `estimate_yaw = false` fixes ψ = 0. The corrected panorama rotation
+//! is `R = Rz(−ψ)·R0` with `R0 = Rz(−yaw)·Rx(pitch)·Ry(roll)` the recorded one, i.e. the panorama's yaw
+//! becomes `yaw + ψ`.
+//!
+//! Panorama observation residual (radians): with `p = Rᵀ(X − C)` the point in the panorama frame,
+//! azimuth `A = atan2(p_x, p_y)` and elevation `E = atan2(p_z, ‖p_xy‖)`, the residual is
+//! `(wrap(A − A_obs)·cos E_obs, E − E_obs)`: two nearly isotropic angular components (the azimuth
+//! difference scaled to arc length on the unit sphere), whitened by σ_θ = σ_px·2π/W.
+
+use super::problem::AdjustOptions;
+use crate::geometry::{rot_z, LocalOrigin};
+use nalgebra::{Matrix2x3, Matrix3, SMatrix, Vector2, Vector3};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+/// Number of recording parameters before masking: x, y, z, ψ.
+pub const FULL_CAMERA_PARAMS: usize = 4;
+
+/// 2 × 4 Jacobian of a panorama residual with respect to (x, y, z, ψ) of its recording.
+pub type CameraJacobian2 = SMatrix<f64, 2, FULL_CAMERA_PARAMS>;
+
+/// Which of (x, y, z, ψ) are free.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Parameterization {
+    /// Free full-parameter indices in order (subset of 0..4).
+    pub active: Vec<usize>,
+}
+
+impl Parameterization {
+    /// The free parameters of a configuration.
+    pub fn from_options(options: &AdjustOptions) -> Self {
+        let mut active = vec![0, 1];
+        if !options.horizontal_only {
+            active.push(2);
+        }
+        if options.estimate_yaw {
+            active.push(3);
+        }
+        Self { active }
+    }
+
+    /// Free parameters per recording.
+    pub fn per_recording(&self) -> usize {
+        self.active.len()
+    }
+}
+
+/// The current estimate, in the local frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct State {
+    pub origin: LocalOrigin,
+    /// Recording centres, local frame, metres.
+    pub centers_local: Vec<Vector3<f64>>,
+    /// Yaw corrections ψ, radians.
+    pub yaw_correction_rad: Vec<f64>,
+    /// Tie points, local frame, metres.
+    pub points_local: Vec<Vector3<f64>>,
+}
+
+impl State {
+    /// Adds an update of the free camera parameters (`camera_step`, `per_recording` values per recording in
+    /// `parameterization.active` order) and of the points (3 per point; unconstrained points get zero).
+    pub fn apply(
+        &self,
+        parameterization: &Parameterization,
+        camera_step: &[f64],
+        point_step: &[Vector3<f64>],
+    ) -> State {
+        let k = parameterization.per_recording();
+        let mut next = self.clone();
+        for (c, center) in next.centers_local.iter_mut().enumerate() {
+            for (slot, &full) in parameterization.active.iter().enumerate() {
+                let delta = camera_step[c * k + slot];
+                if full < 3 {
+                    center[full] += delta;
+                } else {
+                    next.yaw_correction_rad[c] += delta;
+                }
+            }
+        }
+        for (p, step) in next.points_local.iter_mut().zip(point_step) {
+            *p += step;
+        }
+        next
+    }
+}
+
+/// Observed azimuth and elevation (radians) of a continuous panorama pixel (campaign-format.md).
+pub fn observed_angles_rad(u_px: f64, v_px: f64, width_px: u32, height_px: u32) -> (f64, f64) {
+    let azimuth = TAU * u_px / f64::from(width_px) - PI;
+    let elevation = FRAC_PI_2 - PI * v_px / f64::from(height_px);
+    (azimuth, elevation)
+}
+
+/// Wraps an angle difference into [−π, π).
+pub fn wrap_pi(a_rad: f64) -> f64 {
+    (a_rad + PI).rem_euclid(TAU) - PI
+}
+
+/// Generator of rotations about Z: d/dψ Rz(ψ) = Rz(ψ)·K.
+fn k_z() -> Matrix3<f64> {
+    Matrix3::new(0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+}
+
+/// Residual (radians, unwhitened) of a panorama observation and its Jacobians with respect to the recording's
+/// (x, y, z, ψ) and the point's (x, y, z). `rotation0` is the recorded pano→world rotation R0.
+/// `None` if the point coincides with the projection centre or lies on the vertical through it.
+pub fn pano_residual(
+    observed_rad: (f64, f64),
+    rotation0: &Matrix3<f64>,
+    yaw_correction_rad: f64,
+    center_local: &Vector3<f64>,
+    point_local: &Vector3<f64>,
+) -> Option<(Vector2<f64>, CameraJacobian2, Matrix2x3<f64>)> {
+    let rotation = rot_z(-yaw_correction_rad) * rotation0;
+    let rt = rotation.transpose();
+    let diff = point_local - center_local;
+    let p = rt * diff;
+    let h2 = p.x * p.x + p.y * p.y;
+    let n2 = h2 + p.z * p.z;
+    if !(h2 > 1e-18 && n2.is_finite()) {
+        return None;
+    }
+    let h = h2.sqrt();
+    let (az_obs, el_obs) = observed_rad;
+    let cos_el_obs = el_obs.cos();
+    let az = p.x.atan2(p.y);
+    let el = p.z.atan2(h);
+    let r = Vector2::new(wrap_pi(az - az_obs) * cos_el_obs, el - el_obs);
+    // d(az, el)/dp.
+    let d_az = [p.y / h2, -p.x / h2, 0.0];
+    let d_el = [-p.x * p.z / (h * n2), -p.y * p.z / (h * n2), h / n2];
+    let mut d_res_dp = Matrix2x3::zeros();
+    for j in 0..3 {
+        d_res_dp[(0, j)] = d_az[j] * cos_el_obs;
+        d_res_dp[(1, j)] = d_el[j];
+    }
+    let j_point = d_res_dp * rt;
+    let dp_dyaw = rt * (k_z() * diff);
+    let mut j_camera = CameraJacobian2::zeros();
+    for row in 0..2 {
+        for col in 0..3 {
+            j_camera[(row, col)] = -j_point[(row, col)];
+        }
+        j_camera[(row, 3)] = (d_res_dp.row(row) * dp_dyaw)[(0, 0)];
+    }
+    Some((r, j_camera, j_point))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{panorama_rotation, PanoramaCamera};
+
+    #[test]
+    fn residual_is_zero_at_the_true_pose_and_jacobian_matches_finite_differences() {
+        let center = Vector3::new(1.0, -2.0, 2.5);
+        let point = Vector3::new(7.0, 4.0, 0.3);
+        let (yaw, pitch, roll) = (12.0, 1.5, -0.7);
+        let psi = 0.01_f64;
+        let cam = PanoramaCamera::new(4800, 2400, center, yaw + psi.to_degrees(), pitch, roll);
+        let (u, v) = cam.project_world(&point).unwrap();
+        let obs = observed_angles_rad(u, v, 4800, 2400);
+        let r0 = panorama_rotation(yaw, pitch, roll);
+        let (r, jc, jp) = pano_residual(obs, &r0, psi, &center, &point).unwrap();
+        assert!(r.norm() < 1e-12, "{r:?}");
+        // Move off the solution and compare with central differences.
+        let c1 = center + Vector3::new(0.2, -0.1, 0.05);
+        let x1 = point + Vector3::new(-0.3, 0.2, 0.1);
+        let psi1 = 0.03;
+        let (_, jc, jp) = pano_residual(obs, &r0, psi1, &c1, &x1).unwrap_or((r, jc, jp));
+        let h = 1e-6;
+        for k in 0..4 {
+            let (mut cp, mut cm) = (c1, c1);
+            let (mut yp, mut ym) = (psi1, psi1);
+            if k < 3 {
+                cp[k] += h;
+                cm[k] -= h;
+            } else {
+                yp += h;
+                ym -= h;
+            }
+            let rp = pano_residual(obs, &r0, yp, &cp, &x1).unwrap().0;
+            let rm = pano_residual(obs, &r0, ym, &cm, &x1).unwrap().0;
+            let numeric = (rp - rm) / (2.0 * h);
+            for row in 0..2 {
+                assert!(
+                    (numeric[row] - jc[(row, k)]).abs() < 1e-8,
+                    "camera {k} row {row}"
+                );
+            }
+        }
+        for k in 0..3 {
+            let (mut xp, mut xm) = (x1, x1);
+            xp[k] += h;
+            xm[k] -= h;
+            let rp = pano_residual(obs, &r0, psi1, &c1, &xp).unwrap().0;
+            let rm = pano_residual(obs, &r0, psi1, &c1, &xm).unwrap().0;
+            let numeric = (rp - rm) / (2.0 * h);
+            for row in 0..2 {
+                assert!(
+                    (numeric[row] - jp[(row, k)]).abs() < 1e-8,
+                    "point {k} row {row}"
+                );
+            }
+        }
+    }
+}
