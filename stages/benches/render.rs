@@ -41,7 +41,7 @@ fn time_one_of_each(plan: &CampaignPlan) -> [(f64, u64); 3] {
         t.elapsed().as_secs_f64(),
         primary_rays(cam.width_px, cam.height_px, p.panorama_spp_axis),
     );
-    let mut frame = |a: &skytie_stages::campaign::AerialImage| {
+    let frame = |a: &skytie_stages::campaign::AerialImage| {
         let cam = FrameCamera::from_aerial(a);
         let t = Instant::now();
         std::hint::black_box(render_frame(
