@@ -692,6 +692,38 @@ fn include_builds_on_a_base_workflow() {
 }
 
 #[test]
+fn diamond_includes_merge_the_shared_file_once() {
+    let dir = Dir::new();
+    dir.write("base.toml", &format!("{BASE}{SWEEP}"));
+    dir.write(
+        "left.toml",
+        "include = \"base.toml\"\n[ortho]\ngsd_m = 0.07\n",
+    );
+    dir.write(
+        "right.toml",
+        "include = \"base.toml\"\n[oblique]\nthreshold = 0.9\n",
+    );
+    let top = dir.write("top.toml", "include = [\"left.toml\", \"right.toml\"]\n");
+    let w = Workflow::load(&top).unwrap();
+    assert_eq!(
+        w.variants(),
+        vec!["bins32", "tight"],
+        "variants of the shared file are not duplicated"
+    );
+    assert_eq!(w.sources.len(), 4);
+    assert_eq!(
+        w.params::<OrthoParams>("ortho", "default").unwrap().gsd_m,
+        0.07
+    );
+    assert_eq!(
+        w.params::<ObliqueParams>("oblique", "bins32")
+            .unwrap()
+            .threshold,
+        0.9
+    );
+}
+
+#[test]
 fn errors_in_included_files_carry_their_path() {
     let dir = Dir::new();
     let base = dir.write(

@@ -1,7 +1,8 @@
 //! Loading a workflow file together with the files it includes (`include = ["base.toml"]`): each file is parsed
 //! into a located tree, included files are merged first (in the order listed) and the including file is merged
 //! on top. Relative include paths are resolved against the including file's folder; cycles are errors that show
-//! the chain. Keys that belong to one file only (`include`, `name`) are not inherited; sweep variants accumulate.
+//! the chain. A file reached twice (diamond) is merged once, where it is first included. Keys that belong to one
+//! file only (`include`, `name`) are not inherited; sweep variants accumulate.
 
 use std::path::{Path, PathBuf};
 
@@ -25,6 +26,7 @@ pub(crate) fn load_document(text: &str, path: &Path) -> Result<Loaded, WorkflowE
     let mut loader = Loader {
         sources: Vec::new(),
         stack: Vec::new(),
+        seen: Vec::new(),
     };
     let canonical = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
     let document = loader.load(text, path, canonical)?;
@@ -38,6 +40,8 @@ struct Loader {
     sources: Vec<SourceFile>,
     /// The chain of files being loaded: (canonical path, path as shown).
     stack: Vec<(PathBuf, PathBuf)>,
+    /// Canonical paths of all files read so far: a file reached twice (diamond includes) is merged once.
+    seen: Vec<PathBuf>,
 }
 
 impl Loader {
@@ -47,6 +51,7 @@ impl Loader {
         shown: &Path,
         canonical: PathBuf,
     ) -> Result<Table, WorkflowError> {
+        self.seen.push(canonical.clone());
         let file_index = self.sources.len();
         self.sources.push(SourceFile {
             path: shown.to_path_buf(),
@@ -93,6 +98,9 @@ impl Loader {
                 "include cycle: {}; remove one of these includes",
                 chain.join(" -> ")
             )));
+        }
+        if self.seen.contains(&canonical) {
+            return Ok(Table::default()); // already merged where it was first included
         }
         if self.stack.len() >= MAX_INCLUDE_DEPTH {
             return Err(error(format!(
