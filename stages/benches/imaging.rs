@@ -2,6 +2,7 @@
 //! 100×100, Gaussian blur of a 4000×3000 image, Förstner on 512². Prints median wall time per call and, for the
 //! matchers, the error against the known sub-pixel shift (inputs are exact Fourier shifts of a band-limited
 //! texture, see `tests/imaging_support`). Run: `cargo bench -p skytie-stages --bench imaging`.
+//! With `SKYTIE_PEER_DIR=dir` the phase-correlation pairs are also written there for `benches/peers/phasecorr.py`.
 
 #[path = "../tests/imaging_support/mod.rs"]
 mod imaging_support;
@@ -11,6 +12,7 @@ use std::time::Instant;
 use imaging_support::{radiometric, SplitMix64, Texture};
 use skytie_stages::features::forstner::{forstner_corners, ForstnerParams};
 use skytie_stages::imaging::gaussian::gaussian_blur;
+use skytie_stages::imaging::io::{load_gray, save_gray};
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::matching::ncc::match_template;
 use skytie_stages::matching::phase_correlation::{phase_correlate, PhaseCorrelationParams};
@@ -52,6 +54,9 @@ fn bench_phase_correlation(size: usize) {
         let s = phase_correlate(a, b, &p).unwrap();
         sum_sq += (s.dx_px - tx).powi(2) + (s.dy_px - ty).powi(2);
     }
+    if let Some(dir) = std::env::var_os("SKYTIE_PEER_DIR") {
+        write_peer_pairs(std::path::Path::new(&dir), size, &pairs, &p);
+    }
     let ms = median_ms(50, || {
         std::hint::black_box(phase_correlate(&pairs[0].0, &pairs[0].1, &p).unwrap());
     });
@@ -66,6 +71,36 @@ fn bench_phase_correlation(size: usize) {
         "phase correlation {size}x{size}: {ms:.3} ms/call (default, ≤4 passes), {ms1:.3} ms/pass; RMS error {:.4} px over 10 pairs",
         (sum_sq / pairs.len() as f64).sqrt()
     );
+}
+
+/// For `benches/peers/phasecorr.py`: write the pairs as 8-bit PNGs plus `truth_{size}.csv` with the true shift
+/// and our estimate on the re-loaded (quantised) PNGs, so peers and we see identical inputs.
+fn write_peer_pairs(
+    dir: &std::path::Path,
+    size: usize,
+    pairs: &[(GrayImage, GrayImage, f64, f64)],
+    p: &PhaseCorrelationParams,
+) {
+    std::fs::create_dir_all(dir).expect("create SKYTIE_PEER_DIR");
+    let mut csv = String::from("reference,moving,tx_px,ty_px,skytie_dx_px,skytie_dy_px\n");
+    for (k, (a, b, tx, ty)) in pairs.iter().enumerate() {
+        let (na, nb) = (
+            format!("pc{size}_{k}_ref.png"),
+            format!("pc{size}_{k}_mov.png"),
+        );
+        save_gray(&dir.join(&na), a).expect("write PNG");
+        save_gray(&dir.join(&nb), b).expect("write PNG");
+        let (la, lb) = (
+            load_gray(&dir.join(&na)).unwrap(),
+            load_gray(&dir.join(&nb)).unwrap(),
+        );
+        let s = phase_correlate(&la, &lb, p).unwrap();
+        csv.push_str(&format!(
+            "{na},{nb},{tx:.6},{ty:.6},{:.6},{:.6}\n",
+            s.dx_px, s.dy_px
+        ));
+    }
+    std::fs::write(dir.join(format!("truth_{size}.csv")), csv).expect("write truth CSV");
 }
 
 fn bench_ncc() {
