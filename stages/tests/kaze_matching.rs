@@ -49,9 +49,10 @@ fn ratio_and_mutual_matching_recover_a_planted_permutation() {
     let t2 = vec![1.0f32, 0.0, -1.0, 0.0]; // both at distance 1 from query 0
     let m = match_ratio(&q2, &t2, 2, 0.8, false).unwrap();
     assert!(m.iter().all(|mm| mm.query != 0), "{m:?}");
-    let m = match_ratio(&q2, &t2, 2, 1.0, true).unwrap();
-    // Query 1 (1,1) → train 0 (1,0); train 0's nearest query is 0 (distance 1) vs 1 (distance 1): tie → lower
-    // index 0, so query 1 is not mutual; query 0 → train 0 (tie, lower index) is mutual.
+    // With ratio 2 (no ratio filtering): query 0 ties between both train features → lower index 0; query 1
+    // (1,1) → train 0 (1,0). Train 0's nearest query is a tie (distance 1 to both) → lower index 0, so only
+    // query 0 survives the mutual check.
+    let m = match_ratio(&q2, &t2, 2, 2.0, true).unwrap();
     assert_eq!(m.len(), 1);
     assert_eq!((m[0].query, m[0].train), (0, 0));
 }

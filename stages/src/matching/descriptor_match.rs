@@ -89,7 +89,7 @@ fn passes_ratio(best_sq: f32, second_sq: f32, ratio: f32) -> bool {
     second_sq.is_infinite() || best_sq < ratio * ratio * second_sq
 }
 
-/// Nearest neighbour of every query among all train descriptors, kept if d1 < `ratio`·d2 (ratio ≥ 1 keeps
+/// Nearest neighbour of every query among all train descriptors, kept if d1 < `ratio`·d2 (ratio > 1 keeps
 /// all) and, if `mutual`, only if the query is also the train feature's nearest query. Sorted by query.
 pub fn match_ratio(
     query: &[f32],
