@@ -414,8 +414,14 @@ impl<'a> Exec<'a> {
                 }
             }
         }
-        // 4. release values nobody needs any more
+        // 4. release values nobody needs any more (leaf nodes of this wave, inputs whose consumers are done)
         for &id in wave {
+            if !self.dag.nodes[id].requested {
+                let mut s = self.slot(id);
+                if s.consumers_left == 0 {
+                    s.value = None;
+                }
+            }
             for u in self.dag.nodes[id].upstream_ids() {
                 let mut s = self.slot(u);
                 s.consumers_left = s.consumers_left.saturating_sub(1);
