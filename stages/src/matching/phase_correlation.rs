@@ -198,17 +198,24 @@ fn prepare(
     out
 }
 
-/// Correlation surface (`pw × ph`, row-major, peak 1 for identical inputs) of two prepared canvases.
+/// Spectrum (transposed layout, see [`forward_2d`]) of a prepared `pw × ph` canvas.
+fn spectrum(mut canvas: Vec<Complex<f64>>, pw: usize, ph: usize) -> Vec<Complex<f64>> {
+    let mut tmp = Vec::with_capacity(pw * ph);
+    forward_2d(&mut canvas, &mut tmp, pw, ph);
+    canvas
+}
+
+/// Correlation surface (`pw × ph`, row-major, peak 1 for identical inputs) of the reference spectrum and a
+/// prepared moving canvas.
 fn correlation_surface(
-    reference: Vec<Complex<f64>>,
+    f_ref: &[Complex<f64>],
     moving: Vec<Complex<f64>>,
     pw: usize,
     ph: usize,
     lowpass_sigma_px: f64,
 ) -> Vec<f64> {
-    let (mut f_ref, mut f_mov) = (reference, moving);
+    let mut f_mov = moving;
     let mut tmp = Vec::with_capacity(pw * ph);
-    forward_2d(&mut f_ref, &mut tmp, pw, ph);
     forward_2d(&mut f_mov, &mut tmp, pw, ph);
     // Transposed layout: index kx·ph + ky.
     let max_abs = f_ref
@@ -310,7 +317,7 @@ pub fn phase_correlate(
         origin: (0.0, 0.0),
         size: (w, h),
     };
-    let a = prepare(reference, full, pw, ph, 0, 0);
+    let f_ref = spectrum(prepare(reference, full, pw, ph, 0, 0), pw, ph);
     let mut shift = PhaseShift {
         dx_px: 0.0,
         dy_px: 0.0,
@@ -328,7 +335,7 @@ pub fn phase_correlate(
             ..full
         };
         let b = prepare(moving, taper, pw, ph, 0, 0);
-        let r = correlation_surface(a.clone(), b, pw, ph, params.lowpass_sigma_px);
+        let r = correlation_surface(&f_ref, b, pw, ph, params.lowpass_sigma_px);
         let next = find_peak(&r, pw, ph, params.peak_fit);
         let converged =
             pass > 0 && (next.dx_px - shift.dx_px).hypot(next.dy_px - shift.dy_px) < 1e-3;
@@ -379,6 +386,7 @@ pub fn locate_template(
         ox,
         oy,
     );
+    let f_ref = spectrum(a, pw, ph);
     let mut shift = PhaseShift {
         dx_px: 0.0,
         dy_px: 0.0,
@@ -405,7 +413,7 @@ pub fn locate_template(
             }
         };
         let b = prepare(search, taper, pw, ph, 0, 0);
-        let r = correlation_surface(a.clone(), b, pw, ph, params.lowpass_sigma_px);
+        let r = correlation_surface(&f_ref, b, pw, ph, params.lowpass_sigma_px);
         let next = find_peak(&r, pw, ph, params.peak_fit);
         let converged =
             pass > 0 && (next.dx_px - shift.dx_px).hypot(next.dy_px - shift.dy_px) < 1e-3;
