@@ -11,6 +11,8 @@ pub mod dag;
 pub mod explain;
 pub mod hashing;
 pub mod metrics;
+pub mod nodes;
+pub mod pipelines;
 pub mod plan;
 pub mod progress;
 pub mod provenance;

@@ -22,6 +22,7 @@ pub trait Pipeline: Sync {
 /// The pipeline a workflow asks for.
 pub fn pipeline_by_name(name: &str) -> Result<&'static dyn Pipeline, String> {
     match name {
+        "skytie" => Ok(&crate::pipelines::skytie::SkytiePipeline),
         "toy" => Ok(&crate::testing::toy_pipeline::ToyPipeline),
         other => Err(format!(
             "unknown pipeline '{other}': this skytie knows: {} (set `pipeline = ...` in the workflow)",
@@ -32,5 +33,5 @@ pub fn pipeline_by_name(name: &str) -> Result<&'static dyn Pipeline, String> {
 
 /// Names of the registered pipelines.
 pub fn known_pipelines() -> Vec<&'static str> {
-    vec!["toy"]
+    vec!["skytie", "toy"]
 }

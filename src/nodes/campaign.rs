@@ -1,0 +1,134 @@
+//! `campaign`: read and validate a campaign folder (campaign-format.md) into a snapshot, and `recording`: pick
+//! one recording's row out of it — the per-item entry point of the pipeline.
+//!
+//! Keys: the load node hashes the campaign's CSV/TOML files by content (raw-file inputs) plus the listing of all
+//! file names (a parameter), so adding an image or editing a row re-reads the campaign. Every per-recording
+//! node then re-selects its row; rows that did not change produce identical output, so by early cutoff only the
+//! new or edited recordings' downstream nodes run again.
+
+use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::workflow::{ParamError, StageParams};
+use serde::{Deserialize, Serialize};
+use skytie_stages::campaign::{read_campaign, Campaign, Problem, Recording};
+use std::path::Path;
+use std::sync::Arc;
+
+/// The campaign's metadata files, in a fixed order (only those that exist are inputs).
+pub const METADATA_FILES: [&str; 6] = [
+    "campaign.toml",
+    "mm/recordings.csv",
+    "aerial/nadir/cameras.csv",
+    "aerial/oblique/cameras.csv",
+    "control/checkpoints.csv",
+    "control/observations.csv",
+];
+
+/// Parameters of the load node (set by the pipeline, not by users).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LoadCampaignParams {
+    /// The campaign folder (absolute).
+    pub root: String,
+    /// blake3 of the sorted list of every file name below the folder (so file presence is part of the key).
+    pub listing_hash: String,
+}
+
+impl StageParams for LoadCampaignParams {
+    fn validate(&self) -> Result<(), Vec<ParamError>> {
+        Ok(())
+    }
+}
+
+/// A validated campaign and the problems found while reading it (bad rows were skipped, never guessed).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CampaignSnapshot {
+    pub campaign: Campaign,
+    pub problems: Vec<Problem>,
+}
+crate::serde_artifact!(CampaignSnapshot, Recording);
+
+/// The raw-file inputs of the load node for the campaign in `root`.
+pub fn metadata_inputs(root: &Path) -> Vec<RawFile> {
+    METADATA_FILES
+        .iter()
+        .map(|f| root.join(f))
+        .filter(|p| p.is_file())
+        .map(RawFile)
+        .collect()
+}
+
+/// blake3 (hex) of the sorted relative names of every file below `root` (not their contents).
+pub fn listing_hash(root: &Path) -> std::io::Result<String> {
+    let files = crate::nodes::synth::list_files(root)?;
+    let mut h = blake3::Hasher::new();
+    for (name, _) in &files {
+        h.update(name.as_bytes());
+        h.update(&[0]);
+    }
+    Ok(h.finalize().to_hex().to_string())
+}
+
+/// Reads the campaign (validation without decoding images; `skytie check` decodes them too).
+pub struct LoadCampaign;
+
+impl Stage for LoadCampaign {
+    const NAME: &'static str = "load";
+    const VERSION: &'static str = "1";
+    type Params = LoadCampaignParams;
+    type Output = CampaignSnapshot;
+    type Inputs = Vec<RawFile>;
+
+    fn run(
+        &self,
+        p: &LoadCampaignParams,
+        _files: Vec<RawFileValue>,
+        _: &NodeCtx,
+    ) -> Result<CampaignSnapshot, StageError> {
+        let (campaign, problems) = read_campaign(Path::new(&p.root))
+            .map_err(|e| StageError::new(format!("cannot read the campaign: {e}")))?;
+        Ok(CampaignSnapshot { campaign, problems })
+    }
+}
+
+/// Parameters of the per-recording selector (set by the pipeline).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SelectRecordingParams {
+    pub image_id: String,
+}
+
+impl StageParams for SelectRecordingParams {
+    fn validate(&self) -> Result<(), Vec<ParamError>> {
+        Ok(())
+    }
+}
+
+/// One recording's row of the snapshot.
+pub struct SelectRecording;
+
+impl Stage for SelectRecording {
+    const NAME: &'static str = "recording";
+    const VERSION: &'static str = "1";
+    type Params = SelectRecordingParams;
+    type Output = Recording;
+    type Inputs = Handle<CampaignSnapshot>;
+
+    fn run(
+        &self,
+        p: &SelectRecordingParams,
+        snap: Arc<CampaignSnapshot>,
+        _: &NodeCtx,
+    ) -> Result<Recording, StageError> {
+        snap.campaign
+            .recordings
+            .iter()
+            .find(|r| r.image_id == p.image_id)
+            .cloned()
+            .ok_or_else(|| {
+                StageError::new(format!(
+                    "recording '{}' is not in the campaign any more",
+                    p.image_id
+                ))
+            })
+    }
+}

@@ -1,0 +1,16 @@
+//! The engine's wrappers of `skytie-stages` algorithms as typed, cached DAG stages (one file per stage), and
+//! the artifacts they exchange. The algorithms live in `stages/`; this layer only adds names, versions, typed
+//! inputs, parameter validation and encoding.
+
+pub mod campaign;
+pub mod ortho;
+pub mod params;
+pub mod summary;
+pub mod synth;
+
+pub use campaign::{
+    CampaignSnapshot, LoadCampaign, LoadCampaignParams, SelectRecording, SelectRecordingParams,
+};
+pub use ortho::OrthoProject;
+pub use summary::{CampaignSummary, SummarizeCampaign, SummaryParams};
+pub use synth::{GeneratedCampaign, SynthCampaign, SynthParams};

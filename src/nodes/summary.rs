@@ -1,0 +1,113 @@
+//! `summary`: a global node over the campaign snapshot and the per-recording ortho images: counts, input
+//! problems and ortho coverage, contributed to `metrics.json` under `campaign` and `ortho`.
+
+use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::nodes::campaign::CampaignSnapshot;
+use crate::workflow::{ParamError, StageParams};
+use serde::{Deserialize, Serialize};
+use skytie_stages::campaign::Severity;
+use skytie_stages::nadir::OrthoImage;
+use std::sync::Arc;
+
+/// The summary has no tunable parameters.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SummaryParams {}
+
+impl StageParams for SummaryParams {
+    fn validate(&self) -> Result<(), Vec<ParamError>> {
+        Ok(())
+    }
+}
+
+/// What the campaign holds and how much of it the per-recording stages covered.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CampaignSummary {
+    pub name: String,
+    pub recordings: usize,
+    pub nadir_images: usize,
+    pub oblique_images: usize,
+    pub checkpoints: usize,
+    pub observations: usize,
+    pub input_errors: usize,
+    pub input_warnings: usize,
+    /// Every input problem, rendered (`file:row: field …`).
+    pub problems: Vec<String>,
+    /// Recordings whose ortho image was produced.
+    pub ortho_images: usize,
+    /// Mean fraction of ortho pixels that hold ground (not masked by the vehicle).
+    pub ortho_valid_fraction_mean: f64,
+}
+crate::serde_artifact!(CampaignSummary);
+
+impl CampaignSummary {
+    /// The `campaign` and `ortho` metrics sections.
+    pub fn metrics(&self) -> (serde_json::Value, serde_json::Value) {
+        (
+            serde_json::json!({
+                "name": self.name,
+                "recordings": self.recordings,
+                "nadir_images": self.nadir_images,
+                "oblique_images": self.oblique_images,
+                "checkpoints": self.checkpoints,
+                "observations": self.observations,
+                "input_errors": self.input_errors,
+                "input_warnings": self.input_warnings,
+            }),
+            serde_json::json!({
+                "images": self.ortho_images,
+                "valid_fraction_mean": self.ortho_valid_fraction_mean,
+            }),
+        )
+    }
+}
+
+/// The summary node.
+pub struct SummarizeCampaign;
+
+impl Stage for SummarizeCampaign {
+    const NAME: &'static str = "summary";
+    const VERSION: &'static str = "1";
+    type Params = SummaryParams;
+    type Output = CampaignSummary;
+    type Inputs = (Handle<CampaignSnapshot>, Vec<Handle<OrthoImage>>);
+
+    fn run(
+        &self,
+        _: &SummaryParams,
+        (snap, orthos): (Arc<CampaignSnapshot>, Vec<Arc<OrthoImage>>),
+        _: &NodeCtx,
+    ) -> Result<CampaignSummary, StageError> {
+        let c = &snap.campaign;
+        let valid_fraction = |o: &OrthoImage| {
+            let n = o.valid.len().max(1);
+            o.valid.iter().filter(|&&v| v != 0).count() as f64 / n as f64
+        };
+        let mean = if orthos.is_empty() {
+            0.0
+        } else {
+            orthos.iter().map(|o| valid_fraction(o)).sum::<f64>() / orthos.len() as f64
+        };
+        Ok(CampaignSummary {
+            name: c.name.clone(),
+            recordings: c.recordings.len(),
+            nadir_images: c.nadir.len(),
+            oblique_images: c.oblique.len(),
+            checkpoints: c.checkpoints.len(),
+            observations: c.observations.len(),
+            input_errors: snap
+                .problems
+                .iter()
+                .filter(|p| p.severity == Severity::Error)
+                .count(),
+            input_warnings: snap
+                .problems
+                .iter()
+                .filter(|p| p.severity == Severity::Warning)
+                .count(),
+            problems: snap.problems.iter().map(|p| p.to_string()).collect(),
+            ortho_images: orthos.len(),
+            ortho_valid_fraction_mean: mean,
+        })
+    }
+}

@@ -1,0 +1,148 @@
+//! `synth`: the synthetic campaign generator as a cached node (`campaign = "synth:<preset>"` in a workflow).
+//!
+//! The node writes the whole campaign folder into its own cache folder (`<cache>/dirs/<key>/campaign`), so a
+//! second run — or any workflow naming the same preset, seed and options — reuses it. The output records every
+//! file's size; a cached folder whose files went missing or changed size is regenerated.
+
+use crate::dag::{NodeCtx, Stage, StageError};
+use crate::workflow::{ParamError, StageParams};
+use serde::{Deserialize, Serialize};
+use skytie_stages::synth::{generate, Deterioration, Preset, SynthOptions, SynthSummary};
+use std::path::{Path, PathBuf};
+
+/// Parameters of the `[synth]` workflow table (preset and seed come from `campaign = "synth:<preset>"` and `seed`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SynthParams {
+    /// `tiny`, `demo` or `paper`.
+    pub preset: String,
+    pub seed: u64,
+    /// Recorded-position deterioration: `thesis` (0.80 m systematic + N(0, 0.10 m), thesis 3.5.1.2) or `none`.
+    pub deterioration: String,
+    /// Override of the panorama width in pixels (even; 0 = the preset's).
+    pub panorama_width_px: u32,
+    /// Override of the number of recordings per route (0 = the preset's).
+    pub max_recordings_per_route: usize,
+}
+
+impl Default for SynthParams {
+    fn default() -> Self {
+        Self {
+            preset: "demo".into(),
+            seed: 1,
+            deterioration: "thesis".into(),
+            panorama_width_px: 0,
+            max_recordings_per_route: 0,
+        }
+    }
+}
+
+impl SynthParams {
+    /// The generator options these parameters stand for.
+    pub fn options(&self) -> Result<SynthOptions, String> {
+        let preset = Preset::from_name(&self.preset).map_err(|e| e.to_string())?;
+        let mut o = SynthOptions::new(preset, self.seed);
+        o.deterioration = match self.deterioration.as_str() {
+            "thesis" => Deterioration::Thesis,
+            "none" => Deterioration::None,
+            other => {
+                return Err(format!(
+                    "unknown deterioration '{other}': use \"thesis\" or \"none\""
+                ))
+            }
+        };
+        if self.panorama_width_px != 0 {
+            o.panorama_width_px = Some(self.panorama_width_px);
+        }
+        if self.max_recordings_per_route != 0 {
+            o.max_recordings_per_route = Some(self.max_recordings_per_route);
+        }
+        o.params().map_err(|e| e.to_string())?;
+        Ok(o)
+    }
+}
+
+impl StageParams for SynthParams {
+    fn validate(&self) -> Result<(), Vec<ParamError>> {
+        match self.options() {
+            Ok(_) => Ok(()),
+            Err(m) => Err(vec![ParamError::new("synth", m)]),
+        }
+    }
+}
+
+/// A generated campaign folder and what it holds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GeneratedCampaign {
+    /// Absolute path of the campaign folder inside the cache.
+    pub dir: String,
+    /// (path relative to `dir`, size in bytes) of every file, sorted.
+    pub files: Vec<(String, u64)>,
+    pub summary: SynthSummary,
+}
+crate::serde_artifact!(GeneratedCampaign);
+
+impl GeneratedCampaign {
+    pub fn path(&self) -> PathBuf {
+        PathBuf::from(&self.dir)
+    }
+}
+
+/// Every file below `root` as (relative path with '/', size), sorted.
+pub fn list_files(root: &Path) -> std::io::Result<Vec<(String, u64)>> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<(String, u64)>) -> std::io::Result<()> {
+        for entry in std::fs::read_dir(dir)? {
+            let entry = entry?;
+            let path = entry.path();
+            let meta = entry.metadata()?;
+            if meta.is_dir() {
+                walk(root, &path, out)?;
+            } else {
+                let rel = path.strip_prefix(root).unwrap_or(&path);
+                let rel = rel
+                    .components()
+                    .map(|c| c.as_os_str().to_string_lossy())
+                    .collect::<Vec<_>>()
+                    .join("/");
+                out.push((rel, meta.len()));
+            }
+        }
+        Ok(())
+    }
+    let mut out = Vec::new();
+    walk(root, root, &mut out)?;
+    out.sort();
+    Ok(out)
+}
+
+/// The generator node.
+pub struct SynthCampaign;
+
+impl Stage for SynthCampaign {
+    const NAME: &'static str = "synth";
+    const VERSION: &'static str = "1";
+    type Params = SynthParams;
+    type Output = GeneratedCampaign;
+    type Inputs = ();
+
+    fn run(&self, p: &SynthParams, _: (), ctx: &NodeCtx) -> Result<GeneratedCampaign, StageError> {
+        let options = p.options().map_err(StageError::new)?;
+        let tmp = ctx.output_dir_tmp()?;
+        let summary = generate(&options, &tmp.join("campaign"))
+            .map_err(|e| StageError::new(format!("synthetic campaign generation failed: {e}")))?;
+        let files = list_files(&tmp.join("campaign"))?;
+        let dir = ctx.output_dir().join("campaign");
+        Ok(GeneratedCampaign {
+            dir: dir.to_string_lossy().into_owned(),
+            files,
+            summary,
+        })
+    }
+
+    fn cached_output_ok(&self, out: &GeneratedCampaign, _ctx: &NodeCtx) -> bool {
+        match list_files(&out.path()) {
+            Ok(files) => files == out.files,
+            Err(_) => false,
+        }
+    }
+}

@@ -1,0 +1,134 @@
+//! The `skytie` pipeline: the thesis' processing chain as cached DAG phases.
+//!
+//! Phases (each built from the values of the previous one — staged planning):
+//! 1. `campaign`: the synthetic generator node when the workflow says `campaign = "synth:<preset>"`;
+//! 2. `load`: read and validate the campaign;
+//! 3. `items`, per sweep variant: per recording `recording` → `ortho` (thesis 3.4.3), then the global `summary`.
+//!
+//! Stages not yet implemented (MM-to-MM matching, KAZE transform, phase correlation, oblique chain,
+//! adjustment) are refused with a clear message when a workflow enables them, never silently skipped.
+
+use crate::dag::{DagBuilder, Pipeline, PipelineError, RawFile, Session};
+use crate::nodes::campaign::{listing_hash, metadata_inputs};
+use crate::nodes::{
+    CampaignSummary, LoadCampaign, LoadCampaignParams, OrthoProject, SelectRecording,
+    SelectRecordingParams, SummarizeCampaign, SummaryParams, SynthCampaign, SynthParams,
+};
+use crate::workflow::{CampaignSource, Workflow};
+use skytie_stages::nadir::OrthoParams;
+use std::path::{Path, PathBuf};
+
+/// See the module documentation.
+pub struct SkytiePipeline;
+
+/// Stage names a workflow may enable in `stages = [...]`.
+pub const STAGES: [&str; 4] = ["synth", "load", "ortho", "summary"];
+
+fn wf_err(e: impl std::fmt::Display) -> PipelineError {
+    PipelineError::Workflow(e.to_string())
+}
+
+/// Absolute form of a campaign folder (keys must not depend on the working directory's spelling).
+fn absolute(p: &Path) -> PathBuf {
+    std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf())
+}
+
+impl Pipeline for SkytiePipeline {
+    fn name(&self) -> &'static str {
+        "skytie"
+    }
+
+    fn stage_names(&self) -> Vec<&'static str> {
+        STAGES.to_vec()
+    }
+
+    fn run(&self, wf: &Workflow, session: &mut Session<'_>) -> Result<(), PipelineError> {
+        for s in &wf.stages {
+            if !STAGES.contains(&s.as_str()) {
+                return Err(PipelineError::Workflow(format!(
+                    "{}: stage '{s}' is not available in this skytie (available: {})",
+                    wf.path.display(),
+                    STAGES.join(", ")
+                )));
+            }
+        }
+        // Phase 1: the campaign folder.
+        let root: PathBuf = match &wf.campaign {
+            CampaignSource::Path(p) => absolute(p),
+            CampaignSource::Synth { preset, seed } => {
+                let mut params: SynthParams = wf.params("synth", "default").map_err(wf_err)?;
+                params.preset = preset.clone();
+                params.seed = *seed;
+                let mut b = DagBuilder::new();
+                let h = b.add(SynthCampaign, preset, params, ())?;
+                b.request(h);
+                let values = session.execute("campaign", b.build());
+                values.require(h, "the synthetic campaign")?.path()
+            }
+        };
+        // Phase 2: read and validate it.
+        let load_params = LoadCampaignParams {
+            root: root.to_string_lossy().into_owned(),
+            listing_hash: listing_hash(&root).map_err(|e| {
+                PipelineError::Input(format!(
+                    "{}: cannot list the campaign folder: {e}",
+                    root.display()
+                ))
+            })?,
+        };
+        let inputs = metadata_inputs(&root);
+        if inputs.is_empty() {
+            return Err(PipelineError::Input(format!(
+                "{}: not a campaign (no campaign.toml or mm/recordings.csv; see shared/docs/campaign-format.md)",
+                root.display()
+            )));
+        }
+        let mut b = DagBuilder::new();
+        let snap_h = b.add(LoadCampaign, "", load_params.clone(), inputs.clone())?;
+        b.request(snap_h);
+        let values = session.execute("load", b.build());
+        let snapshot = values.require(snap_h, "the campaign")?;
+        if !snapshot.problems.is_empty() {
+            eprintln!(
+                "campaign {}: {} problem(s) in the input; affected items are skipped (run `skytie check {}` for the list)",
+                root.display(),
+                snapshot.problems.len(),
+                root.display()
+            );
+        }
+        // Phase 3: per-recording stages and the summary, for every variant.
+        let ortho_on = wf.stages.iter().any(|s| s == "ortho");
+        let mut b = DagBuilder::new();
+        for variant in wf.variants() {
+            b.set_variant(&variant);
+            let snap = b.add(LoadCampaign, "", load_params.clone(), inputs.clone())?;
+            let ortho: OrthoParams = wf.params("ortho", &variant).map_err(wf_err)?;
+            let mut orthos = Vec::new();
+            for rec in &snapshot.campaign.recordings {
+                let label = format!("rec {}", rec.image_id);
+                let row = b.add(
+                    SelectRecording,
+                    &label,
+                    SelectRecordingParams {
+                        image_id: rec.image_id.clone(),
+                    },
+                    snap,
+                )?;
+                if ortho_on {
+                    let pano = RawFile(root.join("mm/panoramas").join(&rec.file));
+                    orthos.push(b.add(OrthoProject, &label, ortho.clone(), (row, pano))?);
+                }
+            }
+            let summary = b.add(
+                SummarizeCampaign,
+                "",
+                SummaryParams::default(),
+                (snap, orthos),
+            )?;
+            b.metrics(summary, "campaign", |s: &CampaignSummary| s.metrics().0);
+            b.metrics(summary, "ortho", |s: &CampaignSummary| s.metrics().1);
+        }
+        session.execute("items", b.build());
+        Ok(())
+    }
+}
