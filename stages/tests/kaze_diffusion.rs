@@ -102,7 +102,7 @@ fn smooth_image(w: usize, h: usize, seed: u64) -> GrayImage {
             [
                 freq * angle.cos(),
                 freq * angle.sin(),
-                rng.next() * 6.28,
+                rng.next() * std::f64::consts::TAU,
                 0.5 + rng.next(),
             ]
         })

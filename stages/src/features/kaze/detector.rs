@@ -98,7 +98,7 @@ fn suppress_duplicates(candidates: &[Candidate], levels: &[Level], width: usize)
                     }
                     let dx = a.col as f32 - c.col as f32;
                     let dy = a.row as f32 - c.row as f32;
-                    if dx * dx + dy * dy < s * s && earliest.map_or(true, |e| k < e) {
+                    if dx * dx + dy * dy < s * s && earliest.is_none_or(|e| k < e) {
                         earliest = Some(k);
                     }
                 }
