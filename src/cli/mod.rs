@@ -6,10 +6,13 @@
 //! output folder not usable).
 
 pub mod cache;
+pub mod check;
 pub mod common;
 pub mod explain;
 pub mod plan;
 pub mod run;
+pub mod synth;
+pub mod tool;
 
 use clap::{Parser, Subcommand};
 
@@ -36,6 +39,13 @@ pub enum Command {
     Explain(explain::ExplainArgs),
     /// Inspect and maintain the cache.
     Cache(cache::CacheArgs),
+    /// Generate a synthetic campaign (campaign format plus truth/).
+    Synth(synth::SynthArgs),
+    /// Validate a campaign folder and list every problem.
+    Check(check::CheckArgs),
+    /// Building blocks on plain files (ortho, kaze, forstner, wallis, phasecorr, ncc), CSV/plain output.
+    #[command(subcommand)]
+    Tool(tool::ToolCommand),
 }
 
 /// Parse the process arguments and run; returns the exit code.
@@ -46,5 +56,8 @@ pub fn main() -> i32 {
         Command::Plan(a) => plan::main(a),
         Command::Explain(a) => explain::main(a),
         Command::Cache(a) => cache::main(a),
+        Command::Synth(a) => synth::main(a),
+        Command::Check(a) => check::main(a),
+        Command::Tool(t) => tool::main(t),
     }
 }

@@ -1,0 +1,255 @@
+//! `skytie tool …`: the pipeline's building blocks on plain files, for debugging, figures and side-by-side
+//! comparisons with other software. Pixel conventions as in campaign-format.md (continuous coordinates, centre of
+//! the first pixel at (0.5, 0.5)); tables are CSV with a header row; single results are printed on one line.
+
+use clap::{Args, Subcommand};
+use skytie_stages::campaign::read_campaign;
+use skytie_stages::features::forstner::{forstner_corners, ForstnerParams};
+use skytie_stages::features::kaze::{detect_and_describe, KazeParams};
+use skytie_stages::fsutil::atomic_write;
+use skytie_stages::imaging::io::{load_gray, save_gray};
+use skytie_stages::imaging::wallis::{wallis_filter, WallisParams};
+use skytie_stages::matching::ncc::match_template;
+use skytie_stages::matching::phase_correlation::{phase_correlate, PhaseCorrelationParams};
+use skytie_stages::nadir::{ortho_project, OrthoParams};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The tools.
+#[derive(Subcommand, Debug)]
+pub enum ToolCommand {
+    /// Ortho-project one recording's panorama onto the ground plane (thesis 3.4.3).
+    Ortho(OrthoArgs),
+    /// KAZE keypoints (x, y, size, response[, descriptor…]) as CSV.
+    Kaze(KazeArgs),
+    /// Förstner corners (x, y, weight, roundness) as CSV.
+    Forstner(ForstnerArgs),
+    /// Wallis filter an image.
+    Wallis(WallisArgs),
+    /// Phase correlation of two equally sized images: prints "dx dy peak" (shift of B relative to A, px).
+    Phasecorr(PairArgs),
+    /// NCC template matching (TM_CCOEFF_NORMED): prints "x y score" of the template centre in IMAGE.
+    Ncc(NccArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct OrthoArgs {
+    #[arg(long)]
+    pub campaign: PathBuf,
+    #[arg(long)]
+    pub recording: String,
+    /// Ground pixel spacing, m.
+    #[arg(long, default_value_t = 0.03)]
+    pub gsd: f64,
+    /// Azimuth of the image's up direction, degrees clockwise from grid north.
+    #[arg(long, default_value_t = 0.0)]
+    pub rotate_deg: f64,
+    /// Do not mask the recording vehicle.
+    #[arg(long)]
+    pub no_mask: bool,
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct KazeArgs {
+    pub image: PathBuf,
+    #[arg(long, default_value_t = 0.001)]
+    pub threshold: f32,
+    #[arg(long, default_value_t = 4)]
+    pub octaves: usize,
+    #[arg(long)]
+    pub upright: bool,
+    #[arg(long)]
+    pub extended: bool,
+    /// Append the descriptor values to each row.
+    #[arg(long)]
+    pub descriptors: bool,
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct ForstnerArgs {
+    pub image: PathBuf,
+    /// Keep at most this many corners (strongest first).
+    #[arg(long)]
+    pub max: Option<usize>,
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct WallisArgs {
+    pub image: PathBuf,
+    /// Statistics window side, px.
+    #[arg(long, default_value_t = 21)]
+    pub window: usize,
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct PairArgs {
+    pub a: PathBuf,
+    pub b: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct NccArgs {
+    pub template: PathBuf,
+    pub image: PathBuf,
+}
+
+/// Run a tool; returns the exit code (0 ok, 1 the computation failed, 2 bad input).
+pub fn main(cmd: &ToolCommand) -> i32 {
+    let result = match cmd {
+        ToolCommand::Ortho(a) => ortho(a),
+        ToolCommand::Kaze(a) => kaze(a),
+        ToolCommand::Forstner(a) => forstner(a),
+        ToolCommand::Wallis(a) => wallis(a),
+        ToolCommand::Phasecorr(a) => phasecorr(a),
+        ToolCommand::Ncc(a) => ncc(a),
+    };
+    match result {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("error: {e}");
+            2
+        }
+    }
+}
+
+fn write_text(path: &Path, text: &str) -> Result<(), String> {
+    atomic_write(path, text.as_bytes())
+        .map_err(|e| format!("{}: cannot write: {e}", path.display()))
+}
+
+fn ortho(a: &OrthoArgs) -> Result<(), String> {
+    let (campaign, problems) = read_campaign(&a.campaign).map_err(|e| e.to_string())?;
+    let rec = campaign
+        .recordings
+        .iter()
+        .find(|r| r.image_id == a.recording)
+        .ok_or_else(|| {
+            let bad = problems
+                .iter()
+                .find(|p| p.to_string().contains(&a.recording));
+            match bad {
+                Some(p) => format!("recording '{}' was rejected: {p}", a.recording),
+                None => format!(
+                    "no recording '{}' in {}/mm/recordings.csv",
+                    a.recording,
+                    a.campaign.display()
+                ),
+            }
+        })?;
+    let pano =
+        load_gray(&a.campaign.join("mm/panoramas").join(&rec.file)).map_err(|e| e.to_string())?;
+    let mut params = OrthoParams {
+        gsd_m: a.gsd,
+        rotation_deg: a.rotate_deg,
+        ..OrthoParams::default()
+    };
+    params.vehicle.enabled = !a.no_mask;
+    params.validate().map_err(|errs| {
+        errs.iter()
+            .map(|(f, m)| format!("--{f}: {m}"))
+            .collect::<Vec<_>>()
+            .join("; ")
+    })?;
+    let ortho = ortho_project(&pano, rec, &params);
+    save_gray(&a.out, &ortho.image).map_err(|e| e.to_string())?;
+    let g = &ortho.georef;
+    println!(
+        "{}: {}×{} px, {} m/px, up = {}°, centre (foot point) {:.3} {:.3} {:.3}",
+        a.out.display(),
+        g.width_px,
+        g.height_px,
+        g.gsd_m,
+        g.rotation_deg,
+        g.foot_world[0],
+        g.foot_world[1],
+        g.foot_world[2]
+    );
+    Ok(())
+}
+
+fn kaze(a: &KazeArgs) -> Result<(), String> {
+    let img = load_gray(&a.image).map_err(|e| e.to_string())?;
+    if a.octaves == 0 || a.octaves > 8 || !(a.threshold > 0.0) {
+        return Err("--octaves must be in 1..=8 and --threshold > 0".into());
+    }
+    let p = KazeParams {
+        threshold: a.threshold,
+        octaves: a.octaves,
+        upright: a.upright,
+        extended: a.extended,
+        ..KazeParams::default()
+    };
+    let f = detect_and_describe(&img, &p);
+    let mut s = String::from("x,y,size,response");
+    if a.descriptors {
+        for i in 0..f.descriptor_len {
+            let _ = write!(s, ",d{i}");
+        }
+    }
+    s.push('\n');
+    for (i, k) in f.keypoints.iter().enumerate() {
+        let _ = write!(s, "{},{},{},{}", k.u_px, k.v_px, k.size_px, k.response);
+        if a.descriptors {
+            for v in f.descriptor(i) {
+                let _ = write!(s, ",{v}");
+            }
+        }
+        s.push('\n');
+    }
+    write_text(&a.out, &s)?;
+    println!("{} keypoints -> {}", f.len(), a.out.display());
+    Ok(())
+}
+
+fn forstner(a: &ForstnerArgs) -> Result<(), String> {
+    let img = load_gray(&a.image).map_err(|e| e.to_string())?;
+    let p = ForstnerParams {
+        max_corners: a.max,
+        ..ForstnerParams::default()
+    };
+    let corners = forstner_corners(&img, &p);
+    let mut s = String::from("x,y,weight,roundness\n");
+    for c in &corners {
+        let _ = writeln!(s, "{},{},{},{}", c.u_px, c.v_px, c.weight, c.roundness);
+    }
+    write_text(&a.out, &s)?;
+    println!("{} corners -> {}", corners.len(), a.out.display());
+    Ok(())
+}
+
+fn wallis(a: &WallisArgs) -> Result<(), String> {
+    let img = load_gray(&a.image).map_err(|e| e.to_string())?;
+    let p = WallisParams {
+        window_px: a.window,
+        ..WallisParams::default()
+    };
+    let out = wallis_filter(&img, &p).map_err(|e| e.to_string())?;
+    save_gray(&a.out, &out).map_err(|e| e.to_string())?;
+    println!("-> {}", a.out.display());
+    Ok(())
+}
+
+fn phasecorr(a: &PairArgs) -> Result<(), String> {
+    let ia = load_gray(&a.a).map_err(|e| e.to_string())?;
+    let ib = load_gray(&a.b).map_err(|e| e.to_string())?;
+    let s =
+        phase_correlate(&ia, &ib, &PhaseCorrelationParams::default()).map_err(|e| e.to_string())?;
+    println!("{} {} {}", s.dx_px, s.dy_px, s.peak);
+    Ok(())
+}
+
+fn ncc(a: &NccArgs) -> Result<(), String> {
+    let t = load_gray(&a.template).map_err(|e| e.to_string())?;
+    let i = load_gray(&a.image).map_err(|e| e.to_string())?;
+    let m = match_template(&i, &t).map_err(|e| e.to_string())?;
+    println!("{} {} {}", m.u_px, m.v_px, m.score);
+    Ok(())
+}
