@@ -8,8 +8,10 @@
 //!
 //! Panorama observation residual (radians): with `p = Rᵀ(X − C)` the point in the panorama frame,
 //! azimuth `A = atan2(p_x, p_y)` and elevation `E = atan2(p_z, ‖p_xy‖)`, the residual is
-//! `(wrap(A − A_obs)·cos E_obs, E − E_obs)`: two nearly isotropic angular components (the azimuth
-//! difference scaled to arc length on the unit sphere), whitened by σ_θ = σ_px·2π/W.
+//! `(wrap(A − A_obs), E − E_obs)`, i.e. the reprojection error d(x, x̂) of thesis 5.7 in equirectangular pixels
+//! times the pixel angle 2π/W (the two image axes have the same angular pitch when W = 2H). It is whitened by
+//! σ_θ = σ_px·2π/W: matching noise is isotropic in pixels, so the azimuth component is deliberately not scaled
+//! by cos E (which would model noise isotropic on the sphere and under-weight rays far from the horizon).
 
 use super::problem::AdjustOptions;
 use crate::geometry::{rot_z, LocalOrigin};
@@ -126,16 +128,15 @@ pub fn pano_residual(
     }
     let h = h2.sqrt();
     let (az_obs, el_obs) = observed_rad;
-    let cos_el_obs = el_obs.cos();
     let az = p.x.atan2(p.y);
     let el = p.z.atan2(h);
-    let r = Vector2::new(wrap_pi(az - az_obs) * cos_el_obs, el - el_obs);
+    let r = Vector2::new(wrap_pi(az - az_obs), el - el_obs);
     // d(az, el)/dp.
     let d_az = [p.y / h2, -p.x / h2, 0.0];
     let d_el = [-p.x * p.z / (h * n2), -p.y * p.z / (h * n2), h / n2];
     let mut d_res_dp = Matrix2x3::zeros();
     for j in 0..3 {
-        d_res_dp[(0, j)] = d_az[j] * cos_el_obs;
+        d_res_dp[(0, j)] = d_az[j];
         d_res_dp[(1, j)] = d_el[j];
     }
     let j_point = d_res_dp * rt;

@@ -41,6 +41,8 @@ pub struct SyntheticBlockSpec {
     /// σ of the Gaussian noise actually added to the pixels (0 = exact).
     pub pixel_noise_px: f64,
     pub control_sigma_m: f64,
+    /// σ of the Gaussian noise actually added to each control-point coordinate, metres (0 = exact).
+    pub control_noise_m: f64,
     /// Fraction of panorama observations replaced by gross outliers.
     pub outlier_fraction: f64,
     pub outlier_min_px: f64,
@@ -70,6 +72,7 @@ impl Default for SyntheticBlockSpec {
             sigma_px: 1.0,
             pixel_noise_px: 0.0,
             control_sigma_m: 0.10,
+            control_noise_m: 0.0,
             outlier_fraction: 0.0,
             outlier_min_px: 20.0,
             outlier_max_px: 50.0,
@@ -202,9 +205,14 @@ impl SyntheticBlockSpec {
                 continue;
             }
             is_control[p] = true;
+            let noise = Vector3::new(
+                rng.next_gaussian(),
+                rng.next_gaussian(),
+                rng.next_gaussian(),
+            ) * self.control_noise_m;
             control_points.push(ControlPoint::isotropic(
                 p,
-                true_points[p],
+                true_points[p] + noise,
                 self.control_sigma_m,
             ));
         }
