@@ -169,6 +169,15 @@ fn scene_seed(seed: u64, area: usize) -> u64 {
 }
 
 /// Plan a campaign without rendering: scenes, true and recorded trajectory, aerial flight plans, check points.
+/// Whether any of `recordings`' projection centres projects into the aerial frame `img`.
+fn sees_any(img: &AerialImage, recordings: &[Recording]) -> bool {
+    let cam = crate::geometry::FrameCamera::from_aerial(img);
+    recordings.iter().any(|r| {
+        cam.project_world(&nalgebra::Vector3::new(r.x, r.y, r.z))
+            .is_some_and(|(u, v)| cam.contains(u, v))
+    })
+}
+
 pub fn plan_campaign(options: &SynthOptions) -> Result<CampaignPlan, SynthError> {
     let params = options.params()?;
     let seed = options.seed;
@@ -226,8 +235,13 @@ pub fn plan_campaign(options: &SynthOptions) -> Result<CampaignPlan, SynthError>
     }
     let deterioration = options.deterioration.resolve(seed);
     let mut recorded = Vec::new();
-    for a in &areas {
-        recorded.extend(deterioration.apply(&a.truth, &a.along_m, seed));
+    for a in &mut areas {
+        let area_recorded = deterioration.apply(&a.truth, &a.along_m, seed);
+        // An aerial frame that sees none of the recorded positions is of no use to the pipeline (and
+        // `skytie check` warns about it): the flight plan covers more than the route, so leave those out.
+        a.nadir.retain(|img| sees_any(img, &area_recorded));
+        a.oblique.retain(|img| sees_any(img, &area_recorded));
+        recorded.extend(area_recorded);
     }
     Ok(CampaignPlan {
         name: options.campaign_name(),

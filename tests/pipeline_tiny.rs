@@ -1,0 +1,172 @@
+//! End-to-end on the real `skytie` binary and the tiny synthetic campaign: `synth` + `check` are clean, the
+//! `synth:` workflow node generates the same bytes as the CLI, a second run executes nothing, and adding one
+//! recording to a user campaign re-runs only that recording's nodes.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn skytie() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_skytie"))
+}
+
+fn run_ok(cmd: &mut Command) -> String {
+    let out = cmd.output().expect("start skytie");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.status.success(), "{cmd:?} failed: {text}");
+    text
+}
+
+fn files(root: &Path) -> BTreeMap<String, Vec<u8>> {
+    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<String, Vec<u8>>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(root, &p, out);
+            } else {
+                out.insert(
+                    p.strip_prefix(root).unwrap().display().to_string(),
+                    std::fs::read(&p).unwrap(),
+                );
+            }
+        }
+    }
+    let mut out = BTreeMap::new();
+    walk(root, root, &mut out);
+    out
+}
+
+fn metrics(out: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(out.join("metrics.json")).unwrap()).unwrap()
+}
+
+fn stage(m: &serde_json::Value, stage: &str, what: &str) -> u64 {
+    m["stages"][stage][what]
+        .as_u64()
+        .unwrap_or_else(|| panic!("stages.{stage}.{what} missing in {m}"))
+}
+
+fn write_workflow(dir: &Path, campaign: &str) -> PathBuf {
+    let wf = dir.join("wf.toml");
+    std::fs::write(
+        &wf,
+        format!("name = \"t\"\ncampaign = \"{campaign}\"\nseed = 1\nstages = [\"synth\", \"load\", \"ortho\", \"summary\"]\n[ortho]\ngsd_m = 0.05\n"),
+    )
+    .unwrap();
+    wf
+}
+
+#[test]
+fn tiny_campaign_end_to_end() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let cache = dir.join("cache");
+
+    // 1. The CLI generator and the checker.
+    let camp = dir.join("tiny");
+    run_ok(
+        skytie()
+            .args(["synth", "--preset", "tiny", "--seed", "1", "--out"])
+            .arg(&camp),
+    );
+    let report = run_ok(skytie().arg("check").arg(&camp));
+    assert!(
+        report.contains("0 errors, 0 warnings"),
+        "check is not clean:\n{report}"
+    );
+
+    // 2. The same campaign as a cached workflow node: identical bytes; a second run executes nothing.
+    let wf = write_workflow(dir, "synth:tiny");
+    let out = dir.join("out1");
+    run_ok(
+        skytie()
+            .arg("run")
+            .arg(&wf)
+            .arg("--cache")
+            .arg(&cache)
+            .arg("--out")
+            .arg(&out)
+            .arg("--quiet"),
+    );
+    let m = metrics(&out);
+    let recordings = m["campaign"]["recordings"].as_u64().unwrap();
+    assert!(recordings >= 4, "{m}");
+    assert_eq!(stage(&m, "synth", "executed"), 1);
+    assert_eq!(stage(&m, "ortho", "executed"), recordings);
+    assert_eq!(m["campaign"]["input_errors"].as_u64(), Some(0));
+    let generated: Vec<PathBuf> = std::fs::read_dir(cache.join("dirs"))
+        .unwrap()
+        .map(|e| e.unwrap().path().join("campaign"))
+        .filter(|p| p.join("campaign.toml").is_file())
+        .collect();
+    assert_eq!(generated.len(), 1);
+    assert!(
+        files(&generated[0]) == files(&camp),
+        "the synth node's campaign differs from `skytie synth`'s"
+    );
+    run_ok(
+        skytie()
+            .arg("run")
+            .arg(&wf)
+            .arg("--cache")
+            .arg(&cache)
+            .arg("--out")
+            .arg(&out)
+            .arg("--quiet"),
+    );
+    let m = metrics(&out);
+    assert_eq!(m["engine"]["nodes_executed"].as_u64(), Some(0), "{m}");
+
+    // 3. A user campaign that grows by one recording re-runs only that recording's ortho node.
+    let user = dir.join("user");
+    std::fs::create_dir_all(&user).unwrap();
+    for (rel, bytes) in files(&camp) {
+        let p = user.join(&rel);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, bytes).unwrap();
+    }
+    let csv_path = user.join("mm/recordings.csv");
+    let full = std::fs::read_to_string(&csv_path).unwrap();
+    let lines: Vec<&str> = full.lines().collect();
+    std::fs::write(&csv_path, lines[..lines.len() - 1].join("\n") + "\n").unwrap();
+    let wf_user = write_workflow(dir, &user.display().to_string());
+    let out2 = dir.join("out2");
+    run_ok(
+        skytie()
+            .arg("run")
+            .arg(&wf_user)
+            .arg("--cache")
+            .arg(&cache)
+            .arg("--out")
+            .arg(&out2)
+            .arg("--quiet"),
+    );
+    let m = metrics(&out2);
+    assert_eq!(m["campaign"]["recordings"].as_u64(), Some(recordings - 1));
+    // Same panoramas and rows as the synthetic copy: every ortho is served from the cache.
+    assert_eq!(stage(&m, "ortho", "executed"), 0, "{m}");
+    std::fs::write(&csv_path, full).unwrap();
+    run_ok(
+        skytie()
+            .arg("run")
+            .arg(&wf_user)
+            .arg("--cache")
+            .arg(&cache)
+            .arg("--out")
+            .arg(&out2)
+            .arg("--quiet"),
+    );
+    let m = metrics(&out2);
+    assert_eq!(m["campaign"]["recordings"].as_u64(), Some(recordings));
+    assert_eq!(
+        stage(&m, "ortho", "executed"),
+        0,
+        "the added recording's ortho was computed before: {m}"
+    );
+    assert_eq!(stage(&m, "ortho", "cached"), recordings);
+    assert_eq!(stage(&m, "summary", "executed"), 1);
+}
