@@ -256,11 +256,31 @@ pub fn roof(rgb: [f32; 3], along: f64, across: f64, tiles: bool, seed: u64) -> [
             - 0.25 * smoothstep(0.75, 1.0, f);
         scale(rgb, k)
     } else {
+        // bitumen sheets 1 m wide with dark seams, weathered patches on a 3 m lattice, fine grit
         let g = value2(along * 60.0, across * 60.0, seed) * 0.05
-            + fbm2(along, across, seed, 0.2, 3, 0.5) * 0.05;
-        let r = scale(rgb, 1.0 + g);
-        r
+            + fbm2(along, across, seed, 0.2, 3, 0.5) * 0.08;
+        let sheet = across - floor_f64(across);
+        let seam = if sheet < 0.02 { 0.6 } else { 1.0 };
+        let h = hash2(
+            floor_f64(along / 3.0) as i64,
+            floor_f64(across / 3.0) as i64,
+            seed ^ 0x400F,
+        );
+        let patch = if unit_f32(h) < 0.2 { 0.75 } else { 1.0 };
+        scale(rgb, (1.0 + g) * seam * patch)
     }
+}
+
+/// Coping (light edge band) of a flat roof.
+pub fn roof_coping(x: f64, y: f64, seed: u64) -> [f32; 3] {
+    let v = 0.55 + 0.04 * value2(x * 20.0, y * 20.0, seed);
+    [v, v, v * 0.98]
+}
+
+/// Rooftop unit (air conditioner, skylight frame): light metal.
+pub fn metal(x: f64, y: f64, z: f64, seed: u64) -> [f32; 3] {
+    let v = 0.62 + 0.05 * value3(x * 8.0, y * 8.0, z * 8.0, seed);
+    [v * 0.98, v, v * 1.02]
 }
 
 /// Sky radiance for a world direction with elevation sin `dz` (zenith blue to hazy horizon).

@@ -335,6 +335,36 @@ fn add_building(
             }
         }
     }
+    // rooftop units on flat roofs
+    if ridge.is_none() {
+        for _ in 0..rng.below(3) {
+            let (w, l, h) = (
+                rng.range(0.8, 2.2),
+                rng.range(0.8, 2.5),
+                rng.range(0.5, 1.4),
+            );
+            let cx = rng.range(
+                min[0] + 1.0 + 0.5 * w,
+                (max[0] - 1.0 - 0.5 * w).max(min[0] + 1.0 + 0.5 * w),
+            );
+            let cy = rng.range(
+                min[1] + 1.0 + 0.5 * l,
+                (max[1] - 1.0 - 0.5 * l).max(min[1] + 1.0 + 0.5 * l),
+            );
+            let unit = Aabb::new(
+                Vector3::new(cx - 0.5 * w, cy - 0.5 * l, eave - 0.05),
+                Vector3::new(cx + 0.5 * w, cy + 0.5 * l, eave + h),
+            );
+            objects.push(
+                Object::new(
+                    Shape::Box(unit),
+                    Material::RoofUnit { building: id },
+                    IN_BOTH,
+                )
+                .as_child(),
+            );
+        }
+    }
     // the body is a compound enclosing its roof and protrusions
     let mut env = objects[parent].bounds;
     for o in &objects[parent + 1..] {

@@ -40,6 +40,10 @@ pub enum Material {
         building: u32,
     },
     /// Protrusion (balcony/oriel) of a building's façade.
+    /// Rooftop unit (air conditioner, lift housing) on a flat roof: counts as roof.
+    RoofUnit {
+        building: u32,
+    },
     Balcony {
         building: u32,
     },

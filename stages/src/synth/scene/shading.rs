@@ -74,6 +74,7 @@ impl Scene {
                     }
                 }
                 Material::Balcony { building } => SurfaceKind::Facade { building },
+                Material::RoofUnit { building } => SurfaceKind::Roof { building },
                 Material::GableRoof { building } => {
                     if h.n.z.abs() < 1e-6 {
                         SurfaceKind::Facade { building }
@@ -170,10 +171,23 @@ impl Scene {
                 Material::Building { building } => {
                     if h.n.z > 0.5 {
                         let b = &self.buildings[building as usize];
-                        texture::roof(b.roof_rgb, p.x, p.y, false, b.seed)
+                        let (lo, hi) = (b.footprint_min_local, b.footprint_max_local);
+                        let edge = (p.x - lo[0])
+                            .min(hi[0] - p.x)
+                            .min(p.y - lo[1])
+                            .min(hi[1] - p.y);
+                        if edge < 0.3 {
+                            texture::roof_coping(p.x, p.y, b.seed)
+                        } else {
+                            texture::roof(b.roof_rgb, p.x, p.y, false, b.seed)
+                        }
                     } else {
                         self.facade_albedo(building, p, &h.n)
                     }
+                }
+                Material::RoofUnit { building } => {
+                    let b = &self.buildings[building as usize];
+                    texture::metal(p.x, p.y, p.z, b.seed)
                 }
                 Material::Balcony { building } => {
                     let b = &self.buildings[building as usize];
