@@ -178,8 +178,8 @@ impl SyntheticBlockSpec {
         let mut observations = Vec::new();
         let mut point_obs: Vec<Vec<usize>> = vec![Vec::new(); true_points.len()];
         for (p, &(s, v)) in views.iter().enumerate() {
-            for r in s..s + v {
-                let (u, vv) = true_cameras[r]
+            for (r, cam) in true_cameras.iter().enumerate().skip(s).take(v) {
+                let (u, vv) = cam
                     .project_world(&true_points[p])
                     .expect("point off centre");
                 point_obs[p].push(observations.len());
