@@ -362,3 +362,51 @@ fn all_presets_generate_and_render() {
     }
     assert!(tree > 40, "area 1: road under trees ({tree}/190)");
 }
+
+#[test]
+fn scene_is_send_and_sync_and_kerb_faces_are_hit() {
+    fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<Scene>();
+    let s = Scene::generate(&SceneSpec::tiny(), 5);
+    let spec = SceneSpec::tiny();
+    // a horizontal ray 5 cm above the road edge, across the street, hits the kerb's vertical face
+    let x = 15.0;
+    let edge = world(&s, x, -(spec.road_half_width_m - 0.001), 0.0);
+    let z = s.ground_height_m(edge.x, edge.y) + 0.05;
+    let o = world(&s, x, 0.0, z);
+    let h = s
+        .first_hit(&o, &local_dir(&s, 0.0, -1.0, 0.0), Epoch::MobileMapping)
+        .unwrap();
+    assert_eq!(h.surface, SurfaceKind::Kerb);
+    assert!((h.distance_m - spec.road_half_width_m).abs() < 1e-6);
+    let n_local = s.world_to_local_xy([
+        h.normal_world.x + s.origin_world()[0],
+        h.normal_world.y + s.origin_world()[1],
+    ]);
+    assert!(
+        (n_local[1] - 1.0).abs() < 1e-9,
+        "kerb face faces the road: {n_local:?}"
+    );
+}
+
+#[test]
+fn paper_area_3_has_far_facades() {
+    let spec = SceneSpec::paper_area(3);
+    let s = Scene::generate(&spec, 2);
+    let min_q = spec.road_half_width_m + spec.sidewalk_width_m + spec.setback_m[0];
+    let main_street: Vec<_> = s
+        .buildings()
+        .iter()
+        .filter(|b| b.front_normal_local[1].abs() > 0.5)
+        .collect();
+    assert!(!main_street.is_empty());
+    for b in main_street {
+        let near = b.footprint_min_local[1]
+            .abs()
+            .min(b.footprint_max_local[1].abs());
+        assert!(
+            near >= min_q - 1e-9,
+            "façade at {near} m, expected ≥ {min_q}"
+        );
+    }
+}
