@@ -50,11 +50,26 @@ fn stage(m: &serde_json::Value, stage: &str, what: &str) -> u64 {
         .unwrap_or_else(|| panic!("stages.{stage}.{what} missing in {m}"))
 }
 
-fn write_workflow(dir: &Path, campaign: &str) -> PathBuf {
-    let wf = dir.join("wf.toml");
+/// `skytie run WF --cache CACHE --out OUT --quiet`, then OUT's metrics.
+fn run_workflow(wf: &Path, cache: &Path, out: &Path) -> serde_json::Value {
+    run_ok(
+        skytie()
+            .arg("run")
+            .arg(wf)
+            .arg("--cache")
+            .arg(cache)
+            .arg("--out")
+            .arg(out)
+            .arg("--quiet"),
+    );
+    metrics(out)
+}
+
+fn write_workflow(dir: &Path, campaign: &str, gsd_m: f64) -> PathBuf {
+    let wf = dir.join(format!("wf-{gsd_m}.toml"));
     std::fs::write(
         &wf,
-        format!("name = \"t\"\ncampaign = \"{campaign}\"\nseed = 1\nstages = [\"synth\", \"load\", \"ortho\", \"summary\"]\n[ortho]\ngsd_m = 0.05\n"),
+        format!("name = \"t\"\ncampaign = \"{campaign}\"\nseed = 1\nstages = [\"synth\", \"load\", \"ortho\", \"summary\"]\n[ortho]\ngsd_m = {gsd_m}\n"),
     )
     .unwrap();
     wf
@@ -80,19 +95,9 @@ fn tiny_campaign_end_to_end() {
     );
 
     // 2. The same campaign as a cached workflow node: identical bytes; a second run executes nothing.
-    let wf = write_workflow(dir, "synth:tiny");
+    let wf = write_workflow(dir, "synth:tiny", 0.05);
     let out = dir.join("out1");
-    run_ok(
-        skytie()
-            .arg("run")
-            .arg(&wf)
-            .arg("--cache")
-            .arg(&cache)
-            .arg("--out")
-            .arg(&out)
-            .arg("--quiet"),
-    );
-    let m = metrics(&out);
+    let m = run_workflow(&wf, &cache, &out);
     let recordings = m["campaign"]["recordings"].as_u64().unwrap();
     assert!(recordings >= 4, "{m}");
     assert_eq!(stage(&m, "synth", "executed"), 1);
@@ -108,20 +113,10 @@ fn tiny_campaign_end_to_end() {
         files(&generated[0]) == files(&camp),
         "the synth node's campaign differs from `skytie synth`'s"
     );
-    run_ok(
-        skytie()
-            .arg("run")
-            .arg(&wf)
-            .arg("--cache")
-            .arg(&cache)
-            .arg("--out")
-            .arg(&out)
-            .arg("--quiet"),
-    );
-    let m = metrics(&out);
+    let m = run_workflow(&wf, &cache, &out);
     assert_eq!(m["engine"]["nodes_executed"].as_u64(), Some(0), "{m}");
 
-    // 3. A user campaign that grows by one recording re-runs only that recording's ortho node.
+    // 3. A user campaign (other ortho params) that grows by one recording re-runs only that recording's ortho.
     let user = dir.join("user");
     std::fs::create_dir_all(&user).unwrap();
     for (rel, bytes) in files(&camp) {
@@ -133,39 +128,18 @@ fn tiny_campaign_end_to_end() {
     let full = std::fs::read_to_string(&csv_path).unwrap();
     let lines: Vec<&str> = full.lines().collect();
     std::fs::write(&csv_path, lines[..lines.len() - 1].join("\n") + "\n").unwrap();
-    let wf_user = write_workflow(dir, &user.display().to_string());
+    let wf_user = write_workflow(dir, &user.display().to_string(), 0.04);
     let out2 = dir.join("out2");
-    run_ok(
-        skytie()
-            .arg("run")
-            .arg(&wf_user)
-            .arg("--cache")
-            .arg(&cache)
-            .arg("--out")
-            .arg(&out2)
-            .arg("--quiet"),
-    );
-    let m = metrics(&out2);
+    let m = run_workflow(&wf_user, &cache, &out2);
     assert_eq!(m["campaign"]["recordings"].as_u64(), Some(recordings - 1));
-    // Same panoramas and rows as the synthetic copy: every ortho is served from the cache.
-    assert_eq!(stage(&m, "ortho", "executed"), 0, "{m}");
+    assert_eq!(stage(&m, "ortho", "executed"), recordings - 1, "{m}");
     std::fs::write(&csv_path, full).unwrap();
-    run_ok(
-        skytie()
-            .arg("run")
-            .arg(&wf_user)
-            .arg("--cache")
-            .arg(&cache)
-            .arg("--out")
-            .arg(&out2)
-            .arg("--quiet"),
-    );
-    let m = metrics(&out2);
+    let m = run_workflow(&wf_user, &cache, &out2);
     assert_eq!(m["campaign"]["recordings"].as_u64(), Some(recordings));
     assert_eq!(
         stage(&m, "ortho", "executed"),
-        0,
-        "the added recording's ortho was computed before: {m}"
+        1,
+        "only the added recording's ortho runs: {m}"
     );
     assert_eq!(stage(&m, "ortho", "cached"), recordings);
     assert_eq!(stage(&m, "summary", "executed"), 1);
