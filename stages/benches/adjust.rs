@@ -16,13 +16,10 @@ fn main() {
         .filter(|a| !a.starts_with("--"))
         .collect();
     let n: usize = args.first().and_then(|a| a.parse().ok()).unwrap_or(1000);
-    let out = args
-        .get(1)
-        .cloned()
-        .unwrap_or_else(|| {
-            let p = std::env::temp_dir().join("adjust_bench_problem.json");
-            p.to_string_lossy().into_owned()
-        });
+    let out = args.get(1).cloned().unwrap_or_else(|| {
+        let p = std::env::temp_dir().join("adjust_bench_problem.json");
+        p.to_string_lossy().into_owned()
+    });
     let spec = SyntheticBlockSpec {
         recordings: n,
         control_points: n * 15 / 40,

@@ -5,6 +5,7 @@
 //! `shared/docs/campaign-format.md`), [`synth`] (the synthetic campaign generator). The engine in the
 //! root crate wraps the stages built from these as cached DAG nodes.
 
+pub mod adjustment;
 pub mod campaign;
 pub mod estimators;
 pub mod features;
@@ -14,4 +15,3 @@ pub mod imaging;
 pub mod matching;
 pub mod nadir;
 pub mod synth;
-pub mod adjustment;

@@ -16,12 +16,20 @@ pub struct GrayImage {
 impl GrayImage {
     /// An image of `width × height` filled with `value`.
     pub fn filled(width: usize, height: usize, value: f32) -> Self {
-        Self { width, height, data: vec![value; width * height] }
+        Self {
+            width,
+            height,
+            data: vec![value; width * height],
+        }
     }
 
     /// An image from row-major data; `None` if `data.len() != width * height`.
     pub fn from_vec(width: usize, height: usize, data: Vec<f32>) -> Option<Self> {
-        (data.len() == width * height).then_some(Self { width, height, data })
+        (data.len() == width * height).then_some(Self {
+            width,
+            height,
+            data,
+        })
     }
 
     #[inline]
@@ -55,7 +63,11 @@ impl RgbImage {
         for _ in 0..width * height {
             data.extend_from_slice(&rgb);
         }
-        Self { width, height, data }
+        Self {
+            width,
+            height,
+            data,
+        }
     }
 
     #[inline]
@@ -77,6 +89,10 @@ impl RgbImage {
             .chunks_exact(3)
             .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
             .collect();
-        GrayImage { width: self.width, height: self.height, data }
+        GrayImage {
+            width: self.width,
+            height: self.height,
+            data,
+        }
     }
 }

@@ -15,17 +15,28 @@ pub struct ImageIoError {
 }
 
 fn err(path: &Path, message: impl Into<String>) -> ImageIoError {
-    ImageIoError { path: path.display().to_string(), message: message.into() }
+    ImageIoError {
+        path: path.display().to_string(),
+        message: message.into(),
+    }
 }
 
 fn open(path: &Path) -> Result<image::DynamicImage, ImageIoError> {
     let reader = image::ImageReader::open(path)
-        .map_err(|e| err(path, format!("cannot open ({e}); check that the file exists and is readable")))?
+        .map_err(|e| {
+            err(
+                path,
+                format!("cannot open ({e}); check that the file exists and is readable"),
+            )
+        })?
         .with_guessed_format()
         .map_err(|e| err(path, format!("cannot read ({e})")))?;
-    reader
-        .decode()
-        .map_err(|e| err(path, format!("does not decode as an image ({e}); is it truncated or not JPEG/PNG/TIFF?")))
+    reader.decode().map_err(|e| {
+        err(
+            path,
+            format!("does not decode as an image ({e}); is it truncated or not JPEG/PNG/TIFF?"),
+        )
+    })
 }
 
 /// Load any supported image as a single-channel image (luminance for colour files).
@@ -33,20 +44,35 @@ pub fn load_gray(path: &Path) -> Result<GrayImage, ImageIoError> {
     let img = open(path)?;
     let (w, h) = (img.width() as usize, img.height() as usize);
     let data = match img {
-        image::DynamicImage::ImageLuma16(b) => b.into_raw().into_iter().map(|v| v as f32 / 65535.0).collect(),
+        image::DynamicImage::ImageLuma16(b) => b
+            .into_raw()
+            .into_iter()
+            .map(|v| v as f32 / 65535.0)
+            .collect(),
         other => {
             let rgb = other.to_rgb32f();
-            rgb.into_raw().chunks_exact(3).map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]).collect()
+            rgb.into_raw()
+                .chunks_exact(3)
+                .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
+                .collect()
         }
     };
-    Ok(GrayImage { width: w, height: h, data })
+    Ok(GrayImage {
+        width: w,
+        height: h,
+        data,
+    })
 }
 
 /// Load any supported image as RGB.
 pub fn load_rgb(path: &Path) -> Result<RgbImage, ImageIoError> {
     let img = open(path)?;
     let (w, h) = (img.width() as usize, img.height() as usize);
-    Ok(RgbImage { width: w, height: h, data: img.to_rgb32f().into_raw() })
+    Ok(RgbImage {
+        width: w,
+        height: h,
+        data: img.to_rgb32f().into_raw(),
+    })
 }
 
 /// Only the dimensions (width, height) of an image file, without decoding the pixels.
@@ -60,10 +86,15 @@ fn to_u8(v: f32) -> u8 {
 }
 
 fn format_for(path: &Path) -> Result<image::ImageFormat, ImageIoError> {
-    image::ImageFormat::from_path(path).map_err(|_| err(path, "unknown image extension; use .png, .jpg or .tif"))
+    image::ImageFormat::from_path(path)
+        .map_err(|_| err(path, "unknown image extension; use .png, .jpg or .tif"))
 }
 
-fn save_dynamic(path: &Path, img: image::DynamicImage, jpeg_quality: u8) -> Result<(), ImageIoError> {
+fn save_dynamic(
+    path: &Path,
+    img: image::DynamicImage,
+    jpeg_quality: u8,
+) -> Result<(), ImageIoError> {
     let format = format_for(path)?;
     crate::fsutil::atomic_write_with(path, |w| {
         let res = if format == image::ImageFormat::Jpeg {
@@ -84,16 +115,26 @@ fn save_dynamic(path: &Path, img: image::DynamicImage, jpeg_quality: u8) -> Resu
 /// Save as 8-bit RGB (format from the extension; JPEG at `jpeg_quality`).
 pub fn save_rgb(path: &Path, img: &RgbImage, jpeg_quality: u8) -> Result<(), ImageIoError> {
     let raw: Vec<u8> = img.data.iter().map(|&v| to_u8(v)).collect();
-    let buf = image::RgbImage::from_raw(img.width as u32, img.height as u32, raw)
-        .ok_or_else(|| err(path, "internal: RGB buffer size does not match its dimensions"))?;
+    let buf =
+        image::RgbImage::from_raw(img.width as u32, img.height as u32, raw).ok_or_else(|| {
+            err(
+                path,
+                "internal: RGB buffer size does not match its dimensions",
+            )
+        })?;
     save_dynamic(path, image::DynamicImage::ImageRgb8(buf), jpeg_quality)
 }
 
 /// Save as 8-bit grey (format from the extension; JPEG at quality 95).
 pub fn save_gray(path: &Path, img: &GrayImage) -> Result<(), ImageIoError> {
     let raw: Vec<u8> = img.data.iter().map(|&v| to_u8(v)).collect();
-    let buf = image::GrayImage::from_raw(img.width as u32, img.height as u32, raw)
-        .ok_or_else(|| err(path, "internal: grey buffer size does not match its dimensions"))?;
+    let buf =
+        image::GrayImage::from_raw(img.width as u32, img.height as u32, raw).ok_or_else(|| {
+            err(
+                path,
+                "internal: grey buffer size does not match its dimensions",
+            )
+        })?;
     save_dynamic(path, image::DynamicImage::ImageLuma8(buf), 95)
 }
 
