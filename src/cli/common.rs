@@ -76,3 +76,31 @@ pub fn load_workflow(
     pipeline.validate(&wf)?;
     Ok((wf, pipeline))
 }
+
+/// Build a workflow's graph in plan mode (nothing executes) and hand the session to `report`, with the note
+/// `plan_stop` gives when planning stopped at a phase whose inputs are not computed yet. Shared by `plan` and
+/// `explain`. Errors are (exit code, message).
+pub fn with_plan_session<T>(
+    workflow: &Path,
+    campaign: Option<&Path>,
+    cache: &CacheOpt,
+    threads: &ThreadsOpt,
+    report: impl FnOnce(
+        &crate::dag::Session<'_>,
+        Option<crate::dag::PipelineError>,
+    ) -> Result<T, (i32, String)>,
+) -> Result<T, (i32, String)> {
+    use crate::progress::{Progress, ProgressMode};
+    let (wf, pipeline) = load_workflow(workflow, campaign).map_err(|e| (2, e))?;
+    let store = cache.open().map_err(|e| (2, e))?;
+    let stat_cache = crate::hashing::StatCache::open(store.root());
+    let progress = Progress::new(ProgressMode::Quiet);
+    let mut session =
+        crate::dag::Session::new(&store, &stat_cache, &progress, crate::dag::Mode::Plan);
+    let result = threads
+        .install(|| pipeline.run(&wf, &mut session))
+        .map_err(|e| (2, e))?;
+    let _ = stat_cache.save();
+    let stopped = crate::cli::run::plan_stop(result).map_err(|e| (1, e.to_string()))?;
+    report(&session, stopped)
+}

@@ -1,11 +1,7 @@
 //! `skytie explain WORKFLOW NODE`: one node's key ingredients and provenance. NODE is `stage[item]`
 //! (as printed by `plan`), or a unique prefix of it.
 
-use crate::cli::common::{load_workflow, CacheOpt, ThreadsOpt};
-use crate::cli::run::plan_stop;
-use crate::dag::{Mode, Session};
-use crate::hashing::StatCache;
-use crate::progress::{Progress, ProgressMode};
+use crate::cli::common::{with_plan_session, CacheOpt, ThreadsOpt};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -25,24 +21,19 @@ pub struct ExplainArgs {
 }
 
 pub fn main(args: &ExplainArgs) -> i32 {
-    let r = (|| {
-        let (wf, pipeline) =
-            load_workflow(&args.workflow, args.campaign.as_deref()).map_err(|e| (2, e))?;
-        let store = args.cache.open().map_err(|e| (2, e))?;
-        let stat_cache = StatCache::open(store.root());
-        let progress = Progress::new(ProgressMode::Quiet);
-        let mut session = Session::new(&store, &stat_cache, &progress, Mode::Plan);
-        let result = args
-            .threads
-            .install(|| pipeline.run(&wf, &mut session))
-            .map_err(|e| (2, e))?;
-        let stopped = plan_stop(result).map_err(|e| (1, e.to_string()))?;
-        let mut text = crate::explain::explain(&session, &args.node).map_err(|e| (1, e))?;
-        if let Some(s) = stopped {
-            text.push_str(&format!("note: {s}\n"));
-        }
-        Ok::<String, (i32, String)>(text)
-    })();
+    let r = with_plan_session(
+        &args.workflow,
+        args.campaign.as_deref(),
+        &args.cache,
+        &args.threads,
+        |session, stopped| {
+            let mut text = crate::explain::explain(session, &args.node).map_err(|e| (1, e))?;
+            if let Some(s) = stopped {
+                text.push_str(&format!("note: {s}\n"));
+            }
+            Ok(text)
+        },
+    );
     match r {
         Ok(text) => {
             print!("{text}");

@@ -1,10 +1,6 @@
 //! `skytie plan WORKFLOW [--campaign DIR] [--cache DIR]`: per stage, cached / will run, and why.
 
-use crate::cli::common::{load_workflow, CacheOpt, ThreadsOpt};
-use crate::cli::run::plan_stop;
-use crate::dag::{Mode, Session};
-use crate::hashing::StatCache;
-use crate::progress::{Progress, ProgressMode};
+use crate::cli::common::{with_plan_session, CacheOpt, ThreadsOpt};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -36,17 +32,11 @@ pub fn main(args: &PlanArgs) -> i32 {
 
 /// The plan text, or (exit code, message).
 pub fn plan(args: &PlanArgs) -> Result<String, (i32, String)> {
-    let (wf, pipeline) =
-        load_workflow(&args.workflow, args.campaign.as_deref()).map_err(|e| (2, e))?;
-    let store = args.cache.open().map_err(|e| (2, e))?;
-    let stat_cache = StatCache::open(store.root());
-    let progress = Progress::new(ProgressMode::Quiet);
-    let mut session = Session::new(&store, &stat_cache, &progress, Mode::Plan);
-    let result = args
-        .threads
-        .install(|| pipeline.run(&wf, &mut session))
-        .map_err(|e| (2, e))?;
-    let _ = stat_cache.save();
-    let stopped = plan_stop(result).map_err(|e| (1, e.to_string()))?;
-    Ok(crate::plan::plan_text(&session, stopped.as_ref()))
+    with_plan_session(
+        &args.workflow,
+        args.campaign.as_deref(),
+        &args.cache,
+        &args.threads,
+        |session, stopped| Ok(crate::plan::plan_text(session, stopped.as_ref())),
+    )
 }
