@@ -2,7 +2,12 @@
 //! transform to aerial nadir patches, phase-correlation refinement and aerial control points.
 
 pub mod ortho;
+pub mod registration;
 pub mod vehicle_mask;
 
 pub use ortho::{ortho_project, OrthoGeoref, OrthoImage, OrthoParams};
+pub use registration::{
+    AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch, PairMethod, PairReport,
+    TransformOutcome,
+};
 pub use vehicle_mask::VehicleMask;

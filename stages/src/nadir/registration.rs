@@ -1,0 +1,101 @@
+//! Results of the nadir registration stages that later stages consume (thesis 3.4.4–3.4.5): the outcome of
+//! MM-to-MM matching for one recording window, the initial MM→aerial transform, and the per-aerial-image
+//! refined correspondences. Produced by `mm_matching`, `initial_transform` and `refine`; cached by the engine.
+
+use crate::correspondence::{AerialObservation, MmTiePoint};
+use crate::geometry::Similarity2;
+use serde::{Deserialize, Serialize};
+
+/// How two adjacent ortho images were related (thesis 3.4.4.2–3.4.4.3).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum PairMethod {
+    /// KAZE + RANSAC homography that passed the centre-distance verification.
+    Kaze,
+    /// The recorded poses (KAZE failed or was rejected; `reason` says why).
+    Fallback { reason: String },
+}
+
+/// One pair (detecting recording → neighbour) of an MM matching window.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PairReport {
+    /// The neighbour's `image_id`.
+    pub to_id: String,
+    pub method: PairMethod,
+    /// KAZE matches before / after RANSAC (0 when KAZE was not usable).
+    pub kaze_matches: usize,
+    pub kaze_inliers: usize,
+    /// |projected centre distance − recorded inter-pose distance|, metres (`None` when no homography).
+    pub centre_check_error_m: Option<f64>,
+    /// Förstner corners transferred into the neighbour and accepted by template matching + verification.
+    pub corners_matched: usize,
+}
+
+/// Output of MM-to-MM matching for the window starting at one recording (thesis 3.4.4): corners detected in
+/// that recording's 3 cm ortho image, tracked into the next one or two recordings and triangulated.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MmWindowMatch {
+    /// The detecting recording's `image_id`.
+    pub recording_id: String,
+    pub pairs: Vec<PairReport>,
+    /// Förstner corners detected in the detecting ortho image.
+    pub corners_detected: usize,
+    /// Triangulated tie points (observations: detecting panorama first).
+    pub tie_points: Vec<MmTiePoint>,
+    /// For each tie point (same order): its corner position on the detecting recording's ortho ground plane,
+    /// world frame, metres — where the aerial stages look for it.
+    pub ground_world: Vec<[f64; 3]>,
+}
+
+/// The initial transform between a recording's MM ortho image (aerial GSD, aerial orientation) and one aerial
+/// nadir image (thesis 3.4.5.2).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct InitialTransform {
+    pub recording_id: String,
+    pub aerial_id: String,
+    /// Maps MM ortho pixel coordinates to **full** aerial image pixel coordinates (not patch coordinates).
+    pub ortho_to_aerial: Similarity2,
+    /// Descriptor matches inside the error windows / RANSAC inliers.
+    pub matches: usize,
+    pub inliers: usize,
+    /// Distance between the MM ortho centre mapped by the transform and by the recorded pose, metres (the
+    /// plausibility check: must not exceed the expected maximum localisation error).
+    pub centre_offset_m: f64,
+    /// `true` when this transform was taken from a neighbouring recording (option `reuse_neighbour`).
+    pub reused_from: Option<String>,
+}
+
+/// Outcome of the initial-transform stage for one (recording, aerial image).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum TransformOutcome {
+    Accepted(InitialTransform),
+    /// No plausible transform; `reason` is for metrics and the report (e.g. "12 matches, RANSAC found 3
+    /// inliers < 6", "centre offset 2.3 m > 1.5 m").
+    Rejected {
+        recording_id: String,
+        aerial_id: String,
+        reason: String,
+        matches: usize,
+        inliers: usize,
+    },
+}
+
+/// One MM tie point located in one aerial image by phase correlation (thesis 3.4.5.3).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AerialMatch {
+    /// `MmTiePoint::id`.
+    pub tie_point_id: String,
+    pub observation: AerialObservation,
+    /// The location predicted by the initial transform (full aerial pixels), before refinement.
+    pub predicted_u_px: f64,
+    pub predicted_v_px: f64,
+}
+
+/// All refined correspondences of one (recording, aerial image).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AerialRefinement {
+    pub recording_id: String,
+    pub aerial_id: String,
+    /// Tie points tried (inside the aerial image) and located (peak accepted).
+    pub tried: usize,
+    pub matches: Vec<AerialMatch>,
+}
