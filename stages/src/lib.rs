@@ -7,7 +7,9 @@
 
 pub mod adjustment;
 pub mod campaign;
+pub mod correspondence;
 pub mod estimators;
+pub mod export;
 pub mod features;
 pub mod fsutil;
 pub mod geometry;

@@ -1,7 +1,15 @@
 //! The nadir pipeline (thesis chapter 3): ortho-projection of panoramas, MM-to-MM matching, the initial KAZE
 //! transform to aerial nadir patches, phase-correlation refinement and aerial control points.
 
+pub mod aerial_overlap;
+pub mod aerial_patch;
+pub mod baseline;
+pub mod control_points;
+pub mod grading;
+pub mod initial_transform;
+pub mod mm_matching;
 pub mod ortho;
+pub mod refine;
 pub mod registration;
 pub mod vehicle_mask;
 

@@ -1,0 +1,1 @@
+//! (placeholder: exports being written in session 2)
