@@ -16,6 +16,7 @@ pub use check::{check_campaign, CheckReport};
 pub use model::{AerialImage, AerialKind, Campaign, CheckPoint, Observation, Recording};
 pub use problem::{Problem, Severity};
 pub use read::{read_campaign, CampaignError};
+pub use read_aerial::read_aerial_csv;
 pub use read_recordings::read_recordings_csv;
 pub use time::{format_time_iso, parse_time_s};
 pub use write::{

@@ -82,7 +82,7 @@ pub(crate) fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>
         let folder = Path::new(rel).parent().unwrap_or(Path::new(""));
         if root.join(rel).is_file() {
             aerial.extend(
-                read_aerial_rows(root, Path::new(rel), &mut problems)
+                read_aerial_rows(root, Path::new(rel), true, &mut problems)
                     .into_iter()
                     .map(|r| (rel, r)),
             );

@@ -13,11 +13,12 @@ const AERIAL_COLUMNS: &[&str] = &[
     "height",
 ];
 
-/// Valid rows of `root/rel` in file order; `file` must exist next to the CSV. Id uniqueness is checked by
-/// the caller across nadir and oblique together.
+/// Valid rows of `root/rel` in file order; with `check_files`, `file` must exist next to the CSV. Id
+/// uniqueness is checked by the caller across nadir and oblique together.
 pub(crate) fn read_aerial_rows(
     root: &Path,
     rel: &Path,
+    check_files: bool,
     problems: &mut Vec<Problem>,
 ) -> Vec<Sourced<AerialImage>> {
     let Some(table) = read_table(root, rel, AERIAL_COLUMNS, problems) else {
@@ -71,7 +72,7 @@ pub(crate) fn read_aerial_rows(
                 "write a value > 0 px, or leave the cell empty for the default 0.5",
             );
         }
-        if !file.is_empty() {
+        if check_files && !file.is_empty() {
             check_file_exists(&mut f, root, dir, &file);
         }
         if f.ok {
@@ -103,4 +104,19 @@ pub(crate) fn read_aerial_rows(
         }
     }
     rows
+}
+
+/// Read any file with the columns of `aerial/*/cameras.csv` (e.g. `truth/aerial_nadir.csv`) without checking
+/// that the image files exist. Returns the valid rows in file order and the problems (file as given).
+pub fn read_aerial_csv(path: &Path) -> (Vec<AerialImage>, Vec<Problem>) {
+    let mut problems = Vec::new();
+    let (root, rel) = match (path.parent(), path.file_name()) {
+        (Some(parent), Some(name)) => (parent, Path::new(name)),
+        _ => (Path::new("."), path),
+    };
+    let rows = read_aerial_rows(root, rel, false, &mut problems);
+    for p in &mut problems {
+        p.file = path.to_path_buf();
+    }
+    (rows.into_iter().map(|r| r.item).collect(), problems)
 }

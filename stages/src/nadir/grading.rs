@@ -1,1 +1,181 @@
-//! (placeholder: being written in session 2)
+//! Grading the nadir pipeline against a synthetic campaign's `truth/` (issue 4's `nadir.*` truth metrics).
+//! Evaluation only: the pipeline never calls this; the engine runs it as a separate node when `truth/` exists.
+//!
+//! The rule for a **correct** MM–aerial correspondence (one MM tie point located in one aerial image): the tie
+//! point's panorama observations, triangulated with the **true** recording poses, give its true object point X;
+//! the correspondence is correct when X, projected into the aerial image with its true pose, lies within
+//! [`CORRECT_TOLERANCE_PX`] (one aerial pixel) of the aerial observation — i.e. the MM rays and the aerial ray
+//! meet within one aerial pixel. A control point's error is its (aerial-triangulated) position minus X.
+//! An MM tie point is correct when every one of its panorama rays passes within [`MM_CORRECT_TOLERANCE_M`] of X.
+
+use crate::campaign::{AerialImage, Recording};
+use crate::correspondence::{AerialControlPoint, MmTiePoint, PanoObservation};
+use crate::geometry::{triangulate_rays, FrameCamera, PanoramaCamera, Ray};
+use crate::nadir::registration::AerialRefinement;
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+
+/// A correspondence is correct within this distance, aerial pixels.
+pub const CORRECT_TOLERANCE_PX: f64 = 1.0;
+/// An MM tie point's rays must pass within this distance of the true point, metres.
+pub const MM_CORRECT_TOLERANCE_M: f64 = 0.05;
+
+/// True poses of a synthetic campaign, keyed by `image_id`, with each panorama's size in pixels.
+pub struct Truth {
+    pub recordings: HashMap<String, (Recording, u32, u32)>,
+    /// True aerial poses (the recorded ones where `truth/aerial_*.csv` does not exist).
+    pub aerial: HashMap<String, AerialImage>,
+}
+
+/// Error statistics of a set of 3-D errors, metres.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ErrorStats {
+    pub count: usize,
+    pub median_horizontal_m: f64,
+    pub rms_horizontal_m: f64,
+    pub median_vertical_m: f64,
+    pub rms_vertical_m: f64,
+}
+
+impl ErrorStats {
+    /// Statistics of `errors` (world frame, metres).
+    pub fn from_errors(errors: &[Vector3<f64>]) -> Self {
+        if errors.is_empty() {
+            return Self::default();
+        }
+        let mut h: Vec<f64> = errors.iter().map(|e| e.x.hypot(e.y)).collect();
+        let mut v: Vec<f64> = errors.iter().map(|e| e.z.abs()).collect();
+        let rms = |x: &[f64]| (x.iter().map(|a| a * a).sum::<f64>() / x.len() as f64).sqrt();
+        let (rh, rv) = (rms(&h), rms(&v));
+        Self {
+            count: errors.len(),
+            median_horizontal_m: median(&mut h),
+            rms_horizontal_m: rh,
+            median_vertical_m: median(&mut v),
+            rms_vertical_m: rv,
+        }
+    }
+}
+
+fn median(x: &mut [f64]) -> f64 {
+    x.sort_by(f64::total_cmp);
+    let n = x.len();
+    if n == 0 {
+        0.0
+    } else if n % 2 == 1 {
+        x[n / 2]
+    } else {
+        0.5 * (x[n / 2 - 1] + x[n / 2])
+    }
+}
+
+/// The truth grades of one run of the nadir pipeline.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct NadirGrade {
+    /// MM tie point × aerial image correspondences that could be graded / are correct.
+    pub tie_points: usize,
+    pub correct_tie_points: usize,
+    /// Correspondences whose MM observations could not be triangulated with the true poses.
+    pub ungraded: usize,
+    /// MM tie points graded / correct (rays within [`MM_CORRECT_TOLERANCE_M`] of the true point).
+    pub mm_tie_points: usize,
+    pub mm_tie_points_correct: usize,
+    /// Aerial control points (≥ 2 aerial images) vs their true points.
+    pub control_points: ErrorStats,
+}
+
+impl NadirGrade {
+    /// correct / graded correspondences (0 when there are none).
+    pub fn inlier_ratio(&self) -> f64 {
+        if self.tie_points == 0 {
+            0.0
+        } else {
+            self.correct_tie_points as f64 / self.tie_points as f64
+        }
+    }
+}
+
+impl Truth {
+    fn ray(&self, o: &PanoObservation) -> Option<(Ray, f64)> {
+        let (rec, w, h) = self.recordings.get(&o.image_id)?;
+        let cam = PanoramaCamera::from_recording(rec, *w, *h);
+        Some((cam.pixel_ray(o.u_px, o.v_px), cam.angular_sigma_rad(0.5)))
+    }
+
+    /// The true object point of a set of panorama observations (triangulated with the true poses).
+    pub fn true_point(&self, observations: &[PanoObservation]) -> Option<Vector3<f64>> {
+        let (rays, sigmas): (Vec<Ray>, Vec<f64>) =
+            observations.iter().filter_map(|o| self.ray(o)).unzip();
+        if rays.len() < 2 || rays.len() != observations.len() {
+            return None;
+        }
+        triangulate_rays(&rays, &sigmas).ok().map(|t| t.point_world)
+    }
+
+    /// Distance (aerial px) between the true projection of `x_world` into aerial image `aerial_id` and (u, v).
+    fn aerial_error_px(
+        &self,
+        aerial_id: &str,
+        x_world: &Vector3<f64>,
+        u: f64,
+        v: f64,
+    ) -> Option<f64> {
+        let cam = FrameCamera::from_aerial(self.aerial.get(aerial_id)?);
+        let (pu, pv) = cam.project_world(x_world)?;
+        Some((pu - u).hypot(pv - v))
+    }
+}
+
+/// Grade MM tie points, MM–aerial correspondences and aerial control points against the truth.
+pub fn grade_nadir(
+    truth: &Truth,
+    tie_points: &[&MmTiePoint],
+    refinements: &[&AerialRefinement],
+    control: &[&AerialControlPoint],
+) -> NadirGrade {
+    let mut g = NadirGrade::default();
+    let mut true_points: HashMap<&str, Option<Vector3<f64>>> = HashMap::new();
+    for tp in tie_points {
+        let x = truth.true_point(&tp.observations);
+        if let Some(x) = x {
+            g.mm_tie_points += 1;
+            let ok = tp.observations.iter().all(|o| {
+                truth
+                    .ray(o)
+                    .map(|(r, _)| {
+                        let d = x - r.origin_world;
+                        (d - r.dir_world * d.dot(&r.dir_world)).norm() <= MM_CORRECT_TOLERANCE_M
+                    })
+                    .unwrap_or(false)
+            });
+            g.mm_tie_points_correct += usize::from(ok);
+        }
+        true_points.insert(tp.id.as_str(), x);
+    }
+    for r in refinements {
+        for m in &r.matches {
+            let x = true_points.get(m.tie_point_id.as_str()).copied().flatten();
+            let err = x.and_then(|x| {
+                truth.aerial_error_px(&r.aerial_id, &x, m.observation.u_px, m.observation.v_px)
+            });
+            match err {
+                Some(e) => {
+                    g.tie_points += 1;
+                    g.correct_tie_points += usize::from(e <= CORRECT_TOLERANCE_PX);
+                }
+                None => g.ungraded += 1,
+            }
+        }
+    }
+    let errors: Vec<Vector3<f64>> = control
+        .iter()
+        .filter_map(|c| {
+            let p = c.point_world?;
+            let x = truth.true_point(&c.mm)?;
+            Some(Vector3::new(p[0], p[1], p[2]) - x)
+        })
+        .collect();
+    g.control_points = ErrorStats::from_errors(&errors);
+    g
+}
