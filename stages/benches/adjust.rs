@@ -4,7 +4,7 @@
 //! (or the second argument) for the peer `benches/peers/adjust_scipy.py`.
 
 use nalgebra::Vector3;
-use skytie_stages::adjustment::prepared::Prepared;
+use skytie_stages::adjustment::prepared::{Prepared, Rejected};
 use skytie_stages::adjustment::residuals::State;
 use skytie_stages::adjustment::{adjust, AdjustOptions, SyntheticBlockSpec};
 use skytie_stages::geometry::LocalOrigin;
@@ -69,14 +69,7 @@ fn main() {
             .map(|p| origin.to_local(p))
             .collect(),
     };
-    let prep = Prepared::new(
-        b,
-        &options,
-        &state,
-        &vec![false; b.pano_observations.len()],
-        &vec![false; b.control_points.len()],
-    )
-    .unwrap();
+    let prep = Prepared::new(b, &options, &state, &Rejected::none(b)).unwrap();
     let v3 = |v: &Vector3<f64>| serde_json::json!([v.x, v.y, v.z]);
     let json = serde_json::json!({
         "final_cost_rust": adj.final_cost,

@@ -5,12 +5,13 @@
 //!
 //! Normalised residual: the residual divided by its a-priori σ (σ0 = 1), per component — the angular
 //! components of a panorama observation in units of its σ_θ (without the 5.7 weighting factor, so the test is
-//! the same for every weighting method) and the whitened coordinate residual `L⁻¹·e` of a control point. We do
+//! the same for every weighting method), the pixel residual of an aerial observation in units of its σ_px and
+//! the whitened coordinate residual `L⁻¹·e` of a control point. We do
 //! not divide by σ̂0 (exact synthetic data would make it 0) nor by the redundancy numbers (they would need the
 //! full inverse). Priors and relative constraints are never rejected.
 
 use super::covariance::recording_covariances;
-use super::prepared::Prepared;
+use super::prepared::{Prepared, Rejected};
 use super::problem::{AdjustError, AdjustOptions, Block};
 use super::residuals::{pano_residual, State};
 use super::solver::{solve, SolveReport, Termination};
@@ -37,6 +38,8 @@ pub struct AdjustedRecording {
 pub struct ObservationCounts {
     pub pano: usize,
     pub control: usize,
+    /// Aerial image observations (issue 6 (a)).
+    pub aerial: usize,
     pub priors: usize,
     pub relative: usize,
 }
@@ -47,6 +50,7 @@ pub struct RoundReport {
     pub solve: SolveReport,
     pub rejected_pano: usize,
     pub rejected_control: usize,
+    pub rejected_aerial: usize,
 }
 
 /// The result of [`adjust`].
@@ -73,6 +77,7 @@ pub struct Adjustment {
     /// Indices of rejected panorama observations / control points, ascending.
     pub rejected_pano: Vec<usize>,
     pub rejected_control: Vec<usize>,
+    pub rejected_aerial: Vec<usize>,
     /// Panorama observations unused in the final solve although not rejected (undetermined point, or
     /// weight 0 under weighting method 2).
     pub unused_pano: usize,
@@ -98,8 +103,7 @@ pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, Adju
             .map(|p| origin.to_local(p))
             .collect(),
     };
-    let mut pano_rejected = vec![false; block.pano_observations.len()];
-    let mut control_rejected = vec![false; block.control_points.len()];
+    let mut rejected = Rejected::none(block);
     let mut rounds = Vec::new();
     let max_rounds = if options.rejection_threshold.is_some() {
         options.max_rejection_rounds + 1
@@ -108,12 +112,13 @@ pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, Adju
     };
     let mut prep;
     loop {
-        prep = Prepared::new(block, options, &state, &pano_rejected, &control_rejected)?;
+        prep = Prepared::new(block, options, &state, &rejected)?;
         let report = solve(&prep, &mut state, &options.lm)?;
         let mut round = RoundReport {
             solve: report,
             rejected_pano: 0,
             rejected_control: 0,
+            rejected_aerial: 0,
         };
         if let Some(k) = options
             .rejection_threshold
@@ -137,6 +142,14 @@ pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, Adju
                     );
                 }
             }
+            for (i, o) in prep.aerial.iter().enumerate() {
+                if o.active {
+                    let value = prep
+                        .aerial_whitened(i, &state)
+                        .map_or(f64::INFINITY, |(r, _)| r.amax());
+                    offer(o.point, value, Candidate::Aerial(i));
+                }
+            }
             for (i, c) in prep.control.iter().enumerate() {
                 if c.active {
                     offer(
@@ -149,17 +162,21 @@ pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, Adju
             for (_, candidate) in worst.into_iter().flatten() {
                 match candidate {
                     Candidate::Pano(i) => {
-                        pano_rejected[i] = true;
+                        rejected.pano[i] = true;
                         round.rejected_pano += 1;
                     }
                     Candidate::Control(i) => {
-                        control_rejected[i] = true;
+                        rejected.control[i] = true;
                         round.rejected_control += 1;
+                    }
+                    Candidate::Aerial(i) => {
+                        rejected.aerial[i] = true;
+                        round.rejected_aerial += 1;
                     }
                 }
             }
         }
-        let done = round.rejected_pano + round.rejected_control == 0;
+        let done = round.rejected_pano + round.rejected_control + round.rejected_aerial == 0;
         rounds.push(round);
         if done {
             break;
@@ -180,12 +197,10 @@ pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, Adju
         })
         .collect();
     let last = rounds.last().copied().expect("at least one round");
-    let rejected_pano: Vec<usize> = (0..pano_rejected.len())
-        .filter(|&i| pano_rejected[i])
-        .collect();
-    let rejected_control: Vec<usize> = (0..control_rejected.len())
-        .filter(|&i| control_rejected[i])
-        .collect();
+    let flagged = |v: &[bool]| -> Vec<usize> { (0..v.len()).filter(|&i| v[i]).collect() };
+    let rejected_pano = flagged(&rejected.pano);
+    let rejected_control = flagged(&rejected.control);
+    let rejected_aerial = flagged(&rejected.aerial);
     let priors = block
         .recordings
         .iter()
@@ -210,23 +225,26 @@ pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, Adju
         observations: ObservationCounts {
             pano: block.pano_observations.len(),
             control: block.control_points.len(),
+            aerial: block.aerial_observations.len(),
             priors,
             relative: block.relative_constraints.len(),
         },
         rejected: ObservationCounts {
             pano: rejected_pano.len(),
             control: rejected_control.len(),
+            aerial: rejected_aerial.len(),
             priors: 0,
             relative: 0,
         },
         unused_pano: prep
             .pano
             .iter()
-            .zip(&pano_rejected)
+            .zip(&rejected.pano)
             .filter(|(o, &rej)| !o.active && !rej)
             .count(),
         rejected_pano,
         rejected_control,
+        rejected_aerial,
         rounds,
     })
 }
@@ -236,6 +254,7 @@ pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, Adju
 enum Candidate {
     Pano(usize),
     Control(usize),
+    Aerial(usize),
 }
 
 /// Largest |component| of a panorama observation's residual in units of its σ_θ (no 5.7 factor).

@@ -2,7 +2,8 @@
 //! optionally, a yaw correction per recording) from panorama observations of tie points, aerial control
 //! points, weak priors on the recorded positions and optional relative constraints along the trajectory.
 //!
-//! Layers: [`problem`] (the block and the options), [`weighting`] (residual weighting methods 1–4 of thesis
+//! Layers: [`problem`] (the block and the options), [`aerial`] (aerial image observations with the aerial
+//! orientation fixed, issue 6 (a)), [`weighting`] (residual weighting methods 1–4 of thesis
 //! 5.7), [`robust`] (Huber/Cauchy losses), [`residuals`] (residuals and analytic Jacobians), [`skyline`]
 //! (envelope Cholesky of the reduced camera matrix), [`solver`] (Levenberg–Marquardt with the points
 //! eliminated by a Schur complement), [`covariance`] (posterior σ per recording), [`adjust`] (solve, reject
@@ -10,6 +11,7 @@
 //! (known-answer test blocks).
 
 pub mod adjust;
+pub mod aerial;
 pub mod covariance;
 pub mod evaluate;
 pub mod prepared;
@@ -27,8 +29,8 @@ pub use evaluate::{
     ViewSelection,
 };
 pub use problem::{
-    AdjustError, AdjustOptions, Block, BlockRecording, ControlPoint, LmOptions, PanoObservation,
-    RelativeConstraint,
+    AdjustError, AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint,
+    LmOptions, PanoObservation, RelativeConstraint,
 };
 pub use robust::RobustLoss;
 pub use solver::Termination;

@@ -2,10 +2,11 @@
 //! cost and its linearisation (thesis 5.4: the adjustment model; 5.7: residual weighting).
 //!
 //! Whitening: every residual is divided by its a-priori standard deviation, so the cost is
-//! `½·Σ ρ(‖r_obs‖²)` over panorama and control-point observations (robust loss ρ) plus `½·Σ ‖r‖²` over the
+//! `½·Σ ρ(‖r_obs‖²)` over panorama, aerial-image and control-point observations (robust loss ρ) plus `½·Σ ‖r‖²` over the
 //! priors and relative constraints. Panorama residuals are additionally multiplied by the thesis 5.7 weighting
 //! factor, fixed per solve from the distances at the start of the solve.
 
+use super::aerial::FixedFrameCamera;
 use super::problem::{AdjustError, AdjustOptions, Block};
 use super::residuals::{observed_angles_rad, pano_residual, Parameterization, State};
 use super::robust::RobustLoss;
@@ -38,6 +39,17 @@ pub struct PreparedControl {
     pub active: bool,
 }
 
+/// An aerial image observation ready for evaluation (issue 6 (a): the aerial orientation is fixed).
+#[derive(Clone, Copy, Debug)]
+pub struct PreparedAerial {
+    pub camera: usize,
+    pub point: usize,
+    pub observed_px: (f64, f64),
+    /// 1 / σ_px: whitens the pixel residual.
+    pub whitening: f64,
+    pub active: bool,
+}
+
 /// The fixed setup of one solve.
 #[derive(Clone, Debug)]
 pub struct Prepared {
@@ -53,6 +65,9 @@ pub struct Prepared {
     pub yaw_prior_sigma_rad: Option<f64>,
     pub pano: Vec<PreparedPano>,
     pub control: Vec<PreparedControl>,
+    /// Fixed aerial cameras in the local frame.
+    pub aerial_cameras: Vec<FixedFrameCamera>,
+    pub aerial: Vec<PreparedAerial>,
     /// (from, to, σ) with from ≠ to.
     pub relative: Vec<(usize, usize, f64)>,
     /// Points with enough active observations to be determined.
@@ -81,15 +96,15 @@ pub struct Linearization {
 }
 
 impl Prepared {
-    /// Sets up a solve at `state`; `pano_rejected` / `control_rejected` flag observations removed by
-    /// earlier rejection rounds.
+    /// Sets up a solve at `state`; `rejected` flags observations removed by earlier rejection rounds.
     pub fn new(
         block: &Block,
         options: &AdjustOptions,
         state: &State,
-        pano_rejected: &[bool],
-        control_rejected: &[bool],
+        rejected: &Rejected,
     ) -> Result<Self, AdjustError> {
+        let pano_rejected = &rejected.pano;
+        let control_rejected = &rejected.control;
         let n_rec = block.recordings.len();
         let n_pts = block.points_initial_world.len();
         let rotations0: Vec<Matrix3<f64>> = block
@@ -159,9 +174,39 @@ impl Prepared {
                 active: !control_rejected[index],
             });
         }
-        // A point is determined by ≥ 2 active panorama rays or an active control point.
+        let aerial_cameras: Vec<FixedFrameCamera> = block
+            .aerial_cameras
+            .iter()
+            .map(|c| FixedFrameCamera::new(c, &state.origin))
+            .collect();
+        let mut aerial = Vec::with_capacity(block.aerial_observations.len());
+        for (index, o) in block.aerial_observations.iter().enumerate() {
+            let observed_px = (o.u_px, o.v_px);
+            if aerial_cameras[o.camera]
+                .residual(observed_px, &state.points_local[o.point])
+                .is_none()
+            {
+                return Err(AdjustError::InvalidAerialObservation {
+                    index,
+                    problem: "the tie point is not in front of the aerial camera (or far outside its \
+                              image); check the point's initial coordinates and the camera orientation"
+                        .to_string(),
+                });
+            }
+            aerial.push(PreparedAerial {
+                camera: o.camera,
+                point: o.point,
+                observed_px,
+                whitening: 1.0 / o.sigma_px,
+                active: !rejected.aerial[index],
+            });
+        }
+        // A point is determined by ≥ 2 active rays (panorama or aerial) or an active control point.
         let mut rays = vec![0usize; n_pts];
         for o in pano.iter().filter(|o| o.active) {
+            rays[o.point] += 1;
+        }
+        for o in aerial.iter().filter(|o| o.active) {
             rays[o.point] += 1;
         }
         let mut controlled = vec![false; n_pts];
@@ -170,6 +215,9 @@ impl Prepared {
         }
         let point_active: Vec<bool> = (0..n_pts).map(|p| rays[p] >= 2 || controlled[p]).collect();
         for o in pano.iter_mut() {
+            o.active &= point_active[o.point];
+        }
+        for o in aerial.iter_mut() {
             o.active &= point_active[o.point];
         }
         let mut point_observations = vec![Vec::new(); n_pts];
@@ -212,6 +260,8 @@ impl Prepared {
                 .flatten(),
             pano,
             control,
+            aerial_cameras,
+            aerial,
             relative,
             point_active,
             point_observations,
@@ -249,6 +299,19 @@ impl Prepared {
         )?;
         let s = o.whitening * o.weight_factor;
         Some((r * s, jc * s, jp * s))
+    }
+
+    /// Whitened residual (pixels / σ_px) of aerial observation `i` and its Jacobian with respect to the point;
+    /// `None` when the point is behind the camera.
+    pub fn aerial_whitened(
+        &self,
+        i: usize,
+        state: &State,
+    ) -> Option<(nalgebra::Vector2<f64>, nalgebra::Matrix2x3<f64>)> {
+        let o = &self.aerial[i];
+        let (r, j) =
+            self.aerial_cameras[o.camera].residual(o.observed_px, &state.points_local[o.point])?;
+        Some((r * o.whitening, j * o.whitening))
     }
 
     /// Whitened residual of control point `i`.
@@ -299,6 +362,15 @@ impl Prepared {
                 total += self
                     .loss
                     .rho(self.control_whitened(i, state).norm_squared());
+            }
+        }
+        for (i, o) in self.aerial.iter().enumerate() {
+            if !o.active {
+                continue;
+            }
+            match self.aerial_whitened(i, state) {
+                Some((r, _)) => total += self.loss.rho(r.norm_squared()),
+                None => return f64::INFINITY,
             }
         }
         total += self.gaussian_terms(state);
@@ -359,6 +431,19 @@ impl Prepared {
             lin.point_diag[c.point] += w * j.transpose() * j;
             lin.point_rhs[c.point] -= w * j.transpose() * r;
         }
+        // Aerial observations touch only their point (the camera is fixed): no coupling with the recordings,
+        // so they enter the Schur complement through V alone.
+        for (i, o) in self.aerial.iter().enumerate() {
+            if !o.active {
+                continue;
+            }
+            let Some((r, j)) = self.aerial_whitened(i, state) else {
+                continue;
+            };
+            let w = self.loss.weight(r.norm_squared());
+            lin.point_diag[o.point] += w * j.transpose() * j;
+            lin.point_rhs[o.point] -= w * j.transpose() * r;
+        }
         for c in 0..n_rec {
             for (axis, r, inv_sigma) in self.prior_terms(c, state) {
                 if inv_sigma > 0.0 {
@@ -409,6 +494,14 @@ impl Prepared {
                 count += 3;
             }
         }
+        for (i, o) in self.aerial.iter().enumerate() {
+            if o.active {
+                if let Some((r, _)) = self.aerial_whitened(i, state) {
+                    total += r.norm_squared();
+                    count += 2;
+                }
+            }
+        }
         for c in 0..self.recorded_local.len() {
             count += self
                 .prior_terms(c, state)
@@ -421,5 +514,24 @@ impl Prepared {
         }
         count += self.relative.len() * self.position_axes();
         (total, count)
+    }
+}
+
+/// Observations removed by rejection rounds, per kind (indices as in the [`Block`]).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Rejected {
+    pub pano: Vec<bool>,
+    pub control: Vec<bool>,
+    pub aerial: Vec<bool>,
+}
+
+impl Rejected {
+    /// Nothing rejected yet.
+    pub fn none(block: &Block) -> Self {
+        Self {
+            pano: vec![false; block.pano_observations.len()],
+            control: vec![false; block.control_points.len()],
+            aerial: vec![false; block.aerial_observations.len()],
+        }
     }
 }

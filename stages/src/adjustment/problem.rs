@@ -7,7 +7,7 @@
 
 use super::robust::RobustLoss;
 use super::weighting::ResidualWeighting;
-use crate::geometry::PanoramaCamera;
+use crate::geometry::{FrameCamera, PanoramaCamera};
 use nalgebra::{Matrix3, Vector3};
 
 /// Default σ of an aerial control point, metres (thesis 5.4.3).
@@ -57,6 +57,18 @@ impl ControlPoint {
     }
 }
 
+/// An observation of tie point `point` in aerial image `camera` (an index into [`Block::aerial_cameras`],
+/// whose orientation is held fixed; issue 6 (a)): continuous pixel (u, v) of the original aerial image.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AerialImageObservation {
+    pub camera: usize,
+    pub point: usize,
+    pub u_px: f64,
+    pub v_px: f64,
+    /// Standard deviation of the pixel measurement, pixels (the aerial row's `sigma_px`).
+    pub sigma_px: f64,
+}
+
 /// A relative constraint between two recordings (thesis 3.4.2: the trajectory's high relative accuracy):
 /// the difference of their recorded positions is kept with standard deviation `sigma_m` per axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -76,6 +88,10 @@ pub struct Block {
     pub pano_observations: Vec<PanoObservation>,
     pub control_points: Vec<ControlPoint>,
     pub relative_constraints: Vec<RelativeConstraint>,
+    /// Fixed aerial cameras referenced by `aerial_observations`.
+    pub aerial_cameras: Vec<FrameCamera>,
+    /// Observations of tie points in the fixed aerial images (issue 6 (a)).
+    pub aerial_observations: Vec<AerialImageObservation>,
 }
 
 /// Levenberg–Marquardt settings and convergence criteria.
@@ -168,6 +184,10 @@ pub enum AdjustError {
     InvalidPanoObservation { index: usize, problem: String },
     #[error("control point {index}: {problem}")]
     InvalidControlPoint { index: usize, problem: String },
+    #[error("aerial observation {index}: {problem}")]
+    InvalidAerialObservation { index: usize, problem: String },
+    #[error("{item}: {problem}")]
+    InvalidInput { item: String, problem: String },
     #[error("relative constraint {index}: {problem}")]
     InvalidRelativeConstraint { index: usize, problem: String },
     #[error("option {field} = {value} is not valid ({hint})")]
@@ -276,6 +296,39 @@ impl Block {
             };
             if let Some(problem) = problem {
                 return Err(AdjustError::InvalidControlPoint { index, problem });
+            }
+        }
+        for (index, cam) in self.aerial_cameras.iter().enumerate() {
+            let finite = cam.center_world.iter().all(|v| v.is_finite())
+                && cam.rotation_cam_to_world.iter().all(|v| v.is_finite())
+                && cam.cx_px.is_finite()
+                && cam.cy_px.is_finite();
+            if !finite || !positive_finite(cam.focal_px) {
+                return Err(AdjustError::InvalidInput {
+                    item: format!("aerial camera {index}"),
+                    problem: "centre, rotation and principal point must be finite and focal_px > 0"
+                        .to_string(),
+                });
+            }
+        }
+        let n_cam = self.aerial_cameras.len();
+        for (index, o) in self.aerial_observations.iter().enumerate() {
+            let problem = if o.camera >= n_cam {
+                Some(format!(
+                    "camera index {} ≥ {n_cam} aerial cameras",
+                    o.camera
+                ))
+            } else if o.point >= n_pts {
+                Some(format!("point index {} ≥ {n_pts} points", o.point))
+            } else if !(o.u_px.is_finite() && o.v_px.is_finite()) {
+                Some("pixel coordinates are not finite".to_string())
+            } else if !positive_finite(o.sigma_px) {
+                Some(format!("sigma_px = {} must be finite and > 0", o.sigma_px))
+            } else {
+                None
+            };
+            if let Some(problem) = problem {
+                return Err(AdjustError::InvalidAerialObservation { index, problem });
             }
         }
         for (index, rc) in self.relative_constraints.iter().enumerate() {

@@ -301,6 +301,8 @@ impl SyntheticBlockSpec {
                 pano_observations: observations,
                 control_points,
                 relative_constraints: Vec::new(),
+                aerial_cameras: Vec::new(),
+                aerial_observations: Vec::new(),
             },
             true_centers_world: true_centers,
             true_yaw_correction_deg: yaw_corr,
