@@ -1,1 +1,362 @@
-//! (placeholder: being written in session 2)
+//! The chapter-2 baseline for MM↔aerial registration (thesis 2.2.3): isolated Förstner keypoints in the aerial
+//! image and normalised cross-correlation template matching — the "Förstner/CC" column of thesis Table 2-10,
+//! run as a workflow variant against the full method (3.4.5.3). It produces the same [`AerialRefinement`] as
+//! [`super::refine::refine_in_aerial`], so control points and grading are shared.
+//!
+//! Steps (thesis 2.2.3.1–2.2.3.2):
+//! 1. Förstner keypoints (Köthe's 2× tensor) only in the aerial image, inside the region the MM ortho image
+//!    covers (through the initial transform);
+//! 2. a kd-tree over them; a keypoint is **isolated** when at most `max_neighbours` others lie in the
+//!    `isolation_box_m` × `isolation_box_m` box around it (repetitive markings produce crowded corners);
+//! 3. the MM ortho image is blurred by a Gaussian to resemble the aerial image (2.2.3.1);
+//! 4. per MM tie point: a `template_px` MM template around its corner is cross-correlated (NCC,
+//!    `TM_CCOEFF_NORMED`) inside a `search_px` aerial window (resampled onto the ortho grid through the
+//!    transform, as in `refine`), sub-pixel peak by a quadratic fit; the peak must reach `min_ncc`;
+//! 5. as in the thesis, the measurement in the aerial image is the keypoint itself ("the location of the peak
+//!    is assumed to correspond to the extracted keypoint"): the nearest isolated keypoint within `snap_px` of
+//!    the peak becomes the observation; without one the tie point is not located.
+//!
+//! The thesis matched aerial templates inside MM windows and named the reverse ("using parts of the MM image as
+//! a template") as future work; we run the reverse so that each observation belongs to an MM tie point.
+
+mod kdtree;
+
+pub use kdtree::KdTree2;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::ortho::OrthoImage;
+use super::refine::{cut_ortho_template, grey_std, sample_aerial_on_ortho_grid};
+use super::registration::{AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch};
+use crate::campaign::{AerialImage, AerialKind};
+use crate::correspondence::AerialObservation;
+use crate::features::forstner::{forstner_corners, ForstnerParams};
+use crate::geometry::FrameCamera;
+use crate::imaging::gaussian::gaussian_blur;
+use crate::imaging::GrayImage;
+use crate::matching::ncc::match_template;
+use nalgebra::{Vector2, Vector3};
+
+/// Parameters of [`baseline_matches`]; thesis 2.2.3 values as defaults.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BaselineParams {
+    /// Förstner σ of the derivative-of-Gaussian gradient, aerial px.
+    pub forstner_sigma_gradient_px: f32,
+    /// Förstner σ of the tensor's integration window, aerial px.
+    pub forstner_sigma_integration_px: f32,
+    /// Förstner minimum roundness q.
+    pub forstner_min_roundness: f32,
+    /// Förstner minimum weight relative to the patch's mean weight.
+    pub forstner_min_weight_rel: f32,
+    /// Side of the square neighbourhood of the isolation test, m (thesis: 6 × 6 m).
+    pub isolation_box_m: f64,
+    /// A keypoint is isolated with at most this many other keypoints in the box (thesis: 7).
+    pub max_neighbours: usize,
+    /// σ of the Gaussian blur of the MM ortho image, px (0 = none).
+    pub mm_blur_sigma_px: f32,
+    /// Template side, px (thesis: 16).
+    pub template_px: usize,
+    /// Search window side, px (thesis: 40).
+    pub search_px: usize,
+    /// Smallest accepted NCC peak.
+    pub min_ncc: f64,
+    /// Largest distance from the NCC peak to the isolated aerial keypoint that becomes the observation, px.
+    pub snap_px: f64,
+    /// Smallest grey-value standard deviation of a template (0..1 scale).
+    pub min_template_std: f64,
+}
+
+impl Default for BaselineParams {
+    fn default() -> Self {
+        Self {
+            forstner_sigma_gradient_px: 0.7,
+            forstner_sigma_integration_px: 2.0,
+            forstner_min_roundness: 0.5,
+            forstner_min_weight_rel: 1.0,
+            isolation_box_m: 6.0,
+            max_neighbours: 7,
+            mm_blur_sigma_px: 1.0,
+            template_px: 16,
+            search_px: 40,
+            min_ncc: 0.7,
+            snap_px: 1.5,
+            min_template_std: 0.01,
+        }
+    }
+}
+
+impl BaselineParams {
+    /// Check ranges; each error is (field, message with the allowed range).
+    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
+        let mut errs: Vec<(String, String)> = Vec::new();
+        let mut check = |ok: bool, field: &str, msg: String| {
+            if !ok {
+                errs.push((field.into(), msg));
+            }
+        };
+        let s = |v: f32| v.is_finite() && v > 0.0 && v <= 20.0;
+        check(
+            s(self.forstner_sigma_gradient_px),
+            "forstner_sigma_gradient_px",
+            format!(
+                "must be in (0, 20] px, got {}",
+                self.forstner_sigma_gradient_px
+            ),
+        );
+        check(
+            s(self.forstner_sigma_integration_px),
+            "forstner_sigma_integration_px",
+            format!(
+                "must be in (0, 20] px, got {}",
+                self.forstner_sigma_integration_px
+            ),
+        );
+        check(
+            (0.0..=1.0).contains(&self.forstner_min_roundness),
+            "forstner_min_roundness",
+            format!("must be in [0, 1], got {}", self.forstner_min_roundness),
+        );
+        check(
+            self.forstner_min_weight_rel.is_finite() && self.forstner_min_weight_rel >= 0.0,
+            "forstner_min_weight_rel",
+            format!("must be ≥ 0, got {}", self.forstner_min_weight_rel),
+        );
+        check(
+            self.isolation_box_m.is_finite()
+                && self.isolation_box_m > 0.0
+                && self.isolation_box_m <= 100.0,
+            "isolation_box_m",
+            format!("must be in (0, 100] m, got {}", self.isolation_box_m),
+        );
+        check(
+            self.mm_blur_sigma_px.is_finite() && (0.0..=10.0).contains(&self.mm_blur_sigma_px),
+            "mm_blur_sigma_px",
+            format!("must be in [0, 10] px, got {}", self.mm_blur_sigma_px),
+        );
+        check(
+            (4..=128).contains(&self.template_px),
+            "template_px",
+            format!("must be in [4, 128] px, got {}", self.template_px),
+        );
+        check(
+            self.search_px > self.template_px && self.search_px <= 512,
+            "search_px",
+            format!(
+                "must be larger than template_px ({}) and ≤ 512 px, got {}",
+                self.template_px, self.search_px
+            ),
+        );
+        check(
+            self.min_ncc.is_finite() && (-1.0..=1.0).contains(&self.min_ncc),
+            "min_ncc",
+            format!("must be in [−1, 1], got {}", self.min_ncc),
+        );
+        check(
+            self.snap_px.is_finite() && self.snap_px > 0.0 && self.snap_px <= 20.0,
+            "snap_px",
+            format!("must be in (0, 20] px, got {}", self.snap_px),
+        );
+        check(
+            self.min_template_std.is_finite() && self.min_template_std >= 0.0,
+            "min_template_std",
+            format!("must be ≥ 0, got {}", self.min_template_std),
+        );
+        if errs.is_empty() {
+            Ok(())
+        } else {
+            Err(errs)
+        }
+    }
+
+    fn forstner(&self) -> ForstnerParams {
+        ForstnerParams {
+            sigma_gradient_px: self.forstner_sigma_gradient_px,
+            sigma_integration_px: self.forstner_sigma_integration_px,
+            min_roundness: self.forstner_min_roundness,
+            min_weight_rel: self.forstner_min_weight_rel,
+            ..ForstnerParams::default()
+        }
+    }
+}
+
+/// Isolated Förstner keypoints (full aerial pixels) in the part of `aerial` that `mm_ortho` covers through
+/// `ortho_to_aerial`; `gsd_m` is the aerial GSD on the ground, m/px (thesis 2.2.3.2).
+pub fn isolated_aerial_keypoints(
+    mm_ortho: &OrthoImage,
+    aerial: &GrayImage,
+    t: &InitialTransform,
+    gsd_m: f64,
+    p: &BaselineParams,
+) -> Vec<[f64; 2]> {
+    // Bounding box of the ortho footprint in the aerial image, enlarged by half the isolation box so that
+    // keypoints near its edge see all their neighbours.
+    let (w, h) = (
+        mm_ortho.georef.width_px as f64,
+        mm_ortho.georef.height_px as f64,
+    );
+    let half_box_px = p.isolation_box_m / 2.0 / gsd_m;
+    let corners = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)]
+        .map(|(x, y)| t.ortho_to_aerial.apply(&Vector2::new(x, y)));
+    let lo = |f: fn(&Vector2<f64>) -> f64| corners.iter().map(f).fold(f64::INFINITY, f64::min);
+    let hi = |f: fn(&Vector2<f64>) -> f64| corners.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
+    let x0 = (lo(|c| c.x) - half_box_px).floor().max(0.0);
+    let y0 = (lo(|c| c.y) - half_box_px).floor().max(0.0);
+    let x1 = (hi(|c| c.x) + half_box_px).ceil().min(aerial.width as f64);
+    let y1 = (hi(|c| c.y) + half_box_px).ceil().min(aerial.height as f64);
+    if !(x1 - x0 >= 8.0 && y1 - y0 >= 8.0) {
+        return Vec::new();
+    }
+    let (x0, y0, pw, ph) = (
+        x0 as usize,
+        y0 as usize,
+        (x1 - x0) as usize,
+        (y1 - y0) as usize,
+    );
+    let mut patch = GrayImage::filled(pw, ph, 0.0);
+    for row in 0..ph {
+        let src = &aerial.row(y0 + row)[x0..x0 + pw];
+        patch.data[row * pw..(row + 1) * pw].copy_from_slice(src);
+    }
+    let points: Vec<[f64; 2]> = forstner_corners(&patch, &p.forstner())
+        .into_iter()
+        .map(|c| [c.u_px + x0 as f64, c.v_px + y0 as f64])
+        .collect();
+    let tree = KdTree2::build(&points);
+    points
+        .iter()
+        .copied()
+        .filter(|&c| tree.count_in_box(c, [half_box_px, half_box_px]) - 1 <= p.max_neighbours)
+        .collect()
+}
+
+/// Locate the tie points of `window` in one aerial nadir image with the chapter-2 method (thesis 2.2.3);
+/// inputs as for [`super::refine::refine_in_aerial`]. Matches keep the tie-point order; the score is the NCC
+/// peak. Invalid parameters or transform yield an empty refinement.
+pub fn baseline_matches(
+    mm_ortho: &OrthoImage,
+    aerial: &GrayImage,
+    aerial_row: &AerialImage,
+    t: &InitialTransform,
+    window: &MmWindowMatch,
+    p: &BaselineParams,
+) -> AerialRefinement {
+    let mut result = AerialRefinement {
+        recording_id: t.recording_id.clone(),
+        aerial_id: aerial_row.image_id.clone(),
+        tried: 0,
+        matches: Vec::new(),
+    };
+    let tf = t.ortho_to_aerial;
+    let transform_ok = [tf.scale, tf.rotation_rad, tf.tx, tf.ty]
+        .iter()
+        .all(|v| v.is_finite())
+        && tf.scale > 1e-6;
+    if !transform_ok || p.validate().is_err() {
+        return result;
+    }
+    let foot = Vector3::from(mm_ortho.georef.foot_world);
+    let gsd_m = FrameCamera::from_aerial(aerial_row).gsd_at(&foot);
+    if !(gsd_m.is_finite() && gsd_m > 0.0) {
+        return result;
+    }
+    let keypoints = isolated_aerial_keypoints(mm_ortho, aerial, t, gsd_m, p);
+    let keypoint_tree = KdTree2::build(&keypoints);
+    let blurred = OrthoImage {
+        image: if p.mm_blur_sigma_px > 0.0 {
+            gaussian_blur(&mm_ortho.image, p.mm_blur_sigma_px)
+        } else {
+            mm_ortho.image.clone()
+        },
+        valid: mm_ortho.valid.clone(),
+        georef: mm_ortho.georef.clone(),
+    };
+    let n = window.tie_points.len().min(window.ground_world.len());
+    let outcomes: Vec<(bool, Option<AerialMatch>)> = (0..n)
+        .into_par_iter()
+        .map_init(
+            || (GrayImage::filled(0, 0, 0.0), GrayImage::filled(0, 0, 0.0)),
+            |(template, search), i| {
+                let g = window.ground_world[i];
+                let (u_o, v_o) = blurred
+                    .georef
+                    .world_to_pixel(&Vector3::new(g[0], g[1], g[2]));
+                let predicted = tf.apply(&Vector2::new(u_o, v_o));
+                if !(predicted.x >= 0.0
+                    && predicted.y >= 0.0
+                    && predicted.x < aerial.width as f64
+                    && predicted.y < aerial.height as f64)
+                {
+                    return (false, None);
+                }
+                // No isolated keypoint anywhere near: nothing to measure (saves the NCC).
+                let reach = (p.search_px as f64 / 2.0 + p.snap_px) * tf.scale;
+                if keypoint_tree.count_in_box([predicted.x, predicted.y], [reach, reach]) == 0 {
+                    return (true, None);
+                }
+                let half = p.template_px as f64 / 2.0;
+                let (x0, y0) = ((u_o - half).round(), (v_o - half).round());
+                if !cut_ortho_template(&blurred, x0 as isize, y0 as isize, p.template_px, template)
+                    || grey_std(template) < p.min_template_std
+                {
+                    return (true, None);
+                }
+                let margin = ((p.search_px - p.template_px) / 2) as f64;
+                let side = p.template_px + 2 * ((p.search_px - p.template_px) / 2);
+                if !sample_aerial_on_ortho_grid(
+                    aerial,
+                    &tf,
+                    x0 - margin,
+                    y0 - margin,
+                    side,
+                    side,
+                    search,
+                ) {
+                    return (true, None);
+                }
+                let Ok(m) = match_template(search, template) else {
+                    return (true, None);
+                };
+                if !(m.score as f64 >= p.min_ncc) {
+                    return (true, None);
+                }
+                let dx = (x0 - margin + m.u_px) - (x0 + half);
+                let dy = (y0 - margin + m.v_px) - (y0 + half);
+                let peak = tf.apply(&Vector2::new(u_o + dx, v_o + dy));
+                // Snap to the nearest isolated keypoint (ties: the first in keypoint order).
+                let mut best: Option<([f64; 2], f64)> = None;
+                for &k in &keypoints {
+                    let d = (k[0] - peak.x).hypot(k[1] - peak.y);
+                    if d <= p.snap_px && best.is_none_or(|(_, bd)| d < bd) {
+                        best = Some((k, d));
+                    }
+                }
+                let Some((k, _)) = best else {
+                    return (true, None);
+                };
+                let observation = AerialObservation {
+                    image_id: aerial_row.image_id.clone(),
+                    kind: AerialKind::Nadir,
+                    u_px: k[0],
+                    v_px: k[1],
+                    score: m.score as f64,
+                };
+                (
+                    true,
+                    Some(AerialMatch {
+                        tie_point_id: window.tie_points[i].id.clone(),
+                        observation,
+                        predicted_u_px: predicted.x,
+                        predicted_v_px: predicted.y,
+                    }),
+                )
+            },
+        )
+        .collect();
+    for (tried, m) in outcomes {
+        result.tried += usize::from(tried);
+        result.matches.extend(m);
+    }
+    result
+}

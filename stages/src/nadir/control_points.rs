@@ -1,1 +1,310 @@
-//! (placeholder: being written in session 2)
+//! Aerial control points: the observations of one MM tie point across all overlapping aerial nadir images,
+//! checked for consistency and triangulated from the aerial images alone (thesis 3.4.5.4).
+//!
+//! The aerial images need no registration with each other: all observations of a tie point come from the same
+//! MM corner, so they are linked indirectly (3.4.5.4). Their locations still have to be verified before
+//! triangulation.
+//!
+//! **Consistency check (object space, chosen over a reprojection-residual test).** Nadir images of one strip
+//! intersect at well under 1° (baseline ≈ 20–60 m at ≈ 4500 m), so a mislocated observation that is off
+//! *along* the baseline only changes the triangulated height: its reprojection residual stays small. We
+//! therefore intersect every aerial ray with the horizontal plane at the tie point's MM height (known to
+//! decimetres; a height error δz moves a ray's ground point only by δz·tan(tilt) ≤ a few mm) and compare the
+//! ground points, each with σ = σ_px·GSD (⊕ δz·tan(tilt)): with ≥ 3 observations the one farthest from the
+//! weighted mean of the others is dropped while that distance exceeds `k_sigma`; two observations must agree
+//! within `k_sigma` of their combined σ, else the point is dropped (the wrong one cannot be told). The MM height
+//! serves only this test; the point itself comes from the aerial rays alone, so it does not inherit the MM
+//! positioning error (3.4.5.4). After the least-squares triangulation (`triangulate_rays`, σ of each ray from
+//! the aerial row's `sigma_px`) the reprojection residuals must also stay within `k_sigma`·`sigma_px`.
+//!
+//! Points seen in one aerial image are kept with `point_world: None` (a bundle with fixed aerial orientation
+//! can still use them). Output order: the window's tie-point order; observations sorted by aerial `image_id`.
+
+use std::collections::HashMap;
+
+use serde::{Deserialize, Serialize};
+
+use super::registration::{AerialRefinement, MmWindowMatch};
+use crate::campaign::AerialImage;
+use crate::correspondence::{AerialControlPoint, AerialObservation};
+use crate::geometry::{
+    intersect_ray_plane, triangulate_rays, FrameCamera, Plane, Ray, Triangulation,
+};
+use nalgebra::{Vector2, Vector3};
+
+/// Parameters of [`aerial_control_points`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ControlParams {
+    /// Rejection threshold in standard deviations (ground-point agreement and reprojection residuals).
+    pub k_sigma: f64,
+    /// Standard deviation of the MM tie point's height used by the ground-plane check, m.
+    pub mm_height_sigma_m: f64,
+    /// Observations with a matching score below this are ignored.
+    pub min_score: f64,
+}
+
+impl Default for ControlParams {
+    fn default() -> Self {
+        Self {
+            k_sigma: 3.0,
+            mm_height_sigma_m: 1.0,
+            min_score: 0.0,
+        }
+    }
+}
+
+impl ControlParams {
+    /// Check ranges; each error is (field, message with the allowed range).
+    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
+        let mut errs = Vec::new();
+        if !(self.k_sigma.is_finite() && self.k_sigma >= 1.0 && self.k_sigma <= 100.0) {
+            errs.push((
+                "k_sigma".into(),
+                format!("must be in [1, 100], got {}", self.k_sigma),
+            ));
+        }
+        if !(self.mm_height_sigma_m.is_finite()
+            && self.mm_height_sigma_m >= 0.0
+            && self.mm_height_sigma_m <= 1000.0)
+        {
+            errs.push((
+                "mm_height_sigma_m".into(),
+                format!("must be in [0, 1000] m, got {}", self.mm_height_sigma_m),
+            ));
+        }
+        if !self.min_score.is_finite() {
+            errs.push(("min_score".into(), "must be a finite number".into()));
+        }
+        if errs.is_empty() {
+            Ok(())
+        } else {
+            Err(errs)
+        }
+    }
+}
+
+/// One aerial observation of a tie point with what the checks need.
+struct Candidate {
+    observation: AerialObservation,
+    ray: Ray,
+    /// Angular σ of the ray, rad.
+    sigma_rad: f64,
+    sigma_px: f64,
+    camera: FrameCamera,
+    /// Ray ∩ horizontal plane at the MM height (x, y), m; and that point's horizontal σ, m.
+    ground_xy: Vector2<f64>,
+    ground_sigma_m: f64,
+}
+
+fn candidate(
+    row: &AerialImage,
+    obs: &AerialObservation,
+    mm_z: f64,
+    p: &ControlParams,
+) -> Option<Candidate> {
+    let camera = FrameCamera::from_aerial(row);
+    let sigma_px = if row.sigma_px.is_finite() && row.sigma_px > 0.0 {
+        row.sigma_px
+    } else {
+        0.5
+    };
+    let ray = camera.pixel_ray(obs.u_px, obs.v_px);
+    if !ray.dir_world.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let ground = intersect_ray_plane(&ray, &Plane::horizontal(mm_z))?;
+    let gsd_m = camera.gsd_at(&ground);
+    if !(gsd_m > 0.0 && gsd_m.is_finite()) {
+        return None;
+    }
+    let d = ray.dir_world;
+    let tilt_tan = d.x.hypot(d.y) / d.z.abs().max(1e-9);
+    let ground_sigma_m = (sigma_px * gsd_m).hypot(p.mm_height_sigma_m * tilt_tan);
+    Some(Candidate {
+        observation: obs.clone(),
+        ray,
+        sigma_rad: camera.angular_sigma_rad(sigma_px),
+        sigma_px,
+        camera,
+        ground_xy: Vector2::new(ground.x, ground.y),
+        ground_sigma_m,
+    })
+}
+
+/// Weighted mean of the ground points of `c` except index `skip`, with its σ.
+fn mean_without(c: &[Candidate], skip: usize) -> (Vector2<f64>, f64) {
+    // Local origin: the first other point (world coordinates are ≈ 1e5 m).
+    let origin = c
+        .iter()
+        .enumerate()
+        .find(|(k, _)| *k != skip)
+        .map(|(_, x)| x.ground_xy)
+        .unwrap_or_else(Vector2::zeros);
+    let (mut sw, mut acc) = (0.0, Vector2::zeros());
+    for (k, x) in c.iter().enumerate() {
+        if k == skip {
+            continue;
+        }
+        let w = 1.0 / x.ground_sigma_m.powi(2);
+        sw += w;
+        acc += (x.ground_xy - origin) * w;
+    }
+    (origin + acc / sw, (1.0 / sw).sqrt())
+}
+
+/// Ground-plane consistency check (see the module documentation); returns the surviving candidates.
+fn consistent_subset(mut c: Vec<Candidate>, k_sigma: f64) -> Vec<Candidate> {
+    while c.len() >= 3 {
+        let mut worst = (0usize, 0.0f64);
+        for k in 0..c.len() {
+            let (mean, sigma_mean) = mean_without(&c, k);
+            let z = (c[k].ground_xy - mean).norm() / c[k].ground_sigma_m.hypot(sigma_mean);
+            if z > worst.1 {
+                worst = (k, z);
+            }
+        }
+        if worst.1 <= k_sigma {
+            return c;
+        }
+        c.remove(worst.0);
+    }
+    if c.len() == 2 {
+        let z = (c[0].ground_xy - c[1].ground_xy).norm()
+            / c[0].ground_sigma_m.hypot(c[1].ground_sigma_m);
+        if z > k_sigma {
+            c.clear();
+        }
+    }
+    c
+}
+
+/// Largest reprojection residual of `t` in the candidates' images, in units of each image's σ_px.
+fn max_reprojection_sigma(c: &[&Candidate], t: &Triangulation) -> f64 {
+    c.iter()
+        .map(|x| match x.camera.project_world(&t.point_world) {
+            Some((u, v)) => (u - x.observation.u_px).hypot(v - x.observation.v_px) / x.sigma_px,
+            None => f64::INFINITY,
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Least-squares triangulation of the candidates' rays and its largest reprojection residual (σ units).
+fn triangulate(c: &[&Candidate]) -> Option<(Triangulation, f64)> {
+    let rays: Vec<Ray> = c.iter().map(|x| x.ray).collect();
+    let sigmas: Vec<f64> = c.iter().map(|x| x.sigma_rad).collect();
+    let t = triangulate_rays(&rays, &sigmas).ok()?;
+    let r = max_reprojection_sigma(c, &t);
+    Some((t, r))
+}
+
+/// Triangulate the consistent candidates; with ≥ 3 and a reprojection residual above `k_sigma`, drop the one
+/// observation whose removal leaves the smallest residual (once). Returns the kept candidates and the point,
+/// or nothing.
+fn triangulate_checked(
+    kept: Vec<Candidate>,
+    k_sigma: f64,
+) -> Option<(Vec<Candidate>, Triangulation)> {
+    let all: Vec<&Candidate> = kept.iter().collect();
+    let (t, r) = triangulate(&all)?;
+    if r <= k_sigma {
+        return Some((kept, t));
+    }
+    if kept.len() < 3 {
+        return None;
+    }
+    let best = (0..kept.len())
+        .filter_map(|k| {
+            let rest: Vec<&Candidate> = kept
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != k)
+                .map(|(_, c)| c)
+                .collect();
+            let (t, r) = triangulate(&rest)?;
+            (r <= k_sigma).then_some((k, r, t))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    let mut kept = kept;
+    kept.remove(best.0);
+    Some((kept, best.2))
+}
+
+/// Aerial control points of one MM window from its refinements in all overlapping aerial images
+/// (thesis 3.4.5.4). `refinements` pairs each aerial row with its refinement; refinements of other
+/// recordings, unknown tie points and repeated images (the best score is kept) are ignored.
+pub fn aerial_control_points(
+    window: &MmWindowMatch,
+    refinements: &[(&AerialImage, &AerialRefinement)],
+    p: &ControlParams,
+) -> Vec<AerialControlPoint> {
+    if p.validate().is_err() {
+        return Vec::new();
+    }
+    let index: HashMap<&str, usize> = window
+        .tie_points
+        .iter()
+        .enumerate()
+        .map(|(i, tp)| (tp.id.as_str(), i))
+        .collect();
+    // Per tie point: (aerial row, observation), at most one per aerial image (best score).
+    let mut per_point: Vec<Vec<(&AerialImage, &AerialObservation)>> =
+        vec![Vec::new(); window.tie_points.len()];
+    for (row, refinement) in refinements {
+        if refinement.recording_id != window.recording_id {
+            continue;
+        }
+        for m in &refinement.matches {
+            let Some(&i) = index.get(m.tie_point_id.as_str()) else {
+                continue;
+            };
+            let obs = &m.observation;
+            if !(obs.score >= p.min_score && obs.u_px.is_finite() && obs.v_px.is_finite()) {
+                continue;
+            }
+            let list = &mut per_point[i];
+            match list.iter_mut().find(|(r, _)| r.image_id == row.image_id) {
+                Some(slot) if obs.score > slot.1.score => *slot = (*row, obs),
+                Some(_) => {}
+                None => list.push((*row, obs)),
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for (tp, mut list) in window.tie_points.iter().zip(per_point) {
+        list.sort_by(|a, b| a.0.image_id.cmp(&b.0.image_id));
+        let mm_z = tp.point_world[2];
+        let candidates: Vec<Candidate> = list
+            .iter()
+            .filter_map(|(row, obs)| candidate(row, obs, mm_z, p))
+            .collect();
+        let kept = consistent_subset(candidates, p.k_sigma);
+        let (kept, point) = match kept.len() {
+            0 => continue,
+            1 => (kept, None),
+            _ => match triangulate_checked(kept, p.k_sigma) {
+                Some((kept, t)) => (kept, Some(t)),
+                None => continue,
+            },
+        };
+        out.push(AerialControlPoint {
+            tie_point_id: tp.id.clone(),
+            mm: tp.observations.clone(),
+            aerial: kept.into_iter().map(|c| c.observation).collect(),
+            point_world: point.as_ref().map(|t| to_array(&t.point_world)),
+            covariance_m2: point.as_ref().map(|t| {
+                let c = &t.covariance_m2;
+                [
+                    [c[(0, 0)], c[(0, 1)], c[(0, 2)]],
+                    [c[(1, 0)], c[(1, 1)], c[(1, 2)]],
+                    [c[(2, 0)], c[(2, 1)], c[(2, 2)]],
+                ]
+            }),
+        });
+    }
+    out
+}
+
+fn to_array(v: &Vector3<f64>) -> [f64; 3] {
+    [v.x, v.y, v.z]
+}

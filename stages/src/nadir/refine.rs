@@ -1,1 +1,358 @@
-//! (placeholder: being written in session 2)
+//! Accurate registration of MM corner points in one aerial nadir image by phase correlation (thesis 3.4.5.3).
+//!
+//! Input: the MM tie points of one recording window (their corners on the detecting recording's ground plane),
+//! that recording's MM ortho image at about the aerial GSD, and the initial similarity `ortho px → aerial px`
+//! of thesis 3.4.5.2. For every tie point:
+//! 1. ground point → MM ortho pixel (`OrthoGeoref::world_to_pixel`) → predicted aerial pixel (the transform);
+//! 2. MM template: `template_px²` ortho pixels around the corner; skipped if it leaves the ortho image, touches a
+//!    pixel masked by the vehicle, or is nearly flat (phase correlation of a flat patch is noise);
+//! 3. aerial window: the aerial image is **resampled onto the MM ortho grid** (bicubic, through the transform)
+//!    over the template region enlarged by `search_margin_px` on every side. Resampling the aerial side keeps the
+//!    MM template exactly as ortho-projected, and both images then share orientation and pixel size, so only a
+//!    translation is left (the thesis: "only the translation elements are identified");
+//! 4. phase correlation on the normalised cross-power spectrum (windowed, eq. 3/1) → integer peak → sub-pixel
+//!    peak by a second-order fit (`matching::phase_correlation::locate_template`);
+//! 5. weak peaks (below `min_peak`) and shifts beyond the margin are rejected; the corner, moved by the found
+//!    shift on the ortho grid, is mapped by the transform to an observation in ORIGINAL aerial pixel coordinates.
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::ortho::OrthoImage;
+use super::registration::{AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch};
+use crate::campaign::{AerialImage, AerialKind};
+use crate::correspondence::AerialObservation;
+use crate::geometry::Similarity2;
+use crate::imaging::border::Border;
+use crate::imaging::sample::sample_bicubic;
+use crate::imaging::window::WindowKind;
+use crate::imaging::GrayImage;
+use crate::matching::phase_correlation::{locate_template, PhaseCorrelationParams};
+use crate::matching::subpixel::PeakFit;
+use nalgebra::{Vector2, Vector3};
+
+/// Taper applied before the Fourier transform (serialisable mirror of [`WindowKind`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TaperWindow {
+    Hann,
+    Blackman,
+    Rectangular,
+}
+
+impl TaperWindow {
+    pub fn kind(self) -> WindowKind {
+        match self {
+            TaperWindow::Hann => WindowKind::Hann,
+            TaperWindow::Blackman => WindowKind::Blackman,
+            TaperWindow::Rectangular => WindowKind::Rectangular,
+        }
+    }
+}
+
+/// Parameters of [`refine_in_aerial`]; lengths in MM ortho pixels (≈ aerial pixels).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RefineParams {
+    /// Side of the square MM template, px (32 px = 3.2 m at 10 cm GSD; FFT-friendly sizes are fastest).
+    pub template_px: usize,
+    /// The aerial window extends the template by this many px on each side: the largest correction of the
+    /// initial transform that can be found (larger shifts are rejected).
+    pub search_margin_px: usize,
+    /// Taper of template and window before the FFT.
+    pub window: TaperWindow,
+    /// σ of the Gaussian low-pass on the cross-power spectrum, px (0 = none; see `PhaseCorrelationParams`).
+    pub lowpass_sigma_px: f64,
+    /// Re-estimations with the window re-centred on the content found (removes the fixed-window bias).
+    pub refinements: usize,
+    /// Smallest accepted correlation peak (1 = identical images; unrelated content gives ≲ 0.1).
+    pub min_peak: f64,
+    /// Smallest standard deviation of the template grey values (0..1 scale); flatter templates are skipped.
+    pub min_template_std: f64,
+}
+
+impl Default for RefineParams {
+    fn default() -> Self {
+        Self {
+            template_px: 32,
+            search_margin_px: 8,
+            window: TaperWindow::Hann,
+            lowpass_sigma_px: 1.0,
+            refinements: 3,
+            min_peak: 0.15,
+            min_template_std: 0.01,
+        }
+    }
+}
+
+impl RefineParams {
+    /// Check ranges; each error is (field, message with the allowed range).
+    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
+        let mut errs = Vec::new();
+        if !(8..=256).contains(&self.template_px) {
+            errs.push((
+                "template_px".into(),
+                format!("must be in [8, 256] px, got {}", self.template_px),
+            ));
+        }
+        if !(1..=128).contains(&self.search_margin_px) {
+            errs.push((
+                "search_margin_px".into(),
+                format!("must be in [1, 128] px, got {}", self.search_margin_px),
+            ));
+        }
+        if !(self.lowpass_sigma_px.is_finite() && (0.0..=10.0).contains(&self.lowpass_sigma_px)) {
+            errs.push((
+                "lowpass_sigma_px".into(),
+                format!("must be in [0, 10] px, got {}", self.lowpass_sigma_px),
+            ));
+        }
+        if self.refinements > 10 {
+            errs.push((
+                "refinements".into(),
+                format!("must be in [0, 10], got {}", self.refinements),
+            ));
+        }
+        if !(self.min_peak.is_finite() && (0.0..1.0).contains(&self.min_peak)) {
+            errs.push((
+                "min_peak".into(),
+                format!("must be in [0, 1), got {}", self.min_peak),
+            ));
+        }
+        if !(self.min_template_std.is_finite() && self.min_template_std >= 0.0) {
+            errs.push((
+                "min_template_std".into(),
+                format!("must be ≥ 0, got {}", self.min_template_std),
+            ));
+        }
+        if errs.is_empty() {
+            Ok(())
+        } else {
+            Err(errs)
+        }
+    }
+
+    fn phase_params(&self) -> PhaseCorrelationParams {
+        PhaseCorrelationParams {
+            window: self.window.kind(),
+            lowpass_sigma_px: self.lowpass_sigma_px,
+            peak_fit: PeakFit::LogQuadratic,
+            refinements: self.refinements,
+        }
+    }
+}
+
+/// Cut the `size × size` ortho template whose top-left pixel is (x0, y0) into `out`; `false` if it leaves the
+/// ortho image or touches a masked pixel.
+pub fn cut_ortho_template(
+    ortho: &OrthoImage,
+    x0: isize,
+    y0: isize,
+    size: usize,
+    out: &mut GrayImage,
+) -> bool {
+    let (w, h) = (ortho.image.width as isize, ortho.image.height as isize);
+    if x0 < 0 || y0 < 0 || x0 + size as isize > w || y0 + size as isize > h {
+        return false;
+    }
+    out.width = size;
+    out.height = size;
+    out.data.clear();
+    for row in y0 as usize..y0 as usize + size {
+        let start = row * ortho.image.width + x0 as usize;
+        if ortho.valid[start..start + size].iter().any(|&v| v == 0) {
+            return false;
+        }
+        out.data
+            .extend_from_slice(&ortho.image.data[start..start + size]);
+    }
+    true
+}
+
+/// Fill `out` (`width × height`) with `aerial` sampled (bicubic) on the ortho grid: pixel (c, r) takes the
+/// aerial value at `ortho_to_aerial(x0 + c + 0.5, y0 + r + 0.5)`. `false` if any sample falls closer than 2 px
+/// to the aerial image border (the window would be partly invented).
+pub fn sample_aerial_on_ortho_grid(
+    aerial: &GrayImage,
+    ortho_to_aerial: &Similarity2,
+    x0: f64,
+    y0: f64,
+    width: usize,
+    height: usize,
+    out: &mut GrayImage,
+) -> bool {
+    let (a, b) = ortho_to_aerial.ab();
+    let map = |x: f64, y: f64| {
+        (
+            a * x - b * y + ortho_to_aerial.tx,
+            b * x + a * y + ortho_to_aerial.ty,
+        )
+    };
+    let (aw, ah) = (aerial.width as f64, aerial.height as f64);
+    // The map is affine: the window is inside when its four corners are.
+    for (cx, cy) in [
+        (x0, y0),
+        (x0 + width as f64, y0),
+        (x0, y0 + height as f64),
+        (x0 + width as f64, y0 + height as f64),
+    ] {
+        let (u, v) = map(cx, cy);
+        if !(u >= 2.0 && v >= 2.0 && u <= aw - 2.0 && v <= ah - 2.0) {
+            return false;
+        }
+    }
+    out.width = width;
+    out.height = height;
+    out.data.clear();
+    for r in 0..height {
+        let y = y0 + r as f64 + 0.5;
+        for c in 0..width {
+            let (u, v) = map(x0 + c as f64 + 0.5, y);
+            out.data.push(sample_bicubic(aerial, u, v, Border::Reflect));
+        }
+    }
+    true
+}
+
+/// Standard deviation of the grey values of `img`.
+pub fn grey_std(img: &GrayImage) -> f64 {
+    let n = img.data.len().max(1) as f64;
+    let mean = img.data.iter().map(|&g| g as f64).sum::<f64>() / n;
+    let var = img
+        .data
+        .iter()
+        .map(|&g| (g as f64 - mean).powi(2))
+        .sum::<f64>()
+        / n;
+    var.sqrt()
+}
+
+/// Reusable per-thread buffers of one tie point's matching.
+struct Buffers {
+    template: GrayImage,
+    search: GrayImage,
+}
+
+fn new_buffers() -> Buffers {
+    Buffers {
+        template: GrayImage::filled(0, 0, 0.0),
+        search: GrayImage::filled(0, 0, 0.0),
+    }
+}
+
+/// What happened to one tie point.
+enum Outcome {
+    /// Predicted outside the aerial image: not tried.
+    Outside,
+    /// Tried but not located (template unusable, window outside, weak peak, shift too large).
+    Rejected,
+    Located(AerialMatch),
+}
+
+/// Locate every tie point of `window` in one aerial nadir image by phase correlation (thesis 3.4.5.3).
+///
+/// `mm_ortho` must be the ortho image of the window's detecting recording (`window.recording_id`) at about the
+/// aerial GSD; `t.ortho_to_aerial` maps its pixels to full `aerial` pixels. Matches keep the order of
+/// `window.tie_points`; the result is identical for any thread count. An invalid transform (non-finite or
+/// zero scale) yields an empty refinement.
+pub fn refine_in_aerial(
+    mm_ortho: &OrthoImage,
+    aerial: &GrayImage,
+    aerial_row: &AerialImage,
+    t: &InitialTransform,
+    window: &MmWindowMatch,
+    p: &RefineParams,
+) -> AerialRefinement {
+    let mut result = AerialRefinement {
+        recording_id: t.recording_id.clone(),
+        aerial_id: aerial_row.image_id.clone(),
+        tried: 0,
+        matches: Vec::new(),
+    };
+    let tf = t.ortho_to_aerial;
+    let transform_ok = [tf.scale, tf.rotation_rad, tf.tx, tf.ty]
+        .iter()
+        .all(|v| v.is_finite())
+        && tf.scale > 1e-6;
+    if !transform_ok || p.validate().is_err() {
+        return result;
+    }
+    let phase = p.phase_params();
+    let n = window.tie_points.len().min(window.ground_world.len());
+    let outcomes: Vec<Outcome> = (0..n)
+        .into_par_iter()
+        .map_init(new_buffers, |buf, i| {
+            let g = window.ground_world[i];
+            let (u_o, v_o) = mm_ortho
+                .georef
+                .world_to_pixel(&Vector3::new(g[0], g[1], g[2]));
+            let predicted = tf.apply(&Vector2::new(u_o, v_o));
+            if !(predicted.x >= 0.0
+                && predicted.y >= 0.0
+                && predicted.x < aerial.width as f64
+                && predicted.y < aerial.height as f64)
+            {
+                return Outcome::Outside;
+            }
+            let half = p.template_px as f64 / 2.0;
+            let x0 = (u_o - half).round();
+            let y0 = (v_o - half).round();
+            if !cut_ortho_template(
+                mm_ortho,
+                x0 as isize,
+                y0 as isize,
+                p.template_px,
+                &mut buf.template,
+            ) || grey_std(&buf.template) < p.min_template_std
+            {
+                return Outcome::Rejected;
+            }
+            let margin = p.search_margin_px as f64;
+            let side = p.template_px + 2 * p.search_margin_px;
+            if !sample_aerial_on_ortho_grid(
+                aerial,
+                &tf,
+                x0 - margin,
+                y0 - margin,
+                side,
+                side,
+                &mut buf.search,
+            ) {
+                return Outcome::Rejected;
+            }
+            let Ok(loc) = locate_template(&buf.template, &buf.search, &phase) else {
+                return Outcome::Rejected;
+            };
+            // Template centre in ortho-grid coordinates, and where it was found.
+            let dx = (x0 - margin + loc.u_px) - (x0 + half);
+            let dy = (y0 - margin + loc.v_px) - (y0 + half);
+            if !(loc.peak >= p.min_peak && dx.abs() <= margin && dy.abs() <= margin) {
+                return Outcome::Rejected;
+            }
+            let observed = tf.apply(&Vector2::new(u_o + dx, v_o + dy));
+            Outcome::Located(AerialMatch {
+                tie_point_id: window.tie_points[i].id.clone(),
+                observation: AerialObservation {
+                    image_id: aerial_row.image_id.clone(),
+                    kind: AerialKind::Nadir,
+                    u_px: observed.x,
+                    v_px: observed.y,
+                    score: loc.peak,
+                },
+                predicted_u_px: predicted.x,
+                predicted_v_px: predicted.y,
+            })
+        })
+        .collect();
+    for o in outcomes {
+        match o {
+            Outcome::Outside => {}
+            Outcome::Rejected => result.tried += 1,
+            Outcome::Located(m) => {
+                result.tried += 1;
+                result.matches.push(m);
+            }
+        }
+    }
+    result
+}
