@@ -34,7 +34,7 @@ pub struct AdjustedRecording {
 }
 
 /// Observation counts per type.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct ObservationCounts {
     pub pano: usize,
     pub control: usize,

@@ -8,12 +8,17 @@
 //! (envelope Cholesky of the reduced camera matrix), [`solver`] (Levenberg–Marquardt with the points
 //! eliminated by a Schur complement), [`covariance`] (posterior σ per recording), [`adjust`] (solve, reject
 //! by normalised residuals, re-solve), [`evaluate`] (check-point triangulation and RMSE), [`synthetic_block`]
-//! (known-answer test blocks).
+//! (known-answer test blocks). On top: [`config`] (the adjust node's params), [`from_correspondences`]
+//! (correspondences → block → [`AdjustmentRun`]), [`verify`] (thesis Table 5-13 verification per trajectory
+//! segment) and [`synthetic_campaign`] (a synthetic block as campaign rows and correspondences, with aerial
+//! images, for known-answer tests).
 
 pub mod adjust;
 pub mod aerial;
+pub mod config;
 pub mod covariance;
 pub mod evaluate;
+pub mod from_correspondences;
 pub mod prepared;
 pub mod problem;
 pub mod residuals;
@@ -21,12 +26,18 @@ pub mod robust;
 pub mod skyline;
 pub mod solver;
 pub mod synthetic_block;
+pub mod synthetic_campaign;
 pub mod weighting;
 
 pub use adjust::{adjust, AdjustedRecording, Adjustment, ObservationCounts, RoundReport};
+pub use config::{AdjustConfig, ControlWeighting, Dimensions, LossKind, Sources};
 pub use evaluate::{
     evaluate_checkpoints, CheckObservation, CheckPointError, CheckPointEvaluation, RmseSummary,
     ViewSelection,
+};
+pub use from_correspondences::{
+    build_block, run, AdjustInputs, AdjustmentRun, BlockBuild, BlockPoint, BuildCounts, PointKind,
+    RunPoint, RunRecording,
 };
 pub use problem::{
     AdjustError, AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint,

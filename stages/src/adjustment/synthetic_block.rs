@@ -101,6 +101,8 @@ pub struct SyntheticBlock {
     pub check_observations: Vec<CheckObservation>,
     /// The true cameras.
     pub true_cameras: Vec<PanoramaCamera>,
+    /// Recorded (yaw, pitch, roll) of each recording, degrees (the recorded camera's attitude).
+    pub recorded_attitude_deg: Vec<[f64; 3]>,
 }
 
 impl SyntheticBlockSpec {
@@ -124,6 +126,7 @@ impl SyntheticBlockSpec {
         let mut recordings = Vec::with_capacity(n);
         let mut true_cameras = Vec::with_capacity(n);
         let mut yaw_corr = Vec::with_capacity(n);
+        let mut recorded_attitude_deg = Vec::with_capacity(n);
         for center in &true_centers {
             let recorded_yaw = (rng.next_f64() - 0.5) * 1.0;
             let pitch = (rng.next_f64() - 0.5) * 0.6;
@@ -141,6 +144,7 @@ impl SyntheticBlockSpec {
                 roll,
             ));
             yaw_corr.push(err);
+            recorded_attitude_deg.push([recorded_yaw, pitch, roll]);
             recordings.push(BlockRecording {
                 camera: PanoramaCamera::new(width, height, recorded, recorded_yaw, pitch, roll),
                 prior_sigma_xy_m: Some(self.prior_sigma_xy_m),
@@ -312,6 +316,7 @@ impl SyntheticBlockSpec {
             check_points_world: check_points,
             check_observations,
             true_cameras,
+            recorded_attitude_deg,
         }
     }
 }

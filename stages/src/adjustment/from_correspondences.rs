@@ -1,0 +1,491 @@
+//! From the registration stages' correspondences to an adjustment block and back to per-recording results
+//! (thesis 5.4.3; issue 6 "Adjustment"): MM tie points become tie-point unknowns with their panorama
+//! observations; aerial control points either tie their point to the aerial triangulation (thesis scheme:
+//! ≥ 2 aerial observations, σ = 0.10 m or the triangulation covariance) or, with `aerial_observations`, put
+//! their aerial pixels into the bundle with the aerial orientation fixed (issue 6 (a): single-aerial points
+//! count). Recorded positions are weak priors (σ from the config, else `sigma_xy`/`sigma_z`, else the
+//! documented defaults); consecutive recordings optionally keep their recorded differences (3.4.2).
+//!
+//! Recordings are used in the order given (the campaign sorts them by time, which the relative constraints
+//! rely on). Everything an adjust node reports is in [`AdjustmentRun`] (serde, so it can be cached).
+
+use super::adjust::{adjust, ObservationCounts};
+use super::config::{AdjustConfig, ControlWeighting};
+use super::problem::{
+    AdjustError, AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint,
+    PanoObservation, RelativeConstraint,
+};
+use crate::campaign::{AerialImage, AerialKind, Recording};
+use crate::correspondence::{AerialControlPoint, MmTiePoint};
+use crate::geometry::{triangulate_rays, FrameCamera, PanoramaCamera};
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+
+/// The inputs of one adjustment.
+#[derive(Clone, Copy, Debug)]
+pub struct AdjustInputs<'a> {
+    /// `mm/recordings.csv` rows, sorted by time (the recorded poses).
+    pub recordings: &'a [Recording],
+    /// Panorama (width, height) in pixels, one per recording.
+    pub pano_size_px: &'a [(u32, u32)],
+    /// MM–MM tie points (nadir matching and/or the oblique sparse cloud).
+    pub tie_points: &'a [MmTiePoint],
+    /// Aerial control points (nadir and/or oblique).
+    pub control: &'a [AerialControlPoint],
+    /// `aerial/nadir/cameras.csv` and `aerial/oblique/cameras.csv` rows (fixed orientations).
+    pub nadir: &'a [AerialImage],
+    pub oblique: &'a [AerialImage],
+}
+
+/// What a tie-point unknown is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum PointKind {
+    /// MM tie point without aerial observations.
+    Tie,
+    /// Aerial control point seen in ≥ 2 aerial images.
+    Control,
+    /// Aerial control point seen in a single aerial image.
+    SingleAerial,
+}
+
+/// One tie-point unknown and its observations (indices into the run's recordings and aerial images).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BlockPoint {
+    /// `MmTiePoint::id` / `AerialControlPoint::tie_point_id`.
+    pub id: String,
+    pub kind: PointKind,
+    /// (recording index, u, v) panorama pixels.
+    pub pano: Vec<(usize, f64, f64)>,
+    /// (aerial image index, u, v) aerial pixels (all aerial observations of the point, used or not).
+    pub aerial: Vec<(usize, f64, f64)>,
+}
+
+/// An aerial image referenced by the block.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AerialImageRef {
+    pub kind: AerialKind,
+    pub image_id: String,
+}
+
+/// How the correspondences entered the block.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct BuildCounts {
+    pub tie_points: usize,
+    pub control_points: usize,
+    /// Control points used as triangulated control (thesis scheme).
+    pub control_as_gcp: usize,
+    /// Control points whose aerial pixels went into the bundle (issue 6 (a)).
+    pub control_as_aerial_observations: usize,
+    /// Control points not used: a single aerial observation in the thesis scheme, or no usable point.
+    pub control_unused: usize,
+    pub aerial_observations: usize,
+    pub relative_constraints: usize,
+}
+
+/// A block with the names of its unknowns.
+#[derive(Clone, Debug)]
+pub struct BlockBuild {
+    pub block: Block,
+    pub options: AdjustOptions,
+    pub recording_ids: Vec<String>,
+    pub points: Vec<BlockPoint>,
+    pub aerial_images: Vec<AerialImageRef>,
+    pub counts: BuildCounts,
+}
+
+/// One adjusted recording.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunRecording {
+    pub image_id: String,
+    /// Recorded projection centre, world, metres.
+    pub recorded_world: [f64; 3],
+    /// Adjusted projection centre, world, metres.
+    pub adjusted_world: [f64; 3],
+    /// Added to the recorded yaw, degrees (0 unless estimated).
+    pub yaw_correction_deg: f64,
+    /// Posterior σ of x, y, z, metres: a posteriori (scaled by σ̂0) when there is redundancy, else a priori.
+    pub sigma_m: [f64; 3],
+    pub sigma_is_a_posteriori: bool,
+}
+
+/// One adjusted tie point.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunPoint {
+    pub point: BlockPoint,
+    /// Adjusted coordinates (initial ones when undetermined), world, metres.
+    pub position_world: [f64; 3],
+    /// Determined in the final solve (≥ 2 rays or a control point).
+    pub determined: bool,
+}
+
+/// Everything the adjust node reports (issue 6 metrics: iterations, observations, rejected, cost).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AdjustmentRun {
+    pub config: AdjustConfig,
+    pub recordings: Vec<RunRecording>,
+    pub points: Vec<RunPoint>,
+    pub aerial_images: Vec<AerialImageRef>,
+    /// Accepted LM steps over all rejection rounds.
+    pub iterations: usize,
+    /// Why the final solve stopped (`StepSize`, `CostChange`, `ZeroCost`, `MaxIterations`, `DampingLimit`).
+    pub termination: String,
+    pub observations: ObservationCounts,
+    pub rejected: ObservationCounts,
+    /// Rejected observations of all kinds.
+    pub rejected_total: usize,
+    /// Final cost ½Σρ (whitened).
+    pub final_cost: f64,
+    /// σ̂0² (`None` without redundancy).
+    pub variance_factor: Option<f64>,
+    pub redundancy: i64,
+    pub rejection_rounds: usize,
+    pub build: BuildCounts,
+}
+
+/// Builds the block of one configuration.
+pub fn build_block(
+    inputs: &AdjustInputs,
+    config: &AdjustConfig,
+) -> Result<BlockBuild, AdjustError> {
+    if let Err(problems) = config.validate() {
+        let (field, problem) = problems[0].clone();
+        return Err(AdjustError::InvalidInput {
+            item: format!("adjust parameter {field}"),
+            problem,
+        });
+    }
+    let n_rec = inputs.recordings.len();
+    if inputs.pano_size_px.len() != n_rec {
+        return Err(AdjustError::InvalidInput {
+            item: "panorama sizes".to_string(),
+            problem: format!(
+                "{} sizes for {n_rec} recordings; pass one (width, height) per recording",
+                inputs.pano_size_px.len()
+            ),
+        });
+    }
+    let mut recording_index: HashMap<&str, usize> = HashMap::with_capacity(n_rec);
+    let mut recordings = Vec::with_capacity(n_rec);
+    for (i, (rec, &(w, h))) in inputs
+        .recordings
+        .iter()
+        .zip(inputs.pano_size_px)
+        .enumerate()
+    {
+        if recording_index.insert(rec.image_id.as_str(), i).is_some() {
+            return Err(AdjustError::InvalidInput {
+                item: format!("recording '{}'", rec.image_id),
+                problem: "image_id occurs twice; image ids must be unique".to_string(),
+            });
+        }
+        recordings.push(BlockRecording {
+            camera: PanoramaCamera::from_recording(rec, w, h),
+            prior_sigma_xy_m: Some(
+                config
+                    .prior_sigma_xy_m
+                    .or(rec.sigma_xy_m)
+                    .unwrap_or(config.default_prior_sigma_xy_m),
+            ),
+            prior_sigma_z_m: Some(
+                config
+                    .prior_sigma_z_m
+                    .or(rec.sigma_z_m)
+                    .unwrap_or(config.default_prior_sigma_z_m),
+            ),
+        });
+    }
+    let mut block = Block {
+        recordings,
+        ..Block::default()
+    };
+    let mut points: Vec<BlockPoint> = Vec::new();
+    let mut point_index: HashMap<String, usize> = HashMap::new();
+    let mut counts = BuildCounts::default();
+    let sigma_px = config.pano_sigma_px;
+
+    let resolve = |owner: &str, image_id: &str| -> Result<usize, AdjustError> {
+        recording_index
+            .get(image_id)
+            .copied()
+            .ok_or_else(|| AdjustError::InvalidInput {
+                item: owner.to_string(),
+                problem: format!(
+                    "panorama '{image_id}' is not among the {n_rec} recordings of the adjustment; \
+                     pass the recordings the correspondences were made with"
+                ),
+            })
+    };
+
+    for tp in inputs.tie_points {
+        let owner = format!("tie point '{}'", tp.id);
+        if point_index.contains_key(&tp.id) {
+            return Err(AdjustError::InvalidInput {
+                item: owner,
+                problem: "id occurs twice; tie-point ids must be unique".to_string(),
+            });
+        }
+        if !tp.point_world.iter().all(|v| v.is_finite()) {
+            return Err(AdjustError::InvalidInput {
+                item: owner,
+                problem: "point_world is not finite".to_string(),
+            });
+        }
+        let p = points.len();
+        let mut pano = Vec::with_capacity(tp.observations.len());
+        for o in &tp.observations {
+            let r = resolve(&owner, &o.image_id)?;
+            block.pano_observations.push(PanoObservation {
+                recording: r,
+                point: p,
+                u_px: o.u_px,
+                v_px: o.v_px,
+                sigma_px,
+            });
+            pano.push((r, o.u_px, o.v_px));
+        }
+        block
+            .points_initial_world
+            .push(Vector3::from(tp.point_world));
+        point_index.insert(tp.id.clone(), p);
+        points.push(BlockPoint {
+            id: tp.id.clone(),
+            kind: PointKind::Tie,
+            pano,
+            aerial: Vec::new(),
+        });
+        counts.tie_points += 1;
+    }
+
+    let mut aerial_index: HashMap<(AerialKind, &str), usize> = HashMap::new();
+    let mut aerial_images: Vec<AerialImageRef> = Vec::new();
+    let mut aerial_rows: Vec<&AerialImage> = Vec::new();
+    let rows_of = |kind: AerialKind| match kind {
+        AerialKind::Nadir => inputs.nadir,
+        AerialKind::Oblique => inputs.oblique,
+    };
+    for cp in inputs.control {
+        counts.control_points += 1;
+        let owner = format!("aerial control point '{}'", cp.tie_point_id);
+        // Resolve the aerial images (in order of first use, so the numbering is deterministic).
+        let mut aerial = Vec::with_capacity(cp.aerial.len());
+        for a in &cp.aerial {
+            let key = (a.kind, a.image_id.as_str());
+            let idx = match aerial_index.get(&key) {
+                Some(&i) => i,
+                None => {
+                    let row = rows_of(a.kind)
+                        .iter()
+                        .find(|r| r.image_id == a.image_id)
+                        .ok_or_else(|| AdjustError::InvalidInput {
+                            item: owner.clone(),
+                            problem: format!(
+                                "aerial image '{}' ({:?}) is not among the aerial cameras passed; pass \
+                                 the cameras.csv rows the control points were measured in",
+                                a.image_id, a.kind
+                            ),
+                        })?;
+                    let i = aerial_images.len();
+                    aerial_index.insert(key, i);
+                    aerial_images.push(AerialImageRef {
+                        kind: a.kind,
+                        image_id: a.image_id.clone(),
+                    });
+                    aerial_rows.push(row);
+                    i
+                }
+            };
+            aerial.push((idx, a.u_px, a.v_px));
+        }
+        let p = match point_index.get(&cp.tie_point_id) {
+            Some(&p) => p,
+            None => {
+                // A control point whose tie point was not passed: its own point from its MM observations.
+                let mut pano = Vec::with_capacity(cp.mm.len());
+                for o in &cp.mm {
+                    pano.push((resolve(&owner, &o.image_id)?, o.u_px, o.v_px));
+                }
+                let Some(initial) = initial_point(&block, &pano, cp.point_world, sigma_px) else {
+                    counts.control_unused += 1;
+                    continue;
+                };
+                let p = points.len();
+                for &(r, u, v) in &pano {
+                    block.pano_observations.push(PanoObservation {
+                        recording: r,
+                        point: p,
+                        u_px: u,
+                        v_px: v,
+                        sigma_px,
+                    });
+                }
+                block.points_initial_world.push(initial);
+                point_index.insert(cp.tie_point_id.clone(), p);
+                points.push(BlockPoint {
+                    id: cp.tie_point_id.clone(),
+                    kind: PointKind::Tie,
+                    pano,
+                    aerial: Vec::new(),
+                });
+                p
+            }
+        };
+        let kind = if cp.aerial.len() >= 2 {
+            PointKind::Control
+        } else {
+            PointKind::SingleAerial
+        };
+        if points[p].kind != PointKind::Control {
+            points[p].kind = kind;
+        }
+        points[p].aerial.extend(aerial.iter().copied());
+        if config.aerial_observations {
+            for &(camera, u, v) in &aerial {
+                block.aerial_observations.push(AerialImageObservation {
+                    camera,
+                    point: p,
+                    u_px: u,
+                    v_px: v,
+                    sigma_px: aerial_rows[camera].sigma_px,
+                });
+            }
+            counts.aerial_observations += aerial.len();
+            counts.control_as_aerial_observations += usize::from(!aerial.is_empty());
+        } else if let Some(xyz) = cp.point_world.filter(|_| cp.aerial.len() >= 2) {
+            let covariance_m2 = match config.control_weighting {
+                ControlWeighting::Fixed => {
+                    Matrix3::identity() * (config.control_sigma_m * config.control_sigma_m)
+                }
+                ControlWeighting::Covariance => {
+                    let c = cp.covariance_m2.ok_or_else(|| AdjustError::InvalidInput {
+                        item: owner.clone(),
+                        problem:
+                            "control_weighting = \"covariance\" but the point has no covariance_m2"
+                                .to_string(),
+                    })?;
+                    Matrix3::from_row_slice(&[
+                        c[0][0], c[0][1], c[0][2], c[1][0], c[1][1], c[1][2], c[2][0], c[2][1],
+                        c[2][2],
+                    ])
+                }
+            };
+            block.control_points.push(ControlPoint {
+                point: p,
+                position_world: Vector3::from(xyz),
+                covariance_m2,
+            });
+            counts.control_as_gcp += 1;
+        } else {
+            counts.control_unused += 1;
+        }
+    }
+    block.aerial_cameras = aerial_rows
+        .iter()
+        .map(|r| FrameCamera::from_aerial(r))
+        .collect();
+
+    if config.relative_constraints {
+        for i in 1..n_rec {
+            let (a, b) = (&inputs.recordings[i - 1], &inputs.recordings[i]);
+            if (a.x - b.x).hypot(a.y - b.y) <= config.relative_max_gap_m {
+                block.relative_constraints.push(RelativeConstraint {
+                    from: i - 1,
+                    to: i,
+                    sigma_m: config.relative_sigma_m,
+                });
+            }
+        }
+        counts.relative_constraints = block.relative_constraints.len();
+    }
+    block.validate()?;
+    Ok(BlockBuild {
+        block,
+        options: config.options(),
+        recording_ids: inputs
+            .recordings
+            .iter()
+            .map(|r| r.image_id.clone())
+            .collect(),
+        points,
+        aerial_images,
+        counts,
+    })
+}
+
+/// Initial coordinates of a point from its panorama rays with the recorded poses, else `fallback`.
+fn initial_point(
+    block: &Block,
+    pano: &[(usize, f64, f64)],
+    fallback: Option<[f64; 3]>,
+    sigma_px: f64,
+) -> Option<Vector3<f64>> {
+    if pano.len() >= 2 {
+        let rays: Vec<_> = pano
+            .iter()
+            .map(|&(r, u, v)| block.recordings[r].camera.pixel_ray(u, v))
+            .collect();
+        let sigmas: Vec<f64> = pano
+            .iter()
+            .map(|&(r, _, _)| block.recordings[r].camera.angular_sigma_rad(sigma_px))
+            .collect();
+        if let Ok(t) = triangulate_rays(&rays, &sigmas) {
+            return Some(t.point_world);
+        }
+    }
+    fallback
+        .map(Vector3::from)
+        .filter(|p| p.iter().all(|v| v.is_finite()))
+}
+
+/// Builds and adjusts one configuration.
+pub fn run(inputs: &AdjustInputs, config: &AdjustConfig) -> Result<AdjustmentRun, AdjustError> {
+    let build = build_block(inputs, config)?;
+    let adj = adjust(&build.block, &build.options)?;
+    let recordings = build
+        .recording_ids
+        .iter()
+        .zip(&build.block.recordings)
+        .zip(&adj.recordings)
+        .map(|((id, rec), a)| {
+            let (sigma, posterior) = match a.sigma_a_posteriori_m {
+                Some(s) => (s, true),
+                None => (a.sigma_a_priori_m, false),
+            };
+            RunRecording {
+                image_id: id.clone(),
+                recorded_world: rec.camera.center_world.into(),
+                adjusted_world: a.position_world.into(),
+                yaw_correction_deg: a.yaw_correction_deg,
+                sigma_m: sigma.into(),
+                sigma_is_a_posteriori: posterior,
+            }
+        })
+        .collect();
+    let points = build
+        .points
+        .into_iter()
+        .enumerate()
+        .map(|(i, point)| RunPoint {
+            point,
+            position_world: adj.points_world[i].into(),
+            determined: adj.point_determined[i],
+        })
+        .collect();
+    let rejected_total = adj.rejected.pano + adj.rejected.control + adj.rejected.aerial;
+    Ok(AdjustmentRun {
+        config: config.clone(),
+        recordings,
+        points,
+        aerial_images: build.aerial_images,
+        iterations: adj.iterations,
+        termination: format!("{:?}", adj.termination),
+        observations: adj.observations,
+        rejected: adj.rejected,
+        rejected_total,
+        final_cost: adj.final_cost,
+        variance_factor: adj.variance_factor,
+        redundancy: adj.redundancy,
+        rejection_rounds: adj.rounds.len(),
+        build: build.counts,
+    })
+}
