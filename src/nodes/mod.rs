@@ -2,11 +2,20 @@
 //! the artifacts they exchange. The algorithms live in `stages/`; this layer only adds names, versions, typed
 //! inputs, parameter validation and encoding.
 
+pub mod aerial;
 pub mod campaign;
+pub mod control;
+pub mod mm_match;
+pub mod nadir_grade;
+pub mod nadir_options;
+pub mod nadir_summary;
 pub mod ortho;
+pub mod ortho_aerial;
 pub mod params;
+pub mod refine;
 pub mod summary;
 pub mod synth;
+pub mod transform;
 
 pub use campaign::{
     CampaignSnapshot, LoadCampaign, LoadCampaignParams, SelectRecording, SelectRecordingParams,

@@ -2,6 +2,10 @@
 //! [`StageParams`] trait): each implementation forwards to the type's own `validate`.
 
 use crate::workflow::{ParamError, StageParams};
+use skytie_stages::nadir::control_points::ControlParams;
+use skytie_stages::nadir::initial_transform::TransformParams;
+use skytie_stages::nadir::mm_matching::MmMatchParams;
+use skytie_stages::nadir::refine::RefineParams;
 use skytie_stages::nadir::OrthoParams;
 
 fn convert(errs: Vec<(String, String)>) -> Vec<ParamError> {
@@ -10,8 +14,21 @@ fn convert(errs: Vec<(String, String)>) -> Vec<ParamError> {
         .collect()
 }
 
-impl StageParams for OrthoParams {
-    fn validate(&self) -> Result<(), Vec<ParamError>> {
-        OrthoParams::validate(self).map_err(convert)
-    }
+/// `impl StageParams for T` forwarding to `T::validate(&self) -> Result<(), Vec<(String, String)>>`.
+macro_rules! forward_validate {
+    ($($t:ty),+ $(,)?) => {$(
+        impl StageParams for $t {
+            fn validate(&self) -> Result<(), Vec<ParamError>> {
+                <$t>::validate(self).map_err(convert)
+            }
+        }
+    )+};
 }
+
+forward_validate!(
+    OrthoParams,
+    MmMatchParams,
+    TransformParams,
+    RefineParams,
+    ControlParams,
+);

@@ -3,11 +3,13 @@
 //! Phases (each built from the values of the previous one — staged planning):
 //! 1. `campaign`: the synthetic generator node when the workflow says `campaign = "synth:<preset>"`;
 //! 2. `load`: read and validate the campaign;
-//! 3. `items`, per sweep variant: per recording `recording` → `ortho` (thesis 3.4.3), then the global `summary`.
+//! 3. `items`, per sweep variant: per recording `recording` → `ortho` (thesis 3.4.3), the nadir chain
+//!    (`pipelines::nadir`, thesis chapter 3), then the global `summary`.
 //!
-//! Stages not yet implemented (MM-to-MM matching, KAZE transform, phase correlation, oblique chain,
-//! adjustment) are refused with a clear message when a workflow enables them, never silently skipped.
+//! Stages not yet implemented (oblique chain, adjustment) are refused with a clear message when a workflow
+//! enables them, never silently skipped.
 
+use super::nadir;
 use crate::dag::{DagBuilder, Pipeline, PipelineError, RawFile, Session};
 use crate::nodes::campaign::{listing_hash, metadata_inputs};
 use crate::nodes::{
@@ -22,7 +24,19 @@ use std::path::{Path, PathBuf};
 pub struct SkytiePipeline;
 
 /// Stage names a workflow may enable in `stages = [...]`.
-pub const STAGES: [&str; 4] = ["synth", "load", "ortho", "summary"];
+pub const STAGES: [&str; 11] = [
+    "synth",
+    "load",
+    "ortho",
+    "summary",
+    "mm_match",
+    "ortho_aerial",
+    "transform",
+    "refine",
+    "control",
+    "nadir",
+    "grade_nadir",
+];
 
 fn wf_err(e: impl std::fmt::Display) -> PipelineError {
     PipelineError::Workflow(e.to_string())
@@ -98,12 +112,14 @@ impl Pipeline for SkytiePipeline {
         }
         // Phase 3: per-recording stages and the summary, for every variant.
         let ortho_on = wf.stages.iter().any(|s| s == "ortho");
+        let nadir_on = nadir::enabled(wf)?;
         let mut b = DagBuilder::new();
         for variant in wf.variants() {
             b.set_variant(&variant);
             let snap = b.add(LoadCampaign, "", load_params.clone(), inputs.clone())?;
             let ortho: OrthoParams = wf.params("ortho", &variant).map_err(wf_err)?;
             let mut orthos = Vec::new();
+            let mut items = Vec::new();
             for rec in &snapshot.campaign.recordings {
                 let label = format!("rec {}", rec.image_id);
                 let row = b.add(
@@ -116,8 +132,18 @@ impl Pipeline for SkytiePipeline {
                 )?;
                 if ortho_on {
                     let pano = RawFile(root.join("mm/panoramas").join(&rec.file));
-                    orthos.push(b.add(OrthoProject, &label, ortho.clone(), (row, pano))?);
+                    let o = b.add(OrthoProject, &label, ortho.clone(), (row, pano.clone()))?;
+                    orthos.push(o);
+                    items.push(nadir::RecordingItem {
+                        recording: rec,
+                        row,
+                        ortho: o,
+                        pano,
+                    });
                 }
+            }
+            if nadir_on {
+                nadir::add_nadir(&mut b, wf, &variant, &root, &snapshot, snap, &items)?;
             }
             let summary = b.add(
                 SummarizeCampaign,

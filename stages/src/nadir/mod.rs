@@ -11,11 +11,12 @@ pub mod mm_matching;
 pub mod ortho;
 pub mod refine;
 pub mod registration;
+pub mod summary;
 pub mod vehicle_mask;
 
 pub use ortho::{ortho_project, OrthoGeoref, OrthoImage, OrthoParams};
 pub use registration::{
     AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch, PairMethod, PairReport,
-    TransformOutcome,
+    RecordingControl, TransformOutcome,
 };
 pub use vehicle_mask::VehicleMask;

@@ -99,3 +99,11 @@ pub struct AerialRefinement {
     pub tried: usize,
     pub matches: Vec<AerialMatch>,
 }
+
+/// The aerial control points of one recording (thesis 3.4.5.4): its window's tie points located in ≥ 1 aerial
+/// image(s).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RecordingControl {
+    pub recording_id: String,
+    pub points: Vec<crate::correspondence::AerialControlPoint>,
+}

@@ -1,0 +1,53 @@
+//! `nadir`: the global summary of the nadir pipeline — counts of MM pairs, tie points, transforms,
+//! correspondences and control points (`skytie_stages::nadir::summary`), contributed to metrics as `nadir`.
+
+use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::nodes::campaign::CampaignSnapshot;
+use crate::nodes::summary::SummaryParams;
+use skytie_stages::nadir::summary::NadirSummary;
+use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, RecordingControl, TransformOutcome};
+use std::sync::Arc;
+
+crate::serde_artifact!(NadirSummary);
+
+/// The nadir summary node (no tunable parameters).
+pub struct SummarizeNadir;
+
+impl Stage for SummarizeNadir {
+    const NAME: &'static str = "nadir";
+    const VERSION: &'static str = "1";
+    type Params = SummaryParams;
+    type Output = NadirSummary;
+    type Inputs = (
+        Handle<CampaignSnapshot>,
+        Vec<Handle<MmWindowMatch>>,
+        Vec<Handle<TransformOutcome>>,
+        Vec<Handle<AerialRefinement>>,
+        Vec<Handle<RecordingControl>>,
+    );
+
+    fn run(
+        &self,
+        _: &SummaryParams,
+        (snap, windows, transforms, refinements, control): (
+            Arc<CampaignSnapshot>,
+            Vec<Arc<MmWindowMatch>>,
+            Vec<Arc<TransformOutcome>>,
+            Vec<Arc<AerialRefinement>>,
+            Vec<Arc<RecordingControl>>,
+        ),
+        _: &NodeCtx,
+    ) -> Result<NadirSummary, StageError> {
+        let w: Vec<&MmWindowMatch> = windows.iter().map(|x| x.as_ref()).collect();
+        let t: Vec<&TransformOutcome> = transforms.iter().map(|x| x.as_ref()).collect();
+        let r: Vec<&AerialRefinement> = refinements.iter().map(|x| x.as_ref()).collect();
+        let c: Vec<&RecordingControl> = control.iter().map(|x| x.as_ref()).collect();
+        Ok(NadirSummary::from_parts(
+            snap.campaign.recordings.len(),
+            &w,
+            &t,
+            &r,
+            &c,
+        ))
+    }
+}

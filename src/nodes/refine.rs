@@ -1,0 +1,53 @@
+//! `refine`: per (recording × nadir image) with an accepted initial transform, every MM tie point of the
+//! recording's window located in the aerial image by phase correlation (thesis 3.4.5.3,
+//! `skytie_stages::nadir::refine`). A rejected transform gives an empty refinement.
+
+use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use skytie_stages::campaign::AerialImage;
+use skytie_stages::imaging::io::load_gray;
+use skytie_stages::nadir::refine::{refine_in_aerial, RefineParams};
+use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, OrthoImage, TransformOutcome};
+use std::sync::Arc;
+
+crate::serde_artifact!(AerialRefinement);
+
+/// The phase-correlation refinement node.
+pub struct RefineStage;
+
+impl Stage for RefineStage {
+    const NAME: &'static str = "refine";
+    const VERSION: &'static str = "1";
+    type Params = RefineParams;
+    type Output = AerialRefinement;
+    type Inputs = (
+        Handle<OrthoImage>,
+        RawFile,
+        Handle<AerialImage>,
+        Handle<TransformOutcome>,
+        Handle<MmWindowMatch>,
+    );
+
+    fn run(
+        &self,
+        p: &RefineParams,
+        (ortho, aerial_file, aerial, outcome, window): (
+            Arc<OrthoImage>,
+            RawFileValue,
+            Arc<AerialImage>,
+            Arc<TransformOutcome>,
+            Arc<MmWindowMatch>,
+        ),
+        _: &NodeCtx,
+    ) -> Result<AerialRefinement, StageError> {
+        let TransformOutcome::Accepted(t) = outcome.as_ref() else {
+            return Ok(AerialRefinement {
+                recording_id: window.recording_id.clone(),
+                aerial_id: aerial.image_id.clone(),
+                tried: 0,
+                matches: Vec::new(),
+            });
+        };
+        let image = load_gray(&aerial_file.path).map_err(|e| StageError::new(e.to_string()))?;
+        Ok(refine_in_aerial(&ortho, &image, &aerial, t, &window, p))
+    }
+}

@@ -1,0 +1,257 @@
+//! The nadir part of the `skytie` pipeline (thesis chapter 3) for one variant: per recording an MM matching
+//! window (`mm_match`), per (recording × overlapping nadir image) the aerial-oriented ortho (`ortho_aerial`),
+//! the initial transform (`transform`) and the phase-correlation refinement (`refine`), per recording the
+//! aerial control points (`control`), then the global `nadir` summary and — on synthetic campaigns with
+//! `truth/` — the evaluation node `grade_nadir`.
+
+use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
+use crate::nodes::aerial::{SelectAerial, SelectAerialParams};
+use crate::nodes::campaign::CampaignSnapshot;
+use crate::nodes::control::ControlStage;
+use crate::nodes::mm_match::MmMatch;
+use crate::nodes::nadir_grade::{grade_metrics, GradeNadir, TRUTH_AERIAL_NADIR, TRUTH_RECORDINGS};
+use crate::nodes::nadir_options::NadirOptions;
+use crate::nodes::nadir_summary::SummarizeNadir;
+use crate::nodes::ortho_aerial::OrthoForAerial;
+use crate::nodes::refine::RefineStage;
+use crate::nodes::summary::SummaryParams;
+use crate::nodes::transform::InitialTransformStage;
+use crate::workflow::Workflow;
+use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
+use skytie_stages::nadir::aerial_overlap::overlapping_nadir;
+use skytie_stages::nadir::control_points::ControlParams;
+use skytie_stages::nadir::grading::NadirGrade;
+use skytie_stages::nadir::initial_transform::TransformParams;
+use skytie_stages::nadir::mm_matching::MmMatchParams;
+use skytie_stages::nadir::refine::RefineParams;
+use skytie_stages::nadir::summary::NadirSummary;
+use skytie_stages::nadir::{
+    AerialRefinement, MmWindowMatch, OrthoImage, OrthoParams, RecordingControl, TransformOutcome,
+};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The stages of the nadir chain, in dependency order.
+pub const NADIR_STAGES: [&str; 7] = [
+    "mm_match",
+    "ortho_aerial",
+    "transform",
+    "refine",
+    "control",
+    "nadir",
+    "grade_nadir",
+];
+
+/// One recording's per-item handles, built by the main pipeline.
+pub struct RecordingItem<'a> {
+    pub recording: &'a Recording,
+    pub row: Handle<Recording>,
+    pub ortho: Handle<OrthoImage>,
+    pub pano: RawFile,
+}
+
+/// What the nadir chain hands to later stages (the adjustment).
+pub struct NadirHandles {
+    pub windows: Vec<Handle<MmWindowMatch>>,
+    pub control: Vec<Handle<RecordingControl>>,
+}
+
+fn wf_err(e: impl std::fmt::Display) -> PipelineError {
+    PipelineError::Workflow(e.to_string())
+}
+
+/// Which nadir stages the workflow enables; an enabled stage whose upstream is not enabled is an error.
+pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
+    let on = |s: &str| wf.stages.iter().any(|x| x == s);
+    let Some(last) = NADIR_STAGES
+        .iter()
+        .rposition(|s| on(s) && *s != "grade_nadir")
+    else {
+        if on("grade_nadir") {
+            return Err(wf_err(format!(
+                "{}: stage 'grade_nadir' needs the nadir chain ({})",
+                wf.path.display(),
+                NADIR_STAGES[..6].join(", ")
+            )));
+        }
+        return Ok(false);
+    };
+    let mut needed: Vec<&str> = NADIR_STAGES[..=last].to_vec();
+    if !on("ortho") {
+        needed.insert(0, "ortho");
+    }
+    let missing: Vec<&str> = needed.into_iter().filter(|s| !on(s)).collect();
+    if !missing.is_empty() {
+        return Err(wf_err(format!(
+            "{}: the nadir chain is enabled up to '{}' but its upstream stage(s) {} are not in `stages`; \
+             add them (order: ortho, {})",
+            wf.path.display(),
+            NADIR_STAGES[last],
+            missing.join(", "),
+            NADIR_STAGES.join(", ")
+        )));
+    }
+    Ok(true)
+}
+
+/// Horizontal distance between two recordings' recorded positions, metres.
+fn distance_m(a: &Recording, b: &Recording) -> f64 {
+    (a.x - b.x).hypot(a.y - b.y)
+}
+
+/// Add the nadir chain for `variant`. `items` are in trajectory (time) order.
+#[allow(clippy::too_many_arguments)]
+pub fn add_nadir(
+    b: &mut DagBuilder,
+    wf: &Workflow,
+    variant: &str,
+    root: &Path,
+    snapshot: &CampaignSnapshot,
+    snap: Handle<CampaignSnapshot>,
+    items: &[RecordingItem<'_>],
+) -> Result<NadirHandles, PipelineError> {
+    let on = |s: &str| wf.stages.iter().any(|x| x == s);
+    let options: NadirOptions = wf.params("nadir", variant).map_err(wf_err)?;
+    let mm_params: MmMatchParams = wf.params("mm_match", variant).map_err(wf_err)?;
+    let ortho_base: OrthoParams = wf.params("ortho", variant).map_err(wf_err)?;
+    let transform_params: TransformParams = wf.params("transform", variant).map_err(wf_err)?;
+    let refine_params: RefineParams = wf.params("refine", variant).map_err(wf_err)?;
+    let control_params: ControlParams = wf.params("control", variant).map_err(wf_err)?;
+    let window_len = if options.triples { 2 } else { 1 };
+    let nadir_dir = root.join("aerial/nadir");
+
+    let mut aerial_rows: BTreeMap<usize, Handle<AerialImage>> = BTreeMap::new();
+    let mut windows = Vec::new();
+    let mut transforms: Vec<Handle<TransformOutcome>> = Vec::new();
+    let mut refinements: Vec<Handle<AerialRefinement>> = Vec::new();
+    let mut control = Vec::new();
+    for (i, item) in items.iter().enumerate() {
+        let neighbours: Vec<&RecordingItem> = items[i + 1..]
+            .iter()
+            .take(window_len)
+            .take_while(|n| {
+                distance_m(item.recording, n.recording) <= options.max_neighbour_distance_m
+            })
+            .collect();
+        if neighbours.is_empty() {
+            continue;
+        }
+        let label = format!("rec {}", item.recording.image_id);
+        let members: Vec<&RecordingItem> = std::iter::once(item).chain(neighbours).collect();
+        let window = b.add(
+            MmMatch,
+            &label,
+            mm_params.clone(),
+            (
+                members.iter().map(|m| m.row).collect::<Vec<_>>(),
+                members.iter().map(|m| m.ortho).collect::<Vec<_>>(),
+                members.iter().map(|m| m.pano.clone()).collect::<Vec<_>>(),
+            ),
+        )?;
+        windows.push(window);
+        if !on("ortho_aerial") {
+            continue;
+        }
+        let mut rec_refinements = Vec::new();
+        let mut rec_aerials = Vec::new();
+        for a in overlapping_nadir(
+            item.recording,
+            &snapshot.campaign.nadir,
+            options.overlap_margin_m,
+        ) {
+            let row = &snapshot.campaign.nadir[a];
+            let aerial = match aerial_rows.get(&a) {
+                Some(h) => *h,
+                None => {
+                    let h = b.add(
+                        SelectAerial,
+                        &format!("nadir {}", row.image_id),
+                        SelectAerialParams {
+                            image_id: row.image_id.clone(),
+                            kind: AerialKind::Nadir,
+                        },
+                        snap,
+                    )?;
+                    aerial_rows.insert(a, h);
+                    h
+                }
+            };
+            let pair = format!("rec {} × {}", item.recording.image_id, row.image_id);
+            let aerial_file = RawFile(nadir_dir.join(&row.file));
+            let ortho = b.add(
+                OrthoForAerial,
+                &pair,
+                ortho_base.clone(),
+                (item.row, item.pano.clone(), aerial),
+            )?;
+            if !on("transform") {
+                continue;
+            }
+            let outcome = b.add(
+                InitialTransformStage,
+                &pair,
+                transform_params.clone(),
+                (item.row, ortho, aerial_file.clone(), aerial),
+            )?;
+            transforms.push(outcome);
+            if !on("refine") {
+                continue;
+            }
+            let refined = b.add(
+                RefineStage,
+                &pair,
+                refine_params.clone(),
+                (ortho, aerial_file, aerial, outcome, window),
+            )?;
+            refinements.push(refined);
+            rec_refinements.push(refined);
+            rec_aerials.push(aerial);
+        }
+        if on("control") {
+            control.push(b.add(
+                ControlStage,
+                &label,
+                control_params.clone(),
+                (window, rec_refinements, rec_aerials),
+            )?);
+        }
+    }
+    if on("nadir") {
+        let summary = b.add(
+            SummarizeNadir,
+            "",
+            SummaryParams::default(),
+            (
+                snap,
+                windows.clone(),
+                transforms,
+                refinements.clone(),
+                control.clone(),
+            ),
+        )?;
+        b.metrics(summary, "nadir", |s: &NadirSummary| s.metrics());
+    }
+    let truth = root.join(TRUTH_RECORDINGS);
+    if on("grade_nadir") && truth.is_file() {
+        let mut truth_files = vec![RawFile(truth)];
+        let truth_aerial = root.join(TRUTH_AERIAL_NADIR);
+        if truth_aerial.is_file() {
+            truth_files.push(RawFile(truth_aerial));
+        }
+        let grade = b.add(
+            GradeNadir,
+            "",
+            SummaryParams::default(),
+            (
+                snap,
+                truth_files,
+                items.iter().map(|i| i.pano.clone()).collect::<Vec<_>>(),
+                windows.clone(),
+                refinements,
+                control.clone(),
+            ),
+        )?;
+        b.metrics(grade, "nadir", |g: &NadirGrade| grade_metrics(g));
+    }
+    Ok(NadirHandles { windows, control })
+}
