@@ -22,7 +22,7 @@ pub struct NadirSummary {
     /// (recording, nadir image) pairs tried / with an accepted initial transform (thesis 3.4.5.2).
     pub transforms_tried: usize,
     pub transforms_accepted: usize,
-    /// Rejection reasons (first word group before a number) → count.
+    /// Rejection reasons (numbers replaced by `N`) → count.
     pub transforms_rejected: BTreeMap<String, usize>,
     /// MM tie point × aerial image correspondences (as Table 3-1 counts them).
     pub tie_points: usize,
@@ -35,17 +35,23 @@ pub struct NadirSummary {
     pub single_aerial_points: usize,
 }
 
-/// A rejection reason without its numbers, for counting ("centre offset 2.3 m > 1.5 m" → "centre offset").
+/// A rejection reason with its numbers replaced by `N`, for counting ("centre offset 2.3 m > 1.5 m" →
+/// "centre offset N m > N m").
 fn reason_class(reason: &str) -> String {
     let words: Vec<&str> = reason
         .split_whitespace()
-        .take_while(|w| !w.chars().next().is_some_and(|c| c.is_ascii_digit()))
-        .take(4)
+        .map(|w| {
+            if w.chars().any(|c| c.is_ascii_digit()) {
+                "N"
+            } else {
+                w
+            }
+        })
         .collect();
     if words.is_empty() {
         "other".into()
     } else {
-        words.join(" ").trim_end_matches([':', ',']).to_string()
+        words.join(" ")
     }
 }
 
