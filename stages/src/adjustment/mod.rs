@@ -27,6 +27,7 @@ pub mod skyline;
 pub mod solver;
 pub mod synthetic_block;
 pub mod synthetic_campaign;
+pub mod verify;
 pub mod weighting;
 
 pub use adjust::{adjust, AdjustedRecording, Adjustment, ObservationCounts, RoundReport};

@@ -1,0 +1,497 @@
+//! Verification without adjustment (thesis 5.7, Table 5-13; issue 6 "Verification"): are a campaign's recorded
+//! positions good enough? Each aerial control point triangulated from ≥ 2 aerial images is compared with the
+//! same point triangulated from its MM observations alone with the RECORDED poses; the offset `MM − aerial`
+//! estimates the local trajectory error. Per trajectory segment (a number of recordings or an along-track
+//! length): mean and SD of the offsets in X, Y, Z and of their 3-D length (Table 5-13), the uncertainty of the
+//! mean, and pass/fail against a tolerance.
+//!
+//! Uncertainty of the mean per axis: the larger of the empirical `SD/√n` and the propagated
+//! `√(Σ σ²_k)/n` with `σ²_k` the diagonal of `C_MM + C_aerial` (a-priori triangulation covariances), so a
+//! segment with few points is not overconfident. Status: `pass` when the mean horizontal offset is within
+//! `tolerance_xy_m` and |mean Z| within `tolerance_z_m`, `fail` otherwise, `insufficient` with fewer than
+//! `min_points` points.
+
+use crate::campaign::Recording;
+use crate::correspondence::AerialControlPoint;
+use crate::fsutil::atomic_write_with;
+use crate::geometry::{triangulate_rays, PanoramaCamera};
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+use std::io::{self, Write};
+use std::path::Path;
+
+/// Parameters of a verification (the verify node's params).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct VerifyConfig {
+    /// Segment length in recordings (used when `segment_length_m` is absent).
+    pub segment_recordings: usize,
+    /// Segment length along the recorded trajectory, metres (overrides `segment_recordings`).
+    pub segment_length_m: Option<f64>,
+    /// Largest acceptable mean horizontal offset, metres.
+    pub tolerance_xy_m: f64,
+    /// Largest acceptable |mean vertical offset|, metres.
+    pub tolerance_z_m: f64,
+    /// Fewer points in a segment give status `insufficient`.
+    pub min_points: usize,
+    /// σ of a panorama observation, pixels (weights the MM triangulation).
+    pub pano_sigma_px: f64,
+}
+
+impl Default for VerifyConfig {
+    fn default() -> Self {
+        Self {
+            segment_recordings: 20,
+            segment_length_m: None,
+            tolerance_xy_m: 0.20,
+            tolerance_z_m: 0.30,
+            min_points: 3,
+            pano_sigma_px: 1.0,
+        }
+    }
+}
+
+impl VerifyConfig {
+    /// Every invalid field as (field, problem); empty = valid.
+    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
+        let mut problems = Vec::new();
+        let mut positive = |field: &str, v: f64| {
+            if !(v.is_finite() && v > 0.0) {
+                problems.push((field.to_string(), format!("{v} must be finite and > 0")));
+            }
+        };
+        positive("tolerance_xy_m", self.tolerance_xy_m);
+        positive("tolerance_z_m", self.tolerance_z_m);
+        positive("pano_sigma_px", self.pano_sigma_px);
+        if let Some(l) = self.segment_length_m {
+            positive("segment_length_m", l);
+        }
+        if self.segment_recordings == 0 {
+            problems.push((
+                "segment_recordings".to_string(),
+                "0 recordings per segment; use e.g. 20".to_string(),
+            ));
+        }
+        if self.min_points == 0 {
+            problems.push(("min_points".to_string(), "must be ≥ 1 (e.g. 3)".to_string()));
+        }
+        if problems.is_empty() {
+            Ok(())
+        } else {
+            Err(problems)
+        }
+    }
+}
+
+/// The verdict on a segment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum VerifyStatus {
+    Pass,
+    Fail,
+    Insufficient,
+}
+
+impl VerifyStatus {
+    pub fn label(&self) -> &'static str {
+        match self {
+            VerifyStatus::Pass => "pass",
+            VerifyStatus::Fail => "fail",
+            VerifyStatus::Insufficient => "insufficient",
+        }
+    }
+}
+
+/// One compared point.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VerifiedPoint {
+    pub tie_point_id: String,
+    /// Segment index.
+    pub segment: usize,
+    /// MM triangulation (recorded poses) − aerial triangulation, world axes, metres.
+    pub offset_m: [f64; 3],
+    /// Diagonal of `C_MM + C_aerial` (a priori), m².
+    pub variance_m2: [f64; 3],
+    pub mm_views: usize,
+}
+
+/// Table 5-13 statistics of one trajectory segment.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VerificationSegment {
+    pub index: usize,
+    pub first_image_id: String,
+    pub last_image_id: String,
+    pub recordings: usize,
+    pub points: usize,
+    /// Mean offset X, Y, Z, metres.
+    pub mean_m: [f64; 3],
+    /// SD of the offsets X, Y, Z, metres (0 with one point).
+    pub sd_m: [f64; 3],
+    /// Mean and SD of the 3-D offset lengths, metres.
+    pub mean_3d_m: f64,
+    pub sd_3d_m: f64,
+    /// Uncertainty (σ) of the mean offset X, Y, Z, metres.
+    pub sigma_mean_m: [f64; 3],
+    /// Length of the mean horizontal offset, metres.
+    pub offset_2d_m: f64,
+    pub status: VerifyStatus,
+}
+
+/// The result of [`verify`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Verification {
+    pub segments: Vec<VerificationSegment>,
+    pub points: Vec<VerifiedPoint>,
+    /// All points together (index = number of segments, ids of the first and last recording).
+    pub overall: VerificationSegment,
+    /// Control points without an aerial triangulation (< 2 aerial images).
+    pub skipped_single_aerial: usize,
+    /// Control points whose MM observations could not be triangulated (< 2 known panoramas, bad geometry).
+    pub skipped_mm: usize,
+    pub config: VerifyConfig,
+}
+
+impl Verification {
+    /// True when no segment failed and at least one passed.
+    pub fn passed(&self) -> bool {
+        self.segments.iter().all(|s| s.status != VerifyStatus::Fail)
+            && self.segments.iter().any(|s| s.status == VerifyStatus::Pass)
+    }
+}
+
+/// Segment index of every recording.
+fn segment_of_recordings(recordings: &[Recording], config: &VerifyConfig) -> Vec<usize> {
+    match config.segment_length_m {
+        Some(length) => {
+            let mut along = 0.0;
+            let mut out = Vec::with_capacity(recordings.len());
+            for (i, r) in recordings.iter().enumerate() {
+                if i > 0 {
+                    let p = &recordings[i - 1];
+                    along += (r.x - p.x).hypot(r.y - p.y);
+                }
+                out.push((along / length).floor() as usize);
+            }
+            out
+        }
+        None => (0..recordings.len())
+            .map(|i| i / config.segment_recordings)
+            .collect(),
+    }
+}
+
+/// Compares aerial control points with their MM triangulation from the recorded poses, per segment.
+/// `recordings` in trajectory (time) order, `pano_size_px` one per recording.
+pub fn verify(
+    recordings: &[Recording],
+    pano_size_px: &[(u32, u32)],
+    control: &[AerialControlPoint],
+    config: &VerifyConfig,
+) -> Result<Verification, String> {
+    if let Err(problems) = config.validate() {
+        return Err(format!(
+            "verify parameter {}: {}",
+            problems[0].0, problems[0].1
+        ));
+    }
+    if pano_size_px.len() != recordings.len() {
+        return Err(format!(
+            "{} panorama sizes for {} recordings; pass one (width, height) per recording",
+            pano_size_px.len(),
+            recordings.len()
+        ));
+    }
+    let cameras: Vec<PanoramaCamera> = recordings
+        .iter()
+        .zip(pano_size_px)
+        .map(|(r, &(w, h))| PanoramaCamera::from_recording(r, w, h))
+        .collect();
+    let index: HashMap<&str, usize> = recordings
+        .iter()
+        .enumerate()
+        .map(|(i, r)| (r.image_id.as_str(), i))
+        .collect();
+    let segment_of = segment_of_recordings(recordings, config);
+    let n_segments = segment_of.last().map_or(0, |&s| s + 1);
+    let mut points = Vec::new();
+    let (mut skipped_single_aerial, mut skipped_mm) = (0, 0);
+    let mut rays = Vec::new();
+    let mut sigmas = Vec::new();
+    for cp in control {
+        let (Some(aerial_xyz), true) = (cp.point_world, cp.aerial.len() >= 2) else {
+            skipped_single_aerial += 1;
+            continue;
+        };
+        let aerial = Vector3::from(aerial_xyz);
+        rays.clear();
+        sigmas.clear();
+        let mut nearest: Option<(f64, usize)> = None;
+        for o in &cp.mm {
+            if let Some(&r) = index.get(o.image_id.as_str()) {
+                rays.push(cameras[r].pixel_ray(o.u_px, o.v_px));
+                sigmas.push(cameras[r].angular_sigma_rad(config.pano_sigma_px));
+                let d = (cameras[r].center_world - aerial).norm();
+                if nearest.is_none_or(|(best, _)| d < best) {
+                    nearest = Some((d, r));
+                }
+            }
+        }
+        let (Ok(t), Some((_, r))) = (triangulate_rays(&rays, &sigmas), nearest) else {
+            skipped_mm += 1;
+            continue;
+        };
+        let offset = t.point_world - aerial;
+        let aerial_cov = cp
+            .covariance_m2
+            .map(|c| Matrix3::from_fn(|i, j| c[i][j]))
+            .unwrap_or_else(Matrix3::zeros);
+        let cov = t.covariance_m2 + aerial_cov;
+        points.push(VerifiedPoint {
+            tie_point_id: cp.tie_point_id.clone(),
+            segment: segment_of[r],
+            offset_m: offset.into(),
+            variance_m2: [cov[(0, 0)], cov[(1, 1)], cov[(2, 2)]],
+            mm_views: rays.len(),
+        });
+    }
+    let segment_recordings = |s: usize| -> (usize, String, String) {
+        let members: Vec<usize> = (0..recordings.len())
+            .filter(|&i| segment_of[i] == s)
+            .collect();
+        match (members.first(), members.last()) {
+            (Some(&a), Some(&b)) => (
+                members.len(),
+                recordings[a].image_id.clone(),
+                recordings[b].image_id.clone(),
+            ),
+            _ => (0, String::new(), String::new()),
+        }
+    };
+    let segments: Vec<VerificationSegment> = (0..n_segments)
+        .map(|s| {
+            let (n_rec, first, last) = segment_recordings(s);
+            let members: Vec<&VerifiedPoint> = points.iter().filter(|p| p.segment == s).collect();
+            statistics(s, n_rec, first, last, &members, config)
+        })
+        .filter(|s| s.recordings > 0)
+        .collect();
+    let all: Vec<&VerifiedPoint> = points.iter().collect();
+    let overall = statistics(
+        n_segments,
+        recordings.len(),
+        recordings
+            .first()
+            .map(|r| r.image_id.clone())
+            .unwrap_or_default(),
+        recordings
+            .last()
+            .map(|r| r.image_id.clone())
+            .unwrap_or_default(),
+        &all,
+        config,
+    );
+    Ok(Verification {
+        segments,
+        points,
+        overall,
+        skipped_single_aerial,
+        skipped_mm,
+        config: config.clone(),
+    })
+}
+
+/// Table 5-13 statistics of a set of points.
+fn statistics(
+    index: usize,
+    recordings: usize,
+    first_image_id: String,
+    last_image_id: String,
+    points: &[&VerifiedPoint],
+    config: &VerifyConfig,
+) -> VerificationSegment {
+    let n = points.len();
+    let nf = n as f64;
+    let mut mean = [0.0; 3];
+    let mut sd = [0.0; 3];
+    let mut sigma_mean = [0.0; 3];
+    let (mut mean_3d, mut sd_3d) = (0.0, 0.0);
+    if n > 0 {
+        for k in 0..3 {
+            mean[k] = points.iter().map(|p| p.offset_m[k]).sum::<f64>() / nf;
+            if n > 1 {
+                let ss: f64 = points
+                    .iter()
+                    .map(|p| (p.offset_m[k] - mean[k]).powi(2))
+                    .sum();
+                sd[k] = (ss / (nf - 1.0)).sqrt();
+            }
+            let propagated = points.iter().map(|p| p.variance_m2[k]).sum::<f64>().sqrt() / nf;
+            sigma_mean[k] = (sd[k] / nf.sqrt()).max(propagated);
+        }
+        let lengths: Vec<f64> = points
+            .iter()
+            .map(|p| Vector3::from(p.offset_m).norm())
+            .collect();
+        mean_3d = lengths.iter().sum::<f64>() / nf;
+        if n > 1 {
+            sd_3d =
+                (lengths.iter().map(|l| (l - mean_3d).powi(2)).sum::<f64>() / (nf - 1.0)).sqrt();
+        }
+    }
+    let offset_2d = mean[0].hypot(mean[1]);
+    let status = if n < config.min_points {
+        VerifyStatus::Insufficient
+    } else if offset_2d <= config.tolerance_xy_m && mean[2].abs() <= config.tolerance_z_m {
+        VerifyStatus::Pass
+    } else {
+        VerifyStatus::Fail
+    };
+    VerificationSegment {
+        index,
+        first_image_id,
+        last_image_id,
+        recordings,
+        points: n,
+        mean_m: mean,
+        sd_m: sd,
+        mean_3d_m: mean_3d,
+        sd_3d_m: sd_3d,
+        sigma_mean_m: sigma_mean,
+        offset_2d_m: offset_2d,
+        status,
+    }
+}
+
+/// Column names of `verification.csv`.
+pub const VERIFICATION_CSV_HEADER: [&str; 17] = [
+    "segment",
+    "first_image_id",
+    "last_image_id",
+    "recordings",
+    "points",
+    "mean_x",
+    "mean_y",
+    "mean_z",
+    "sd_x",
+    "sd_y",
+    "sd_z",
+    "mean_3d",
+    "sd_3d",
+    "sigma_mean_x",
+    "sigma_mean_y",
+    "sigma_mean_z",
+    "status",
+];
+
+/// `verification.csv`: one row per segment (metres; floats in shortest round-trip form), then a row
+/// `segment = all` with the overall statistics. Written atomically.
+pub fn write_verification_csv(path: &Path, v: &Verification) -> io::Result<()> {
+    atomic_write_with(path, |w| {
+        writeln!(w, "{}", VERIFICATION_CSV_HEADER.join(","))?;
+        for s in v.segments.iter().chain(std::iter::once(&v.overall)) {
+            let label = if std::ptr::eq(s, &v.overall) {
+                "all".to_string()
+            } else {
+                s.index.to_string()
+            };
+            let nums = [
+                s.mean_m[0],
+                s.mean_m[1],
+                s.mean_m[2],
+                s.sd_m[0],
+                s.sd_m[1],
+                s.sd_m[2],
+                s.mean_3d_m,
+                s.sd_3d_m,
+                s.sigma_mean_m[0],
+                s.sigma_mean_m[1],
+                s.sigma_mean_m[2],
+            ]
+            .map(|x| format!("{x}"));
+            writeln!(
+                w,
+                "{label},{},{},{},{},{},{}",
+                csv_text(&s.first_image_id),
+                csv_text(&s.last_image_id),
+                s.recordings,
+                s.points,
+                nums.join(","),
+                s.status.label()
+            )?;
+        }
+        Ok(())
+    })
+}
+
+fn csv_text(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) || s.starts_with('#') {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// A short fixed-width table for stdout (Table 5-13 layout per segment, centimetres).
+pub fn render_verification_table(v: &Verification) -> String {
+    let mut out = String::new();
+    out.push_str(&format!(
+        "verification: MM (recorded poses) − aerial control, per segment [cm]; tolerance {:.0} cm horizontal, \
+         {:.0} cm vertical\n",
+        v.config.tolerance_xy_m * 100.0,
+        v.config.tolerance_z_m * 100.0
+    ));
+    out.push_str(&format!(
+        "{:>4} {:<14} {:<14} {:>4} {:>7} {:>7} {:>7} {:>6} {:>6} {:>6} {:>7} {:>6} {:>7}  {}\n",
+        "seg",
+        "first",
+        "last",
+        "pts",
+        "mean X",
+        "mean Y",
+        "mean Z",
+        "SD X",
+        "SD Y",
+        "SD Z",
+        "mean 3D",
+        "±2D",
+        "2D",
+        "status"
+    ));
+    for s in v.segments.iter().chain(std::iter::once(&v.overall)) {
+        let label = if std::ptr::eq(s, &v.overall) {
+            "all".to_string()
+        } else {
+            s.index.to_string()
+        };
+        let cm = |x: f64| x * 100.0;
+        out.push_str(&format!(
+            "{:>4} {:<14} {:<14} {:>4} {:>7.1} {:>7.1} {:>7.1} {:>6.1} {:>6.1} {:>6.1} {:>7.1} {:>6.1} {:>7.1}  {}\n",
+            label,
+            truncate(&s.first_image_id, 14),
+            truncate(&s.last_image_id, 14),
+            s.points,
+            cm(s.mean_m[0]),
+            cm(s.mean_m[1]),
+            cm(s.mean_m[2]),
+            cm(s.sd_m[0]),
+            cm(s.sd_m[1]),
+            cm(s.sd_m[2]),
+            cm(s.mean_3d_m),
+            cm(s.sigma_mean_m[0].hypot(s.sigma_mean_m[1])),
+            cm(s.offset_2d_m),
+            s.status.label()
+        ));
+    }
+    if v.skipped_single_aerial + v.skipped_mm > 0 {
+        out.push_str(&format!(
+            "skipped: {} control points seen in < 2 aerial images, {} without an MM triangulation\n",
+            v.skipped_single_aerial, v.skipped_mm
+        ));
+    }
+    out
+}
+
+fn truncate(s: &str, n: usize) -> String {
+    s.chars().take(n).collect()
+}

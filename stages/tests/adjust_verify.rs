@@ -1,0 +1,144 @@
+//! Known-answer tests of the verification (thesis Table 5-13, issue 6 "Verification"): with exact observations
+//! and a purely systematic position error, every MM − aerial offset equals that error; a deteriorated campaign
+//! is flagged, an undeteriorated one passes; `verification.csv` parses back; segments by count and by length.
+
+use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
+use skytie_stages::adjustment::verify::{
+    render_verification_table, verify, write_verification_csv, VerifyConfig, VerifyStatus,
+    VERIFICATION_CSV_HEADER,
+};
+use skytie_stages::adjustment::SyntheticBlockSpec;
+
+fn campaign(systematic_m: f64, random_m: f64, noise_px: f64, seed: u64) -> SyntheticCampaign {
+    SyntheticCampaignSpec {
+        block: SyntheticBlockSpec {
+            recordings: 60,
+            control_points: 30,
+            systematic_offset_m: systematic_m,
+            random_offset_m: random_m,
+            pixel_noise_px: noise_px,
+            sigma_px: noise_px.max(0.5),
+            seed,
+            ..SyntheticBlockSpec::default()
+        },
+        aerial_noise_px: noise_px,
+        single_aerial_every: 5,
+        ..SyntheticCampaignSpec::default()
+    }
+    .generate()
+}
+
+#[test]
+fn systematic_error_is_recovered_exactly_and_flagged() {
+    let c = campaign(0.8, 0.0, 0.0, 3);
+    let truth_offset = {
+        let r = &c.recordings[0];
+        let t = c.truth.true_centers_world[0];
+        [r.x - t.x, r.y - t.y, r.z - t.z]
+    };
+    let config = VerifyConfig::default();
+    let v = verify(&c.recordings, &c.pano_size_px, &c.control, &config).unwrap();
+    let singles = c.control.iter().filter(|cp| cp.aerial.len() < 2).count();
+    assert_eq!(v.skipped_single_aerial, singles);
+    assert_eq!(v.points.len() + singles + v.skipped_mm, c.control.len());
+    assert!(v.points.len() >= 15, "{} points", v.points.len());
+    for p in &v.points {
+        for k in 0..3 {
+            assert!(
+                (p.offset_m[k] - truth_offset[k]).abs() < 1e-6,
+                "{}: axis {k} offset {} vs {}",
+                p.tie_point_id,
+                p.offset_m[k],
+                truth_offset[k]
+            );
+        }
+    }
+    assert_eq!(v.segments.len(), 3);
+    for s in &v.segments {
+        assert_eq!(s.recordings, 20);
+        assert_eq!(s.status, VerifyStatus::Fail, "segment {}", s.index);
+        assert!((s.offset_2d_m - 0.8).abs() < 1e-6);
+        assert!(s.sd_m.iter().all(|&x| x < 1e-6));
+        assert!((s.mean_3d_m - 0.8).abs() < 1e-6);
+    }
+    assert!(!v.passed());
+    let table = render_verification_table(&v);
+    eprintln!("{table}");
+    assert!(table.contains("fail") && table.contains("all"));
+}
+
+#[test]
+fn undeteriorated_campaign_passes_and_deteriorated_one_fails_with_noise() {
+    for seed in [1, 2, 3] {
+        let good = campaign(0.0, 0.0, 0.5, seed);
+        let bad = campaign(0.8, 0.1, 0.5, seed);
+        let config = VerifyConfig::default();
+        let vg = verify(&good.recordings, &good.pano_size_px, &good.control, &config).unwrap();
+        let vb = verify(&bad.recordings, &bad.pano_size_px, &bad.control, &config).unwrap();
+        eprintln!(
+            "seed {seed}: undeteriorated overall offset {:.3} m ± {:.3} ({}), deteriorated {:.3} m ({})",
+            vg.overall.offset_2d_m,
+            vg.overall.sigma_mean_m[0].hypot(vg.overall.sigma_mean_m[1]),
+            vg.overall.status.label(),
+            vb.overall.offset_2d_m,
+            vb.overall.status.label()
+        );
+        assert!(
+            vg.passed(),
+            "seed {seed}:\n{}",
+            render_verification_table(&vg)
+        );
+        assert!(!vb.passed());
+        assert!(vb.segments.iter().all(|s| s.status != VerifyStatus::Pass));
+        // The mean offset of the deteriorated campaign is its systematic error within 3 σ of the mean + 10 cm
+        // random part / √n.
+        assert!((vb.overall.offset_2d_m - 0.8).abs() < 0.1);
+    }
+}
+
+#[test]
+fn segments_by_length_and_csv_round_trip() {
+    let c = campaign(0.8, 0.0, 0.0, 5);
+    let config = VerifyConfig {
+        segment_length_m: Some(100.0),
+        min_points: 2,
+        ..VerifyConfig::default()
+    };
+    let v = verify(&c.recordings, &c.pano_size_px, &c.control, &config).unwrap();
+    // 60 recordings 5 m apart: 295 m along track → segments [0,100), [100,200), [200,300).
+    assert_eq!(v.segments.len(), 3);
+    assert_eq!(
+        v.segments.iter().map(|s| s.recordings).collect::<Vec<_>>(),
+        [20, 20, 20]
+    );
+    let dir = std::env::temp_dir().join(format!("skytie_verify_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("verification.csv");
+    write_verification_csv(&path, &v).unwrap();
+    let mut reader = csv::Reader::from_path(&path).unwrap();
+    assert_eq!(
+        reader.headers().unwrap().iter().collect::<Vec<_>>(),
+        VERIFICATION_CSV_HEADER
+    );
+    let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
+    assert_eq!(rows.len(), v.segments.len() + 1);
+    for (row, s) in rows.iter().zip(v.segments.iter().chain([&v.overall])) {
+        assert_eq!(row[1].to_string(), s.first_image_id);
+        assert_eq!(row[4].parse::<usize>().unwrap(), s.points);
+        for k in 0..3 {
+            assert_eq!(row[5 + k].parse::<f64>().unwrap(), s.mean_m[k]);
+            assert_eq!(row[8 + k].parse::<f64>().unwrap(), s.sd_m[k]);
+            assert_eq!(row[13 + k].parse::<f64>().unwrap(), s.sigma_mean_m[k]);
+        }
+        assert_eq!(&row[16], s.status.label());
+    }
+    assert_eq!(&rows[rows.len() - 1][0], "all");
+    std::fs::remove_dir_all(&dir).unwrap();
+    // Bad parameters are named.
+    let bad = VerifyConfig {
+        tolerance_xy_m: 0.0,
+        ..VerifyConfig::default()
+    };
+    let err = verify(&c.recordings, &c.pano_size_px, &c.control, &bad).unwrap_err();
+    assert!(err.contains("tolerance_xy_m"), "{err}");
+}
