@@ -11,14 +11,20 @@
 //! they are returned in `[−N/2, N/2)`. The estimate is then repeated with the moving image's window shifted
 //! by the current estimate (`refinements`), which removes the bias a fixed window causes.
 //!
-//! FFT plans are cached per thread (rustfft's planner), so concurrent calls from rayon are fine and
-//! deterministic.
+//! For repeated use, [`PhaseCorrelator`] holds the rustfft plans, the window and low-pass tables and every
+//! buffer for one image size, so a call allocates nothing; the free functions [`phase_correlate`] and
+//! [`locate_template`] use a small per-thread cache of correlators, so concurrent calls from rayon are fine and
+//! deterministic. The 2-D FFTs run on the half spectrum of the real images (`real_fft_2d`).
+
+mod real_fft_2d;
 
 use std::cell::RefCell;
 
 use rustfft::num_complex::Complex;
-use rustfft::{FftDirection, FftPlanner};
+use rustfft::FftPlanner;
 use thiserror::Error;
+
+use real_fft_2d::{Cplx, Real, RealFft2d};
 
 use super::subpixel::{refine_peak, PeakFit};
 use crate::imaging::window::{window_value, WindowKind};
@@ -95,11 +101,22 @@ pub enum PhaseCorrelationError {
         "image contains non-finite values (NaN/inf); mask or fill them before phase correlation"
     )]
     NonFinite,
+    #[error("this phase correlator was built for {expected_w}×{expected_h} images, got {got_w}×{got_h}; build one per size")]
+    CorrelatorSize {
+        expected_w: usize,
+        expected_h: usize,
+        got_w: usize,
+        got_h: usize,
+    },
 }
 
 thread_local! {
-    static PLANNER: RefCell<FftPlanner<f64>> = RefCell::new(FftPlanner::new());
+    static PLANNER: RefCell<FftPlanner<Real>> = RefCell::new(FftPlanner::new());
+    static CORRELATORS: RefCell<Vec<PhaseCorrelator>> = const { RefCell::new(Vec::new()) };
 }
+
+/// Correlators kept per thread by the free functions (one per image size and parameter set, oldest dropped).
+const CACHED_CORRELATORS: usize = 8;
 
 /// Smallest n' ≥ n whose only prime factors are 2, 3 and 5 (sizes rustfft handles fastest).
 pub fn fft_friendly_size(n: usize) -> usize {
@@ -118,43 +135,6 @@ pub fn fft_friendly_size(n: usize) -> usize {
     }
 }
 
-/// In-place 2-D FFT of a `w × h` row-major buffer; the result is left TRANSPOSED (`h`-long rows, `w` of them),
-/// which is all the element-wise cross-power spectrum needs. `inverse_2d` undoes it.
-fn forward_2d(buf: &mut Vec<Complex<f64>>, tmp: &mut Vec<Complex<f64>>, w: usize, h: usize) {
-    fft_rows(buf, w, FftDirection::Forward);
-    transpose(buf, tmp, w, h);
-    std::mem::swap(buf, tmp);
-    fft_rows(buf, h, FftDirection::Forward);
-}
-
-/// Inverse of [`forward_2d`] (input transposed, output `w × h` row-major), scaled by 1/(w·h).
-fn inverse_2d(buf: &mut Vec<Complex<f64>>, tmp: &mut Vec<Complex<f64>>, w: usize, h: usize) {
-    fft_rows(buf, h, FftDirection::Inverse);
-    transpose(buf, tmp, h, w);
-    std::mem::swap(buf, tmp);
-    fft_rows(buf, w, FftDirection::Inverse);
-    let s = 1.0 / (w * h) as f64;
-    for v in buf.iter_mut() {
-        *v *= s;
-    }
-}
-
-fn fft_rows(buf: &mut [Complex<f64>], len: usize, dir: FftDirection) {
-    let fft = PLANNER.with(|p| p.borrow_mut().plan_fft(len, dir));
-    fft.process(buf);
-}
-
-/// `src` is `w × h` row-major; `dst` becomes `h × w` row-major (its transpose).
-fn transpose(src: &[Complex<f64>], dst: &mut Vec<Complex<f64>>, w: usize, h: usize) {
-    dst.clear();
-    dst.resize(w * h, Complex::new(0.0, 0.0));
-    for y in 0..h {
-        for x in 0..w {
-            dst[x * h + y] = src[y * w + x];
-        }
-    }
-}
-
 /// Where and how large the taper is, in the image's own pixel-index frame: the window's first sample sits at
 /// continuous index `origin` (may be fractional or partly outside the image; outside the window weights are 0).
 #[derive(Clone, Copy)]
@@ -164,92 +144,300 @@ struct Taper {
     size: (usize, usize),
 }
 
-/// Windowed copy of `img` with the window-weighted mean removed, placed at (x0, y0) in a zero `pw × ph` canvas.
-fn prepare(
-    img: &GrayImage,
-    taper: Taper,
+/// Phase correlation for one image size with everything a call needs prepared once: rustfft plans, the
+/// low-pass table and all buffers (no allocation per call). Use one per thread (it is `Send`, not shared);
+/// results are identical to [`phase_correlate`] / [`locate_template`] with the same parameters.
+pub struct PhaseCorrelator {
+    width: usize,
+    height: usize,
+    params: PhaseCorrelationParams,
     pw: usize,
     ph: usize,
-    x0: usize,
-    y0: usize,
-) -> Vec<Complex<f64>> {
-    let wx: Vec<f64> = (0..img.width)
-        .map(|c| window_value(taper.kind, taper.size.0, c as f64 - taper.origin.0))
-        .collect();
-    let wy: Vec<f64> = (0..img.height)
-        .map(|r| window_value(taper.kind, taper.size.1, r as f64 - taper.origin.1))
-        .collect();
-    let (mut sum_w, mut sum_wg) = (0.0f64, 0.0f64);
-    for (row, &ky) in wy.iter().enumerate() {
-        for (&g, &kx) in img.row(row).iter().zip(&wx) {
-            sum_w += kx * ky;
-            sum_wg += kx * ky * g as f64;
-        }
-    }
-    let mean = if sum_w > 0.0 { sum_wg / sum_w } else { 0.0 };
-    let mut out = vec![Complex::new(0.0, 0.0); pw * ph];
-    for (row, &ky) in wy.iter().enumerate() {
-        let src = img.row(row);
-        let dst = &mut out[(y0 + row) * pw + x0..(y0 + row) * pw + x0 + img.width];
-        for ((d, &s), &kx) in dst.iter_mut().zip(src).zip(&wx) {
-            d.re = (s as f64 - mean) * kx * ky;
-        }
-    }
-    out
+    fft: RealFft2d,
+    /// Gaussian low-pass weight per half-spectrum bin divided by the weight sum over the full spectrum; the
+    /// division also scales the unnormalised inverse FFT so that identical images give a peak of 1.
+    lowpass: Vec<Real>,
+    ref_spectrum: Vec<Cplx>,
+    spectrum: Vec<Cplx>,
+    surface: Vec<Real>,
+    window_x: Vec<f64>,
+    window_y: Vec<f64>,
 }
 
-/// Spectrum (transposed layout, see [`forward_2d`]) of a prepared `pw × ph` canvas.
-fn spectrum(mut canvas: Vec<Complex<f64>>, pw: usize, ph: usize) -> Vec<Complex<f64>> {
-    let mut tmp = Vec::with_capacity(pw * ph);
-    forward_2d(&mut canvas, &mut tmp, pw, ph);
-    canvas
-}
-
-/// Correlation surface (`pw × ph`, row-major, peak 1 for identical inputs) of the reference spectrum and a
-/// prepared moving canvas.
-fn correlation_surface(
-    f_ref: &[Complex<f64>],
-    moving: Vec<Complex<f64>>,
-    pw: usize,
-    ph: usize,
-    lowpass_sigma_px: f64,
-) -> Vec<f64> {
-    let mut f_mov = moving;
-    let mut tmp = Vec::with_capacity(pw * ph);
-    forward_2d(&mut f_mov, &mut tmp, pw, ph);
-    // Transposed layout: index kx·ph + ky.
-    let max_abs = f_ref
-        .iter()
-        .zip(&f_mov)
-        .map(|(a, b)| (b * a.conj()).norm())
-        .fold(0.0f64, f64::max);
-    let floor = (max_abs * 1e-12).max(f64::MIN_POSITIVE);
-    let freq = |k: usize, n: usize| if 2 * k >= n { k as f64 - n as f64 } else { k as f64 } / n as f64;
-    let s2 = 2.0 * std::f64::consts::PI.powi(2) * lowpass_sigma_px.max(0.0).powi(2);
-    let mut weight_sum = 0.0f64;
-    for kx in 0..pw {
-        let fx = freq(kx, pw);
+impl PhaseCorrelator {
+    /// A correlator for `width × height` images ([`Self::correlate`]) or search windows
+    /// ([`Self::locate_template`]); both must be ≥ 3.
+    pub fn new(
+        width: usize,
+        height: usize,
+        params: PhaseCorrelationParams,
+    ) -> Result<Self, PhaseCorrelationError> {
+        if width < 3 || height < 3 {
+            return Err(PhaseCorrelationError::TooSmall { width, height });
+        }
+        let (pw, ph) = (fft_friendly_size(width), fft_friendly_size(height));
+        let fft = PLANNER.with(|p| RealFft2d::new(pw, ph, &mut p.borrow_mut()));
+        let hw = fft.half_width();
+        // Signed frequency in cycles per pixel.
+        let freq = |k: usize, n: usize| if 2 * k >= n { k as f64 - n as f64 } else { k as f64 } / n as f64;
+        let s2 = 2.0 * std::f64::consts::PI.powi(2) * params.lowpass_sigma_px.max(0.0).powi(2);
+        let weight = |kx: usize, ky: usize| {
+            let (fx, fy) = (freq(kx, pw), freq(ky, ph));
+            (-s2 * (fx * fx + fy * fy)).exp()
+        };
+        let mut weight_sum = 0.0f64;
         for ky in 0..ph {
-            let fy = freq(ky, ph);
-            let i = kx * ph + ky;
-            let cross = f_mov[i] * f_ref[i].conj();
-            let mag = cross.norm();
-            let weight = (-s2 * (fx * fx + fy * fy)).exp();
-            weight_sum += weight;
-            f_mov[i] = if mag > floor {
-                cross * (weight / mag)
+            for kx in 0..pw {
+                weight_sum += weight(kx, ky);
+            }
+        }
+        let mut lowpass = vec![0.0; hw * ph];
+        for kx in 0..hw {
+            for ky in 0..ph {
+                lowpass[kx * ph + ky] = (weight(kx, ky) / weight_sum) as Real;
+            }
+        }
+        let zero = Complex::new(0.0, 0.0);
+        Ok(Self {
+            width,
+            height,
+            params,
+            pw,
+            ph,
+            lowpass,
+            ref_spectrum: vec![zero; fft.spectrum_len()],
+            spectrum: vec![zero; fft.spectrum_len()],
+            surface: vec![0.0; pw * ph],
+            window_x: Vec::with_capacity(width),
+            window_y: Vec::with_capacity(height),
+            fft,
+        })
+    }
+
+    /// Image (or search-window) width this correlator was built for.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Image (or search-window) height this correlator was built for.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    pub fn params(&self) -> &PhaseCorrelationParams {
+        &self.params
+    }
+
+    /// Shift t of `moving` relative to `reference` (both `width × height`): `moving(x) ≈ reference(x − t)`.
+    /// Same result as [`phase_correlate`].
+    pub fn correlate(
+        &mut self,
+        reference: &GrayImage,
+        moving: &GrayImage,
+    ) -> Result<PhaseShift, PhaseCorrelationError> {
+        let (w, h) = (reference.width, reference.height);
+        if (moving.width, moving.height) != (w, h) {
+            return Err(PhaseCorrelationError::SizeMismatch {
+                ref_w: w,
+                ref_h: h,
+                mov_w: moving.width,
+                mov_h: moving.height,
+            });
+        }
+        self.check_size(w, h)?;
+        check_finite(reference)?;
+        check_finite(moving)?;
+        let full = Taper {
+            kind: self.params.window,
+            origin: (0.0, 0.0),
+            size: (w, h),
+        };
+        self.load(reference, full, 0, 0);
+        self.fft.forward(&mut self.ref_spectrum);
+        // Pass 0: both windows in place; then the moving window follows the content found so far.
+        Ok(self.refine(moving, full, |dx, dy| Taper {
+            origin: (dx, dy),
+            ..full
+        }))
+    }
+
+    /// Centre of `template` (at most `width × height`) in `search` (`width × height`); same result as
+    /// [`locate_template`].
+    pub fn locate_template(
+        &mut self,
+        template: &GrayImage,
+        search: &GrayImage,
+    ) -> Result<TemplateLocation, PhaseCorrelationError> {
+        let (tw, th, sw, sh) = (template.width, template.height, search.width, search.height);
+        if tw > sw || th > sh {
+            return Err(PhaseCorrelationError::TemplateLarger {
+                t_w: tw,
+                t_h: th,
+                s_w: sw,
+                s_h: sh,
+            });
+        }
+        if tw < 3 || th < 3 {
+            return Err(PhaseCorrelationError::TooSmall {
+                width: tw,
+                height: th,
+            });
+        }
+        self.check_size(sw, sh)?;
+        check_finite(template)?;
+        check_finite(search)?;
+        let (ox, oy) = ((sw - tw) / 2, (sh - th) / 2);
+        let kind = self.params.window;
+        let template_taper = Taper {
+            kind,
+            origin: (0.0, 0.0),
+            size: (tw, th),
+        };
+        self.load(template, template_taper, ox, oy);
+        self.fft.forward(&mut self.ref_spectrum);
+        // Pass 0: the whole search window tapered; then a template-sized taper on the content found so far.
+        let whole = Taper {
+            kind,
+            origin: (0.0, 0.0),
+            size: (sw, sh),
+        };
+        let shift = self.refine(search, whole, |dx, dy| Taper {
+            kind,
+            origin: (ox as f64 + dx, oy as f64 + dy),
+            size: (tw, th),
+        });
+        Ok(TemplateLocation {
+            u_px: ox as f64 + tw as f64 / 2.0 + shift.dx_px,
+            v_px: oy as f64 + th as f64 / 2.0 + shift.dy_px,
+            peak: shift.peak,
+        })
+    }
+
+    fn check_size(&self, w: usize, h: usize) -> Result<(), PhaseCorrelationError> {
+        if (w, h) == (self.width, self.height) {
+            Ok(())
+        } else {
+            Err(PhaseCorrelationError::CorrelatorSize {
+                expected_w: self.width,
+                expected_h: self.height,
+                got_w: w,
+                got_h: h,
+            })
+        }
+    }
+
+    /// The estimate loop shared by both entry points (the reference spectrum is already in place): pass 0 with
+    /// the `first` taper on `moving`, then up to `refinements` passes with `follow(dx, dy)` re-centred on the
+    /// shift found so far, until it changes by less than 1e-3 px.
+    fn refine(
+        &mut self,
+        moving: &GrayImage,
+        first: Taper,
+        follow: impl Fn(f64, f64) -> Taper,
+    ) -> PhaseShift {
+        let refinements = if self.params.window == WindowKind::Rectangular {
+            0
+        } else {
+            self.params.refinements
+        };
+        let mut shift = PhaseShift {
+            dx_px: 0.0,
+            dy_px: 0.0,
+            peak: 0.0,
+        };
+        for pass in 0..=refinements {
+            let taper = if pass == 0 {
+                first
+            } else {
+                follow(shift.dx_px, shift.dy_px)
+            };
+            self.load(moving, taper, 0, 0);
+            self.fft.forward(&mut self.spectrum);
+            self.normalised_cross_power();
+            self.fft.inverse(&mut self.spectrum, &mut self.surface);
+            let next = find_peak(&self.surface, self.pw, self.ph, self.params.peak_fit);
+            let converged =
+                pass > 0 && (next.dx_px - shift.dx_px).hypot(next.dy_px - shift.dy_px) < 1e-3;
+            shift = next;
+            if converged {
+                break;
+            }
+        }
+        shift
+    }
+
+    /// Writes the windowed copy of `img` with the window-weighted mean removed at (x0, y0) into the zeroed FFT
+    /// canvas.
+    fn load(&mut self, img: &GrayImage, taper: Taper, x0: usize, y0: usize) {
+        fill_window(
+            &mut self.window_x,
+            img.width,
+            taper.kind,
+            taper.size.0,
+            taper.origin.0,
+        );
+        fill_window(
+            &mut self.window_y,
+            img.height,
+            taper.kind,
+            taper.size.1,
+            taper.origin.1,
+        );
+        let sum_w: f64 = self.window_x.iter().sum::<f64>() * self.window_y.iter().sum::<f64>();
+        let mut sum_wg = 0.0f64;
+        for (row, &ky) in self.window_y.iter().enumerate() {
+            if ky != 0.0 {
+                let s: f64 = img
+                    .row(row)
+                    .iter()
+                    .zip(&self.window_x)
+                    .map(|(&g, &kx)| kx * g as f64)
+                    .sum();
+                sum_wg += ky * s;
+            }
+        }
+        let mean = if sum_w > 0.0 { sum_wg / sum_w } else { 0.0 };
+        self.fft.clear_input();
+        for (row, &ky) in self.window_y.iter().enumerate() {
+            if ky != 0.0 {
+                let values = img
+                    .row(row)
+                    .iter()
+                    .zip(&self.window_x)
+                    .map(|(&s, &kx)| ((s as f64 - mean) * kx * ky) as Real);
+                self.fft.set_row(y0 + row, x0, values);
+            }
+        }
+    }
+
+    /// `spectrum ← F_mov·conj(F_ref) / |F_mov·conj(F_ref)| · low-pass` (thesis eq. 3/1), bins whose magnitude is
+    /// below 1e-12 of the largest set to 0.
+    fn normalised_cross_power(&mut self) {
+        let mut max_sq: Real = 0.0;
+        for (m, r) in self.spectrum.iter_mut().zip(&self.ref_spectrum) {
+            *m *= r.conj();
+            max_sq = max_sq.max(m.norm_sqr());
+        }
+        let floor = (max_sq.sqrt() * 1e-12).max(Real::MIN_POSITIVE);
+        for (m, &weight) in self.spectrum.iter_mut().zip(&self.lowpass) {
+            let mag = m.norm();
+            *m = if mag > floor {
+                *m * (weight / mag)
             } else {
                 Complex::new(0.0, 0.0)
             };
         }
     }
-    inverse_2d(&mut f_mov, &mut tmp, pw, ph);
-    let norm = (pw * ph) as f64 / weight_sum;
-    f_mov.iter().map(|c| c.re * norm).collect()
+}
+
+/// `out[c] = window(c − origin)` for `c ∈ [0, n)` (0 outside the window).
+fn fill_window(out: &mut Vec<f64>, n: usize, kind: WindowKind, size: usize, origin: f64) {
+    out.clear();
+    out.extend((0..n).map(|c| window_value(kind, size, c as f64 - origin)));
 }
 
 /// Integer peak (first maximum in raster order) and its sub-pixel refinement, wrapped to `[−N/2, N/2)`.
-fn find_peak(r: &[f64], pw: usize, ph: usize, fit: PeakFit) -> PhaseShift {
+fn find_peak(r: &[Real], pw: usize, ph: usize, fit: PeakFit) -> PhaseShift {
     let mut best = 0usize;
     for (i, &v) in r.iter().enumerate() {
         if v > r[best] {
@@ -262,7 +450,7 @@ fn find_peak(r: &[f64], pw: usize, ph: usize, fit: PeakFit) -> PhaseShift {
         let y = (py + ph + j - 1) % ph;
         for (i, v) in row.iter_mut().enumerate() {
             let x = (px + pw + i - 1) % pw;
-            *v = r[y * pw + x];
+            *v = r[y * pw + x] as f64;
         }
     }
     let (dx, dy) = refine_peak(&n, fit);
@@ -276,7 +464,7 @@ fn find_peak(r: &[f64], pw: usize, ph: usize, fit: PeakFit) -> PhaseShift {
     PhaseShift {
         dx_px: wrap(px, pw) + dx,
         dy_px: wrap(py, ph) + dy,
-        peak: r[best],
+        peak: r[best] as f64,
     }
 }
 
@@ -286,6 +474,32 @@ fn check_finite(img: &GrayImage) -> Result<(), PhaseCorrelationError> {
     } else {
         Err(PhaseCorrelationError::NonFinite)
     }
+}
+
+/// Runs `f` on this thread's cached correlator for (`width`, `height`, `params`), building it if needed.
+fn with_cached_correlator<R>(
+    width: usize,
+    height: usize,
+    params: &PhaseCorrelationParams,
+    f: impl FnOnce(&mut PhaseCorrelator) -> Result<R, PhaseCorrelationError>,
+) -> Result<R, PhaseCorrelationError> {
+    CORRELATORS.with(|cell| {
+        let mut cache = cell.borrow_mut();
+        let found = cache
+            .iter()
+            .position(|c| (c.width, c.height) == (width, height) && c.params == *params);
+        let index = match found {
+            Some(i) => i,
+            None => {
+                if cache.len() >= CACHED_CORRELATORS {
+                    cache.remove(0);
+                }
+                cache.push(PhaseCorrelator::new(width, height, *params)?);
+                cache.len() - 1
+            }
+        };
+        f(&mut cache[index])
+    })
 }
 
 /// Shift t of `moving` relative to `reference` (equal sizes): `moving(x) ≈ reference(x − t)`.
@@ -303,48 +517,7 @@ pub fn phase_correlate(
             mov_h: moving.height,
         });
     }
-    if w < 3 || h < 3 {
-        return Err(PhaseCorrelationError::TooSmall {
-            width: w,
-            height: h,
-        });
-    }
-    check_finite(reference)?;
-    check_finite(moving)?;
-    let (pw, ph) = (fft_friendly_size(w), fft_friendly_size(h));
-    let full = Taper {
-        kind: params.window,
-        origin: (0.0, 0.0),
-        size: (w, h),
-    };
-    let f_ref = spectrum(prepare(reference, full, pw, ph, 0, 0), pw, ph);
-    let mut shift = PhaseShift {
-        dx_px: 0.0,
-        dy_px: 0.0,
-        peak: 0.0,
-    };
-    let refinements = if params.window == WindowKind::Rectangular {
-        0
-    } else {
-        params.refinements
-    };
-    for pass in 0..=refinements {
-        // Pass 0: both windows in place; then the moving window follows the content found so far.
-        let taper = Taper {
-            origin: (shift.dx_px, shift.dy_px),
-            ..full
-        };
-        let b = prepare(moving, taper, pw, ph, 0, 0);
-        let r = correlation_surface(&f_ref, b, pw, ph, params.lowpass_sigma_px);
-        let next = find_peak(&r, pw, ph, params.peak_fit);
-        let converged =
-            pass > 0 && (next.dx_px - shift.dx_px).hypot(next.dy_px - shift.dy_px) < 1e-3;
-        shift = next;
-        if converged {
-            break;
-        }
-    }
-    Ok(shift)
+    with_cached_correlator(w, h, params, |c| c.correlate(reference, moving))
 }
 
 /// Locate a (smaller or equal) `template` inside `search` by phase correlation (thesis 3.4.5.3: MM template,
@@ -370,63 +543,7 @@ pub fn locate_template(
             height: th,
         });
     }
-    check_finite(template)?;
-    check_finite(search)?;
-    let (pw, ph) = (fft_friendly_size(sw), fft_friendly_size(sh));
-    let (ox, oy) = ((sw - tw) / 2, (sh - th) / 2);
-    let a = prepare(
-        template,
-        Taper {
-            kind: params.window,
-            origin: (0.0, 0.0),
-            size: (tw, th),
-        },
-        pw,
-        ph,
-        ox,
-        oy,
-    );
-    let f_ref = spectrum(a, pw, ph);
-    let mut shift = PhaseShift {
-        dx_px: 0.0,
-        dy_px: 0.0,
-        peak: 0.0,
-    };
-    let refinements = if params.window == WindowKind::Rectangular {
-        0
-    } else {
-        params.refinements
-    };
-    for pass in 0..=refinements {
-        // Pass 0: the whole search window tapered; then a template-sized taper on the content found so far.
-        let taper = if pass == 0 {
-            Taper {
-                kind: params.window,
-                origin: (0.0, 0.0),
-                size: (sw, sh),
-            }
-        } else {
-            Taper {
-                kind: params.window,
-                origin: (ox as f64 + shift.dx_px, oy as f64 + shift.dy_px),
-                size: (tw, th),
-            }
-        };
-        let b = prepare(search, taper, pw, ph, 0, 0);
-        let r = correlation_surface(&f_ref, b, pw, ph, params.lowpass_sigma_px);
-        let next = find_peak(&r, pw, ph, params.peak_fit);
-        let converged =
-            pass > 0 && (next.dx_px - shift.dx_px).hypot(next.dy_px - shift.dy_px) < 1e-3;
-        shift = next;
-        if converged {
-            break;
-        }
-    }
-    Ok(TemplateLocation {
-        u_px: ox as f64 + tw as f64 / 2.0 + shift.dx_px,
-        v_px: oy as f64 + th as f64 / 2.0 + shift.dy_px,
-        peak: shift.peak,
-    })
+    with_cached_correlator(sw, sh, params, |c| c.locate_template(template, search))
 }
 
 #[cfg(test)]
@@ -440,23 +557,6 @@ mod tests {
         assert_eq!(fft_friendly_size(121), 125);
         assert_eq!(fft_friendly_size(7), 8);
         assert_eq!(fft_friendly_size(0), 1);
-    }
-
-    #[test]
-    fn fft_round_trip_is_identity() {
-        let (w, h) = (6, 5);
-        let orig: Vec<Complex<f64>> = (0..w * h)
-            .map(|k| Complex::new((k * 7 % 11) as f64, 0.0))
-            .collect();
-        let mut buf = orig.clone();
-        let mut tmp = Vec::new();
-        forward_2d(&mut buf, &mut tmp, w, h);
-        // DC term equals the sum.
-        assert!((buf[0].re - orig.iter().map(|c| c.re).sum::<f64>()).abs() < 1e-9);
-        inverse_2d(&mut buf, &mut tmp, w, h);
-        for (a, b) in buf.iter().zip(&orig) {
-            assert!((a - b).norm() < 1e-9);
-        }
     }
 
     #[test]

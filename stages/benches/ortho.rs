@@ -1,0 +1,221 @@
+//! Ortho-projection benchmark and peer-input writer for `benches/peers/remap.py` (`cv2.remap` with the SAME map;
+//! issue 4 "Benchmarks against peers"; thesis 3.4.3). Plain `fn main`, no harness.
+//!
+//! A 4000×2000 band-limited texture panorama (8-bit, written as PNG and re-loaded, so both sides see identical
+//! pixels) is ortho-projected at 3 cm (707×707 px) and 10 cm (212×212 px) on a 30 m diagonal. Timed, per GSD,
+//! with 1 thread and the default rayon pool:
+//! - `ortho_project` (projection of every ortho pixel + vehicle mask + bilinear sampling: the real stage);
+//! - `remap` with the precomputed map (bilinear sampling only — the like-for-like peer of `cv2.remap`).
+//!
+//! Written to `$SKYTIE_PEER_DIR/ortho/` (default `<temp>/skytie_peers/ortho/`): `panorama.png`, and per GSD
+//! `map_{gsd}cm_u.npy`, `map_{gsd}cm_v.npy` (float32, campaign pixel convention: pixel centres at +0.5, NaN
+//! where the vehicle hides the ground), `ortho_{gsd}cm.npy` (skytie's float32 output, for the agreement check)
+//! and `skytie_{gsd}cm.csv` (timings). Run: `cargo bench -p skytie-stages --bench ortho`.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use skytie_stages::campaign::Recording;
+use skytie_stages::geometry::PanoramaCamera;
+use skytie_stages::imaging::border::Border;
+use skytie_stages::imaging::gaussian::gaussian_blur;
+use skytie_stages::imaging::io::{load_gray, save_gray};
+use skytie_stages::imaging::resample::{remap, Interpolation};
+use skytie_stages::imaging::GrayImage;
+use skytie_stages::nadir::{ortho_project, OrthoGeoref, OrthoParams};
+
+fn peer_dir() -> PathBuf {
+    std::env::var_os("SKYTIE_PEER_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| std::env::temp_dir().join("skytie_peers"))
+        .join("ortho")
+}
+
+/// Band-limited noise (uniform noise blurred with σ = 2 px, stretched to [0, 1]).
+fn textured(w: usize, h: usize, seed: u64) -> GrayImage {
+    let mut state = seed;
+    let noise: Vec<f32> = (0..w * h)
+        .map(|_| {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+        })
+        .collect();
+    let mut img = gaussian_blur(&GrayImage::from_vec(w, h, noise).unwrap(), 2.0);
+    let (lo, hi) = img
+        .data
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+    img.data.iter_mut().for_each(|v| *v = (*v - lo) / (hi - lo));
+    img
+}
+
+fn recording() -> Recording {
+    Recording {
+        image_id: "bench".into(),
+        file: "bench.jpg".into(),
+        time: "2020-01-01T00:00:00Z".into(),
+        time_s: 1_577_836_800.0,
+        x: 92_345.678,
+        y: 437_123.456,
+        z: 3.5,
+        heading_deg: 30.0,
+        camera_height_m: 2.2,
+        sigma_xy_m: None,
+        sigma_z_m: None,
+        yaw_deg: 0.4,
+        pitch_deg: -0.3,
+        roll_deg: 0.2,
+    }
+}
+
+/// Minimal NumPy `.npy` (format 1.0) writer for a row-major float32 array of shape (rows, cols).
+fn write_npy_f32(path: &Path, rows: usize, cols: usize, data: &[f32]) {
+    let mut header =
+        format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({rows}, {cols}), }}");
+    // Magic (6) + version (2) + header length (2) + header, padded with spaces to a multiple of 64, ending in \n.
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut bytes = Vec::with_capacity(10 + header.len() + 4 * data.len());
+    bytes.extend_from_slice(b"\x93NUMPY\x01\x00");
+    bytes.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    bytes.extend_from_slice(header.as_bytes());
+    for v in data {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    std::fs::write(path, bytes).expect("write .npy");
+}
+
+/// Median wall time (ms) of `reps` runs of `f` inside a rayon pool of `threads`.
+fn median_ms(threads: usize, reps: usize, mut f: impl FnMut() + Send) -> f64 {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let mut t: Vec<f64> = (0..reps)
+            .map(|_| {
+                let s = Instant::now();
+                f();
+                s.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        t.sort_by(f64::total_cmp);
+        t[reps / 2]
+    })
+}
+
+fn bench_gsd(panorama: &GrayImage, gsd_cm: u32, dir: &Path) {
+    let rec = recording();
+    let params = OrthoParams {
+        gsd_m: gsd_cm as f64 / 100.0,
+        ..OrthoParams::default()
+    };
+    let ortho = ortho_project(panorama, &rec, &params);
+    let (w, h) = (ortho.georef.width_px, ortho.georef.height_px);
+
+    // The map ortho_project samples with: panorama pixel of each ortho pixel centre, NaN where masked.
+    let camera =
+        PanoramaCamera::from_recording(&rec, panorama.width as u32, panorama.height as u32);
+    let georef = OrthoGeoref::new(ortho.georef.foot_world, &params);
+    let mut map_u = vec![f32::NAN; w * h];
+    let mut map_v = vec![f32::NAN; w * h];
+    for row in 0..h {
+        for col in 0..w {
+            let i = row * w + col;
+            if ortho.valid[i] == 0 {
+                continue;
+            }
+            if let Some((u, v)) =
+                georef.ortho_to_panorama_pixel(&camera, col as f64 + 0.5, row as f64 + 0.5)
+            {
+                map_u[i] = u as f32;
+                map_v[i] = v as f32;
+            }
+        }
+    }
+    write_npy_f32(&dir.join(format!("map_{gsd_cm}cm_u.npy")), h, w, &map_u);
+    write_npy_f32(&dir.join(format!("map_{gsd_cm}cm_v.npy")), h, w, &map_v);
+    write_npy_f32(
+        &dir.join(format!("ortho_{gsd_cm}cm.npy")),
+        h,
+        w,
+        &ortho.image.data,
+    );
+
+    // skytie's generic remap with the same (f32) map; the seam column is wrapped like ortho_project does.
+    let wrap_u = |u: f32| {
+        let pw = panorama.width as f64;
+        (u as f64).rem_euclid(pw)
+    };
+    let map = |col: usize, row: usize| {
+        let i = row * w + col;
+        let (u, v) = (map_u[i], map_v[i]);
+        (!u.is_nan()).then(|| (wrap_u(u), v as f64))
+    };
+    let remapped = remap(
+        panorama,
+        w,
+        h,
+        Interpolation::Bilinear,
+        Border::Clamp,
+        0.0,
+        map,
+    );
+    let max_diff = remapped
+        .data
+        .iter()
+        .zip(&ortho.image.data)
+        .zip(&ortho.valid)
+        .filter(|(_, &ok)| ok == 1)
+        .map(|((a, b), _)| (a - b).abs())
+        .fold(0.0f32, f32::max);
+
+    let threads = rayon::current_num_threads();
+    let reps = if gsd_cm <= 3 { 15 } else { 60 };
+    let mut csv = String::from("method,threads,ms\n");
+    println!(
+        "ortho {gsd_cm} cm ({w}x{h} px from a {}x{} panorama):",
+        panorama.width, panorama.height
+    );
+    for t in [1, threads] {
+        let full = median_ms(t, reps, || {
+            std::hint::black_box(ortho_project(panorama, &rec, &params));
+        });
+        let sampling = median_ms(t, reps, || {
+            std::hint::black_box(remap(
+                panorama,
+                w,
+                h,
+                Interpolation::Bilinear,
+                Border::Clamp,
+                0.0,
+                map,
+            ));
+        });
+        println!(
+            "  {t} thread(s): ortho_project {full:.3} ms, remap with the map {sampling:.3} ms"
+        );
+        csv.push_str(&format!(
+            "skytie ortho_project,{t},{full:.6}\nskytie remap (same map),{t},{sampling:.6}\n"
+        ));
+    }
+    println!("  remap vs ortho_project, max |difference| on valid pixels: {max_diff:.2e}");
+    std::fs::write(dir.join(format!("skytie_{gsd_cm}cm.csv")), csv).expect("write timing CSV");
+}
+
+fn main() {
+    let dir = peer_dir();
+    std::fs::create_dir_all(&dir).expect("create the peer directory");
+    let png = dir.join("panorama.png");
+    save_gray(&png, &textured(4000, 2000, 7)).expect("write the panorama PNG");
+    let panorama = load_gray(&png).expect("re-load the panorama PNG");
+    for gsd_cm in [3, 10] {
+        bench_gsd(&panorama, gsd_cm, &dir);
+    }
+    println!("inputs for benches/peers/remap.py: {}", dir.display());
+}
