@@ -2,6 +2,8 @@
 //! the artifacts they exchange. The algorithms live in `stages/`; this layer only adds names, versions, typed
 //! inputs, parameter validation and encoding.
 
+pub mod adjust;
+pub mod adjust_grade;
 pub mod aerial;
 pub mod campaign;
 pub mod control;
@@ -16,6 +18,7 @@ pub mod refine;
 pub mod summary;
 pub mod synth;
 pub mod transform;
+pub mod verify;
 
 pub use campaign::{
     CampaignSnapshot, LoadCampaign, LoadCampaignParams, SelectRecording, SelectRecordingParams,

@@ -9,7 +9,7 @@
 //! Stages not yet implemented (oblique chain, adjustment) are refused with a clear message when a workflow
 //! enables them, never silently skipped.
 
-use super::nadir;
+use super::{adjust, nadir};
 use crate::dag::{DagBuilder, Pipeline, PipelineError, RawFile, Session};
 use crate::nodes::campaign::{listing_hash, metadata_inputs};
 use crate::nodes::{
@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 pub struct SkytiePipeline;
 
 /// Stage names a workflow may enable in `stages = [...]`.
-pub const STAGES: [&str; 11] = [
+pub const STAGES: [&str; 14] = [
     "synth",
     "load",
     "ortho",
@@ -36,6 +36,9 @@ pub const STAGES: [&str; 11] = [
     "control",
     "nadir",
     "grade_nadir",
+    "adjust",
+    "grade_adjust",
+    "verify",
 ];
 
 fn wf_err(e: impl std::fmt::Display) -> PipelineError {
@@ -142,9 +145,22 @@ impl Pipeline for SkytiePipeline {
                     });
                 }
             }
-            if nadir_on {
-                nadir::add_nadir(&mut b, wf, &variant, &root, &snapshot, snap, &items)?;
-            }
+            let nadir_handles = if nadir_on {
+                Some(nadir::add_nadir(
+                    &mut b, wf, &variant, &root, &snapshot, snap, &items,
+                )?)
+            } else {
+                None
+            };
+            adjust::add_adjust(
+                &mut b,
+                wf,
+                &variant,
+                &root,
+                snap,
+                &items,
+                nadir_handles.as_ref(),
+            )?;
             let summary = b.add(
                 SummarizeCampaign,
                 "",

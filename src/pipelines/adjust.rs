@@ -1,0 +1,99 @@
+//! The adjustment part of the `skytie` pipeline for one variant (thesis 3.5.3, ch. 5): the global `adjust`
+//! node fed by the registration stages' per-recording outputs, its truth grade `grade_adjust` (synthetic
+//! campaigns only) and the `verify` node (Table 5-13).
+
+use super::nadir::{NadirHandles, RecordingItem};
+use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
+use crate::nodes::adjust::{AdjustReport, AdjustStage};
+use crate::nodes::adjust_grade::{AdjustGrade, GradeAdjust};
+use crate::nodes::campaign::CampaignSnapshot;
+use crate::nodes::nadir_grade::TRUTH_RECORDINGS;
+use crate::nodes::summary::SummaryParams;
+use crate::nodes::verify::{verify_metrics, VerifyStage};
+use crate::workflow::Workflow;
+use skytie_stages::adjustment::verify::{Verification, VerifyConfig};
+use skytie_stages::adjustment::{AdjustConfig, Sources};
+use std::path::Path;
+
+fn wf_err(e: impl std::fmt::Display) -> PipelineError {
+    PipelineError::Workflow(e.to_string())
+}
+
+/// Handles of the adjustment outputs (for the exports written after the run).
+pub struct AdjustHandles {
+    pub report: Option<Handle<AdjustReport>>,
+    pub verification: Option<Handle<Verification>>,
+}
+
+/// Add `adjust`, `grade_adjust` and `verify` when the workflow enables them.
+pub fn add_adjust(
+    b: &mut DagBuilder,
+    wf: &Workflow,
+    variant: &str,
+    root: &Path,
+    snap: Handle<CampaignSnapshot>,
+    items: &[RecordingItem<'_>],
+    nadir: Option<&NadirHandles>,
+) -> Result<AdjustHandles, PipelineError> {
+    let on = |s: &str| wf.stages.iter().any(|x| x == s);
+    let mut out = AdjustHandles {
+        report: None,
+        verification: None,
+    };
+    if !(on("adjust") || on("verify") || on("grade_adjust")) {
+        return Ok(out);
+    }
+    let Some(nadir) = nadir.filter(|n| !n.control.is_empty() || !n.windows.is_empty()) else {
+        return Err(wf_err(format!(
+            "{}: 'adjust'/'verify' need correspondences: enable the nadir chain (ortho, mm_match, ortho_aerial, \
+             transform, refine, control) in `stages`",
+            wf.path.display()
+        )));
+    };
+    let panos: Vec<RawFile> = items.iter().map(|i| i.pano.clone()).collect();
+    if on("adjust") {
+        let config: AdjustConfig = wf.params("adjust", variant).map_err(wf_err)?;
+        if config.sources == Sources::Oblique {
+            return Err(wf_err(format!(
+                "{}: [adjust] sources = \"oblique\": the oblique pipeline is not available in this skytie yet; \
+                 use \"nadir\" or \"combined\"",
+                wf.path.display()
+            )));
+        }
+        let report = b.add(
+            AdjustStage,
+            config.sources.label(),
+            config,
+            (
+                snap,
+                panos.clone(),
+                nadir.windows.clone(),
+                nadir.control.clone(),
+            ),
+        )?;
+        b.metrics(report, "adjust", |r: &AdjustReport| r.metrics());
+        out.report = Some(report);
+        let truth = root.join(TRUTH_RECORDINGS);
+        if on("grade_adjust") && truth.is_file() {
+            let grade = b.add(
+                GradeAdjust,
+                "",
+                SummaryParams::default(),
+                (RawFile(truth), report),
+            )?;
+            b.metrics(grade, "adjust", |g: &AdjustGrade| g.metrics());
+        }
+    }
+    if on("verify") {
+        let config: VerifyConfig = wf.params("verify", variant).map_err(wf_err)?;
+        let v = b.add(
+            VerifyStage,
+            "",
+            config,
+            (snap, panos, nadir.control.clone()),
+        )?;
+        b.metrics(v, "verify", verify_metrics);
+        out.verification = Some(v);
+    }
+    Ok(out)
+}
