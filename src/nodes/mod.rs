@@ -5,6 +5,7 @@
 pub mod adjust;
 pub mod adjust_grade;
 pub mod aerial;
+pub mod baseline;
 pub mod campaign;
 pub mod control;
 pub mod mm_match;

@@ -16,6 +16,18 @@ pub struct NadirOptions {
     /// Expected maximum localisation error of the recorded positions, metres: an aerial image is matched with a
     /// recording only if the recording's foot point grown by this margin lies inside it (thesis 3.4.5.1).
     pub overlap_margin_m: f64,
+    /// How tie points are located in the aerial images: `phase_correlation` (thesis 3.4.5.3, the `refine` node)
+    /// or `baseline` (thesis 2.2.3: isolated Förstner keypoints + NCC, the `baseline` node; Table 2-10).
+    pub matcher: Matcher,
+}
+
+/// See [`NadirOptions::matcher`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Matcher {
+    #[default]
+    PhaseCorrelation,
+    Baseline,
 }
 
 impl Default for NadirOptions {
@@ -24,6 +36,7 @@ impl Default for NadirOptions {
             triples: true,
             max_neighbour_distance_m: 12.0,
             overlap_margin_m: 1.5,
+            matcher: Matcher::PhaseCorrelation,
         }
     }
 }

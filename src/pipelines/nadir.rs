@@ -6,11 +6,12 @@
 
 use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::aerial::{SelectAerial, SelectAerialParams};
+use crate::nodes::baseline::BaselineStage;
 use crate::nodes::campaign::CampaignSnapshot;
 use crate::nodes::control::ControlStage;
 use crate::nodes::mm_match::MmMatch;
 use crate::nodes::nadir_grade::{grade_metrics, GradeNadir, TRUTH_AERIAL_NADIR, TRUTH_RECORDINGS};
-use crate::nodes::nadir_options::NadirOptions;
+use crate::nodes::nadir_options::{Matcher, NadirOptions};
 use crate::nodes::nadir_summary::SummarizeNadir;
 use crate::nodes::ortho_aerial::OrthoForAerial;
 use crate::nodes::refine::RefineStage;
@@ -19,6 +20,7 @@ use crate::nodes::transform::InitialTransformStage;
 use crate::workflow::Workflow;
 use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
 use skytie_stages::nadir::aerial_overlap::overlapping_nadir;
+use skytie_stages::nadir::baseline::BaselineParams;
 use skytie_stages::nadir::control_points::ControlParams;
 use skytie_stages::nadir::grading::NadirGrade;
 use skytie_stages::nadir::initial_transform::TransformParams;
@@ -197,12 +199,16 @@ pub fn add_nadir(
             if !on("refine") {
                 continue;
             }
-            let refined = b.add(
-                RefineStage,
-                &pair,
-                refine_params.clone(),
-                (ortho, aerial_file, aerial, outcome, window),
-            )?;
+            let inputs = (ortho, aerial_file, aerial, outcome, window);
+            let refined = match options.matcher {
+                Matcher::PhaseCorrelation => {
+                    b.add(RefineStage, &pair, refine_params.clone(), inputs)?
+                }
+                Matcher::Baseline => {
+                    let p: BaselineParams = wf.params("baseline", variant).map_err(wf_err)?;
+                    b.add(BaselineStage, &pair, p, inputs)?
+                }
+            };
             refinements.push(refined);
             rec_refinements.push(refined);
             rec_aerials.push(aerial);

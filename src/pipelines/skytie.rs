@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 pub struct SkytiePipeline;
 
 /// Stage names a workflow may enable in `stages = [...]`.
-pub const STAGES: [&str; 14] = [
+pub const STAGES: [&str; 15] = [
     "synth",
     "load",
     "ortho",
@@ -39,6 +39,7 @@ pub const STAGES: [&str; 14] = [
     "adjust",
     "grade_adjust",
     "verify",
+    "baseline",
 ];
 
 fn wf_err(e: impl std::fmt::Display) -> PipelineError {

@@ -22,7 +22,7 @@ pub struct NadirSummary {
     /// (recording, nadir image) pairs tried / with an accepted initial transform (thesis 3.4.5.2).
     pub transforms_tried: usize,
     pub transforms_accepted: usize,
-    /// Rejection reasons (numbers replaced by `N`) → count.
+    /// Rejection reasons as metrics keys (see `reason_class`) → count.
     pub transforms_rejected: BTreeMap<String, usize>,
     /// MM tie point × aerial image correspondences (as Table 3-1 counts them).
     pub tie_points: usize,
@@ -35,23 +35,27 @@ pub struct NadirSummary {
     pub single_aerial_points: usize,
 }
 
-/// A rejection reason with its numbers replaced by `N`, for counting ("centre offset 2.3 m > 1.5 m" →
-/// "centre offset N m > N m").
+/// A rejection reason as a metrics key: numbers replaced by `n`, lower case, words joined by `_`
+/// ("centre offset 2.3 m > 1.5 m" → "centre_offset_n_m_n_m").
 fn reason_class(reason: &str) -> String {
-    let words: Vec<&str> = reason
+    let words: Vec<String> = reason
         .split_whitespace()
         .map(|w| {
             if w.chars().any(|c| c.is_ascii_digit()) {
-                "N"
+                "n".to_string()
             } else {
-                w
+                w.chars()
+                    .filter(|c| c.is_alphanumeric())
+                    .collect::<String>()
+                    .to_lowercase()
             }
         })
+        .filter(|w| !w.is_empty())
         .collect();
     if words.is_empty() {
         "other".into()
     } else {
-        words.join(" ")
+        words.join("_")
     }
 }
 
