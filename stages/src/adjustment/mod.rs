@@ -15,6 +15,7 @@
 
 pub mod adjust;
 pub mod aerial;
+pub mod campaign_checkpoints;
 pub mod config;
 pub mod covariance;
 pub mod evaluate;

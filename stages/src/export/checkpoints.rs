@@ -1,0 +1,144 @@
+//! `checkpoints.csv`: per check point its id, the number of views used and its errors (estimated − surveyed,
+//! metres) per axis, 2-D and 3-D, before (recorded poses) and after (adjusted poses) the adjustment (thesis
+//! 3.5.3, Tables 5-2…5-9). Points that could not be triangulated have empty cells and the reason.
+
+use crate::adjustment::campaign_checkpoints::CheckPointComparison;
+use crate::adjustment::CheckPointError;
+use crate::fsutil::atomic_write_with;
+use serde::{Deserialize, Serialize};
+use std::io::{self, Write};
+use std::path::Path;
+
+/// Column names of `checkpoints.csv`.
+pub const CHECKPOINTS_CSV_HEADER: [&str; 15] = [
+    "point_id",
+    "views_before",
+    "before_x",
+    "before_y",
+    "before_z",
+    "before_2d",
+    "before_3d",
+    "views_after",
+    "after_x",
+    "after_y",
+    "after_z",
+    "after_2d",
+    "after_3d",
+    "improved_2d",
+    "note",
+];
+
+/// Errors of one triangulation, metres.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AxisErrors {
+    pub views: usize,
+    /// Estimated − surveyed X, Y, Z.
+    pub error_m: [f64; 3],
+}
+
+impl AxisErrors {
+    fn from_point(p: &CheckPointError) -> Self {
+        Self {
+            views: p.views,
+            error_m: p.error_m.into(),
+        }
+    }
+
+    /// Horizontal error length.
+    pub fn d2(&self) -> f64 {
+        self.error_m[0].hypot(self.error_m[1])
+    }
+
+    /// 3-D error length.
+    pub fn d3(&self) -> f64 {
+        nalgebra::Vector3::from(self.error_m).norm()
+    }
+}
+
+/// One row of `checkpoints.csv`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CheckPointRow {
+    pub point_id: String,
+    pub before: Option<AxisErrors>,
+    pub after: Option<AxisErrors>,
+    /// Why a triangulation failed (empty when both succeeded).
+    pub note: String,
+}
+
+/// The rows of a comparison, in check-point order.
+pub fn checkpoint_rows(c: &CheckPointComparison) -> Vec<CheckPointRow> {
+    (0..c.ids.len())
+        .map(|i| {
+            let find = |e: &crate::adjustment::CheckPointEvaluation| {
+                e.points
+                    .iter()
+                    .find(|p| p.check_point == i)
+                    .map(AxisErrors::from_point)
+            };
+            let reason = |e: &crate::adjustment::CheckPointEvaluation, when: &str| {
+                e.failed
+                    .iter()
+                    .find(|(k, _)| *k == i)
+                    .map(|(_, why)| format!("{when}: {why}"))
+            };
+            let note = [reason(&c.before, "before"), reason(&c.after, "after")]
+                .into_iter()
+                .flatten()
+                .collect::<Vec<_>>()
+                .join("; ");
+            let before = find(&c.before);
+            let after = find(&c.after);
+            let note = if before.is_none() && after.is_none() && note.is_empty() {
+                "no observations".to_string()
+            } else {
+                note
+            };
+            CheckPointRow {
+                point_id: c.ids[i].clone(),
+                before,
+                after,
+                note,
+            }
+        })
+        .collect()
+}
+
+/// Writes `checkpoints.csv` (atomically; floats in shortest round-trip form).
+pub fn write_checkpoint_errors_csv(path: &Path, rows: &[CheckPointRow]) -> io::Result<()> {
+    let errors = |e: &Option<AxisErrors>| -> Vec<String> {
+        match e {
+            Some(e) => vec![
+                e.views.to_string(),
+                format!("{}", e.error_m[0]),
+                format!("{}", e.error_m[1]),
+                format!("{}", e.error_m[2]),
+                format!("{}", e.d2()),
+                format!("{}", e.d3()),
+            ],
+            None => vec![String::new(); 6],
+        }
+    };
+    atomic_write_with(path, |w| {
+        writeln!(w, "{}", CHECKPOINTS_CSV_HEADER.join(","))?;
+        for r in rows {
+            let mut cells = vec![quote(&r.point_id)];
+            cells.extend(errors(&r.before));
+            cells.extend(errors(&r.after));
+            cells.push(match (&r.before, &r.after) {
+                (Some(b), Some(a)) => (a.d2() < b.d2()).to_string(),
+                _ => String::new(),
+            });
+            cells.push(quote(&r.note));
+            writeln!(w, "{}", cells.join(","))?;
+        }
+        Ok(())
+    })
+}
+
+fn quote(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) || s.starts_with('#') || s.starts_with(' ') {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}

@@ -1,0 +1,308 @@
+//! A COLMAP text model of the adjusted block (`cameras.txt`, `images.txt`, `points3D.txt`) so users can
+//! inspect it in COLMAP (issue 6 "Outputs").
+//!
+//! Cameras: panoramas use COLMAP's `EQUIRECTANGULAR` model (parameters `w, h`; camera frame x right, y down,
+//! z forward; pixel `x = (θ/2π + ½)·w`, `y = (½ − φ/π)·h` with `θ = atan2(x_c, z_c)`, `φ = atan2(−y_c,
+//! ‖(x_c, z_c)‖)`), one camera per panorama size. Our panorama frame is (east, north, up) at azimuth 0 /
+//! elevation 0 = north (campaign-format.md), so `p_colmap = (p.x, −p.z, p.y)`. Aerial frame cameras (x right,
+//! y up, z backwards) become `PINHOLE` (no distortion) or `OPENCV` with `p_colmap = (p.x, −p.y, −p.z)`; the
+//! y flip turns our Brown coefficients into OpenCV's as `(k1, k2, −p1, p2)`. Both conventions put the first
+//! pixel's centre at (0.5, 0.5), like campaign-format.md, so pixels are written unchanged.
+//!
+//! Poses: COLMAP stores world→camera `x_cam = R·X + t` as the quaternion (QW, QX, QY, QZ) of R (QW ≥ 0) and t.
+//! World coordinates are shifted to a local origin (whole metres near the mean recording centre) so single
+//! precision viewers stay exact; the origin and the CRS are written in a comment of every file.
+//! Points: determined tie points with their panorama and aerial observations as tracks; ERROR is the mean
+//! reprojection error in pixels with the written poses.
+
+use crate::adjustment::AdjustmentRun;
+use crate::campaign::{AerialImage, AerialKind, Recording};
+use crate::fsutil::atomic_write_with;
+use crate::geometry::{FrameCamera, PanoramaCamera};
+use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
+use std::collections::BTreeMap;
+use std::io::{self, Write};
+use std::path::Path;
+
+/// What was written.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ColmapExport {
+    /// World = local + origin, metres.
+    pub origin_world: [f64; 3],
+    pub cameras: usize,
+    pub images: usize,
+    pub points: usize,
+}
+
+/// Panorama frame (east, north, up) → COLMAP equirectangular camera frame (right, down, forward).
+pub fn pano_to_colmap() -> Matrix3<f64> {
+    Matrix3::new(1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0)
+}
+
+/// Our frame-camera frame (x right, y up, z backwards) → COLMAP pinhole frame (right, down, forward).
+pub fn frame_to_colmap() -> Matrix3<f64> {
+    Matrix3::new(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, -1.0)
+}
+
+/// COLMAP pose of a camera: (QW, QX, QY, QZ) and t for `x_cam = R·(X_world − origin) + t`.
+pub fn colmap_pose(
+    rotation_world_to_cam: &Matrix3<f64>,
+    center_world: &Vector3<f64>,
+    origin_world: &Vector3<f64>,
+) -> ([f64; 4], [f64; 3]) {
+    let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix(rotation_world_to_cam));
+    let mut qv = [q.w, q.i, q.j, q.k];
+    if qv[0] < 0.0 {
+        qv = qv.map(|v| -v);
+    }
+    let t = -(rotation_world_to_cam * (center_world - origin_world));
+    (qv, t.into())
+}
+
+struct Image {
+    name: String,
+    camera_id: usize,
+    q: [f64; 4],
+    t: [f64; 3],
+    /// (x, y, point3D id)
+    points2d: Vec<(f64, f64, usize)>,
+}
+
+/// Writes `cameras.txt`, `images.txt` and `points3D.txt` into `dir` (created if missing). `recordings` and
+/// `pano_size_px` are the run's recordings; `nadir`/`oblique` the aerial rows its aerial images refer to.
+pub fn write_colmap_model(
+    dir: &Path,
+    crs: &str,
+    recordings: &[Recording],
+    pano_size_px: &[(u32, u32)],
+    run: &AdjustmentRun,
+    nadir: &[AerialImage],
+    oblique: &[AerialImage],
+) -> io::Result<ColmapExport> {
+    let invalid = |m: String| io::Error::new(io::ErrorKind::InvalidInput, m);
+    let pano_cams =
+        crate::adjustment::campaign_checkpoints::adjusted_cameras(recordings, pano_size_px, run)
+            .map_err(invalid)?;
+    let n = pano_cams.len().max(1) as f64;
+    let mean = pano_cams
+        .iter()
+        .fold(Vector3::zeros(), |s, c| s + c.center_world)
+        / n;
+    let origin = mean.map(f64::round);
+    let header = format!(
+        "# skytie adjusted block; coordinates local: world = local + origin ({}, {}, {}) m, CRS {}\n",
+        origin.x,
+        origin.y,
+        origin.z,
+        if crs.is_empty() { "unknown" } else { crs }
+    );
+
+    // Cameras: one EQUIRECTANGULAR per panorama size, one per aerial image.
+    let mut camera_lines: Vec<String> = Vec::new();
+    let mut pano_camera_id: BTreeMap<(u32, u32), usize> = BTreeMap::new();
+    for &(w, h) in pano_size_px {
+        if !pano_camera_id.contains_key(&(w, h)) {
+            let id = camera_lines.len() + 1;
+            pano_camera_id.insert((w, h), id);
+            camera_lines.push(format!("{id} EQUIRECTANGULAR {w} {h} {w} {h}"));
+        }
+    }
+    let mut aerial_cams: Vec<FrameCamera> = Vec::with_capacity(run.aerial_images.len());
+    let mut aerial_names: Vec<String> = Vec::with_capacity(run.aerial_images.len());
+    let mut aerial_camera_id: Vec<usize> = Vec::with_capacity(run.aerial_images.len());
+    for a in &run.aerial_images {
+        let rows = match a.kind {
+            AerialKind::Nadir => nadir,
+            AerialKind::Oblique => oblique,
+        };
+        let row = rows
+            .iter()
+            .find(|r| r.image_id == a.image_id)
+            .ok_or_else(|| {
+                invalid(format!(
+                    "aerial image '{}' of the adjustment is not among the aerial rows passed",
+                    a.image_id
+                ))
+            })?;
+        let cam = FrameCamera::from_aerial(row);
+        let id = camera_lines.len() + 1;
+        let d = cam.distortion;
+        camera_lines.push(if d.is_zero() {
+            format!(
+                "{id} PINHOLE {} {} {} {} {} {}",
+                cam.width_px, cam.height_px, cam.focal_px, cam.focal_px, cam.cx_px, cam.cy_px
+            )
+        } else {
+            format!(
+                "{id} OPENCV {} {} {} {} {} {} {} {} {} {}",
+                cam.width_px,
+                cam.height_px,
+                cam.focal_px,
+                cam.focal_px,
+                cam.cx_px,
+                cam.cy_px,
+                d.k1,
+                d.k2,
+                -d.p1,
+                d.p2
+            )
+        });
+        aerial_camera_id.push(id);
+        aerial_names.push(match a.kind {
+            AerialKind::Nadir => format!("nadir/{}", row.file),
+            AerialKind::Oblique => format!("oblique/{}", row.file),
+        });
+        aerial_cams.push(cam);
+    }
+
+    // Images: panoramas first (ids 1..), then aerial images.
+    let mut images: Vec<Image> = pano_cams
+        .iter()
+        .zip(recordings)
+        .zip(pano_size_px)
+        .map(|((cam, r), size)| {
+            let rot = pano_to_colmap() * cam.rotation_pano_to_world.transpose();
+            let (q, t) = colmap_pose(&rot, &cam.center_world, &origin);
+            Image {
+                name: r.file.clone(),
+                camera_id: pano_camera_id[size],
+                q,
+                t,
+                points2d: Vec::new(),
+            }
+        })
+        .collect();
+    for ((cam, name), &camera_id) in aerial_cams.iter().zip(&aerial_names).zip(&aerial_camera_id) {
+        let rot = frame_to_colmap() * cam.rotation_cam_to_world.transpose();
+        let (q, t) = colmap_pose(&rot, &cam.center_world, &origin);
+        images.push(Image {
+            name: name.clone(),
+            camera_id,
+            q,
+            t,
+            points2d: Vec::new(),
+        });
+    }
+    let n_pano = pano_cams.len();
+
+    // Points and tracks.
+    let mut point_lines: Vec<String> = Vec::new();
+    for p in run.points.iter().filter(|p| p.determined) {
+        let id = point_lines.len() + 1;
+        let x = Vector3::from(p.position_world);
+        let mut track = Vec::new();
+        let (mut err_sum, mut err_n) = (0.0, 0usize);
+        for &(r, u, v) in &p.point.pano {
+            let img = &mut images[r];
+            track.push((r + 1, img.points2d.len()));
+            img.points2d.push((u, v, id));
+            if let Some(e) = pano_reprojection_px(&pano_cams[r], &x, u, v) {
+                err_sum += e;
+                err_n += 1;
+            }
+        }
+        for &(a, u, v) in &p.point.aerial {
+            let img = &mut images[n_pano + a];
+            track.push((n_pano + a + 1, img.points2d.len()));
+            img.points2d.push((u, v, id));
+            if let Some((pu, pv)) = aerial_cams[a].project_world(&x) {
+                err_sum += (pu - u).hypot(pv - v);
+                err_n += 1;
+            }
+        }
+        let [r, g, b] = super::ply::source_colour(match p.point.kind {
+            crate::adjustment::PointKind::Tie => super::ply::PLY_SOURCE_TIE,
+            crate::adjustment::PointKind::Control => super::ply::PLY_SOURCE_CONTROL,
+            crate::adjustment::PointKind::SingleAerial => super::ply::PLY_SOURCE_SINGLE_AERIAL,
+        });
+        let local = x - origin;
+        let error = if err_n > 0 {
+            err_sum / err_n as f64
+        } else {
+            0.0
+        };
+        let mut line = format!(
+            "{id} {} {} {} {r} {g} {b} {error}",
+            local.x, local.y, local.z
+        );
+        for (image_id, idx) in track {
+            line.push_str(&format!(" {image_id} {idx}"));
+        }
+        point_lines.push(line);
+    }
+
+    std::fs::create_dir_all(dir)?;
+    atomic_write_with(&dir.join("cameras.txt"), |w| {
+        w.write_all(header.as_bytes())?;
+        writeln!(w, "# Camera list with one line of data per camera:")?;
+        writeln!(w, "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]")?;
+        writeln!(w, "# Number of cameras: {}", camera_lines.len())?;
+        for l in &camera_lines {
+            writeln!(w, "{l}")?;
+        }
+        Ok(())
+    })?;
+    atomic_write_with(&dir.join("images.txt"), |w| {
+        w.write_all(header.as_bytes())?;
+        writeln!(w, "# Image list with two lines of data per image:")?;
+        writeln!(
+            w,
+            "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME"
+        )?;
+        writeln!(w, "#   POINTS2D[] as (X, Y, POINT3D_ID)")?;
+        writeln!(w, "# Number of images: {}", images.len())?;
+        for (i, img) in images.iter().enumerate() {
+            writeln!(
+                w,
+                "{} {} {} {} {} {} {} {} {} {}",
+                i + 1,
+                img.q[0],
+                img.q[1],
+                img.q[2],
+                img.q[3],
+                img.t[0],
+                img.t[1],
+                img.t[2],
+                img.camera_id,
+                img.name
+            )?;
+            let cells: Vec<String> = img
+                .points2d
+                .iter()
+                .map(|(x, y, p)| format!("{x} {y} {p}"))
+                .collect();
+            writeln!(w, "{}", cells.join(" "))?;
+        }
+        Ok(())
+    })?;
+    atomic_write_with(&dir.join("points3D.txt"), |w| {
+        w.write_all(header.as_bytes())?;
+        writeln!(w, "# 3D point list with one line of data per point:")?;
+        writeln!(
+            w,
+            "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)"
+        )?;
+        writeln!(w, "# Number of points: {}", point_lines.len())?;
+        for l in &point_lines {
+            writeln!(w, "{l}")?;
+        }
+        Ok(())
+    })?;
+    Ok(ColmapExport {
+        origin_world: origin.into(),
+        cameras: camera_lines.len(),
+        images: images.len(),
+        points: point_lines.len(),
+    })
+}
+
+/// Pixel distance between an observation and the projection of `x` (u wrapped across the seam).
+fn pano_reprojection_px(cam: &PanoramaCamera, x: &Vector3<f64>, u: f64, v: f64) -> Option<f64> {
+    let (pu, pv) = cam.project_world(x)?;
+    let w = f64::from(cam.width_px);
+    let mut du = (pu - u).rem_euclid(w);
+    if du > w / 2.0 {
+        du -= w;
+    }
+    Some(du.hypot(pv - v))
+}
