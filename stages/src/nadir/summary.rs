@@ -161,11 +161,14 @@ mod tests {
 
     #[test]
     fn reason_classes_drop_numbers() {
-        assert_eq!(reason_class("centre offset 2.3 m > 1.5 m"), "centre offset");
-        assert_eq!(reason_class("12 matches"), "other");
         assert_eq!(
-            reason_class("RANSAC: too few inliers 3 < 6"),
-            "RANSAC: too few inliers"
+            reason_class("centre offset 2.3 m > 1.5 m"),
+            "centre_offset_n_m_n_m"
         );
+        assert_eq!(
+            reason_class("12 matches, RANSAC found 3 inliers < 6"),
+            "n_matches_ransac_found_n_inliers_n"
+        );
+        assert_eq!(reason_class(""), "other");
     }
 }
