@@ -43,13 +43,11 @@ fn systematic_error_is_recovered_exactly_and_flagged() {
     assert_eq!(v.points.len() + singles + v.skipped_mm, c.control.len());
     assert!(v.points.len() >= 15, "{} points", v.points.len());
     for p in &v.points {
-        for k in 0..3 {
+        for (k, (got, want)) in p.offset_m.iter().zip(&truth_offset).enumerate() {
             assert!(
-                (p.offset_m[k] - truth_offset[k]).abs() < 1e-6,
-                "{}: axis {k} offset {} vs {}",
-                p.tie_point_id,
-                p.offset_m[k],
-                truth_offset[k]
+                (got - want).abs() < 1e-6,
+                "{}: axis {k} offset {got} vs {want}",
+                p.tie_point_id
             );
         }
     }

@@ -54,13 +54,14 @@ impl FixedFrameCamera {
         point_local: &Vector3<f64>,
     ) -> Option<(Vector2<f64>, Matrix2x3<f64>)> {
         let p = self.rotation_world_to_cam * (point_local - self.center_local);
-        if !(p.z < 0.0) {
+        // NaN-safe: a non-finite depth is rejected too.
+        if p.z.partial_cmp(&0.0) != Some(std::cmp::Ordering::Less) {
             return None;
         }
         let inv_depth = 1.0 / -p.z;
         let x = p.x * inv_depth;
         let y = p.y * inv_depth;
-        if !(x * x + y * y < self.max_r2) {
+        if (x * x + y * y).partial_cmp(&self.max_r2) != Some(std::cmp::Ordering::Less) {
             return None;
         }
         let (xd, yd) = self.distortion.distort(x, y);

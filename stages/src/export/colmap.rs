@@ -101,9 +101,9 @@ pub fn write_colmap_model(
     let mut camera_lines: Vec<String> = Vec::new();
     let mut pano_camera_id: BTreeMap<(u32, u32), usize> = BTreeMap::new();
     for &(w, h) in pano_size_px {
-        if !pano_camera_id.contains_key(&(w, h)) {
+        if let std::collections::btree_map::Entry::Vacant(slot) = pano_camera_id.entry((w, h)) {
             let id = camera_lines.len() + 1;
-            pano_camera_id.insert((w, h), id);
+            slot.insert(id);
             camera_lines.push(format!("{id} EQUIRECTANGULAR {w} {h} {w} {h}"));
         }
     }
