@@ -1,7 +1,7 @@
 //! Corner features of the detecting ortho image and their transfer into a neighbour (thesis 3.4.4.4):
 //! Förstner corners at sub-pixel precision (Köthe's 2× tensor) away from masked pixels, carried into the
-//! neighbour by the pair transform, located there by NCC template matching in a small search window, and
-//! verified again: the located position must agree with the transferred one (after removing the pair's
+//! neighbour by the pair transform, located there by NCC template matching in a small search window (and
+//! matched back: the neighbour's template at that location must lead back to the corner), and verified again: the located position must agree with the transferred one (after removing the pair's
 //! median offset, which is the relative pose error when the transform came from the poses) within a
 //! tolerance.
 
@@ -92,6 +92,27 @@ fn locate(
     // position relative to that pixel's centre.
     let u = dc as f64 + 0.5 + peak.offset_u_px + (corner.u_px - (sc as f64 + 0.5));
     let v = dr as f64 + 0.5 + peak.offset_v_px + (corner.v_px - (sr as f64 + 0.5));
+    // Back-matching: the neighbour's template at the located position must lead back to the corner.
+    let (bc, br) = (u.floor() as i64, v.floor() as i64);
+    let back_radius = p.max_backmatch_px.ceil() as usize + 1;
+    let back = match_corner(
+        &nb.filled,
+        bc,
+        br,
+        &det.filled,
+        sc,
+        sr,
+        half,
+        back_radius,
+        scratch,
+    )?;
+    let back_u = sc as f64 + 0.5 + back.offset_u_px + (u - (bc as f64 + 0.5));
+    let back_v = sr as f64 + 0.5 + back.offset_v_px + (v - (br as f64 + 0.5));
+    if back.score < p.min_ncc as f64
+        || (back_u - corner.u_px).hypot(back_v - corner.v_px) > p.max_backmatch_px
+    {
+        return None;
+    }
     Some((
         LocatedCorner {
             u_px: u,

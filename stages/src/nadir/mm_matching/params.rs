@@ -11,8 +11,9 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MmMatchParams {
-    /// KAZE detector threshold on the scale-normalised det(Hessian) of the 0..1 ortho image (default 0.001,
-    /// OpenCV's default). KAZE runs upright with one octave (thesis 3.4.4.2).
+    /// KAZE detector threshold on the scale-normalised det(Hessian) of the 0..1 ortho image (default 1e-4:
+    /// OpenCV's 0.001 finds no keypoints in 3 cm orthos of 1024-px panoramas, which are smooth because the
+    /// ortho is finer than its source). KAZE runs upright with one octave (thesis 3.4.4.2).
     pub kaze_threshold: f32,
     /// KAZE sub-levels of the single octave (default 4).
     pub kaze_sublevels: usize,
@@ -63,6 +64,10 @@ pub struct MmMatchParams {
     pub fallback_search_radius_px: usize,
     /// Lowest accepted NCC peak value (default 0.8).
     pub min_ncc: f32,
+    /// Back-matching check: the neighbour's template at the located position, matched back into the detecting
+    /// image, must land within this distance of the corner, ortho px (default 1.0 px). Rejects the
+    /// asymmetric matches that blur differences between a near and a far panorama produce.
+    pub max_backmatch_px: f64,
     /// Second verification (thesis 3.4.4.4): the refined location must lie within this distance of the
     /// transferred one after removing the pair's median offset, ortho px (default 3 px = 9 cm).
     pub corner_tolerance_px: f64,
@@ -81,7 +86,7 @@ pub struct MmMatchParams {
 impl Default for MmMatchParams {
     fn default() -> Self {
         Self {
-            kaze_threshold: 0.001,
+            kaze_threshold: 1e-4,
             kaze_sublevels: 4,
             kaze_mask_margin_px: 16.0,
             kaze_ratio: 0.8,
@@ -101,6 +106,7 @@ impl Default for MmMatchParams {
             search_radius_px: 6,
             fallback_search_radius_px: 16,
             min_ncc: 0.8,
+            max_backmatch_px: 1.0,
             corner_tolerance_px: 3.0,
             pano_sigma_px: 0.5,
             max_ray_residual_m: 0.30,
@@ -237,6 +243,11 @@ impl MmMatchParams {
             self.min_ncc.is_finite() && self.min_ncc > -1.0 && self.min_ncc <= 1.0,
             "min_ncc",
             format!("must be in (-1, 1], got {}", self.min_ncc),
+        );
+        check(
+            pos(self.max_backmatch_px) && self.max_backmatch_px <= 32.0,
+            "max_backmatch_px",
+            format!("must be in (0, 32] px, got {}", self.max_backmatch_px),
         );
         check(
             pos(self.corner_tolerance_px),
