@@ -5,6 +5,7 @@
 //! `build_block`/`run` from the correspondence types, so the plumbing is tested too.
 
 use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
+use skytie_stages::adjustment::trajectory_errors::trajectory_errors;
 use skytie_stages::adjustment::{
     run, AdjustConfig, AdjustInputs, AdjustmentRun, ControlWeighting, Dimensions, LossKind,
     SyntheticBlockSpec,
@@ -218,4 +219,72 @@ fn noisy_block_all_schemes_within_their_precision() {
             }
         }
     }
+}
+
+#[test]
+fn trajectory_errors_against_truth_and_determinism_across_thread_counts() {
+    // Purely systematic deterioration: the recorded differences between consecutive recordings are then
+    // exact, so relative constraints are consistent with the truth (with a random part they would not be).
+    let mut spec = exact_spec();
+    spec.block.random_offset_m = 0.0;
+    let c = spec.generate();
+    let truth: Vec<_> = c
+        .recordings
+        .iter()
+        .zip(&c.truth.true_centers_world)
+        .map(|(r, t)| {
+            let mut r = r.clone();
+            [r.x, r.y, r.z] = [t.x, t.y, t.z];
+            r
+        })
+        .collect();
+    let config = AdjustConfig {
+        relative_constraints: true,
+        ..aerial_in_bundle()
+    };
+    let in_pool = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| run(&inputs(&c), &config).unwrap())
+    };
+    let one = in_pool(1);
+    let two = in_pool(2);
+    assert_eq!(
+        serde_json::to_string(&one).unwrap(),
+        serde_json::to_string(&two).unwrap()
+    );
+    assert_eq!(one.build.relative_constraints, c.recordings.len() - 1);
+    let e = trajectory_errors(&one, &truth);
+    eprintln!("exact block with relative constraints: {e:?}");
+    assert_eq!(e.missing_truth, 0);
+    assert_eq!(e.before.count, c.recordings.len());
+    // 0.8 m systematic before; exact after.
+    assert!(
+        (e.before.rmse_2d - 0.8).abs() < 1e-9 && (e.before.max_2d - 0.8).abs() < 1e-9,
+        "{e:?}"
+    );
+    assert!(e.after.max_2d < 1e-3 && e.after.rmse_3d < 1e-3, "{e:?}");
+}
+
+#[test]
+fn aerial_observations_behind_the_camera_are_skipped_not_fatal() {
+    let mut c = exact_spec().generate();
+    // Move one nadir camera below the ground: its observations can no longer be of the points.
+    let victim = c.control[0].aerial[0].image_id.clone();
+    let row = c.nadir.iter_mut().find(|r| r.image_id == victim).unwrap();
+    row.z -= 1000.0;
+    let seen_by_victim = c
+        .control
+        .iter()
+        .flat_map(|cp| &cp.aerial)
+        .filter(|a| a.image_id == victim)
+        .count();
+    let r = run(&inputs(&c), &aerial_in_bundle()).unwrap();
+    assert_eq!(r.build.aerial_observations_skipped, seen_by_victim);
+    assert_eq!(
+        r.build.aerial_observations + seen_by_victim,
+        c.control.iter().map(|cp| cp.aerial.len()).sum::<usize>()
+    );
 }

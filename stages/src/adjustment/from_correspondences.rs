@@ -80,6 +80,8 @@ pub struct BuildCounts {
     /// Control points not used: a single aerial observation in the thesis scheme, or no usable point.
     pub control_unused: usize,
     pub aerial_observations: usize,
+    /// Aerial observations left out because the point's initial position is not in front of that camera.
+    pub aerial_observations_skipped: usize,
     pub relative_constraints: usize,
 }
 
@@ -340,7 +342,16 @@ pub fn build_block(
         }
         points[p].aerial.extend(aerial.iter().copied());
         if config.aerial_observations {
+            let initial = block.points_initial_world[p];
             for &(camera, u, v) in &aerial {
+                if FrameCamera::from_aerial(aerial_rows[camera])
+                    .project_world(&initial)
+                    .is_none()
+                {
+                    counts.aerial_observations_skipped += 1;
+                    continue;
+                }
+                counts.aerial_observations += 1;
                 block.aerial_observations.push(AerialImageObservation {
                     camera,
                     point: p,
@@ -349,7 +360,6 @@ pub fn build_block(
                     sigma_px: aerial_rows[camera].sigma_px,
                 });
             }
-            counts.aerial_observations += aerial.len();
             counts.control_as_aerial_observations += usize::from(!aerial.is_empty());
         } else if let Some(xyz) = cp.point_world.filter(|_| cp.aerial.len() >= 2) {
             let covariance_m2 = match config.control_weighting {

@@ -28,6 +28,7 @@ pub mod skyline;
 pub mod solver;
 pub mod synthetic_block;
 pub mod synthetic_campaign;
+pub mod trajectory_errors;
 pub mod verify;
 pub mod weighting;
 
