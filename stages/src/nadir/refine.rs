@@ -11,7 +11,9 @@
 //!    MM template exactly as ortho-projected, and both images then share orientation and pixel size, so only a
 //!    translation is left (the thesis: "only the translation elements are identified");
 //! 4. phase correlation on the normalised cross-power spectrum (windowed, eq. 3/1) → integer peak → sub-pixel
-//!    peak by a second-order fit (`matching::phase_correlation::locate_template`);
+//!    peak by a second-order fit (`matching::phase_correlation::locate_template`); then once more with the aerial
+//!    window re-sampled around the content found, so the final estimate is a near-zero shift (the tapers bias
+//!    large shifts by up to ~0.1 px);
 //! 5. weak peaks (below `min_peak`) and shifts beyond the margin are rejected; the corner, moved by the found
 //!    shift on the ortho grid, is mapped by the transform to an observation in ORIGINAL aerial pixel coordinates.
 
@@ -62,10 +64,14 @@ pub struct RefineParams {
     /// Taper of template and window before the FFT.
     pub window: TaperWindow,
     /// σ of the Gaussian low-pass on the cross-power spectrum, px (0 = none; see `PhaseCorrelationParams`).
+    /// 1.5 px: at 1.0 px a 32-px template of broadband texture occasionally locks onto a wrong peak (measured
+    /// ~10 px errors on noise-free synthetic texture); 1.5–2 px removes that at equal sub-pixel accuracy.
     pub lowpass_sigma_px: f64,
     /// Re-estimations with the window re-centred on the content found (removes the fixed-window bias).
     pub refinements: usize,
-    /// Smallest accepted correlation peak (1 = identical images; unrelated content gives ≲ 0.1).
+    /// Smallest accepted correlation peak (1 = identical images). Measured on the Tiny synthetic campaign with
+    /// a transform from the true poses (lowpass 1.5 px, 32 px): of the located observations, 44 % are within
+    /// 1 aerial px of the truth at peak ≥ 0.3, 75 % at ≥ 0.5, 90 % at ≥ 0.6, 95 % at ≥ 0.7.
     pub min_peak: f64,
     /// Smallest standard deviation of the template grey values (0..1 scale); flatter templates are skipped.
     pub min_template_std: f64,
@@ -75,11 +81,11 @@ impl Default for RefineParams {
     fn default() -> Self {
         Self {
             template_px: 32,
-            search_margin_px: 8,
+            search_margin_px: 12,
             window: TaperWindow::Hann,
-            lowpass_sigma_px: 1.0,
+            lowpass_sigma_px: 1.5,
             refinements: 3,
-            min_peak: 0.15,
+            min_peak: 0.5,
             min_template_std: 0.01,
         }
     }
@@ -309,24 +315,39 @@ pub fn refine_in_aerial(
             }
             let margin = p.search_margin_px as f64;
             let side = p.template_px + 2 * p.search_margin_px;
-            if !sample_aerial_on_ortho_grid(
-                aerial,
-                &tf,
-                x0 - margin,
-                y0 - margin,
-                side,
-                side,
-                &mut buf.search,
-            ) {
-                return Outcome::Rejected;
+            // Pass 1 searches around the prediction; pass 2 re-samples the aerial window centred on the content
+            // found (sub-pixel), so the final estimate is a near-zero shift, where phase correlation is least
+            // biased by the tapers.
+            let (mut dx, mut dy, mut peak) = (0.0f64, 0.0f64, 0.0f64);
+            for _pass in 0..2 {
+                if !sample_aerial_on_ortho_grid(
+                    aerial,
+                    &tf,
+                    x0 - margin + dx,
+                    y0 - margin + dy,
+                    side,
+                    side,
+                    &mut buf.search,
+                ) {
+                    return Outcome::Rejected;
+                }
+                let Ok(loc) = locate_template(&buf.template, &buf.search, &phase) else {
+                    return Outcome::Rejected;
+                };
+                // Template centre in ortho-grid coordinates, and where it was found.
+                let step_x = (x0 - margin + dx + loc.u_px) - (x0 + half) - dx;
+                let step_y = (y0 - margin + dy + loc.v_px) - (y0 + half) - dy;
+                dx += step_x;
+                dy += step_y;
+                peak = loc.peak;
+                if !(dx.abs() <= margin && dy.abs() <= margin) {
+                    return Outcome::Rejected;
+                }
+                if step_x.hypot(step_y) < 0.02 {
+                    break;
+                }
             }
-            let Ok(loc) = locate_template(&buf.template, &buf.search, &phase) else {
-                return Outcome::Rejected;
-            };
-            // Template centre in ortho-grid coordinates, and where it was found.
-            let dx = (x0 - margin + loc.u_px) - (x0 + half);
-            let dy = (y0 - margin + loc.v_px) - (y0 + half);
-            if !(loc.peak >= p.min_peak && dx.abs() <= margin && dy.abs() <= margin) {
+            if !(peak >= p.min_peak) {
                 return Outcome::Rejected;
             }
             let observed = tf.apply(&Vector2::new(u_o + dx, v_o + dy));
@@ -337,7 +358,7 @@ pub fn refine_in_aerial(
                     kind: AerialKind::Nadir,
                     u_px: observed.x,
                     v_px: observed.y,
-                    score: loc.peak,
+                    score: peak,
                 },
                 predicted_u_px: predicted.x,
                 predicted_v_px: predicted.y,
