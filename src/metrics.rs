@@ -4,9 +4,11 @@
 //!
 //! `metrics.json` schema: `{ "engine": { nodes_total, nodes_executed, nodes_cached, nodes_failed,
 //! nodes_skipped, seconds, warnings }, "stages": { <stage>: { executed, cached, failed, skipped, seconds } },
-//! <namespace>: { … contributed by nodes … } }`. In a sweep the top-level file holds the engine and stage
-//! counts of the whole (shared) graph plus `"variants": [names]`; each variant's file holds the counts of
-//! the nodes that variant uses and its contributed sections.
+//! <namespace>: { … contributed by nodes … } }`. In a sweep the top-level file holds ONLY the engine and
+//! stage counts of the whole (shared) graph plus `"variants": [names]` (no contributed sections: they differ
+//! per variant); each variant's file holds the counts of the nodes that variant uses (its `engine.seconds`
+//! and `engine.warnings` are those of the whole run) and its contributed sections. `sweep.csv` has one row per
+//! variant and one column per numeric leaf of the contributed sections (see [`sweep_csv`]).
 
 use crate::dag::{NodeReport, NodeStatus};
 use serde_json::{json, Map, Value};
@@ -121,17 +123,25 @@ pub fn add_sections<'a>(doc: &mut Value, sections: impl IntoIterator<Item = (&'a
     }
 }
 
-/// Numeric leaves of a JSON object as dotted paths (for sweep.csv columns).
+/// Numeric leaves of a JSON value as dotted paths (for sweep.csv columns): object members by key, array
+/// elements by index (`ortho.histogram.3`), booleans as 1/0; strings and nulls are not numeric and skipped.
 pub fn numeric_leaves(prefix: &str, v: &Value, out: &mut BTreeMap<String, f64>) {
+    let child = |k: &str| {
+        if prefix.is_empty() {
+            k.to_string()
+        } else {
+            format!("{prefix}.{k}")
+        }
+    };
     match v {
         Value::Object(m) => {
             for (k, x) in m {
-                let p = if prefix.is_empty() {
-                    k.clone()
-                } else {
-                    format!("{prefix}.{k}")
-                };
-                numeric_leaves(&p, x, out);
+                numeric_leaves(&child(k), x, out);
+            }
+        }
+        Value::Array(items) => {
+            for (i, x) in items.iter().enumerate() {
+                numeric_leaves(&child(&i.to_string()), x, out);
             }
         }
         Value::Number(n) => {
@@ -142,12 +152,38 @@ pub fn numeric_leaves(prefix: &str, v: &Value, out: &mut BTreeMap<String, f64>) 
         Value::Bool(b) => {
             out.insert(prefix.to_string(), if *b { 1.0 } else { 0.0 });
         }
-        _ => {}
+        Value::String(_) | Value::Null => {}
     }
 }
 
-/// `sweep.csv`: one row per variant, columns = `variant` + the union of the numeric leaves of each
-/// variant's contributed sections and engine counters (sorted).
+/// Orders dotted column names segment by segment, numeric segments (array indices) by value: `a.2` before
+/// `a.10`, `a.b` before `a.b.c` before `a.c`.
+fn column_order(a: &str, b: &str) -> std::cmp::Ordering {
+    let mut left = a.split('.');
+    let mut right = b.split('.');
+    loop {
+        match (left.next(), right.next()) {
+            (None, None) => return std::cmp::Ordering::Equal,
+            (None, Some(_)) => return std::cmp::Ordering::Less,
+            (Some(_), None) => return std::cmp::Ordering::Greater,
+            (Some(x), Some(y)) => {
+                let by_value = match (x.parse::<u64>(), y.parse::<u64>()) {
+                    (Ok(i), Ok(j)) => i.cmp(&j),
+                    _ => std::cmp::Ordering::Equal,
+                };
+                let order = by_value.then_with(|| x.cmp(y));
+                if order.is_ne() {
+                    return order;
+                }
+            }
+        }
+    }
+}
+
+/// `sweep.csv`: one row per variant (in the given order); columns = `variant`, then every numeric leaf
+/// ([`numeric_leaves`]) of any variant's document as a dotted path, in [`column_order`] (the same order for
+/// the same metrics, whichever variant has them). A variant lacking a metric has an empty cell. Values are
+/// written in Rust's shortest round-trip form (`3`, `0.25`, `1e-7`).
 pub fn sweep_csv(rows: &[(String, Value)]) -> String {
     let leaves: Vec<(String, BTreeMap<String, f64>)> = rows
         .iter()
@@ -158,7 +194,7 @@ pub fn sweep_csv(rows: &[(String, Value)]) -> String {
         })
         .collect();
     let mut columns: Vec<String> = leaves.iter().flat_map(|(_, m)| m.keys().cloned()).collect();
-    columns.sort();
+    columns.sort_by(|a, b| column_order(a, b));
     columns.dedup();
     let mut out = String::from("variant");
     for c in &columns {
@@ -209,6 +245,65 @@ mod tests {
         ];
         let csv = sweep_csv(&rows);
         assert_eq!(csv, "variant,toy.count,toy.sum,x.flag\na,2,3,\nb,,5.5,1\n");
+    }
+
+    #[test]
+    fn sweep_csv_flattens_arrays_and_orders_indices_by_value() {
+        let rows = vec![
+            (
+                "a".to_string(),
+                json!({"m": {"h": [0.5, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11], "n": null, "s": "text"},
+                       "adjust": {"sigma0": 1.25, "per_axis": {"x": 0.1, "y": [0.2]}}}),
+            ),
+            ("b,c".to_string(), json!({"m": {"h": [7]}})),
+        ];
+        let csv = sweep_csv(&rows);
+        let mut lines = csv.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let mut expected = vec![
+            "variant",
+            "adjust.per_axis.x",
+            "adjust.per_axis.y.0",
+            "adjust.sigma0",
+        ];
+        let h: Vec<String> = (0..12).map(|i| format!("m.h.{i}")).collect();
+        expected.extend(h.iter().map(String::as_str));
+        assert_eq!(header, expected);
+        assert_eq!(
+            lines.next().unwrap(),
+            "a,0.1,0.2,1.25,0.5,1,2,3,4,5,6,7,8,9,10,11"
+        );
+        // Names with commas are quoted; missing metrics are empty cells.
+        assert_eq!(lines.next().unwrap(), "\"b,c\",,,,7,,,,,,,,,,,");
+        assert!(lines.next().is_none());
+    }
+
+    #[test]
+    fn every_numeric_leaf_of_every_variant_is_a_column_with_its_value() {
+        let docs = [
+            json!({"campaign": {"recordings": 39, "name": "demo", "ok": true},
+                   "ortho": {"images": 39, "valid_fraction_mean": 0.8125}}),
+            json!({"campaign": {"recordings": 6}, "extra": {"list": [{"v": -1.5}]}}),
+        ];
+        let rows: Vec<(String, Value)> = docs
+            .iter()
+            .enumerate()
+            .map(|(i, d)| (format!("v{i}"), d.clone()))
+            .collect();
+        let csv = sweep_csv(&rows);
+        let table: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
+        for (row, doc) in table[1..].iter().zip(&docs) {
+            let mut leaves = BTreeMap::new();
+            numeric_leaves("", doc, &mut leaves);
+            for (path, value) in &leaves {
+                let col = table[0].iter().position(|c| c == path).unwrap();
+                assert_eq!(row[col].parse::<f64>().unwrap(), *value, "{path}");
+            }
+            let filled = row[1..].iter().filter(|c| !c.is_empty()).count();
+            assert_eq!(filled, leaves.len());
+        }
+        assert!(table[0].contains(&"extra.list.0.v") && table[0].contains(&"campaign.ok"));
+        assert!(!table[0].contains(&"campaign.name"));
     }
 
     #[test]

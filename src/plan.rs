@@ -1,7 +1,9 @@
 //! `skytie plan`: for each phase and stage, how many nodes are cached and how many will run, and WHY each
-//! node will run (new item, stage version bump, the param field that changed, the input that changed).
+//! node will run (new item, stage version bump, the param field that changed, the input that changed, or
+//! "failed last time: <error>" with what changed since that attempt).
 
-use crate::dag::{NodeStatus, PipelineError, Session};
+use crate::dag::record::{self, RecordedInput};
+use crate::dag::{NodeReport, NodeStatus, Phase, PipelineError, Session};
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
@@ -27,6 +29,36 @@ pub fn plan_counts(session: &Session<'_>) -> PlanCounts {
         }
     }
     c
+}
+
+/// Why `report` (a node of `phase` that will run) will run. The engine compares the node with its last
+/// SUCCESSFUL run; when the node failed since (a failure record exists), the plan says so instead:
+/// `failed last time: <error>`, then what changed since the failed attempt (nothing: it is retried as it
+/// was), and which upstream nodes will run.
+pub fn will_run_reasons(session: &Session<'_>, phase: &Phase, report: &NodeReport) -> Vec<String> {
+    let NodeStatus::WillRun { reasons } = &report.status else {
+        return Vec::new();
+    };
+    let Some(node) = phase.dag.nodes().get(report.id) else {
+        return reasons.clone();
+    };
+    let variant = node
+        .variants
+        .first()
+        .map(String::as_str)
+        .unwrap_or("default");
+    let Some(failure) = record::load_failure(session.store, &report.identity, variant) else {
+        return reasons.clone();
+    };
+    let upstream = |w: &String| w.starts_with("upstream will run");
+    let inputs: &[RecordedInput] = &report.inputs;
+    let mut why: Vec<String> =
+        record::failure_reasons(&failure, node.version, &node.params_json, inputs)
+            .into_iter()
+            .filter(|w| !upstream(w))
+            .collect();
+    why.extend(reasons.iter().filter(|w| upstream(w)).cloned());
+    why
 }
 
 /// The human-readable plan. `stopped` is the reason planning could not continue past the last phase.
@@ -60,9 +92,8 @@ pub fn plan_text(session: &Session<'_>, stopped: Option<&PipelineError>) -> Stri
                 }
             );
             for r in will_run.iter().take(MAX_LISTED_PER_STAGE) {
-                if let NodeStatus::WillRun { reasons } = &r.status {
-                    let _ = writeln!(out, "    {}: {}", r.identity, reasons.join("; "));
-                }
+                let reasons = will_run_reasons(session, phase, r);
+                let _ = writeln!(out, "    {}: {}", r.identity, reasons.join("; "));
             }
             if will_run.len() > MAX_LISTED_PER_STAGE {
                 let _ = writeln!(

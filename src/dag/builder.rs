@@ -5,6 +5,11 @@
 //! common prefix: built bottom-up, shared nodes merge and run once). The graph itself is a petgraph
 //! `DiGraph` (edge upstream → consumer); handles only refer to existing nodes, so insertion order is a
 //! topological order.
+//!
+//! A node's identity `stage[item]` names it in plans, records (`identity@variant`) and `explain`, so within one
+//! variant an identity must denote one node: adding the same `stage[item]` again in a variant that already
+//! has it with a different structure (params, version or inputs) is refused with an error naming the stage,
+//! the item and both variants. Variants of a sweep may of course hold different nodes of one identity.
 
 use crate::codec::encode_params;
 use crate::dag::inputs::{Handle, InputRef, InputSet, NodeId};
@@ -46,6 +51,8 @@ pub struct DagBuilder {
     nodes: Vec<Node>,
     graph: DiGraph<NodeId, ()>,
     by_structure: HashMap<[u8; 32], NodeId>,
+    /// (identity `stage[item]`, variant) → the node that identity denotes in that variant.
+    by_identity: HashMap<(String, String), NodeId>,
     variant: String,
     sinks: Vec<MetricsSink>,
 }
@@ -62,6 +69,7 @@ impl DagBuilder {
             nodes: Vec::new(),
             graph: DiGraph::new(),
             by_structure: HashMap::new(),
+            by_identity: HashMap::new(),
             variant: "default".to_string(),
             sinks: Vec::new(),
         }
@@ -101,11 +109,19 @@ impl DagBuilder {
             }
         }
         let structure = structural_hash(S::NAME, S::VERSION, item, &params_bytes, &refs);
-        if let Some(&id) = self.by_structure.get(&structure) {
+        let existing = self.by_structure.get(&structure).copied();
+        let identity_key = (identity_of(S::NAME, item), self.variant.clone());
+        if let Some(&other) = self.by_identity.get(&identity_key) {
+            if Some(other) != existing {
+                return Err(self.identity_clash(other, S::NAME, item, &params_json));
+            }
+        }
+        if let Some(id) = existing {
             let node = &mut self.nodes[id];
             if !node.variants.contains(&self.variant) {
                 node.variants.push(self.variant.clone());
             }
+            self.by_identity.insert(identity_key, id);
             return Ok(Handle::new(id));
         }
         let id = self.nodes.len();
@@ -139,7 +155,44 @@ impl DagBuilder {
             requested: false,
         });
         self.by_structure.insert(structure, id);
+        self.by_identity.insert(identity_key, id);
         Ok(Handle::new(id))
+    }
+
+    /// The error for a second, different node of identity `stage[item]` in the current variant; `other` is
+    /// the node the variant already has under that identity.
+    fn identity_clash(
+        &self,
+        other: NodeId,
+        stage: &str,
+        item: &str,
+        params_json: &serde_json::Value,
+    ) -> BuildError {
+        let first = &self.nodes[other];
+        let mut differences = Vec::new();
+        crate::dag::record::diff_json("", &first.params_json, params_json, &mut differences);
+        let what = if differences.is_empty() {
+            "same params but different inputs or stage version".to_string()
+        } else {
+            format!("params differ: {}", differences.join("; "))
+        };
+        BuildError {
+            message: format!(
+                "stage {stage}, item '{item}': node {} is added twice with different keys in variant '{}' \
+                 (first added for variant(s) {}, then again for variant '{}'; {what}); one identity may denote \
+                 only one node per variant: give the items distinct labels or build the node once and reuse \
+                 its handle",
+                identity_of(stage, item),
+                self.variant,
+                first
+                    .variants
+                    .iter()
+                    .map(|v| format!("'{v}'"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                self.variant,
+            ),
+        }
     }
 
     /// Keep this node's value after the run so `Outcome::get` can return it (it is loaded from the cache
@@ -182,6 +235,15 @@ impl DagBuilder {
             graph: self.graph,
             sinks: self.sinks,
         }
+    }
+}
+
+/// `stage[item]`, or `stage` for a global node (same as [`Node::identity`]).
+fn identity_of(stage: &str, item: &str) -> String {
+    if item.is_empty() {
+        stage.to_string()
+    } else {
+        format!("{stage}[{item}]")
     }
 }
 

@@ -2,7 +2,9 @@
 //! ingredients of its last successful run. `plan` compares a node's current ingredients with its record to
 //! say WHY it will run (new node, stage version bump, which param field changed, which input changed);
 //! `explain` prints the record as the node's provenance. A second record maps an output key to its content
-//! hash so an all-cached run need not read artifacts it does not use.
+//! hash so an all-cached run need not read artifacts it does not use. A third one keeps a node's last
+//! failure (error message and ingredients) until the node next succeeds, so `plan` can say "failed last
+//! time: <error>" instead of calling the node new.
 
 use crate::hashing::{ContentHash, NodeKey};
 use crate::store::Store;
@@ -12,6 +14,9 @@ use serde::{Deserialize, Serialize};
 pub const NODES_NS: &str = "nodes";
 /// Record namespace: key hex → output content hash (32 raw bytes).
 pub const OUTPUT_NS: &str = "outputs";
+/// Record namespace: node identity@variant → [`FailureRecord`] of its last failed run (JSON); removed when
+/// the node next succeeds.
+pub const FAILURES_NS: &str = "failures";
 
 /// One input as recorded: its label, where it came from (upstream identity or file path) and its hash.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -38,6 +43,42 @@ pub struct NodeRecord {
     pub skytie_version: String,
 }
 
+/// A node's last failed run: the error and the ingredients it failed with.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FailureRecord {
+    pub identity: String,
+    pub variant: String,
+    /// Key of the failed attempt (hex); empty when the node failed before its key was known (e.g. an input
+    /// file could not be read).
+    pub key: String,
+    pub stage_version: String,
+    pub params: serde_json::Value,
+    pub inputs: Vec<RecordedInput>,
+    /// The stage's error (or panic) message.
+    pub error: String,
+    /// When the failure was recorded, seconds since the Unix epoch.
+    pub recorded_unix_s: u64,
+    pub skytie_version: String,
+}
+
+impl FailureRecord {
+    /// The ingredients of the failed attempt as a [`NodeRecord`], to compare with through [`reasons`].
+    fn as_ingredients(&self) -> NodeRecord {
+        NodeRecord {
+            identity: self.identity.clone(),
+            variant: self.variant.clone(),
+            key: self.key.clone(),
+            stage_version: self.stage_version.clone(),
+            params: self.params.clone(),
+            inputs: self.inputs.clone(),
+            output_hash: String::new(),
+            seconds: 0.0,
+            recorded_unix_s: self.recorded_unix_s,
+            skytie_version: self.skytie_version.clone(),
+        }
+    }
+}
+
 /// Record name of a node identity in a variant.
 pub fn record_name(identity: &str, variant: &str) -> String {
     format!("{identity}@{variant}")
@@ -48,15 +89,97 @@ pub fn load_record(store: &Store, identity: &str, variant: &str) -> Option<NodeR
     serde_json::from_slice(&bytes).ok()
 }
 
+/// Saves the record of a successful run; a failure recorded for the node is removed (it succeeded since).
 pub fn save_record(store: &Store, record: &NodeRecord) -> Result<(), String> {
     let bytes = serde_json::to_vec(record).map_err(|e| e.to_string())?;
+    let name = record_name(&record.identity, &record.variant);
+    store
+        .put_record(NODES_NS, &name, &bytes)
+        .map_err(|e| e.to_string())?;
+    store
+        .remove_record(FAILURES_NS, &name)
+        .map(|_| ())
+        .map_err(|e| e.to_string())
+}
+
+pub fn load_failure(store: &Store, identity: &str, variant: &str) -> Option<FailureRecord> {
+    let bytes = store.get_record(FAILURES_NS, &record_name(identity, variant))?;
+    serde_json::from_slice(&bytes).ok()
+}
+
+pub fn save_failure(store: &Store, failure: &FailureRecord) -> Result<(), String> {
+    let bytes = serde_json::to_vec(failure).map_err(|e| e.to_string())?;
     store
         .put_record(
-            NODES_NS,
-            &record_name(&record.identity, &record.variant),
+            FAILURES_NS,
+            &record_name(&failure.identity, &failure.variant),
             &bytes,
         )
         .map_err(|e| e.to_string())
+}
+
+/// Records every FAILED node of an executed (run-mode) phase under its first variant, as node records are
+/// (nodes skipped because an upstream failed are not failures of their own). Returns the number recorded, or
+/// the first error.
+pub fn save_failures(
+    store: &Store,
+    dag: &crate::dag::Dag,
+    reports: &[crate::dag::NodeReport],
+) -> Result<usize, String> {
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs())
+        .unwrap_or(0);
+    let mut recorded = 0;
+    for report in reports {
+        let crate::dag::NodeStatus::Failed(error) = &report.status else {
+            continue;
+        };
+        let Some(node) = dag.nodes().get(report.id) else {
+            continue;
+        };
+        let failure = FailureRecord {
+            identity: report.identity.clone(),
+            variant: node
+                .variants
+                .first()
+                .cloned()
+                .unwrap_or_else(|| "default".to_string()),
+            key: report.key.map(|k| k.to_string()).unwrap_or_default(),
+            stage_version: node.version.to_string(),
+            params: node.params_json.clone(),
+            inputs: report.inputs.clone(),
+            error: error.clone(),
+            recorded_unix_s: now,
+            skytie_version: env!("CARGO_PKG_VERSION").to_string(),
+        };
+        save_failure(store, &failure)?;
+        recorded += 1;
+    }
+    Ok(recorded)
+}
+
+/// Why a node that FAILED last time will run: `failed last time: <error>`, then what changed since that
+/// attempt (nothing, when it is retried with the same ingredients). The error is cut to its first line.
+pub fn failure_reasons(
+    failure: &FailureRecord,
+    stage_version: &str,
+    params: &serde_json::Value,
+    inputs: &[RecordedInput],
+) -> Vec<String> {
+    let first_line = failure.error.lines().next().unwrap_or_default();
+    let mut why = vec![format!("failed last time: {first_line}")];
+    why.extend(
+        reasons(
+            Some(&failure.as_ingredients()),
+            stage_version,
+            params,
+            inputs,
+        )
+        .into_iter()
+        .filter(|w| !w.starts_with("same ingredients")),
+    );
+    why
 }
 
 pub fn load_output_hash(store: &Store, key: &NodeKey) -> Option<ContentHash> {

@@ -14,7 +14,9 @@ use std::io::{self, Read};
 
 use serde::{Deserialize, Serialize};
 
-use crate::hashing::{hash_bytes, ContentHash, NodeKey};
+use super::stream::HashingReader;
+use crate::codec::CodecError;
+use crate::hashing::{ContentHash, NodeKey};
 
 /// Version of the entry layout above; bump it when the layout changes (old entries are then discarded).
 pub const STORE_FORMAT_VERSION: u8 = 1;
@@ -216,12 +218,12 @@ pub(crate) fn read_header(file: &mut File, file_len: u64) -> Result<Header, Entr
     })
 }
 
-/// Reads the whole entry from the open `file`: header, then the payload with one read into a pre-sized buffer,
-/// and verifies the payload hash and that the entry belongs to `expected_key`.
-pub(crate) fn read_entry(
+/// Reads the header of the open entry `file` (see [`read_header`]) and checks that the entry belongs to
+/// `expected_key`; the file position is left at the start of the payload.
+pub(crate) fn read_checked_header(
     file: &mut File,
     expected_key: &NodeKey,
-) -> Result<(Header, Vec<u8>), EntryFault> {
+) -> Result<Header, EntryFault> {
     let file_len = file.metadata().map_err(EntryFault::Unreadable)?.len();
     let header = read_header(file, file_len)?;
     if header.key != *expected_key {
@@ -230,22 +232,70 @@ pub(crate) fn read_entry(
             header.key
         )));
     }
-    // The length was checked against the file size, so this allocation is bounded by the file.
-    let mut payload = vec![0u8; header.payload_len as usize];
-    read_exact_or_fault(file, &mut payload, "payload", file_len)?;
-    let actual = hash_bytes(&payload);
+    Ok(header)
+}
+
+/// Reads the entry in `file`: header (checked, see [`read_checked_header`]), then the payload through
+/// `decode(source, payload_len)`, each byte read once and hashed on the way. The value is returned only if
+/// the payload's hash matches the header. Bytes `decode` leaves unread are still read and hashed, so damage
+/// (reported as such) is told apart from a decoder that rejects intact bytes.
+pub(crate) fn read_entry_with<T>(
+    file: &mut File,
+    expected_key: &NodeKey,
+    decode: impl FnOnce(&mut dyn Read, u64) -> Result<T, CodecError>,
+) -> Result<(Header, T), EntryFault> {
+    let header = read_checked_header(file, expected_key)?;
+    let mut source = HashingReader::new(&mut *file, header.payload_len);
+    let decoded = decode(&mut source, header.payload_len);
+    if decoded.is_err() || source.remaining() > 0 {
+        source.drain();
+    }
+    if let Some(e) = source.error() {
+        return Err(EntryFault::Unreadable(io::Error::new(
+            e.kind(),
+            e.to_string(),
+        )));
+    }
+    if source.remaining() > 0 {
+        return Err(EntryFault::Damaged(format!(
+            "truncated while reading: {} payload bytes missing",
+            source.remaining()
+        )));
+    }
+    let actual = source.finish();
     if actual != header.payload_hash {
         return Err(EntryFault::Damaged(format!(
             "payload hash mismatch (recorded {}, content {actual}): bytes damaged",
             header.payload_hash
         )));
     }
-    Ok((header, payload))
+    match decoded {
+        Ok(value) => Ok((header, value)),
+        Err(e) => Err(EntryFault::Damaged(format!(
+            "intact but cannot be decoded: {e}"
+        ))),
+    }
+}
+
+/// Reads the whole entry from the open `file` into memory and verifies it (see [`read_entry_with`]).
+#[cfg(test)]
+pub(crate) fn read_entry(
+    file: &mut File,
+    expected_key: &NodeKey,
+) -> Result<(Header, Vec<u8>), EntryFault> {
+    read_entry_with(file, expected_key, |source, len| {
+        let mut payload = vec![0u8; len as usize];
+        source
+            .read_exact(&mut payload)
+            .map_err(|e| CodecError(e.to_string()))?;
+        Ok(payload)
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::hashing::hash_bytes;
     use std::io::Write;
 
     fn write_entry(dir: &std::path::Path, key: &NodeKey, payload: &[u8]) -> std::path::PathBuf {

@@ -14,11 +14,12 @@ mod lease;
 mod objects;
 mod records;
 mod stats;
+mod stream;
 mod verify;
 
 use std::collections::HashSet;
 use std::fs::{self, File};
-use std::io::{self, Write};
+use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
@@ -31,8 +32,10 @@ pub use lease::{LiveRun, RunLease};
 pub use stats::{StageStats, StoreStats};
 pub use verify::{BadEntry, VerifyReport};
 
-use crate::hashing::{hash_bytes, ContentHash, NodeKey};
+use crate::codec::CodecError;
+use crate::hashing::{ContentHash, NodeKey};
 use entry::EntryFault;
+use stream::HashingWriter;
 
 /// A verified cache entry.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -51,6 +54,23 @@ pub enum Lookup {
     /// No entry: compute the node.
     Miss,
     /// The entry was damaged or unreadable: it has been deleted; show `message` once and compute the node.
+    Corrupt { message: String },
+}
+
+/// Result of [`Store::load_with`]: like [`Lookup`], with the payload decoded while it was read.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Loaded<T> {
+    /// A verified entry, decoded.
+    Hit {
+        value: T,
+        meta: EntryMeta,
+        /// blake3 of the payload (verified).
+        content_hash: ContentHash,
+    },
+    /// No entry: compute the node.
+    Miss,
+    /// The entry was damaged, unreadable or undecodable: it has been deleted; show `message` once and
+    /// compute the node.
     Corrupt { message: String },
 }
 
@@ -102,10 +122,46 @@ impl Store {
     /// one per handle is reported, later ones are plain misses. A hit marks the entry as used now. `Err` only
     /// when the entry cannot even be opened for a reason that is not its own (e.g. too many open files).
     pub fn load(&self, key: &NodeKey) -> Result<Lookup, StoreError> {
+        let loaded = self.load_with(key, |source, len| {
+            let len = usize::try_from(len).map_err(|_| {
+                CodecError(format!("a payload of {len} bytes does not fit in memory"))
+            })?;
+            let mut payload = vec![0u8; len];
+            source
+                .read_exact(&mut payload)
+                .map_err(|e| CodecError(format!("cannot read the payload: {e}")))?;
+            Ok(payload)
+        })?;
+        Ok(match loaded {
+            Loaded::Hit {
+                value,
+                meta,
+                content_hash,
+            } => Lookup::Hit(Entry {
+                meta,
+                payload: value,
+                content_hash,
+            }),
+            Loaded::Miss => Lookup::Miss,
+            Loaded::Corrupt { message } => Lookup::Corrupt { message },
+        })
+    }
+
+    /// Looks up the artifact of `key` and decodes it while reading: `decode(source, len)` receives the payload
+    /// as a stream of `len` bytes (e.g. [`Artifact::decode_from`](crate::codec::Artifact::decode_from)); each
+    /// byte is read from the file once and hashed on the way. The value is returned only if the whole payload
+    /// matches its recorded hash; a damaged, truncated or unreadable entry, or one `decode` rejects, is
+    /// reported once as [`Loaded::Corrupt`] and deleted, exactly as in [`Store::load`] (whose checks this
+    /// shares). A hit marks the entry as used now.
+    pub fn load_with<T>(
+        &self,
+        key: &NodeKey,
+        decode: impl FnOnce(&mut dyn Read, u64) -> Result<T, CodecError>,
+    ) -> Result<Loaded<T>, StoreError> {
         let path = self.object_path(key);
         let mut file = match File::open(&path) {
             Ok(f) => f,
-            Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Lookup::Miss),
+            Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Loaded::Miss),
             // The entry itself is unusable: report and remove it.
             Err(e)
                 if matches!(
@@ -118,22 +174,22 @@ impl Store {
             // Not the entry's fault (e.g. too many open files): keep it, report the failure.
             Err(e) => return Err(StoreError::io("open cache entry", &path)(e)),
         };
-        match entry::read_entry(&mut file, key) {
-            Ok((header, payload)) => {
+        match entry::read_entry_with(&mut file, key, decode) {
+            Ok((header, value)) => {
                 // Last-use time for LRU gc and live-run protection; failure only weakens gc ordering.
                 let _ = file.set_modified(SystemTime::now());
-                Ok(Lookup::Hit(Entry {
+                Ok(Loaded::Hit {
+                    value,
                     meta: header.meta,
-                    payload,
                     content_hash: header.payload_hash,
-                }))
+                })
             }
             Err(EntryFault::OtherFormat(version)) => {
                 objects::remove_if_same(&path, &file);
                 if self.other_format_noticed.swap(true, Ordering::Relaxed) {
-                    Ok(Lookup::Miss)
+                    Ok(Loaded::Miss)
                 } else {
-                    Ok(Lookup::Corrupt {
+                    Ok(Loaded::Corrupt {
                         message: format!(
                             "cache entry {key} ({}) was written by store format version {version}, this skytie uses \
                              version {STORE_FORMAT_VERSION}: entries of other formats are discarded and recomputed \
@@ -150,21 +206,27 @@ impl Store {
         }
     }
 
-    fn corrupt(&self, key: &NodeKey, path: &Path, opened: Option<&File>, reason: &str) -> Lookup {
+    fn corrupt<T>(
+        &self,
+        key: &NodeKey,
+        path: &Path,
+        opened: Option<&File>,
+        reason: &str,
+    ) -> Loaded<T> {
         let removed = match opened {
             Some(file) => objects::remove_if_same(path, file),
             None => fs::remove_file(path).is_ok(),
         };
         let mut reported = self.reported.lock().unwrap_or_else(|p| p.into_inner());
         if !removed && !reported.insert(*key) {
-            return Lookup::Miss;
+            return Loaded::Miss;
         }
         let action = if removed {
             "deleted"
         } else {
             "could not be deleted, ignored"
         };
-        Lookup::Corrupt {
+        Loaded::Corrupt {
             message: format!(
                 "cache entry {key} ({}) is corrupt: {reason}; {action}, the node will be recomputed",
                 path.display()
@@ -180,17 +242,41 @@ impl Store {
         meta: &EntryMeta,
         payload: &[u8],
     ) -> Result<ContentHash, StoreError> {
+        self.save_with(key, meta, |sink| sink.write_all(payload))
+    }
+
+    /// Atomically stores the payload that `encode` writes to its sink (e.g.
+    /// [`Artifact::encode_to`](crate::codec::Artifact::encode_to)) as the entry of `key`, without building it
+    /// in memory first: the bytes go straight to a temporary file and are hashed on the way; the header
+    /// (length and hash) is written over its placeholder at the end, then the file is fsynced and renamed into
+    /// place. Returns the payload's content hash. An error of `encode` leaves no entry.
+    pub fn save_with(
+        &self,
+        key: &NodeKey,
+        meta: &EntryMeta,
+        encode: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+    ) -> Result<ContentHash, StoreError> {
         let meta_block = entry::encode_meta(meta).map_err(|len| StoreError::MetaTooLarge {
             key: key.to_string(),
             len,
             max: entry::MAX_META_BYTES,
         })?;
-        let content_hash = hash_bytes(payload);
-        let header = entry::encode_header(key, &meta_block, payload.len() as u64, &content_hash);
+        // Same length as the final header: only the length, hash and check fields change.
+        let placeholder = entry::encode_header(key, &meta_block, 0, &ContentHash::default());
         let path = self.object_path(key);
+        let mut content_hash = ContentHash::default();
         skytie_stages::fsutil::atomic_write_with(&path, |w| {
-            w.write_all(&header)?;
-            w.write_all(payload)
+            w.write_all(&placeholder)?;
+            let mut sink = HashingWriter::new(&mut *w);
+            encode(&mut sink)?;
+            let (payload_len, hash) = sink.finish();
+            content_hash = hash;
+            w.flush()?;
+            let header = entry::encode_header(key, &meta_block, payload_len, &hash);
+            let file = w.get_mut();
+            file.seek(SeekFrom::Start(0))?;
+            file.write_all(&header)?;
+            file.seek(SeekFrom::End(0)).map(|_| ())
         })
         .map_err(StoreError::io("write cache entry", &path))?;
         Ok(content_hash)
@@ -227,6 +313,11 @@ impl Store {
     /// The record stored under (`namespace`, `name`); `None` if absent, unreadable or corrupt.
     pub fn get_record(&self, namespace: &str, name: &str) -> Option<Vec<u8>> {
         records::get(&self.records, namespace, name)
+    }
+
+    /// Removes the record (`namespace`, `name`) if there is one; returns whether there was.
+    pub fn remove_record(&self, namespace: &str, name: &str) -> Result<bool, StoreError> {
+        records::remove(&self.records, namespace, name)
     }
 
     /// Registers this process as a live run until the returned lease is dropped. Entries it loads or saves are

@@ -2,7 +2,8 @@
 //! `<root>/records/<namespace>/<blake3(name) hex>`.
 //!
 //! Layout: `"SKYREC\0"` · version (u8) · name length (u32) · name · payload length (u64) · payload blake3 (32)
-//! · payload. A record that fails any check reads as absent (and is replaced by the next `put`).
+//! · payload. A record that fails any check reads as absent (and is replaced by the next `put`). Records can
+//! be removed (`remove`).
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -74,4 +75,14 @@ pub(crate) fn get(records: &Path, namespace: &str, name: &str) -> Option<Vec<u8>
     // A corrupt record is left in place (a concurrent `put` may be replacing it right now); the next `put`
     // overwrites it.
     parse(&file, name).map(<[u8]>::to_vec)
+}
+
+/// Removes the record (`namespace`, `name`); returns whether there was one.
+pub(crate) fn remove(records: &Path, namespace: &str, name: &str) -> Result<bool, StoreError> {
+    let path = record_path(records, namespace, name)?;
+    match fs::remove_file(&path) {
+        Ok(()) => Ok(true),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(false),
+        Err(e) => Err(StoreError::io("remove record", &path)(e)),
+    }
 }

@@ -1,5 +1,5 @@
-//! `Store::verify`: re-reads and re-hashes every entry (in parallel, results in key order), removes the bad
-//! ones and lists them.
+//! `Store::verify`: re-reads and re-hashes every entry (in parallel, results in key order, streaming each
+//! payload through the hash so memory stays small), removes the bad ones and lists them.
 
 use std::fs::File;
 use std::path::PathBuf;
@@ -58,7 +58,8 @@ pub(crate) fn run(store: &Store) -> Result<VerifyReport, StoreError> {
                     return Some(BadEntry { key: object.key, path: object.path.clone(), reason, removed });
                 }
             };
-            let reason = match entry::read_entry(&mut file, &object.key) {
+            // Streamed: every payload byte is read and hashed in blocks, nothing is kept in memory.
+            let reason = match entry::read_entry_with(&mut file, &object.key, |_, _| Ok(())) {
                 Ok(_) => return None,
                 Err(EntryFault::Damaged(reason)) => reason,
                 Err(EntryFault::Unreadable(e)) => format!("read error: {e}"),
