@@ -1,21 +1,24 @@
 #!/usr/bin/env python3
-"""Peer comparison of skytie's phase correlation with OpenCV and scikit-image on identical PNG pairs.
+"""Peer comparison of skytie's phase correlation with OpenCV and scikit-image on IDENTICAL 8-bit PNG pairs.
 
-Setup (never part of the test path):
-    python3 -m venv /tmp/peers && /tmp/peers/bin/pip install opencv-python-headless scikit-image numpy
-    SKYTIE_PEER_DIR=/tmp/pc_pairs cargo bench -p skytie-stages --bench imaging
-    /tmp/peers/bin/python benches/peers/phasecorr.py /tmp/pc_pairs
+Setup (never part of the test path; see benches/README.md):
+    python3 -m venv /tmp/peers && /tmp/peers/bin/pip install opencv-contrib-python-headless scikit-image numpy
+    cargo bench -p skytie-stages --bench phasecorr          # writes <temp>/skytie_peers/phasecorr/
+    /tmp/peers/bin/python benches/peers/phasecorr.py [<temp>/skytie_peers/phasecorr]
 
 The bench writes `pc{size}_{k}_ref.png` / `_mov.png` (moving = reference translated by +t, an exact Fourier
-shift of a band-limited texture, then gain/offset/gamma and noise) and `truth_{size}.csv` with t and skytie's
-estimate on the same 8-bit PNGs. Conventions: OpenCV `phaseCorrelate` returns +t as (x, y); skimage
-`phase_cross_correlation` returns the shift registering moving onto reference, i.e. -t as (row, col).
-Prints RMS error (px) and mean time per call (ms) per method and size.
+shift of a band-limited texture, then gain/offset/gamma and noise), `truth_{size}.csv` (t and skytie's estimate
+on the same PNGs) and `skytie_{size}.csv` (skytie's time per call, thread CPU time). Conventions: OpenCV
+`phaseCorrelate` returns +t as (x, y); skimage `phase_cross_correlation` returns the shift registering moving
+onto reference, i.e. -t as (row, col). Peers are timed the same way (median over rounds of the mean thread CPU
+time per call, 1 OpenCV thread), inputs converted to float64 beforehand. Prints RMS error (px), ms per call and
+the ratio skytie / peer of the times.
 """
 import csv
 import glob
 import os
 import sys
+import tempfile
 import time
 
 import cv2
@@ -24,35 +27,65 @@ from skimage.registration import phase_cross_correlation
 
 
 def load(path):
-    return cv2.imread(path, cv2.IMREAD_GRAYSCALE).astype(np.float64) / 255.0
+    img = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
+    if img is None:
+        sys.exit(f"cannot read {path}: run the Rust bench first (see the docstring)")
+    return img.astype(np.float64) / 255.0
+
+
+def median_ms_per_call(pairs, call, rounds):
+    """Median over rounds of the mean thread CPU time per call, in ms."""
+    samples = []
+    for _ in range(rounds):
+        t0 = time.thread_time_ns()
+        for a, b in pairs:
+            call(a, b)
+        samples.append((time.thread_time_ns() - t0) * 1e-6 / len(pairs))
+    return float(np.median(samples))
 
 
 def main(folder):
-    for truth_path in sorted(glob.glob(os.path.join(folder, "truth_*.csv"))):
+    cv2.setNumThreads(1)
+    rows_out = []
+    for truth_path in sorted(glob.glob(os.path.join(folder, "truth_*.csv")),
+                             key=lambda p: int(os.path.basename(p)[6:-4])):
+        size = int(os.path.basename(truth_path)[len("truth_"):-len(".csv")])
         rows = list(csv.DictReader(open(truth_path)))
-        errors = {"skytie": [], "opencv (hann)": [], "skimage (upsample 100)": []}
-        times = {"opencv (hann)": 0.0, "skimage (upsample 100)": 0.0}
-        for row in rows:
-            a = load(os.path.join(folder, row["reference"]))
-            b = load(os.path.join(folder, row["moving"]))
-            tx, ty = float(row["tx_px"]), float(row["ty_px"])
-            errors["skytie"].append(np.hypot(float(row["skytie_dx_px"]) - tx, float(row["skytie_dy_px"]) - ty))
-            win = cv2.createHanningWindow(a.shape[::-1], cv2.CV_64F)
-            t0 = time.perf_counter()
-            (dx, dy), _ = cv2.phaseCorrelate(a, b, win)
-            times["opencv (hann)"] += time.perf_counter() - t0
-            errors["opencv (hann)"].append(np.hypot(dx - tx, dy - ty))
-            t0 = time.perf_counter()
-            shift, _, _ = phase_cross_correlation(a, b, upsample_factor=100)
-            times["skimage (upsample 100)"] += time.perf_counter() - t0
-            errors["skimage (upsample 100)"].append(np.hypot(-shift[1] - tx, -shift[0] - ty))
-        size = os.path.basename(truth_path)[len("truth_"):-len(".csv")]
-        for name, errs in errors.items():
-            rms = float(np.sqrt(np.mean(np.square(errs))))
-            t = times.get(name)
-            t_txt = f"{1e3 * t / len(rows):.3f} ms/call" if t is not None else "(time: see the Rust bench)"
-            print(f"{size}x{size} {name:>24}: RMS error {rms:.4f} px over {len(rows)} pairs, {t_txt}")
+        pairs = [(load(os.path.join(folder, r["reference"])), load(os.path.join(folder, r["moving"])))
+                 for r in rows]
+        truth = np.array([[float(r["tx_px"]), float(r["ty_px"])] for r in rows])
+        sky = np.array([[float(r["skytie_dx_px"]), float(r["skytie_dy_px"])] for r in rows])
+        sky_times = {r["method"]: (float(r["rms_px"]), float(r["ms_per_call"]))
+                     for r in csv.DictReader(open(os.path.join(folder, f"skytie_{size}.csv")))}
+        sky_ms = sky_times["skytie PhaseCorrelator (default)"][1]
+        sky_free_ms = sky_times["skytie phase_correlate (default)"][1]
+        win = cv2.createHanningWindow((size, size), cv2.CV_64F)
+
+        peers = {
+            "cv2.phaseCorrelate (hann)": lambda a, b: cv2.phaseCorrelate(a, b, win)[0],
+            "cv2.phaseCorrelate (none)": lambda a, b: cv2.phaseCorrelate(a, b)[0],
+            "skimage (upsample 1)": lambda a, b: tuple(-phase_cross_correlation(a, b)[0][::-1]),
+            "skimage (upsample 100)": lambda a, b: tuple(
+                -phase_cross_correlation(a, b, upsample_factor=100)[0][::-1]),
+        }
+        rounds = 20 if size >= 128 else 50
+        rms = float(np.sqrt(np.mean(np.sum((sky - truth) ** 2, axis=1))))
+        rows_out.append((size, "skytie phase_correlate (default)", rms, sky_free_ms, None))
+        rows_out.append((size, "skytie PhaseCorrelator (default)", rms, sky_ms, None))
+        for name, call in peers.items():
+            est = np.array([call(a, b) for a, b in pairs], dtype=np.float64)
+            err = float(np.sqrt(np.mean(np.sum((est - truth) ** 2, axis=1))))
+            ms = median_ms_per_call(pairs, call, rounds)
+            rows_out.append((size, name, err, ms, sky_ms / ms))
+
+    print(f"{'size':>7} | {'method':<33} | {'RMS err px':>10} | {'ms/call':>8} | {'skytie/peer time':>16}")
+    print("-" * 88)
+    for size, name, err, ms, ratio in rows_out:
+        r = f"{ratio:.2f}x" if ratio is not None else ""
+        print(f"{size:>3}x{size:<3} | {name:<33} | {err:>10.4f} | {ms:>8.4f} | {r:>16}")
+    print("times: thread CPU time; skytie/peer uses the reused PhaseCorrelator (default, up to 4 passes)")
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "/tmp/pc_pairs")
+    default = os.path.join(tempfile.gettempdir(), "skytie_peers", "phasecorr")
+    main(sys.argv[1] if len(sys.argv) > 1 else default)

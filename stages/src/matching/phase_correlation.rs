@@ -160,8 +160,8 @@ pub struct PhaseCorrelator {
     ref_spectrum: Vec<Cplx>,
     spectrum: Vec<Cplx>,
     surface: Vec<Real>,
-    window_x: Vec<f64>,
-    window_y: Vec<f64>,
+    window_x: WindowTable,
+    window_y: WindowTable,
 }
 
 impl PhaseCorrelator {
@@ -208,8 +208,8 @@ impl PhaseCorrelator {
             ref_spectrum: vec![zero; fft.spectrum_len()],
             spectrum: vec![zero; fft.spectrum_len()],
             surface: vec![0.0; pw * ph],
-            window_x: Vec::with_capacity(width),
-            window_y: Vec::with_capacity(height),
+            window_x: WindowTable::with_capacity(width),
+            window_y: WindowTable::with_capacity(height),
             fft,
         })
     }
@@ -369,28 +369,19 @@ impl PhaseCorrelator {
     /// Writes the windowed copy of `img` with the window-weighted mean removed at (x0, y0) into the zeroed FFT
     /// canvas.
     fn load(&mut self, img: &GrayImage, taper: Taper, x0: usize, y0: usize) {
-        fill_window(
-            &mut self.window_x,
-            img.width,
-            taper.kind,
-            taper.size.0,
-            taper.origin.0,
-        );
-        fill_window(
-            &mut self.window_y,
-            img.height,
-            taper.kind,
-            taper.size.1,
-            taper.origin.1,
-        );
-        let sum_w: f64 = self.window_x.iter().sum::<f64>() * self.window_y.iter().sum::<f64>();
+        self.window_x
+            .fill(img.width, taper.kind, taper.size.0, taper.origin.0);
+        self.window_y
+            .fill(img.height, taper.kind, taper.size.1, taper.origin.1);
+        let (wx, wy) = (&self.window_x.values, &self.window_y.values);
+        let sum_w: f64 = wx.iter().sum::<f64>() * wy.iter().sum::<f64>();
         let mut sum_wg = 0.0f64;
-        for (row, &ky) in self.window_y.iter().enumerate() {
+        for (row, &ky) in wy.iter().enumerate() {
             if ky != 0.0 {
                 let s: f64 = img
                     .row(row)
                     .iter()
-                    .zip(&self.window_x)
+                    .zip(wx)
                     .map(|(&g, &kx)| kx * g as f64)
                     .sum();
                 sum_wg += ky * s;
@@ -398,12 +389,12 @@ impl PhaseCorrelator {
         }
         let mean = if sum_w > 0.0 { sum_wg / sum_w } else { 0.0 };
         self.fft.clear_input();
-        for (row, &ky) in self.window_y.iter().enumerate() {
+        for (row, &ky) in wy.iter().enumerate() {
             if ky != 0.0 {
                 let values = img
                     .row(row)
                     .iter()
-                    .zip(&self.window_x)
+                    .zip(wx)
                     .map(|(&s, &kx)| ((s as f64 - mean) * kx * ky) as Real);
                 self.fft.set_row(y0 + row, x0, values);
             }
@@ -411,29 +402,49 @@ impl PhaseCorrelator {
     }
 
     /// `spectrum ← F_mov·conj(F_ref) / |F_mov·conj(F_ref)| · low-pass` (thesis eq. 3/1), bins whose magnitude is
-    /// below 1e-12 of the largest set to 0.
+    /// not above 1e-12 of the largest set to 0. Magnitudes via `sqrt(re² + im²)` (no `hypot`: the spectra are
+    /// far from overflow, and `hypot` dominated the run time).
     fn normalised_cross_power(&mut self) {
         let mut max_sq: Real = 0.0;
         for (m, r) in self.spectrum.iter_mut().zip(&self.ref_spectrum) {
             *m *= r.conj();
             max_sq = max_sq.max(m.norm_sqr());
         }
-        let floor = (max_sq.sqrt() * 1e-12).max(Real::MIN_POSITIVE);
+        let floor = max_sq.sqrt() * 1e-12;
+        let floor_sq = floor * floor;
+        // Branch-free select so that the loop vectorises.
         for (m, &weight) in self.spectrum.iter_mut().zip(&self.lowpass) {
-            let mag = m.norm();
-            *m = if mag > floor {
-                *m * (weight / mag)
-            } else {
-                Complex::new(0.0, 0.0)
-            };
+            let mag_sq = m.norm_sqr();
+            let scale = weight / mag_sq.sqrt();
+            *m *= if mag_sq > floor_sq { scale } else { 0.0 };
         }
     }
 }
 
-/// `out[c] = window(c − origin)` for `c ∈ [0, n)` (0 outside the window).
-fn fill_window(out: &mut Vec<f64>, n: usize, kind: WindowKind, size: usize, origin: f64) {
-    out.clear();
-    out.extend((0..n).map(|c| window_value(kind, size, c as f64 - origin)));
+/// A 1-D window table `values[c] = window(c − origin)`, `c ∈ [0, n)` (0 outside the window), remembering what it
+/// was filled for so that an unchanged taper costs no cosines.
+struct WindowTable {
+    values: Vec<f64>,
+    key: Option<(usize, WindowKind, usize, u64)>,
+}
+
+impl WindowTable {
+    fn with_capacity(n: usize) -> Self {
+        Self {
+            values: Vec::with_capacity(n),
+            key: None,
+        }
+    }
+
+    fn fill(&mut self, n: usize, kind: WindowKind, size: usize, origin: f64) {
+        let key = Some((n, kind, size, origin.to_bits()));
+        if self.key != key {
+            self.values.clear();
+            self.values
+                .extend((0..n).map(|c| window_value(kind, size, c as f64 - origin)));
+            self.key = key;
+        }
+    }
 }
 
 /// Integer peak (first maximum in raster order) and its sub-pixel refinement, wrapped to `[−N/2, N/2)`.
