@@ -27,7 +27,7 @@ import numpy as np
 def kaze_create():
     mod = cv2.xfeatures2d if hasattr(cv2, "xfeatures2d") and hasattr(cv2.xfeatures2d, "KAZE_create") else cv2
     return mod.KAZE_create(extended=True, upright=True, threshold=0.001, nOctaves=1, nOctaveLayers=4,
-                           diffusivity=cv2.KAZE_DIFF_PM_G2)
+                           diffusivity=getattr(mod, "KAZE_DIFF_PM_G2", getattr(cv2, "KAZE_DIFF_PM_G2", 1)))
 
 
 def detect(img, threads):
