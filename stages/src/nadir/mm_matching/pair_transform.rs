@@ -1,7 +1,7 @@
 //! The transform between two adjacent ortho images (thesis 3.4.4.2–3.4.4.3): KAZE matches (ratio + mutual),
 //! filtered by the recorded poses' prediction, RANSAC homography, verified by mapping the detecting image's
 //! centre and comparing its distance to the neighbour's centre with the recorded inter-pose distance
-//! (30 cm). If any step fails the recorded poses relate the images instead (ortho pixel → ground → ortho
+//! (30 cm) and by requiring it to stay close to a translation over the corner area. If any step fails the recorded poses relate the images instead (ortho pixel → ground → ortho
 //! pixel), and the reason is kept for the report.
 
 use super::params::MmMatchParams;
@@ -69,6 +69,33 @@ pub fn centre_check_error_m(h: &Homography, a: &OrthoView, b: &OrthoView) -> Opt
     ))?;
     let d_px = (c.x - gb.width_px as f64 / 2.0).hypot(c.y - gb.height_px as f64 / 2.0);
     Some((d_px * gb.gsd_m - recorded_distance_m(a, b)).abs())
+}
+
+/// How far the homography departs from a pure translation within `radius_m` of the detecting centre, m:
+/// max over four points at that radius of |(H(q) − H(c)) − (P(q) − P(c))|, P = the pose transfer (which
+/// carries the common rotation and scale). Adjacent north-up orthos share rotation and, nearly, scale
+/// (thesis 3.4.4.2), so a valid homography is close to a translation there; a strongly projective one is an
+/// extrapolation from keypoints in one part of the image. `None` if a point maps to infinity.
+pub fn homography_distortion_m(
+    h: &Homography,
+    a: &OrthoView,
+    b: &OrthoView,
+    radius_m: f64,
+) -> Option<f64> {
+    let (ga, gb) = (&a.ortho.georef, &b.ortho.georef);
+    let (cu, cv) = (ga.width_px as f64 / 2.0, ga.height_px as f64 / 2.0);
+    let r_px = radius_m / ga.gsd_m;
+    let hc = h.apply(&Vector2::new(cu, cv))?;
+    let pc = poses_transfer(ga, gb, cu, cv);
+    let mut worst: f64 = 0.0;
+    for (du, dv) in [(r_px, 0.0), (-r_px, 0.0), (0.0, r_px), (0.0, -r_px)] {
+        let hq = h.apply(&Vector2::new(cu + du, cv + dv))?;
+        let pq = poses_transfer(ga, gb, cu + du, cv + dv);
+        let ex = (hq.x - hc.x) - (pq.0 - pc.0);
+        let ey = (hq.y - hc.y) - (pq.1 - pc.1);
+        worst = worst.max(ex.hypot(ey) * gb.gsd_m);
+    }
+    Some(worst)
 }
 
 fn fallback(reason: String, matches: usize, inliers: usize, centre: Option<f64>) -> PairEstimate {
@@ -185,6 +212,28 @@ pub fn estimate_pair(
                 "centre check failed: |projected − recorded distance| = {err:.3} m > {:.3} m",
                 p.verify_tolerance_m
             ),
+            n,
+            inliers,
+            Some(err),
+        );
+    }
+    if let Some(distortion_m) =
+        homography_distortion_m(&result.model, det, nb, p.max_corner_distance_m)
+    {
+        if distortion_m > p.max_homography_distortion_m {
+            return fallback(
+                format!(
+                    "homography is not near a translation: {distortion_m:.3} m off at {:.1} m from the centre > {:.3} m",
+                    p.max_corner_distance_m, p.max_homography_distortion_m
+                ),
+                n,
+                inliers,
+                Some(err),
+            );
+        }
+    } else {
+        return fallback(
+            "the homography maps part of the corner area to infinity".into(),
             n,
             inliers,
             Some(err),
