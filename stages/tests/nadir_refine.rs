@@ -726,8 +726,12 @@ mod e2e {
                 let mut ground_world = Vec::new();
                 let mut truth_points = Vec::new();
                 for c in &corners {
-                    let (col, row) = (c.u_px as usize, c.v_px as usize);
-                    if fine.valid[row * fine.image.width + col] == 0 {
+                    let (col, row) = (c.u_px.floor() as isize, c.v_px.floor() as isize);
+                    let (w, h) = (fine.image.width as isize, fine.image.height as isize);
+                    if col < 0 || row < 0 || col >= w || row >= h {
+                        continue;
+                    }
+                    if fine.valid[(row * w + col) as usize] == 0 {
                         continue;
                     }
                     let g = fine.georef.pixel_to_world(c.u_px, c.v_px);
