@@ -154,3 +154,48 @@ fn template_is_located_in_a_larger_search_window() {
     let rms = (sum_sq / n as f64).sqrt();
     assert!(rms < 0.1, "RMS {rms:.4} px");
 }
+
+#[test]
+fn reused_correlator_gives_the_free_functions_results() {
+    use skytie_stages::matching::phase_correlation::{PhaseCorrelationError, PhaseCorrelator};
+    let tex = Texture::new(256, 64, 6);
+    let p = PhaseCorrelationParams::default();
+    let mut c = PhaseCorrelator::new(64, 64, p).unwrap();
+    // Several different pairs through one correlator: no state leaks from one call into the next.
+    for (k, (tx, ty)) in [(1.3, -0.7), (-2.6, 3.1), (0.4, 0.2)]
+        .into_iter()
+        .enumerate()
+    {
+        let x0 = 30.0 * k as f64;
+        let a = tex.render(64, 64, x0, 40.0, 0.0, 0.0);
+        let b = tex.render(64, 64, x0, 40.0, tx, ty);
+        let reused = c.correlate(&a, &b).unwrap();
+        assert_eq!(reused, phase_correlate(&a, &b, &p).unwrap());
+        assert!(
+            (reused.dx_px - tx).abs() < 0.05 && (reused.dy_px - ty).abs() < 0.05,
+            "{reused:?} vs ({tx}, {ty})"
+        );
+    }
+    // Template location through a correlator sized for the search window.
+    let search = tex.render(48, 48, 100.0, 80.0, 0.0, 0.0);
+    let template = tex.render(24, 24, 112.0, 92.0, -0.3, 0.6);
+    let mut s = PhaseCorrelator::new(48, 48, p).unwrap();
+    let loc = s.locate_template(&template, &search).unwrap();
+    assert_eq!(loc, locate_template(&template, &search, &p).unwrap());
+    // render() samples at x0 + i − t: the template starts at (112.3, 91.4) in the texture, (12.3, 11.4) in the
+    // search window ⇒ centre at (24.3, 23.4).
+    assert!(
+        (loc.u_px - 24.3).abs() < 0.1 && (loc.v_px - 23.4).abs() < 0.1,
+        "{loc:?}"
+    );
+    // Wrong sizes are errors, not panics.
+    let small = tex.render(32, 32, 0.0, 0.0, 0.0, 0.0);
+    assert!(matches!(
+        c.correlate(&small, &small),
+        Err(PhaseCorrelationError::CorrelatorSize { .. })
+    ));
+    assert!(matches!(
+        PhaseCorrelator::new(2, 64, p),
+        Err(PhaseCorrelationError::TooSmall { .. })
+    ));
+}
