@@ -9,6 +9,7 @@ pub mod cli;
 pub mod codec;
 pub mod dag;
 pub mod explain;
+pub mod exports;
 pub mod hashing;
 pub mod metrics;
 pub mod nodes;

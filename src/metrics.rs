@@ -106,20 +106,34 @@ fn round6(x: f64) -> f64 {
 }
 
 /// Insert contributed sections (namespace → object) into a metrics object; a namespace contributed twice
-/// is merged key by key.
+/// is merged key by key, recursively.
 pub fn add_sections<'a>(doc: &mut Value, sections: impl IntoIterator<Item = (&'a str, &'a Value)>) {
     let Value::Object(map) = doc else { return };
     for (ns, v) in sections {
-        match (map.get_mut(ns), v) {
-            (Some(Value::Object(existing)), Value::Object(new)) => {
-                for (k, x) in new {
-                    existing.insert(k.clone(), x.clone());
-                }
-            }
-            _ => {
+        match map.get_mut(ns) {
+            Some(existing) => merge_json(existing, v),
+            None => {
                 map.insert(ns.to_string(), v.clone());
             }
         }
+    }
+}
+
+/// Merge `new` into `into`: objects key by key, recursively (two nodes may contribute different leaves of one
+/// subtree, e.g. `adjust.combined.checkpoints` and `adjust.combined.recordings`); anything else is replaced.
+fn merge_json(into: &mut Value, new: &Value) {
+    match (into, new) {
+        (Value::Object(existing), Value::Object(new)) => {
+            for (k, x) in new {
+                match existing.get_mut(k) {
+                    Some(e) => merge_json(e, x),
+                    None => {
+                        existing.insert(k.clone(), x.clone());
+                    }
+                }
+            }
+        }
+        (into, new) => *into = new.clone(),
     }
 }
 
@@ -314,5 +328,17 @@ mod tests {
             [("toy", &json!({"a": 1})), ("toy", &json!({"b": 2}))],
         );
         assert_eq!(doc, json!({"engine": {"n": 1}, "toy": {"a": 1, "b": 2}}));
+    }
+
+    #[test]
+    fn sections_merge_recursively() {
+        let mut doc = json!({});
+        let first = json!({"combined": {"checkpoints": {"x": 1}, "cost": 2}});
+        let second = json!({"combined": {"recordings": {"after": 3}, "cost": 4}});
+        add_sections(&mut doc, [("adjust", &first), ("adjust", &second)]);
+        assert_eq!(
+            doc,
+            json!({"adjust": {"combined": {"checkpoints": {"x": 1}, "recordings": {"after": 3}, "cost": 4}}})
+        );
     }
 }

@@ -83,6 +83,7 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
         .unwrap_or(0);
     let start = Instant::now();
     let mut session = Session::new(&store, &stat_cache, &progress, Mode::Run);
+    session.out_dir = Some(out_dir.clone());
     let result = args
         .threads
         .install(|| pipeline.run(&wf, &mut session))
@@ -196,7 +197,7 @@ pub fn write_outputs(
                 &out_dir.join("variants").join(v).join("metrics.json"),
                 &vdoc,
             )?;
-            // sweep.csv: the contributed sections plus the variant's engine counters.
+            // sweep.csv: the contributed sections.
             let mut row = serde_json::json!({});
             add_sections(
                 &mut row,

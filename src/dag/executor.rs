@@ -23,7 +23,7 @@ use crate::dag::record::{self, NodeRecord, RecordedInput};
 use crate::dag::stage::{dirs_root, tmp_dir_for, NodeCtx};
 use crate::hashing::{ContentHash, NodeKey, StatCache};
 use crate::progress::Progress;
-use crate::store::{EntryMeta, Lookup, Store};
+use crate::store::{EntryMeta, Loaded, Store};
 use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -562,38 +562,36 @@ impl<'a> Exec<'a> {
         expected: Option<ContentHash>,
     ) -> Result<Option<(AnyValue, ContentHash)>, ()> {
         let node = &self.dag.nodes[id];
-        match self.env.store.load(&key) {
-            Ok(Lookup::Hit(entry)) => {
-                if expected.is_some_and(|h| h != entry.content_hash) {
+        // Decoded while read (one read, hashed on the way); an undecodable entry comes back as Corrupt.
+        let loaded = self
+            .env
+            .store
+            .load_with(&key, |source, len| node.erased.decode_from(source, len));
+        match loaded {
+            Ok(Loaded::Hit {
+                value,
+                content_hash,
+                ..
+            }) => {
+                if expected.is_some_and(|h| h != content_hash) {
                     self.warn(format!(
                         "{}: cached artifact {key} differs from the recorded output; recomputing",
                         node.identity()
                     ));
                     return Err(());
                 }
-                match node.erased.decode(&entry.payload) {
-                    Ok(v) => {
-                        if node.erased.cached_output_ok(&v, &self.ctx(node, key)) {
-                            Ok(Some((v, entry.content_hash)))
-                        } else {
-                            self.warn(format!(
-                                "{}: cached output refers to files that are gone; recomputing",
-                                node.identity()
-                            ));
-                            Err(())
-                        }
-                    }
-                    Err(e) => {
-                        self.warn(format!(
-                            "{}: cached artifact {key} cannot be decoded ({e}); recomputing",
-                            node.identity()
-                        ));
-                        Err(())
-                    }
+                if node.erased.cached_output_ok(&value, &self.ctx(node, key)) {
+                    Ok(Some((value, content_hash)))
+                } else {
+                    self.warn(format!(
+                        "{}: cached output refers to files that are gone; recomputing",
+                        node.identity()
+                    ));
+                    Err(())
                 }
             }
-            Ok(Lookup::Miss) => Ok(None),
-            Ok(Lookup::Corrupt { message }) => {
+            Ok(Loaded::Miss) => Ok(None),
+            Ok(Loaded::Corrupt { message }) => {
                 self.warn(format!("{}: {message}; recomputing", node.identity()));
                 Err(())
             }
@@ -733,16 +731,11 @@ impl<'a> Exec<'a> {
         let key = node_key(node, &hashes);
         let ctx = self.ctx(node, key);
         let start = Instant::now();
-        let result = catch_unwind(AssertUnwindSafe(|| {
-            let value = node.erased.run(&values, &ctx)?;
-            let mut payload = Vec::new();
-            node.erased.encode(&value, &mut payload)?;
-            Ok::<_, crate::dag::StageError>((value, payload))
-        }));
+        let result = catch_unwind(AssertUnwindSafe(|| node.erased.run(&values, &ctx)));
         drop(values);
         let seconds = start.elapsed().as_secs_f64();
         let tmp = tmp_dir_for(self.env.store.root(), &key);
-        let (value, payload) = match result {
+        let value = match result {
             Ok(Ok(v)) => v,
             Ok(Err(e)) => {
                 let _ = std::fs::remove_dir_all(&tmp);
@@ -770,12 +763,23 @@ impl<'a> Exec<'a> {
             stage_version: node.version.to_string(),
             item: node.identity(),
         };
-        let hash = self
-            .env
-            .store
-            .save(&key, &meta, &payload)
-            .map_err(|e| format!("could not store the result: {e}"))?;
-        drop(payload);
+        // Encoded straight into the entry file (no payload buffer); encoding may panic on a type bincode cannot
+        // represent (see `serde_artifact!`), which fails the node like a stage panic.
+        let saved = catch_unwind(AssertUnwindSafe(|| {
+            self.env
+                .store
+                .save_with(&key, &meta, |sink| node.erased.encode_to(&value, sink))
+        }));
+        let hash = match saved {
+            Ok(Ok(hash)) => hash,
+            Ok(Err(e)) => return Err(format!("could not store the result: {e}")),
+            Err(p) => {
+                return Err(format!(
+                    "panicked while encoding its result: {}",
+                    panic_message(p.as_ref())
+                ))
+            }
+        };
         let inputs = self.slot(id).inputs.clone();
         self.write_records(node, key, hash, seconds, inputs);
         let mut s = self.slot(id);

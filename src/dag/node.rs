@@ -4,6 +4,7 @@ use crate::codec::{Artifact, CodecError};
 use crate::dag::inputs::{InputRef, InputSet, InputValue};
 use crate::dag::stage::{NodeCtx, Stage, StageError};
 use std::any::Any;
+use std::io::{self, Read, Write};
 use std::sync::Arc;
 
 /// A node's output value, type-erased.
@@ -12,8 +13,10 @@ pub type AnyValue = Arc<dyn Any + Send + Sync>;
 /// The operations the executor needs on a node, independent of its stage type.
 pub(crate) trait ErasedStage: Send + Sync {
     fn run(&self, inputs: &[InputValue], ctx: &NodeCtx) -> Result<AnyValue, StageError>;
-    fn encode(&self, value: &AnyValue, out: &mut Vec<u8>) -> Result<(), StageError>;
-    fn decode(&self, bytes: &[u8]) -> Result<AnyValue, CodecError>;
+    /// Streams the encoding of `value` to `sink` (the store writes it straight into the entry file).
+    fn encode_to(&self, value: &AnyValue, sink: &mut dyn Write) -> io::Result<()>;
+    /// Decodes a value from the next `len` bytes of `source` (the store reads it straight from the file).
+    fn decode_from(&self, source: &mut dyn Read, len: u64) -> Result<AnyValue, CodecError>;
     fn cached_output_ok(&self, value: &AnyValue, ctx: &NodeCtx) -> bool;
 }
 
@@ -38,15 +41,14 @@ impl<S: Stage> ErasedStage for TypedNode<S> {
         let out = self.stage.run(&self.params, values, ctx)?;
         Ok(Arc::new(out))
     }
-    fn encode(&self, value: &AnyValue, out: &mut Vec<u8>) -> Result<(), StageError> {
+    fn encode_to(&self, value: &AnyValue, sink: &mut dyn Write) -> io::Result<()> {
         let v = value
             .downcast_ref::<S::Output>()
-            .ok_or_else(wrong_type::<S>)?;
-        v.encode(out);
-        Ok(())
+            .ok_or_else(|| io::Error::other(wrong_type::<S>().message))?;
+        v.encode_to(sink)
     }
-    fn decode(&self, bytes: &[u8]) -> Result<AnyValue, CodecError> {
-        Ok(Arc::new(S::Output::decode(bytes)?))
+    fn decode_from(&self, source: &mut dyn Read, len: u64) -> Result<AnyValue, CodecError> {
+        Ok(Arc::new(S::Output::decode_from(source, len)?))
     }
     fn cached_output_ok(&self, value: &AnyValue, ctx: &NodeCtx) -> bool {
         match value.downcast_ref::<S::Output>() {

@@ -102,6 +102,9 @@ pub struct Session<'a> {
     pub progress: &'a Progress,
     pub mode: Mode,
     pub phases: Vec<Phase>,
+    /// Where a run writes its outputs (`None` when planning): pipelines write their user-facing exports here
+    /// after the phase that produced them (sweeps: into `variants/<name>/`).
+    pub out_dir: Option<std::path::PathBuf>,
 }
 
 impl<'a> Session<'a> {
@@ -117,6 +120,7 @@ impl<'a> Session<'a> {
             progress,
             mode,
             phases: Vec::new(),
+            out_dir: None,
         }
     }
 
@@ -134,6 +138,13 @@ impl<'a> Session<'a> {
             metrics,
             seconds,
         } = execute(&dag, &env, self.mode);
+        if self.mode == Mode::Run {
+            // `plan` says "failed last time: <error>" for these until they succeed.
+            if let Err(e) = crate::dag::record::save_failures(self.store, &dag, &reports) {
+                self.progress
+                    .warn(&format!("could not record the failed nodes: {e}"));
+            }
+        }
         let failed: HashMap<NodeId, String> = reports
             .iter()
             .filter_map(|r| match &r.status {

@@ -7,21 +7,20 @@
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use crate::nodes::campaign::CampaignSnapshot;
 use crate::workflow::{ParamError, StageParams};
-use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
+use skytie_stages::adjustment::campaign_checkpoints::{compare_checkpoints, CheckPointComparison};
 use skytie_stages::adjustment::config::AdjustConfig;
 use skytie_stages::adjustment::evaluate::MULTI_VIEW_RADIUS_M;
 use skytie_stages::adjustment::from_correspondences::{run, AdjustInputs, AdjustmentRun};
-use skytie_stages::adjustment::{
-    evaluate_checkpoints, CheckObservation, CheckPointEvaluation, ViewSelection,
-};
-use skytie_stages::campaign::{Campaign, Recording};
+use skytie_stages::adjustment::{RmseSummary, ViewSelection};
 use skytie_stages::correspondence::{AerialControlPoint, MmTiePoint};
-use skytie_stages::geometry::PanoramaCamera;
+use skytie_stages::export::{checkpoint_rows, CheckPointRow};
 use skytie_stages::imaging::io::dimensions;
 use skytie_stages::nadir::{MmWindowMatch, RecordingControl};
-use std::collections::HashMap;
 use std::sync::Arc;
+
+/// σ of a check-point observation in the panorama, pixels (the synthetic campaigns add N(0, 0.5 px)).
+pub const CHECKPOINT_SIGMA_PX: f64 = 0.5;
 
 impl StageParams for AdjustConfig {
     fn validate(&self) -> Result<(), Vec<ParamError>> {
@@ -44,33 +43,49 @@ pub struct Rmse {
     pub count: usize,
 }
 
-/// One check point's error with one set of poses.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct CheckPointResidual {
-    pub point_id: String,
-    pub views: usize,
-    /// Estimated − surveyed, metres.
-    pub error_m: [f64; 3],
+impl From<&RmseSummary> for Rmse {
+    fn from(r: &RmseSummary) -> Self {
+        Rmse {
+            x: r.x,
+            y: r.y,
+            z: r.z,
+            d2: r.d2,
+            d3: r.d3,
+            count: r.count,
+        }
+    }
 }
 
-/// Check-point evaluation with one set of poses and one view selection.
+/// Check-point errors before/after with one view selection (thesis 3.5.3).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct CheckPointReport {
-    pub rmse: Rmse,
-    pub points: Vec<CheckPointResidual>,
-    /// Check points that could not be triangulated, with the reason.
-    pub failed: Vec<(String, String)>,
+pub struct CheckPointSummary {
+    pub before: Rmse,
+    pub after: Rmse,
+    /// Per point (the rows of `checkpoints.csv`).
+    pub rows: Vec<CheckPointRow>,
+    /// Observations naming an unknown check point or panorama.
+    pub skipped_observations: usize,
+}
+
+impl CheckPointSummary {
+    fn of(c: &CheckPointComparison) -> Self {
+        CheckPointSummary {
+            before: Rmse::from(&c.before.rmse),
+            after: Rmse::from(&c.after.rmse),
+            rows: checkpoint_rows(c),
+            skipped_observations: c.skipped_observations,
+        }
+    }
 }
 
 /// The adjust node's output: the adjustment and the check-point evaluation before/after.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AdjustReport {
     pub run: AdjustmentRun,
-    /// Multi-view (all recordings within 15 m) and two-view (two nearest) check-point errors.
-    pub multi_view_before: CheckPointReport,
-    pub multi_view_after: CheckPointReport,
-    pub two_view_before: CheckPointReport,
-    pub two_view_after: CheckPointReport,
+    /// All recordings within 15 m of a check point (thesis' multi-view evaluation).
+    pub multi_view: CheckPointSummary,
+    /// The two nearest recordings (two-view evaluation).
+    pub two_view: CheckPointSummary,
 }
 crate::serde_artifact!(AdjustReport);
 
@@ -85,12 +100,12 @@ impl AdjustReport {
         let r = &self.run;
         serde_json::json!({ r.config.sources.label(): {
             "checkpoints": {
-                "before": rmse_json(&self.multi_view_before.rmse),
-                "after": rmse_json(&self.multi_view_after.rmse),
+                "before": rmse_json(&self.multi_view.before),
+                "after": rmse_json(&self.multi_view.after),
             },
             "checkpoints_two_view": {
-                "before": rmse_json(&self.two_view_before.rmse),
-                "after": rmse_json(&self.two_view_after.rmse),
+                "before": rmse_json(&self.two_view.before),
+                "after": rmse_json(&self.two_view.after),
             },
             "iterations": r.iterations,
             "termination": r.termination,
@@ -102,76 +117,6 @@ impl AdjustReport {
             "redundancy": r.redundancy,
             "build": r.build,
         }})
-    }
-}
-
-/// Triangulate every check point of `campaign` with the poses `poses` (parallel to `campaign.recordings`).
-pub fn evaluate_with_poses(
-    campaign: &Campaign,
-    poses: &[Recording],
-    pano_size_px: &[(u32, u32)],
-    selection: ViewSelection,
-) -> CheckPointReport {
-    let cameras: Vec<PanoramaCamera> = poses
-        .iter()
-        .zip(pano_size_px)
-        .map(|(r, &(w, h))| PanoramaCamera::from_recording(r, w, h))
-        .collect();
-    let rec_index: HashMap<&str, usize> = campaign
-        .recordings
-        .iter()
-        .enumerate()
-        .map(|(i, r)| (r.image_id.as_str(), i))
-        .collect();
-    let cp_index: HashMap<&str, usize> = campaign
-        .checkpoints
-        .iter()
-        .enumerate()
-        .map(|(i, c)| (c.point_id.as_str(), i))
-        .collect();
-    let surveyed: Vec<Vector3<f64>> = campaign
-        .checkpoints
-        .iter()
-        .map(|c| Vector3::new(c.x, c.y, c.z))
-        .collect();
-    let observations: Vec<CheckObservation> = campaign
-        .observations
-        .iter()
-        .filter_map(|o| {
-            Some(CheckObservation {
-                check_point: *cp_index.get(o.point_id.as_str())?,
-                recording: *rec_index.get(o.image_id.as_str())?,
-                u_px: o.u_px,
-                v_px: o.v_px,
-            })
-        })
-        .collect();
-    let e: CheckPointEvaluation =
-        evaluate_checkpoints(&cameras, &surveyed, &observations, selection, 0.5);
-    let id = |i: usize| campaign.checkpoints[i].point_id.clone();
-    CheckPointReport {
-        rmse: Rmse {
-            x: e.rmse.x,
-            y: e.rmse.y,
-            z: e.rmse.z,
-            d2: e.rmse.d2,
-            d3: e.rmse.d3,
-            count: e.rmse.count,
-        },
-        points: e
-            .points
-            .iter()
-            .map(|p| CheckPointResidual {
-                point_id: id(p.check_point),
-                views: p.views,
-                error_m: [p.error_m.x, p.error_m.y, p.error_m.z],
-            })
-            .collect(),
-        failed: e
-            .failed
-            .iter()
-            .map(|(i, why)| (id(*i), why.clone()))
-            .collect(),
     }
 }
 
@@ -230,35 +175,27 @@ impl Stage for AdjustStage {
         };
         let result =
             run(&inputs, config).map_err(|e| StageError::new(format!("adjustment failed: {e}")))?;
-        let adjusted: Vec<Recording> = c
-            .recordings
-            .iter()
-            .zip(&result.recordings)
-            .map(|(r, a)| {
-                let mut r = r.clone();
-                (r.x, r.y, r.z) = (
-                    a.adjusted_world[0],
-                    a.adjusted_world[1],
-                    a.adjusted_world[2],
-                );
-                r.yaw_deg += a.yaw_correction_deg;
-                r
-            })
-            .collect();
-        let multi = ViewSelection::WithinRadius {
-            radius_m: MULTI_VIEW_RADIUS_M,
-        };
-        Ok(AdjustReport {
-            multi_view_before: evaluate_with_poses(c, &c.recordings, &sizes, multi),
-            multi_view_after: evaluate_with_poses(c, &adjusted, &sizes, multi),
-            two_view_before: evaluate_with_poses(
-                c,
+        let compare = |selection| {
+            compare_checkpoints(
                 &c.recordings,
                 &sizes,
-                ViewSelection::TwoNearest,
-            ),
-            two_view_after: evaluate_with_poses(c, &adjusted, &sizes, ViewSelection::TwoNearest),
+                &result,
+                &c.checkpoints,
+                &c.observations,
+                selection,
+                CHECKPOINT_SIGMA_PX,
+            )
+            .map(|cmp| CheckPointSummary::of(&cmp))
+            .map_err(|e| StageError::new(format!("check-point evaluation: {e}")))
+        };
+        let multi_view = compare(ViewSelection::WithinRadius {
+            radius_m: MULTI_VIEW_RADIUS_M,
+        })?;
+        let two_view = compare(ViewSelection::TwoNearest)?;
+        Ok(AdjustReport {
             run: result,
+            multi_view,
+            two_view,
         })
     }
 }

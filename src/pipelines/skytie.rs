@@ -11,6 +11,7 @@
 
 use super::{adjust, nadir};
 use crate::dag::{DagBuilder, Pipeline, PipelineError, RawFile, Session};
+use crate::exports::{verification_table, write_exports, ExportInputs};
 use crate::nodes::campaign::{listing_hash, metadata_inputs};
 use crate::nodes::{
     CampaignSummary, LoadCampaign, LoadCampaignParams, OrthoProject, SelectRecording,
@@ -118,6 +119,7 @@ impl Pipeline for SkytiePipeline {
         let ortho_on = wf.stages.iter().any(|s| s == "ortho");
         let nadir_on = nadir::enabled(wf)?;
         let mut b = DagBuilder::new();
+        let mut exports: Vec<(String, adjust::AdjustHandles)> = Vec::new();
         for variant in wf.variants() {
             b.set_variant(&variant);
             let snap = b.add(LoadCampaign, "", load_params.clone(), inputs.clone())?;
@@ -153,7 +155,7 @@ impl Pipeline for SkytiePipeline {
             } else {
                 None
             };
-            adjust::add_adjust(
+            let adjust_handles = adjust::add_adjust(
                 &mut b,
                 wf,
                 &variant,
@@ -162,6 +164,7 @@ impl Pipeline for SkytiePipeline {
                 &items,
                 nadir_handles.as_ref(),
             )?;
+            exports.push((variant.clone(), adjust_handles));
             let summary = b.add(
                 SummarizeCampaign,
                 "",
@@ -171,7 +174,32 @@ impl Pipeline for SkytiePipeline {
             b.metrics(summary, "campaign", |s: &CampaignSummary| s.metrics().0);
             b.metrics(summary, "ortho", |s: &CampaignSummary| s.metrics().1);
         }
-        session.execute("items", b.build());
+        let values = session.execute("items", b.build());
+        if let Some(out) = session.out_dir.clone() {
+            for (variant, h) in &exports {
+                let report = h.report.and_then(|r| values.get(r));
+                let verification = h.verification.and_then(|v| values.get(v));
+                if report.is_none() && verification.is_none() {
+                    continue;
+                }
+                let dir = if wf.is_sweep() {
+                    out.join("variants").join(variant)
+                } else {
+                    out.clone()
+                };
+                let inputs = ExportInputs {
+                    snapshot: &snapshot,
+                    report: report.as_deref(),
+                    verification: verification.as_deref(),
+                };
+                for problem in write_exports(&dir, &inputs) {
+                    session.progress.warn(&problem);
+                }
+                if let (false, Some(v)) = (wf.is_sweep(), &verification) {
+                    session.progress.info(&verification_table(v));
+                }
+            }
+        }
         Ok(())
     }
 }

@@ -1,0 +1,102 @@
+//! Writing a run's user-facing files (issue 6 "Outputs") into `OUT/` (or `OUT/variants/<name>/` in a sweep)
+//! once the adjustment and verification nodes have produced their values: `trajectory_adjusted.csv`,
+//! `trajectory.geojson`, `tie_points.ply`, `checkpoints.csv`, `verification.csv` and a COLMAP text model in
+//! `colmap/`. The encoders live in `skytie_stages::export`; every file is written atomically. A failed export is
+//! a warning naming the file; the run's other outputs are still written.
+
+use crate::nodes::adjust::AdjustReport;
+use crate::nodes::campaign::CampaignSnapshot;
+use skytie_stages::adjustment::verify::{
+    render_verification_table, write_verification_csv, Verification,
+};
+use skytie_stages::export::{
+    write_adjusted_trajectory, write_checkpoint_errors_csv, write_colmap_model, write_run_geojson,
+    write_tie_points_ply,
+};
+use skytie_stages::imaging::io::dimensions;
+use std::path::Path;
+
+/// The values one variant's exports are made of.
+pub struct ExportInputs<'a> {
+    pub snapshot: &'a CampaignSnapshot,
+    pub report: Option<&'a AdjustReport>,
+    pub verification: Option<&'a Verification>,
+}
+
+/// Write every export that the values allow into `dir`; returns the problems (one line each).
+pub fn write_exports(dir: &Path, x: &ExportInputs<'_>) -> Vec<String> {
+    let mut problems = Vec::new();
+    let c = &x.snapshot.campaign;
+    let mut note = |file: &str, r: std::io::Result<()>| {
+        if let Err(e) = r {
+            problems.push(format!("{}: not written: {e}", dir.join(file).display()));
+        }
+    };
+    if let Err(e) = std::fs::create_dir_all(dir) {
+        return vec![format!("{}: cannot create the folder: {e}", dir.display())];
+    }
+    if let Some(v) = x.verification {
+        note(
+            "verification.csv",
+            write_verification_csv(&dir.join("verification.csv"), v),
+        );
+    }
+    let Some(report) = x.report else {
+        return problems;
+    };
+    let run = &report.run;
+    note(
+        "trajectory_adjusted.csv",
+        write_adjusted_trajectory(&dir.join("trajectory_adjusted.csv"), &c.recordings, run),
+    );
+    note(
+        "checkpoints.csv",
+        write_checkpoint_errors_csv(&dir.join("checkpoints.csv"), &report.multi_view.rows),
+    );
+    note(
+        "trajectory.geojson",
+        write_run_geojson(
+            &dir.join("trajectory.geojson"),
+            &c.crs,
+            &c.recordings,
+            run,
+            &c.checkpoints,
+            &report.multi_view.rows,
+            x.verification,
+        ),
+    );
+    note(
+        "tie_points.ply",
+        write_tie_points_ply(&dir.join("tie_points.ply"), run),
+    );
+    let sizes: Result<Vec<(u32, u32)>, String> = c
+        .recordings
+        .iter()
+        .map(|r| dimensions(&c.root.join("mm/panoramas").join(&r.file)).map_err(|e| e.to_string()))
+        .collect();
+    match sizes {
+        Ok(sizes) => note(
+            "colmap/",
+            write_colmap_model(
+                &dir.join("colmap"),
+                &c.crs,
+                &c.recordings,
+                &sizes,
+                run,
+                &c.nadir,
+                &c.oblique,
+            )
+            .map(|_| ()),
+        ),
+        Err(e) => problems.push(format!(
+            "{}: not written: {e}",
+            dir.join("colmap").display()
+        )),
+    }
+    problems
+}
+
+/// The verification table for stdout.
+pub fn verification_table(v: &Verification) -> String {
+    render_verification_table(v)
+}
