@@ -1,26 +1,25 @@
-//! A static 2-D kd-tree for box-neighbourhood counting: the chapter-2 baseline keeps only isolated aerial
-//! keypoints, i.e. those with few neighbours inside a square box (thesis 2.2.3.2, "a kd-tree is used to
-//! identify isolated keypoints").
-//!
-//! The tree is an implicit balanced tree over a permutation of the points: the node of a slice is its median
-//! element along the split axis (x at even depth, y at odd depth), left/right halves are the sub-trees. Building
-//! is O(n log² n) with deterministic `sort_by` (ties by index), a box query O(√n + k).
+//! Box-neighbourhood counting over 2-D points for the chapter-2 baseline, which keeps only isolated aerial
+//! keypoints, i.e. those with few neighbours inside a square box (thesis 2.2.3.2, "a kd-tree is used to identify
+//! isolated keypoints"). The spatial index is the `rstar` crate's R*-tree (bulk-loaded, deterministic);
+//! this wrapper only fixes the query the baseline needs.
 
-/// A kd-tree over 2-D points (any unit; the caller's pixels or metres).
+use rstar::{RTree, AABB};
+
+/// A static spatial index over 2-D points (any unit; the caller's pixels or metres).
 pub struct KdTree2 {
-    points: Vec<[f64; 2]>,
-    /// Indices into `points`, arranged as the implicit tree.
-    order: Vec<usize>,
+    tree: RTree<[f64; 2]>,
 }
 
 impl KdTree2 {
-    /// Build the tree; non-finite points are kept but never found by queries.
+    /// Build the index; non-finite points are left out (they are never found by queries).
     pub fn build(points: &[[f64; 2]]) -> Self {
-        let mut order: Vec<usize> = (0..points.len()).collect();
-        build_rec(points, &mut order, 0);
+        let finite: Vec<[f64; 2]> = points
+            .iter()
+            .copied()
+            .filter(|p| p[0].is_finite() && p[1].is_finite())
+            .collect();
         Self {
-            points: points.to_vec(),
-            order,
+            tree: RTree::bulk_load(finite),
         }
     }
 
@@ -28,39 +27,10 @@ impl KdTree2 {
     pub fn count_in_box(&self, c: [f64; 2], half: [f64; 2]) -> usize {
         let lo = [c[0] - half[0], c[1] - half[1]];
         let hi = [c[0] + half[0], c[1] + half[1]];
-        self.count_rec(&self.order, 0, lo, hi)
+        self.tree
+            .locate_in_envelope(&AABB::from_corners(lo, hi))
+            .count()
     }
-
-    fn count_rec(&self, slice: &[usize], depth: usize, lo: [f64; 2], hi: [f64; 2]) -> usize {
-        if slice.is_empty() {
-            return 0;
-        }
-        let mid = slice.len() / 2;
-        let p = self.points[slice[mid]];
-        let axis = depth % 2;
-        let inside = (lo[0]..=hi[0]).contains(&p[0]) && (lo[1]..=hi[1]).contains(&p[1]);
-        let mut n = usize::from(inside);
-        // Left sub-tree holds values ≤ p[axis], right ≥ p[axis] (ties may sit on both sides).
-        if lo[axis] <= p[axis] {
-            n += self.count_rec(&slice[..mid], depth + 1, lo, hi);
-        }
-        if hi[axis] >= p[axis] {
-            n += self.count_rec(&slice[mid + 1..], depth + 1, lo, hi);
-        }
-        n
-    }
-}
-
-fn build_rec(points: &[[f64; 2]], slice: &mut [usize], depth: usize) {
-    if slice.len() <= 1 {
-        return;
-    }
-    let axis = depth % 2;
-    slice.sort_by(|&a, &b| points[a][axis].total_cmp(&points[b][axis]).then(a.cmp(&b)));
-    let mid = slice.len() / 2;
-    let (left, right) = slice.split_at_mut(mid);
-    build_rec(points, left, depth + 1);
-    build_rec(points, &mut right[1..], depth + 1);
 }
 
 #[cfg(test)]
