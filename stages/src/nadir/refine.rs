@@ -71,7 +71,9 @@ pub struct RefineParams {
     pub refinements: usize,
     /// Smallest accepted correlation peak (1 = identical images). Measured on the Tiny synthetic campaign with
     /// a transform from the true poses (lowpass 1.5 px, 32 px): of the located observations, 44 % are within
-    /// 1 aerial px of the truth at peak ≥ 0.3, 75 % at ≥ 0.5, 90 % at ≥ 0.6, 95 % at ≥ 0.7.
+    /// 1 aerial px of the truth at peak ≥ 0.3, 75 % at ≥ 0.5, 90 % at ≥ 0.6, 95 % at ≥ 0.7. Through the whole
+    /// nadir chain on demo seed 1 (KAZE transform): inlier ratio 0.49 at 0.5, 0.89 at 0.7, 0.945 at 0.75,
+    /// 0.93 at 0.8 with 28 → 20 recordings matched — default 0.75.
     pub min_peak: f64,
     /// Smallest standard deviation of the template grey values (0..1 scale); flatter templates are skipped.
     pub min_template_std: f64,
@@ -85,7 +87,7 @@ impl Default for RefineParams {
             window: TaperWindow::Hann,
             lowpass_sigma_px: 1.5,
             refinements: 3,
-            min_peak: 0.5,
+            min_peak: 0.75,
             min_template_std: 0.01,
         }
     }
