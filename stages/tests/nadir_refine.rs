@@ -236,7 +236,7 @@ fn refinement_recovers_a_subpixel_offset_under_radiometric_change_and_noise() {
     };
     let initial = off.compose(&pair.truth);
     let row = aerial_row("aer", 400, 360);
-    let p = RefineParams::default();
+    let p = params_at_peak_05();
     p.validate().unwrap();
     let r = refine_in_aerial(
         &pair.ortho,
@@ -316,7 +316,7 @@ fn refinement_handles_larger_offsets_within_the_margin() {
         &row,
         &transform(off.compose(&pair.truth)),
         &pair.window,
-        &RefineParams::default(),
+        &params_at_peak_05(),
     );
     let (rms, _) = errors_px(&pair, &r);
     assert!(r.matches.len() >= 70, "{}", r.matches.len());
@@ -334,7 +334,7 @@ fn unrelated_aerial_content_gives_weak_peaks_that_are_rejected() {
         &row,
         &transform(pair.truth),
         &pair.window,
-        &RefineParams::default(),
+        &params_at_peak_05(),
     );
     println!("unrelated: {} of {} accepted", r.matches.len(), r.tried);
     assert!(r.tried > 70);
@@ -353,7 +353,7 @@ fn tie_points_outside_the_aerial_image_are_not_tried_and_bad_transforms_give_not
         tx: pair.truth.tx + 5000.0,
         ..pair.truth
     };
-    let p = RefineParams::default();
+    let p = params_at_peak_05();
     let r = refine_in_aerial(
         &pair.ortho,
         &pair.aerial,
@@ -869,7 +869,7 @@ fn end_to_end_tiny_campaign_control_points_within_15_cm_of_truth() {
     let out = dir.path().join("tiny");
     let options = SynthOptions::new(Preset::Tiny, 7);
     generate(&options, &out).unwrap();
-    let params = RefineParams::default();
+    let params = params_at_peak_05();
     let stats = e2e::run(&out, &options, &params, 300);
     e2e::report("tiny seed 7", &stats);
     assert!(stats.pairs >= 6, "{stats:?}");
@@ -914,6 +914,16 @@ fn demo_campaign_accuracy() {
         })
         .expect("campaign name synth-demo-seed<N>");
     let options = SynthOptions::new(Preset::Demo, seed);
-    let stats = e2e::run(&dir, &options, &RefineParams::default(), 300);
+    let stats = e2e::run(&dir, &options, &params_at_peak_05(), 300);
     e2e::report(&format!("demo seed {seed}"), &stats);
+}
+
+/// The parameters these tests were measured with: the defaults but `min_peak` 0.5 (the stage's default is 0.75,
+/// chosen on the demo campaign through the whole chain; these synthetic pairs with added noise peak lower, and
+/// the tests measure localisation accuracy, not the acceptance threshold).
+fn params_at_peak_05() -> RefineParams {
+    RefineParams {
+        min_peak: 0.5,
+        ..RefineParams::default()
+    }
 }
