@@ -1,6 +1,7 @@
 //! End-to-end on the real `skytie` binary and the tiny synthetic campaign: `synth` + `check` are clean, the
 //! `synth:` workflow node generates the same bytes as the CLI, a second run executes nothing, and adding one
-//! recording to a user campaign re-runs only that recording's nodes.
+//! recording to a user campaign re-runs only that recording's nodes, and the shipped full chain
+//! (`workflows/tiny.toml`) runs through registration, adjustment, verification and the exports.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -146,4 +147,51 @@ fn tiny_campaign_end_to_end() {
     );
     assert_eq!(stage(&m, "ortho", "cached"), recordings - 1);
     assert_eq!(stage(&m, "summary", "executed"), 1);
+
+    // 4. The shipped full chain (workflows/tiny.toml: nadir registration, adjustment, verification) on the same
+    //    synthetic campaign: every stage ran without failures, the metrics sections and the exports exist, and
+    //    a second run is served from the cache.
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("workflows/tiny.toml");
+    let out3 = dir.join("out3");
+    let m = run_workflow(&shipped, &cache, &out3);
+    assert_eq!(m["engine"]["nodes_failed"].as_u64(), Some(0), "{m}");
+    for s in [
+        "mm_match",
+        "transform",
+        "refine",
+        "control",
+        "adjust",
+        "verify",
+    ] {
+        assert!(stage(&m, s, "executed") >= 1, "{s} did not run: {m}");
+    }
+    assert!(m["nadir"]["mm_tie_points"].as_u64().unwrap() > 0, "{m}");
+    assert!(m["nadir"]["transforms_tried"].as_u64().unwrap() > 0, "{m}");
+    assert!(m["nadir"]["inlier_ratio"].is_number(), "{m}");
+    assert_eq!(
+        m["adjust"]["combined"]["recordings"]["after"]["count"].as_u64(),
+        Some(recordings),
+        "{m}"
+    );
+    assert!(m["adjust"]["combined"]["checkpoints"]["before"]["2d"].is_number());
+    assert!(m["verify"]["passed"].is_boolean(), "{m}");
+    for f in [
+        "trajectory_adjusted.csv",
+        "trajectory.geojson",
+        "tie_points.ply",
+        "checkpoints.csv",
+        "verification.csv",
+        "colmap/cameras.txt",
+        "colmap/images.txt",
+        "colmap/points3D.txt",
+    ] {
+        let len = std::fs::metadata(out3.join(f))
+            .map(|m| m.len())
+            .unwrap_or(0);
+        assert!(len > 0, "{f} missing or empty");
+    }
+    let adjusted = std::fs::read_to_string(out3.join("trajectory_adjusted.csv")).unwrap();
+    assert_eq!(adjusted.lines().count() as u64, recordings + 1);
+    let m = run_workflow(&shipped, &cache, &out3);
+    assert_eq!(m["engine"]["nodes_executed"].as_u64(), Some(0), "{m}");
 }
