@@ -50,7 +50,7 @@ pub struct VerifyStage;
 
 impl Stage for VerifyStage {
     const NAME: &'static str = "verify";
-    const VERSION: &'static str = "1";
+    const VERSION: &'static str = "2";
     type Params = VerifyConfig;
     type Output = Verification;
     type Inputs = (
