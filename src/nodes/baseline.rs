@@ -3,9 +3,9 @@
 //! `[nadir] matcher = "baseline"` — so thesis Table 2-10's comparison can be regenerated as a sweep.
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::nodes::refine::locate_with_accepted;
 use crate::workflow::{ParamError, StageParams};
 use skytie_stages::campaign::AerialImage;
-use skytie_stages::imaging::io::load_gray;
 use skytie_stages::nadir::baseline::{baseline_matches, BaselineParams};
 use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, OrthoImage, TransformOutcome};
 use std::sync::Arc;
@@ -48,15 +48,8 @@ impl Stage for BaselineStage {
         ),
         _: &NodeCtx,
     ) -> Result<AerialRefinement, StageError> {
-        let TransformOutcome::Accepted(t) = outcome.as_ref() else {
-            return Ok(AerialRefinement {
-                recording_id: window.recording_id.clone(),
-                aerial_id: aerial.image_id.clone(),
-                tried: 0,
-                matches: Vec::new(),
-            });
-        };
-        let image = load_gray(&aerial_file.path).map_err(|e| StageError::new(e.to_string()))?;
-        Ok(baseline_matches(&ortho, &image, &aerial, t, &window, p))
+        locate_with_accepted(&outcome, &window, &aerial, &aerial_file, |t, image| {
+            baseline_matches(&ortho, image, &aerial, t, &window, p)
+        })
     }
 }

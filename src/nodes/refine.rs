@@ -5,8 +5,11 @@
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use skytie_stages::campaign::AerialImage;
 use skytie_stages::imaging::io::load_gray;
+use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::refine::{refine_in_aerial, RefineParams};
-use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, OrthoImage, TransformOutcome};
+use skytie_stages::nadir::{
+    AerialRefinement, InitialTransform, MmWindowMatch, OrthoImage, TransformOutcome,
+};
 use std::sync::Arc;
 
 crate::serde_artifact!(AerialRefinement);
@@ -39,15 +42,29 @@ impl Stage for RefineStage {
         ),
         _: &NodeCtx,
     ) -> Result<AerialRefinement, StageError> {
-        let TransformOutcome::Accepted(t) = outcome.as_ref() else {
-            return Ok(AerialRefinement {
-                recording_id: window.recording_id.clone(),
-                aerial_id: aerial.image_id.clone(),
-                tried: 0,
-                matches: Vec::new(),
-            });
-        };
-        let image = load_gray(&aerial_file.path).map_err(|e| StageError::new(e.to_string()))?;
-        Ok(refine_in_aerial(&ortho, &image, &aerial, t, &window, p))
+        locate_with_accepted(&outcome, &window, &aerial, &aerial_file, |t, image| {
+            refine_in_aerial(&ortho, image, &aerial, t, &window, p)
+        })
     }
+}
+
+/// Shared by `refine` and `baseline`: an empty refinement when the transform was rejected, else `locate` on
+/// the decoded aerial image.
+pub fn locate_with_accepted(
+    outcome: &TransformOutcome,
+    window: &MmWindowMatch,
+    aerial: &AerialImage,
+    aerial_file: &RawFileValue,
+    locate: impl FnOnce(&InitialTransform, &GrayImage) -> AerialRefinement,
+) -> Result<AerialRefinement, StageError> {
+    let TransformOutcome::Accepted(t) = outcome else {
+        return Ok(AerialRefinement {
+            recording_id: window.recording_id.clone(),
+            aerial_id: aerial.image_id.clone(),
+            tried: 0,
+            matches: Vec::new(),
+        });
+    };
+    let image = load_gray(&aerial_file.path).map_err(|e| StageError::new(e.to_string()))?;
+    Ok(locate(t, &image))
 }
