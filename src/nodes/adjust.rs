@@ -6,7 +6,6 @@
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use crate::nodes::campaign::CampaignSnapshot;
-use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
 use skytie_stages::adjustment::campaign_checkpoints::{compare_checkpoints, CheckPointComparison};
 use skytie_stages::adjustment::config::AdjustConfig;
@@ -21,16 +20,6 @@ use std::sync::Arc;
 
 /// σ of a check-point observation in the panorama, pixels (the synthetic campaigns add N(0, 0.5 px)).
 pub const CHECKPOINT_SIGMA_PX: f64 = 0.5;
-
-impl StageParams for AdjustConfig {
-    fn validate(&self) -> Result<(), Vec<ParamError>> {
-        AdjustConfig::validate(self).map_err(|errs| {
-            errs.into_iter()
-                .map(|(f, m)| ParamError::new(f, m))
-                .collect()
-        })
-    }
-}
 
 /// Root-mean-square check-point errors, metres (thesis Tables 3-3…3-5, 5-2…5-9).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]

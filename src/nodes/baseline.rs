@@ -4,21 +4,10 @@
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use crate::nodes::refine::locate_with_accepted;
-use crate::workflow::{ParamError, StageParams};
 use skytie_stages::campaign::AerialImage;
 use skytie_stages::nadir::baseline::{baseline_matches, BaselineParams};
 use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, OrthoImage, TransformOutcome};
 use std::sync::Arc;
-
-impl StageParams for BaselineParams {
-    fn validate(&self) -> Result<(), Vec<ParamError>> {
-        BaselineParams::validate(self).map_err(|errs| {
-            errs.into_iter()
-                .map(|(f, m)| ParamError::new(f, m))
-                .collect()
-        })
-    }
-}
 
 /// The baseline matching node (same inputs and output as `refine`).
 pub struct BaselineStage;

@@ -2,6 +2,9 @@
 //! [`StageParams`] trait): each implementation forwards to the type's own `validate`.
 
 use crate::workflow::{ParamError, StageParams};
+use skytie_stages::adjustment::verify::VerifyConfig;
+use skytie_stages::adjustment::AdjustConfig;
+use skytie_stages::nadir::baseline::BaselineParams;
 use skytie_stages::nadir::control_points::ControlParams;
 use skytie_stages::nadir::initial_transform::TransformParams;
 use skytie_stages::nadir::mm_matching::MmMatchParams;
@@ -31,4 +34,7 @@ forward_validate!(
     TransformParams,
     RefineParams,
     ControlParams,
+    BaselineParams,
+    AdjustConfig,
+    VerifyConfig,
 );

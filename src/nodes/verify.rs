@@ -5,23 +5,12 @@
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use crate::nodes::adjust::pano_sizes;
 use crate::nodes::campaign::CampaignSnapshot;
-use crate::workflow::{ParamError, StageParams};
 use skytie_stages::adjustment::verify::{verify, Verification, VerifyConfig};
 use skytie_stages::correspondence::AerialControlPoint;
 use skytie_stages::nadir::RecordingControl;
 use std::sync::Arc;
 
 crate::serde_artifact!(Verification);
-
-impl StageParams for VerifyConfig {
-    fn validate(&self) -> Result<(), Vec<ParamError>> {
-        VerifyConfig::validate(self).map_err(|errs| {
-            errs.into_iter()
-                .map(|(f, m)| ParamError::new(f, m))
-                .collect()
-        })
-    }
-}
 
 /// `verify` metrics: overall and per-segment offsets and the flag.
 pub fn verify_metrics(v: &Verification) -> serde_json::Value {
