@@ -16,4 +16,5 @@ pub mod geometry;
 pub mod imaging;
 pub mod matching;
 pub mod nadir;
+pub mod oblique;
 pub mod synth;

@@ -14,11 +14,13 @@ pub mod homography;
 pub mod homography_refine;
 pub mod local_frame;
 pub mod panorama;
+pub mod perspective;
 pub mod point_pair;
 pub mod ray;
 pub mod rotation;
 pub mod similarity2;
 pub mod triangulation;
+pub mod trifocal;
 
 #[cfg(test)]
 mod tests;

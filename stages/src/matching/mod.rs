@@ -2,6 +2,7 @@
 //! sub-pixel peak fit (thesis 3.4.4.4, 3.4.5.3).
 
 pub mod descriptor_match;
+pub mod mattes_mi;
 pub mod ncc;
 pub mod phase_correlation;
 pub mod subpixel;

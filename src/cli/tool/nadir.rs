@@ -1,36 +1,18 @@
-//! `skytie tool …`: the pipeline's building blocks on plain files, for debugging, figures and side-by-side
-//! comparisons with other software. Pixel conventions as in campaign-format.md (continuous coordinates, centre of
-//! the first pixel at (0.5, 0.5)); tables are CSV with a header row; single results are printed on one line.
+//! `skytie tool` building blocks of the nadir pipeline (thesis ch. 3): ortho, kaze, forstner, wallis, phasecorr,
+//! ncc.
 
-use clap::{Args, Subcommand};
+use super::write_text;
+use clap::Args;
 use skytie_stages::campaign::read_campaign;
 use skytie_stages::features::forstner::{forstner_corners, ForstnerParams};
 use skytie_stages::features::kaze::{detect_and_describe, KazeParams};
-use skytie_stages::fsutil::atomic_write;
 use skytie_stages::imaging::io::{load_gray, save_gray};
 use skytie_stages::imaging::wallis::{wallis_filter, WallisParams};
 use skytie_stages::matching::ncc::match_template;
 use skytie_stages::matching::phase_correlation::{phase_correlate, PhaseCorrelationParams};
 use skytie_stages::nadir::{ortho_project, OrthoParams};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-
-/// The tools.
-#[derive(Subcommand, Debug)]
-pub enum ToolCommand {
-    /// Ortho-project one recording's panorama onto the ground plane (thesis 3.4.3).
-    Ortho(OrthoArgs),
-    /// KAZE keypoints (x, y, size, response[, descriptor…]) as CSV.
-    Kaze(KazeArgs),
-    /// Förstner corners (x, y, weight, roundness) as CSV.
-    Forstner(ForstnerArgs),
-    /// Wallis filter an image.
-    Wallis(WallisArgs),
-    /// Phase correlation of two equally sized images: prints "dx dy peak" (shift of B relative to A, px).
-    Phasecorr(PairArgs),
-    /// NCC template matching (TM_CCOEFF_NORMED): prints "x y score" of the template centre in IMAGE.
-    Ncc(NccArgs),
-}
+use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct OrthoArgs {
@@ -101,31 +83,7 @@ pub struct NccArgs {
     pub image: PathBuf,
 }
 
-/// Run a tool; returns the exit code (0 ok, 1 the computation failed, 2 bad input).
-pub fn main(cmd: &ToolCommand) -> i32 {
-    let result = match cmd {
-        ToolCommand::Ortho(a) => ortho(a),
-        ToolCommand::Kaze(a) => kaze(a),
-        ToolCommand::Forstner(a) => forstner(a),
-        ToolCommand::Wallis(a) => wallis(a),
-        ToolCommand::Phasecorr(a) => phasecorr(a),
-        ToolCommand::Ncc(a) => ncc(a),
-    };
-    match result {
-        Ok(()) => 0,
-        Err(e) => {
-            eprintln!("error: {e}");
-            2
-        }
-    }
-}
-
-fn write_text(path: &Path, text: &str) -> Result<(), String> {
-    atomic_write(path, text.as_bytes())
-        .map_err(|e| format!("{}: cannot write: {e}", path.display()))
-}
-
-fn ortho(a: &OrthoArgs) -> Result<(), String> {
+pub fn ortho(a: &OrthoArgs) -> Result<(), String> {
     let (campaign, problems) = read_campaign(&a.campaign).map_err(|e| e.to_string())?;
     let rec = campaign
         .recordings
@@ -175,7 +133,7 @@ fn ortho(a: &OrthoArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn kaze(a: &KazeArgs) -> Result<(), String> {
+pub fn kaze(a: &KazeArgs) -> Result<(), String> {
     let img = load_gray(&a.image).map_err(|e| e.to_string())?;
     if a.octaves == 0 || a.octaves > 8 || !(a.threshold > 0.0) {
         return Err("--octaves must be in 1..=8 and --threshold > 0".into());
@@ -209,7 +167,7 @@ fn kaze(a: &KazeArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn forstner(a: &ForstnerArgs) -> Result<(), String> {
+pub fn forstner(a: &ForstnerArgs) -> Result<(), String> {
     let img = load_gray(&a.image).map_err(|e| e.to_string())?;
     let p = ForstnerParams {
         max_corners: a.max,
@@ -225,7 +183,7 @@ fn forstner(a: &ForstnerArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn wallis(a: &WallisArgs) -> Result<(), String> {
+pub fn wallis(a: &WallisArgs) -> Result<(), String> {
     let img = load_gray(&a.image).map_err(|e| e.to_string())?;
     let p = WallisParams {
         window_px: a.window,
@@ -237,7 +195,7 @@ fn wallis(a: &WallisArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn phasecorr(a: &PairArgs) -> Result<(), String> {
+pub fn phasecorr(a: &PairArgs) -> Result<(), String> {
     let ia = load_gray(&a.a).map_err(|e| e.to_string())?;
     let ib = load_gray(&a.b).map_err(|e| e.to_string())?;
     let s =
@@ -246,7 +204,7 @@ fn phasecorr(a: &PairArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn ncc(a: &NccArgs) -> Result<(), String> {
+pub fn ncc(a: &NccArgs) -> Result<(), String> {
     let t = load_gray(&a.template).map_err(|e| e.to_string())?;
     let i = load_gray(&a.image).map_err(|e| e.to_string())?;
     let m = match_template(&i, &t).map_err(|e| e.to_string())?;

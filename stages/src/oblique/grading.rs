@@ -1,0 +1,1 @@
+//! Truth grading of oblique correspondences — being written.

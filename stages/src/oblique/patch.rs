@@ -1,0 +1,1 @@
+//! Image-to-plane patch projection (thesis 4.4.5) — being written.
