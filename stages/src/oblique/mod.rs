@@ -2,6 +2,7 @@
 //! visibility hypothesis and thinning, image-to-plane patches registered by NCC / Mattes MI, and the median
 //! consensus that yields oblique correspondences and control points.
 
+pub mod candidates;
 pub mod consensus;
 pub mod facades;
 pub mod grading;

@@ -1,0 +1,144 @@
+//! Which oblique images may see the façades of a recording's street, decided before any façade is found so the
+//! per-(recording × oblique image) patch stage can be planned statically (the DAG is built before it runs).
+//!
+//! Rule: façades are looked for within `max_facade_distance_m` to the left and right of the recording, from
+//! the street level up to `max_facade_height_m` (thesis 4.4.1: views pitched 30° up capture the façades). An
+//! oblique image is a candidate when any probe point — the recording's foot point moved `d` metres to either
+//! side (perpendicular to `heading`) for `d` in {`max_facade_distance_m`/2, `max_facade_distance_m`} and raised
+//! to half and to the full façade height — projects inside the image frame. The patch stage itself then only
+//! registers images that the visibility hypothesis (thesis 4.4.3) accepted for a fitted plane; a candidate
+//! that sees no plane gives an empty registration set, never a wrong one. This is a superset by design.
+//!
+//! The result lists indices into `oblique`, ordered by `image_id` (ties by index), independent of the row order
+//! of `cameras.csv`.
+
+use crate::campaign::{AerialImage, Recording};
+use crate::geometry::FrameCamera;
+use nalgebra::Vector3;
+
+/// Probe points of a recording's street façades (see the module documentation), world frame, metres.
+pub fn facade_probe_points(
+    rec: &Recording,
+    max_facade_distance_m: f64,
+    max_facade_height_m: f64,
+) -> Vec<Vector3<f64>> {
+    let heading = rec.heading_deg.to_radians();
+    // Unit vector to the right of the driving direction (heading clockwise from north; x east, y north).
+    let right = Vector3::new(heading.cos(), -heading.sin(), 0.0);
+    let ground_z = rec.z - rec.camera_height_m;
+    let mut out = Vec::with_capacity(8);
+    for side in [-1.0, 1.0] {
+        for d in [0.5 * max_facade_distance_m, max_facade_distance_m] {
+            for h in [0.5 * max_facade_height_m, max_facade_height_m] {
+                out.push(Vector3::new(rec.x, rec.y, ground_z + h) + right * (side * d));
+            }
+        }
+    }
+    out
+}
+
+/// Indices into `oblique` of the candidate images for `rec` (module documentation), ordered by `image_id`.
+/// A non-finite recording position gives no images.
+pub fn candidate_oblique(
+    rec: &Recording,
+    oblique: &[AerialImage],
+    max_facade_distance_m: f64,
+    max_facade_height_m: f64,
+) -> Vec<usize> {
+    let probes = facade_probe_points(rec, max_facade_distance_m, max_facade_height_m);
+    if !probes.iter().all(|p| p.iter().all(|c| c.is_finite())) {
+        return Vec::new();
+    }
+    let mut hits: Vec<usize> = oblique
+        .iter()
+        .enumerate()
+        .filter(|(_, img)| {
+            let cam = FrameCamera::from_aerial(img);
+            probes.iter().any(|p| {
+                cam.project_world(p)
+                    .is_some_and(|(u, v)| cam.contains(u, v))
+            })
+        })
+        .map(|(i, _)| i)
+        .collect();
+    hits.sort_by(|&a, &b| {
+        oblique[a]
+            .image_id
+            .cmp(&oblique[b].image_id)
+            .then(a.cmp(&b))
+    });
+    hits
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn recording() -> Recording {
+        Recording {
+            image_id: "r".into(),
+            file: "r.jpg".into(),
+            time: "2019-06-14T10:00:00Z".into(),
+            time_s: 0.0,
+            x: 1000.0,
+            y: 2000.0,
+            z: 2.2,
+            heading_deg: 90.0,
+            camera_height_m: 2.2,
+            sigma_xy_m: None,
+            sigma_z_m: None,
+            yaw_deg: 0.0,
+            pitch_deg: 0.0,
+            roll_deg: 0.0,
+        }
+    }
+
+    /// An oblique camera 450 m up, looking north at 45° (ω = 45°: the image top tilts towards north), whose
+    /// axis meets the ground at (x0, y0).
+    fn looking_north_at(id: &str, x0: f64, y0: f64) -> AerialImage {
+        AerialImage {
+            image_id: id.into(),
+            file: format!("{id}.jpg"),
+            x: x0,
+            y: y0 - 450.0,
+            z: 450.0,
+            omega_deg: 45.0,
+            phi_deg: 0.0,
+            kappa_deg: 0.0,
+            focal_px: 6000.0,
+            cx_px: 400.0,
+            cy_px: 300.0,
+            width_px: 800,
+            height_px: 600,
+            k1: 0.0,
+            k2: 0.0,
+            p1: 0.0,
+            p2: 0.0,
+            sigma_px: 0.5,
+        }
+    }
+
+    #[test]
+    fn probes_lie_left_and_right_of_the_driving_direction() {
+        let r = recording();
+        let p = facade_probe_points(&r, 10.0, 12.0);
+        assert_eq!(p.len(), 8);
+        // Heading east: left is north (+y), right is south (−y); x unchanged.
+        for q in &p {
+            assert!((q.x - r.x).abs() < 1e-9);
+            assert!(
+                ((q.y - r.y).abs() - 5.0).abs() < 1e-9 || ((q.y - r.y).abs() - 10.0).abs() < 1e-9
+            );
+            assert!(q.z > 0.0 && q.z <= 12.0 + 1e-9);
+        }
+    }
+
+    #[test]
+    fn an_image_aimed_at_the_street_is_a_candidate_and_one_far_away_is_not() {
+        let r = recording();
+        let near = looking_north_at("b_near", r.x, r.y);
+        let far = looking_north_at("a_far", r.x + 500.0, r.y);
+        let hits = candidate_oblique(&r, &[near, far], 10.0, 12.0);
+        assert_eq!(hits, vec![0]);
+    }
+}
