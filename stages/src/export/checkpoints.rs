@@ -135,7 +135,8 @@ pub fn write_checkpoint_errors_csv(path: &Path, rows: &[CheckPointRow]) -> io::R
     })
 }
 
-fn quote(s: &str) -> String {
+/// A CSV cell: quoted when it holds a separator, a quote, a line break, or starts with `#` or a space.
+pub(crate) fn quote(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) || s.starts_with('#') || s.starts_with(' ') {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {
