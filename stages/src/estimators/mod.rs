@@ -4,6 +4,7 @@
 // `!(x > t)` is used on purpose throughout: it also rejects NaN, which `x <= t` would let through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod median_consensus;
 pub mod mlesac;
 pub mod models;
 pub mod one_plus_one;
