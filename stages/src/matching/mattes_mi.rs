@@ -21,6 +21,8 @@
 //! in pixels: fixed pixel `x` is compared with the moving image at `x + t`, so a moving image whose content is
 //! the fixed content moved by `d` gives the best MI at `t = d`.
 
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use crate::estimators::SplitMix64;
 use crate::imaging::GrayImage;
 use thiserror::Error;
@@ -259,6 +261,7 @@ impl<'a> MattesMi<'a> {
             let tau = self.moving_scale.term(m);
             let k0 = tau.floor().clamp(PADDING_BINS as f64, top) as usize;
             let row = &mut self.joint[s.bin * bins..(s.bin + 1) * bins];
+            #[allow(clippy::needless_range_loop)]
             for kappa in k0 - 1..=k0 + 2 {
                 row[kappa] += bspline3(kappa as f64 - tau);
             }

@@ -1,1 +1,258 @@
-//! Image-to-plane patch projection (thesis 4.4.5) — being written.
+//! Image-to-plane patches (thesis 4.4.5, Figure 4.8): a square grid in a façade plane around a sparse object
+//! point, filled from the panorama and from an oblique image by back-projection (bilinear, gray), and the
+//! oblique patch's real-resolution ratio.
+//!
+//! Pixel convention of a patch of `n × n` pixels with spacing `s` metres (same as images, campaign-format.md):
+//! patch pixel (col, row) covers the continuous square `[col, col + 1) × [row, row + 1)`, its centre
+//! (col + 0.5, row + 0.5) is the world point `centre + (x − n/2)·s·axis_u − (y − n/2)·s·axis_v` for the
+//! continuous patch coordinate (x, y). So the grid centre (n/2, n/2) is the object point, columns run along
+//! `axis_u` (along the façade) and rows run *down* (against `axis_v`, which points up), as in an image of the
+//! façade. A patch translation `(dx, dy)` px therefore is the plane shift `(dx·s, −dy·s)` m along
+//! (`axis_u`, `axis_v`) ([`PatchGrid::shift_px_to_plane_m`]), the sign used by `PatchMatch::shift_plane_m`.
+//!
+//! Patch pixels without data (the back-projection leaves the image, or the point is behind the camera) are NaN:
+//! the registration treats them as masked.
+
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use crate::geometry::frame::FrameCamera;
+use crate::geometry::panorama::PanoramaCamera;
+use crate::imaging::GrayImage;
+use nalgebra::Vector3;
+
+/// A square grid of `size_px × size_px` pixels, `spacing_m` apart, in the plane spanned by `axis_u`, `axis_v`,
+/// centred on `centre_world`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PatchGrid {
+    pub centre_world: Vector3<f64>,
+    pub axis_u_world: Vector3<f64>,
+    pub axis_v_world: Vector3<f64>,
+    pub spacing_m: f64,
+    pub size_px: usize,
+}
+
+impl PatchGrid {
+    /// The grid of extent `extent_m` (rounded to whole pixels, at least 3) at `spacing_m` around `centre_world`
+    /// in the plane (`axis_u`, `axis_v`); `None` for a non-finite or non-positive extent or spacing.
+    pub fn new(
+        centre_world: [f64; 3],
+        axis_u_world: [f64; 3],
+        axis_v_world: [f64; 3],
+        extent_m: f64,
+        spacing_m: f64,
+    ) -> Option<Self> {
+        if !(extent_m > 0.0 && spacing_m > 0.0 && extent_m.is_finite() && spacing_m.is_finite()) {
+            return None;
+        }
+        let size = (extent_m / spacing_m).round();
+        if !(size < 1e5) {
+            return None;
+        }
+        Some(Self {
+            centre_world: Vector3::from(centre_world),
+            axis_u_world: Vector3::from(axis_u_world),
+            axis_v_world: Vector3::from(axis_v_world),
+            spacing_m,
+            size_px: (size as usize).max(3),
+        })
+    }
+
+    /// The same grid moved in its plane by `shift_plane_m` (metres along `axis_u`, `axis_v`).
+    pub fn shifted(&self, shift_plane_m: [f64; 2]) -> Self {
+        let mut g = self.clone();
+        g.centre_world +=
+            self.axis_u_world * shift_plane_m[0] + self.axis_v_world * shift_plane_m[1];
+        g
+    }
+
+    /// The world point at continuous patch coordinates (x, y) px.
+    pub fn world_at(&self, x_px: f64, y_px: f64) -> Vector3<f64> {
+        let half = self.size_px as f64 / 2.0;
+        self.centre_world + self.axis_u_world * ((x_px - half) * self.spacing_m)
+            - self.axis_v_world * ((y_px - half) * self.spacing_m)
+    }
+
+    /// A patch translation (dx, dy) px as a plane shift (along `axis_u`, `axis_v`), metres.
+    pub fn shift_px_to_plane_m(&self, d_px: [f64; 2]) -> [f64; 2] {
+        [d_px[0] * self.spacing_m, -d_px[1] * self.spacing_m]
+    }
+
+    /// A plane shift (metres along `axis_u`, `axis_v`) as a patch translation, px.
+    pub fn plane_m_to_shift_px(&self, shift_m: [f64; 2]) -> [f64; 2] {
+        [shift_m[0] / self.spacing_m, -shift_m[1] / self.spacing_m]
+    }
+
+    /// Calls `f(index, world)` for every pixel centre in row-major order.
+    fn for_each_pixel(&self, mut f: impl FnMut(usize, Vector3<f64>)) {
+        let n = self.size_px;
+        for row in 0..n {
+            for col in 0..n {
+                f(
+                    row * n + col,
+                    self.world_at(col as f64 + 0.5, row as f64 + 0.5),
+                );
+            }
+        }
+    }
+}
+
+/// Bilinear sample of an equirectangular panorama at a continuous pixel, wrapping columns across the 0/360°
+/// seam and clamping rows; `None` for a non-finite coordinate or a row outside `[0, H)`.
+fn sample_panorama(pano: &GrayImage, u_px: f64, v_px: f64) -> Option<f32> {
+    let (w, h) = (pano.width, pano.height);
+    if w == 0 || h == 0 || !u_px.is_finite() || !(0.0..h as f64).contains(&v_px) {
+        return None;
+    }
+    let x = u_px - 0.5;
+    let y = (v_px - 0.5).clamp(0.0, (h - 1) as f64);
+    let x0f = x.floor();
+    let fx = x - x0f;
+    let y0 = (y.floor() as usize).min(h - 1);
+    let fy = y - y0 as f64;
+    let y1 = (y0 + 1).min(h - 1);
+    let x0 = (x0f as i64).rem_euclid(w as i64) as usize;
+    let x1 = (x0 + 1) % w;
+    let p = |c: usize, r: usize| f64::from(pano.data[r * w + c]);
+    let v = (1.0 - fy) * ((1.0 - fx) * p(x0, y0) + fx * p(x1, y0))
+        + fy * ((1.0 - fx) * p(x0, y1) + fx * p(x1, y1));
+    Some(v as f32)
+}
+
+/// Bilinear sample inside `[0, W) × [0, H)` (edge pixels replicated within the outer half pixel); `None`
+/// outside.
+fn sample_inside(img: &GrayImage, u_px: f64, v_px: f64) -> Option<f32> {
+    let (w, h) = (img.width, img.height);
+    if w == 0 || h == 0 || !(0.0..w as f64).contains(&u_px) || !(0.0..h as f64).contains(&v_px) {
+        return None;
+    }
+    let x = (u_px - 0.5).clamp(0.0, (w - 1) as f64);
+    let y = (v_px - 0.5).clamp(0.0, (h - 1) as f64);
+    let x0 = (x.floor() as usize).min(w - 1);
+    let y0 = (y.floor() as usize).min(h - 1);
+    let (fx, fy) = (x - x0 as f64, y - y0 as f64);
+    let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
+    let p = |c: usize, r: usize| f64::from(img.data[r * w + c]);
+    let v = (1.0 - fy) * ((1.0 - fx) * p(x0, y0) + fx * p(x1, y0))
+        + fy * ((1.0 - fx) * p(x0, y1) + fx * p(x1, y1));
+    Some(v as f32)
+}
+
+/// The panorama patch: every grid pixel centre projected into the panorama (`cam`, whose `width_px` ×
+/// `height_px` may differ from the image's size: coordinates are scaled) and sampled bilinearly; NaN where
+/// there is no data.
+pub fn fill_from_panorama(grid: &PatchGrid, cam: &PanoramaCamera, pano: &GrayImage) -> GrayImage {
+    let n = grid.size_px;
+    let mut out = GrayImage::filled(n, n, f32::NAN);
+    let sx = pano.width as f64 / f64::from(cam.width_px);
+    let sy = pano.height as f64 / f64::from(cam.height_px);
+    grid.for_each_pixel(|i, p| {
+        if let Some((u, v)) = cam.project_world(&p) {
+            if let Some(g) = sample_panorama(pano, u * sx, v * sy) {
+                out.data[i] = g;
+            }
+        }
+    });
+    out
+}
+
+/// An oblique patch with the count its real-resolution ratio needs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FramePatch {
+    /// Gray values, NaN where the grid point is outside the image or behind the camera.
+    pub image: GrayImage,
+    /// Grid pixels with data.
+    pub valid_pixels: usize,
+    /// Distinct image pixels (integer cells of the image) the valid grid pixels fell into.
+    pub distinct_image_pixels: usize,
+}
+
+impl FramePatch {
+    /// Real-resolution ratio (thesis 4.4.5): distinct image pixels assigned / grid pixels with data; 1 when the
+    /// grid resolves every image pixel once, smaller when several grid pixels read the same image pixel (the
+    /// grid is finer on the façade than the image). 0 without data.
+    pub fn real_resolution_ratio(&self) -> f64 {
+        if self.valid_pixels == 0 {
+            0.0
+        } else {
+            self.distinct_image_pixels as f64 / self.valid_pixels as f64
+        }
+    }
+
+    /// Fraction of the grid with data.
+    pub fn valid_fraction(&self) -> f64 {
+        self.valid_pixels as f64 / self.image.data.len().max(1) as f64
+    }
+}
+
+/// Projects every grid pixel centre into a frame image: `(index, u, v)` in the image's own pixel size
+/// (camera coordinates scaled to the image) for the points inside it, in row-major order.
+fn frame_projections(
+    grid: &PatchGrid,
+    cam: &FrameCamera,
+    img_width: usize,
+    img_height: usize,
+    mut f: impl FnMut(usize, f64, f64),
+) {
+    let sx = img_width as f64 / f64::from(cam.width_px);
+    let sy = img_height as f64 / f64::from(cam.height_px);
+    grid.for_each_pixel(|i, p| {
+        if let Some((u, v)) = cam.project_world(&p) {
+            let (u, v) = (u * sx, v * sy);
+            if (0.0..img_width as f64).contains(&u) && (0.0..img_height as f64).contains(&v) {
+                f(i, u, v);
+            }
+        }
+    });
+}
+
+/// Number of distinct cells among row-major cell indices (sorts `cells`).
+fn count_distinct(cells: &mut [u64]) -> usize {
+    cells.sort_unstable();
+    let mut distinct = 0;
+    for (k, c) in cells.iter().enumerate() {
+        if k == 0 || cells[k - 1] != *c {
+            distinct += 1;
+        }
+    }
+    distinct
+}
+
+/// The oblique patch: every grid pixel centre projected with `cam` (scaled to the image's size) and sampled
+/// bilinearly, with the counts of the real-resolution ratio.
+pub fn fill_from_frame(grid: &PatchGrid, cam: &FrameCamera, img: &GrayImage) -> FramePatch {
+    let n = grid.size_px;
+    let mut out = GrayImage::filled(n, n, f32::NAN);
+    let mut cells: Vec<u64> = Vec::with_capacity(n * n);
+    frame_projections(grid, cam, img.width, img.height, |i, u, v| {
+        if let Some(g) = sample_inside(img, u, v) {
+            out.data[i] = g;
+            cells.push((v.floor() as u64) * img.width as u64 + u.floor() as u64);
+        }
+    });
+    let valid_pixels = cells.len();
+    FramePatch {
+        image: out,
+        valid_pixels,
+        distinct_image_pixels: count_distinct(&mut cells),
+    }
+}
+
+/// Real-resolution ratio of a grid in a frame image of `img_width × img_height` px, without sampling
+/// ([`FramePatch::real_resolution_ratio`]), and the fraction of the grid inside the image.
+pub fn real_resolution_ratio(
+    grid: &PatchGrid,
+    cam: &FrameCamera,
+    img_width: usize,
+    img_height: usize,
+) -> (f64, f64) {
+    let mut cells: Vec<u64> = Vec::with_capacity(grid.size_px * grid.size_px);
+    frame_projections(grid, cam, img_width, img_height, |_, u, v| {
+        cells.push((v.floor() as u64) * img_width as u64 + u.floor() as u64);
+    });
+    let valid = cells.len();
+    let fraction = valid as f64 / (grid.size_px * grid.size_px) as f64;
+    if valid == 0 {
+        return (0.0, fraction);
+    }
+    (count_distinct(&mut cells) as f64 / valid as f64, fraction)
+}

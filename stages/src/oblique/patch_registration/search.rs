@@ -1,0 +1,183 @@
+//! Translation search between two patches of one registration level (thesis 4.4.6): exhaustive masked NCC at
+//! integer shifts with a quadratic sub-pixel peak, and Mattes MI maximised by the (1+1)-ES (optionally seeded
+//! by an exhaustive integer MI scan).
+//!
+//! Shifts are patch translations in px with the Mattes MI convention: fixed pixel `x` is compared with the
+//! moving patch at `x + t` (see `matching::mattes_mi`). NaN pixels are masked in both patches.
+
+use crate::estimators::one_plus_one::{minimize, OnePlusOneParams};
+use crate::imaging::GrayImage;
+use crate::matching::mattes_mi::MattesMi;
+use crate::matching::subpixel::{refine_peak, PeakFit};
+
+/// A found translation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Found {
+    pub shift_px: [f64; 2],
+    /// NCC in [−1, 1] or MI in nats.
+    pub score: f64,
+}
+
+/// Masked NCC of `fixed(x)` against `moving(x + (dx, dy))` over the pixels valid in both; `None` with fewer
+/// than `min_overlap` such pixels or a flat side.
+pub fn masked_ncc(
+    fixed: &GrayImage,
+    moving: &GrayImage,
+    dx: isize,
+    dy: isize,
+    min_overlap: usize,
+) -> Option<f64> {
+    let (w, h) = (fixed.width as isize, fixed.height as isize);
+    let (mw, mh) = (moving.width as isize, moving.height as isize);
+    let c0 = 0.max(-dx);
+    let c1 = w.min(mw - dx);
+    let r0 = 0.max(-dy);
+    let r1 = h.min(mh - dy);
+    if c1 <= c0 || r1 <= r0 {
+        return None;
+    }
+    let (mut n, mut sf, mut sm, mut sff, mut smm, mut sfm) = (0usize, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for r in r0..r1 {
+        let frow = &fixed.data[(r * w) as usize..((r + 1) * w) as usize];
+        let mrow = &moving.data[((r + dy) * mw) as usize..((r + dy + 1) * mw) as usize];
+        for c in c0..c1 {
+            let f = frow[c as usize];
+            let m = mrow[(c + dx) as usize];
+            if f.is_finite() && m.is_finite() {
+                let (f, m) = (f64::from(f), f64::from(m));
+                n += 1;
+                sf += f;
+                sm += m;
+                sff += f * f;
+                smm += m * m;
+                sfm += f * m;
+            }
+        }
+    }
+    if n < min_overlap.max(2) {
+        return None;
+    }
+    let nf = n as f64;
+    let vf = sff - sf * sf / nf;
+    let vm = smm - sm * sm / nf;
+    let cov = sfm - sf * sm / nf;
+    // Flat (relative to the signal energy) on either side: undefined.
+    if !(vf > 1e-9 * sff.max(1e-30) && vm > 1e-9 * smm.max(1e-30)) {
+        return None;
+    }
+    Some((cov / (vf * vm).sqrt()).clamp(-1.0, 1.0))
+}
+
+/// Exhaustive masked NCC over integer shifts `centre + (i, j)`, |i|, |j| ≤ `radius_px`, then the quadratic
+/// sub-pixel fit on the 3 × 3 neighbourhood of the best one (no fit on the border of the search window or
+/// where a neighbour is undefined). `None` if no shift has enough overlap.
+pub fn ncc_search(
+    fixed: &GrayImage,
+    moving: &GrayImage,
+    centre_px: [isize; 2],
+    radius_px: usize,
+    min_overlap: usize,
+) -> Option<Found> {
+    let r = radius_px as isize;
+    let side = (2 * r + 1) as usize;
+    let mut map = vec![f64::NAN; side * side];
+    let mut best: Option<(usize, f64)> = None;
+    for j in -r..=r {
+        for i in -r..=r {
+            let k = ((j + r) as usize) * side + (i + r) as usize;
+            if let Some(v) = masked_ncc(
+                fixed,
+                moving,
+                centre_px[0] + i,
+                centre_px[1] + j,
+                min_overlap,
+            ) {
+                map[k] = v;
+                if best.is_none_or(|(_, b)| v > b) {
+                    best = Some((k, v));
+                }
+            }
+        }
+    }
+    let (k, score) = best?;
+    let (bi, bj) = ((k % side) as isize, (k / side) as isize);
+    let mut shift = [
+        (centre_px[0] + bi - r) as f64,
+        (centre_px[1] + bj - r) as f64,
+    ];
+    if bi > 0 && bj > 0 && bi + 1 < side as isize && bj + 1 < side as isize {
+        let mut n = [[0.0; 3]; 3];
+        let mut complete = true;
+        for (y, row) in n.iter_mut().enumerate() {
+            for (x, v) in row.iter_mut().enumerate() {
+                let kk = ((bj + y as isize - 1) as usize) * side + (bi + x as isize - 1) as usize;
+                *v = map[kk];
+                complete &= v.is_finite();
+            }
+        }
+        if complete {
+            let (ddx, ddy) = refine_peak(&n, PeakFit::Quadratic);
+            shift[0] += ddx;
+            shift[1] += ddy;
+        }
+    }
+    Some(Found {
+        shift_px: shift,
+        score,
+    })
+}
+
+/// Mattes MI maximised by the (1+1)-ES from `start_px`, candidates restricted to ±`window_px` (per axis)
+/// around `window_centre_px`. With `scan_step_px = Some(s)` the start is first replaced by the best of an
+/// exhaustive MI scan at the integer shifts `window_centre + s·(i, j)` inside the window (and the ES then
+/// searches ±s around it). `None` if the metric cannot be set up or no candidate is valid.
+#[allow(clippy::too_many_arguments)]
+pub fn mi_search(
+    fixed: &GrayImage,
+    moving: &GrayImage,
+    bins: usize,
+    samples: Option<usize>,
+    window_centre_px: [f64; 2],
+    window_px: f64,
+    scan_step_px: Option<usize>,
+    es: &OnePlusOneParams,
+) -> Option<Found> {
+    let mut metric = MattesMi::new(fixed, moving, bins, samples, es.seed).ok()?;
+    let (mut start, mut centre, mut half) = (window_centre_px, window_centre_px, window_px);
+    if let Some(step) = scan_step_px {
+        let step = step.max(1) as f64;
+        let k = (window_px / step).floor() as isize;
+        let mut best: Option<([f64; 2], f64)> = None;
+        for j in -k..=k {
+            for i in -k..=k {
+                let t = [
+                    window_centre_px[0] + i as f64 * step,
+                    window_centre_px[1] + j as f64 * step,
+                ];
+                if let Ok(v) = metric.evaluate(t[0], t[1]) {
+                    if best.is_none_or(|(_, b)| v > b) {
+                        best = Some((t, v));
+                    }
+                }
+            }
+        }
+        start = best?.0;
+        centre = start;
+        half = step;
+    }
+    let result = minimize(
+        |x: &[f64]| {
+            if (x[0] - centre[0]).abs() > half || (x[1] - centre[1]).abs() > half {
+                return None;
+            }
+            metric.evaluate(x[0], x[1]).ok().map(|mi| -mi)
+        },
+        &start,
+        &[1.0, 1.0],
+        es,
+    )?;
+    Some(Found {
+        shift_px: [result.x[0], result.x[1]],
+        score: -result.value,
+    })
+}
