@@ -7,6 +7,7 @@
 // `!(x > t)` is used on purpose throughout: it also rejects NaN, which `x <= t` would let through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod aerial_intersection;
 pub mod closest_approach;
 pub mod distortion;
 pub mod frame;
