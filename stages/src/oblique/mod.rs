@@ -9,6 +9,7 @@ pub mod grading;
 pub mod patch;
 pub mod patch_registration;
 pub mod sparse_cloud;
+pub mod summary;
 pub mod types;
 
 pub use types::{
