@@ -1,0 +1,259 @@
+//! Known-answer tests of the oblique truth grading: exact synthetic correspondences are correct, one moved by
+//! 5 oblique pixels (in either image direction, so also along the epipolar line) is wrong.
+
+use std::collections::HashMap;
+
+use nalgebra::{Matrix3, Vector3};
+use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
+use skytie_stages::correspondence::{
+    AerialControlPoint, AerialObservation, MmTiePoint, PanoObservation,
+};
+use skytie_stages::geometry::{matrix_to_opk, FrameCamera, PanoramaCamera};
+use skytie_stages::oblique::grading::{grade_match, grade_oblique, Truth};
+use skytie_stages::oblique::{
+    ConsensusStats, ObliqueCorrespondence, ObliqueResult, PatchMatch, SparseCloud,
+    SparseCloudStats, SparsePoint, StreetSide,
+};
+
+const E0: f64 = 500_000.0;
+const N0: f64 = 5_400_000.0;
+const W: u32 = 1600;
+const H: u32 = 800;
+
+fn recording(id: &str, i: usize) -> Recording {
+    Recording {
+        image_id: id.into(),
+        file: format!("{id}.jpg"),
+        time: String::new(),
+        time_s: i as f64,
+        x: E0 + 5.0 * i as f64,
+        y: N0,
+        z: 102.5,
+        heading_deg: 90.0,
+        camera_height_m: 2.5,
+        sigma_xy_m: None,
+        sigma_z_m: None,
+        yaw_deg: 0.0,
+        pitch_deg: 0.0,
+        roll_deg: 0.0,
+    }
+}
+
+fn oblique_image(id: &str, centre: Vector3<f64>, target: Vector3<f64>) -> AerialImage {
+    let back = (centre - target).normalize();
+    let x = Vector3::z().cross(&back).normalize();
+    let y = back.cross(&x);
+    let (omega_deg, phi_deg, kappa_deg) = matrix_to_opk(&Matrix3::from_columns(&[x, y, back]));
+    AerialImage {
+        image_id: id.into(),
+        file: format!("{id}.jpg"),
+        x: centre.x,
+        y: centre.y,
+        z: centre.z,
+        omega_deg,
+        phi_deg,
+        kappa_deg,
+        focal_px: 8000.0,
+        cx_px: 2000.0,
+        cy_px: 1500.0,
+        width_px: 4000,
+        height_px: 3000,
+        k1: 0.0,
+        k2: 0.0,
+        p1: 0.0,
+        p2: 0.0,
+        sigma_px: 0.5,
+    }
+}
+
+struct Scene {
+    truth: Truth,
+    cloud: SparseCloud,
+    matches: Vec<PatchMatch>,
+    points: Vec<Vector3<f64>>,
+}
+
+/// Two panoramas 5 m apart (true poses), façade points 10 m north (left side when driving east) and south,
+/// one oblique image looking north-down at the street; exact matches of every point from panorama r1.
+fn scene() -> Scene {
+    let recs = [recording("r1", 1), recording("r2", 2)];
+    let target = Vector3::new(E0 + 7.5, N0, 105.0);
+    let oblique = oblique_image("o1", Vector3::new(E0 + 7.5, N0 - 750.0, 850.0), target);
+    let cam = FrameCamera::from_aerial(&oblique);
+    let panos: Vec<PanoramaCamera> = recs
+        .iter()
+        .map(|r| PanoramaCamera::from_recording(r, W, H))
+        .collect();
+    let points: Vec<Vector3<f64>> = (0..6)
+        .map(|i| {
+            let north = if i % 2 == 0 { 10.0 } else { -10.0 };
+            Vector3::new(E0 + 3.0 + i as f64, N0 + north, 104.0 + 0.5 * i as f64)
+        })
+        .collect();
+    let mut sparse = Vec::new();
+    let mut matches = Vec::new();
+    for (i, x) in points.iter().enumerate() {
+        let obs: Vec<PanoObservation> = recs
+            .iter()
+            .zip(&panos)
+            .map(|(r, p)| {
+                let (u, v) = p.project_world(x).unwrap();
+                PanoObservation {
+                    image_id: r.image_id.clone(),
+                    u_px: u,
+                    v_px: v,
+                }
+            })
+            .collect();
+        let id = format!("r1#{}#{i}", if i % 2 == 0 { "left" } else { "right" });
+        let side = if i % 2 == 0 {
+            StreetSide::Left
+        } else {
+            StreetSide::Right
+        };
+        let (u, v) = cam.project_world(x).unwrap();
+        assert!(cam.contains(u, v));
+        matches.push(PatchMatch {
+            point_id: id.clone(),
+            side,
+            object_point_world: [x.x - 0.8, x.y, x.z],
+            mm: obs[0].clone(),
+            oblique_image_id: "o1".into(),
+            shift_plane_m: [0.8, 0.0],
+            coarse_shift_plane_m: None,
+            matched_point_world: [x.x, x.y, x.z],
+            oblique_px: [u, v],
+            score: 0.7,
+            real_resolution_ratio: 1.0,
+            rejected_coarse: false,
+        });
+        sparse.push(SparsePoint {
+            side,
+            tie: MmTiePoint {
+                id,
+                observations: obs,
+                point_world: [x.x - 0.8, x.y, x.z],
+                covariance_m2: [[0.0; 3]; 3],
+                max_angle_deg: 20.0,
+            },
+        });
+    }
+    let truth = Truth {
+        recordings: recs
+            .iter()
+            .map(|r| (r.image_id.clone(), (r.clone(), W, H)))
+            .collect(),
+        aerial: HashMap::from([("o1".to_string(), oblique)]),
+    };
+    let cloud = SparseCloud {
+        recordings: ["r0".into(), "r1".into(), "r2".into()],
+        points: sparse,
+        stats: SparseCloudStats::default(),
+    };
+    Scene {
+        truth,
+        cloud,
+        matches,
+        points,
+    }
+}
+
+fn tie<'a>(s: &'a Scene, m: &PatchMatch) -> Option<&'a MmTiePoint> {
+    s.cloud
+        .points
+        .iter()
+        .map(|p| &p.tie)
+        .find(|t| t.id == m.point_id)
+}
+
+#[test]
+fn exact_correspondences_are_correct_and_five_pixels_off_is_wrong() {
+    let s = scene();
+    for m in &s.matches {
+        assert_eq!(
+            grade_match(&s.truth, tie(&s, m), m),
+            Some(true),
+            "{}",
+            m.point_id
+        );
+        // Also without the tie point (closest-approach midpoint as the best point).
+        assert_eq!(grade_match(&s.truth, None, m), Some(true), "{}", m.point_id);
+        for (du, dv) in [(5.0, 0.0), (0.0, 5.0), (-3.0, 4.0)] {
+            let mut moved = m.clone();
+            moved.oblique_px = [m.oblique_px[0] + du, m.oblique_px[1] + dv];
+            assert_eq!(
+                grade_match(&s.truth, tie(&s, m), &moved),
+                Some(false),
+                "{} moved by ({du}, {dv}) px",
+                m.point_id
+            );
+        }
+    }
+    let mut unknown = s.matches[0].clone();
+    unknown.oblique_image_id = "nope".into();
+    assert_eq!(grade_match(&s.truth, None, &unknown), None);
+}
+
+#[test]
+fn grade_counts_before_and_after_consensus_per_side() {
+    let s = scene();
+    let mut correspondences: Vec<ObliqueCorrespondence> = s
+        .matches
+        .iter()
+        .map(|m| ObliqueCorrespondence {
+            matched: m.clone(),
+            recording: "r1".into(),
+            deviation_from_median_m: 0.0,
+            kept: true,
+        })
+        .collect();
+    // Two wrong ones (moved 5 px): one rejected by the consensus, one kept.
+    correspondences[0].matched.oblique_px[0] += 5.0;
+    correspondences[0].kept = false;
+    correspondences[1].matched.oblique_px[1] += 5.0;
+    // A control point 3 cm east and 4 cm above the true point of point 2.
+    let x = s.points[2];
+    let control = vec![AerialControlPoint {
+        tie_point_id: s.cloud.points[2].tie.id.clone(),
+        mm: s.cloud.points[2].tie.observations.clone(),
+        aerial: vec![AerialObservation {
+            image_id: "o1".into(),
+            kind: AerialKind::Oblique,
+            u_px: 0.0,
+            v_px: 0.0,
+            score: 1.0,
+        }],
+        point_world: Some([x.x + 0.03, x.y, x.z + 0.04]),
+        covariance_m2: None,
+    }];
+    let result = ObliqueResult {
+        correspondences,
+        control,
+        stats: ConsensusStats::default(),
+    };
+    let g = grade_oblique(&s.truth, std::slice::from_ref(&s.cloud), &result);
+    assert_eq!((g.correspondences, g.inliers, g.outliers), (6, 4, 2));
+    assert!((g.inlier_ratio - 4.0 / 6.0).abs() < 1e-12);
+    assert_eq!(
+        (g.inliers_after_consensus, g.outliers_after_consensus),
+        (4, 1)
+    );
+    assert!((g.inlier_ratio_after_consensus - 0.8).abs() < 1e-12);
+    assert_eq!(
+        (g.left.correspondences, g.left.inliers, g.left.kept),
+        (3, 2, 2)
+    );
+    assert_eq!(
+        (g.right.correspondences, g.right.inliers, g.right.kept),
+        (3, 2, 3)
+    );
+    assert_eq!(g.control_points.count, 1);
+    assert!((g.control_points.median_horizontal_m - 0.03).abs() < 1e-4);
+    assert!((g.control_points.median_vertical_m - 0.04).abs() < 1e-4);
+    assert_eq!(g.non_matchable, None);
+    let m = g.metrics();
+    assert_eq!(m["inliers_after_consensus"], 4);
+    assert!((m["control_point_error_m"].as_f64().unwrap() - 0.05).abs() < 1e-4);
+    assert!(m["non_matchable"].is_null());
+    assert_eq!(m["sides"]["right"]["kept"], 3);
+}
