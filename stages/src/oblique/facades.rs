@@ -17,6 +17,9 @@
 //! plane index. Never panics on user data: invalid params, a centre that is not the cloud's centre, or
 //! non-finite positions give no planes (counted as sides without a plane).
 
+// `!(x > t)` is used on purpose throughout: it also rejects NaN, which `x <= t` would let through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod occlusion;
 pub mod params;
 pub mod plane;
