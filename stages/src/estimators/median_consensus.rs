@@ -136,8 +136,8 @@ mod tests {
         }
         let r = median_consensus(&values, 0.5).unwrap();
         assert_eq!(r.inliers, expected);
-        for k in 0..3 {
-            assert!((r.median[k] - truth[k]).abs() < 0.05, "{:?}", r.median);
+        for (m, t) in r.median.iter().zip(truth) {
+            assert!((m - t).abs() < 0.05, "{:?}", r.median);
         }
         assert_eq!(r.inlier_count(), 30);
     }
