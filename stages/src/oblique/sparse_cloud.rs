@@ -1,1 +1,230 @@
-//! Sparse cloud of a panorama triplet (thesis 4.4.1) — being written.
+//! Sparse cloud of a panorama triplet (thesis 4.4.1): per side of the trajectory, three artificial
+//! perspective views (view i from panorama i at yaw deviation i from the driving direction, pitch +30°),
+//! AGAST corners + DAISY descriptors, matches views 1–2 and 2–3 linked through view 2 into three-view tracks,
+//! outlier removal by trifocal point transfer (1, 2 → 3), and triangulation of the survivors in the original
+//! equirectangular geometry with the same track triangulation as the nadir MM matching
+//! ([`crate::nadir::mm_matching::tie_point::triangulate_track`]).
+//!
+//! Deterministic: views and sides run in parallel with ordered results; tracks are sorted by their
+//! view-1/view-2 feature indices; no random sampling is involved (`seed` is kept for future estimators).
+
+mod params;
+
+pub use params::SparseCloudParams;
+
+use super::types::{SparseCloud, SparseCloudStats, SparsePoint, StreetSide};
+use crate::campaign::Recording;
+use crate::correspondence::PanoObservation;
+use crate::features::agast::detect_agast;
+use crate::features::daisy::DaisyExtractor;
+use crate::geometry::perspective::PerspectiveView;
+use crate::geometry::trifocal::TrifocalTensor;
+use crate::geometry::{LocalOrigin, PanoramaCamera};
+use crate::imaging::GrayImage;
+use crate::matching::descriptor_match::match_ratio;
+use crate::nadir::mm_matching::tie_point::{triangulate_track, TrackTriangulation};
+use nalgebra::Vector3;
+use rayon::prelude::*;
+use std::collections::HashMap;
+
+/// Corners of one view with their descriptors (row-major, `len` values each).
+struct ViewFeatures {
+    view: PerspectiveView,
+    points_px: Vec<[f64; 2]>,
+    descriptors: Vec<f32>,
+    len: usize,
+    corners: usize,
+}
+
+/// Render view `view`, detect AGAST corners and describe them with DAISY (corners whose descriptor window
+/// leaves the view are dropped).
+fn view_features(
+    view: PerspectiveView,
+    pano: &GrayImage,
+    cam: &PanoramaCamera,
+    p: &SparseCloudParams,
+) -> ViewFeatures {
+    let img = view.render(pano, cam);
+    let corners = detect_agast(&img, &p.agast);
+    let ex = DaisyExtractor::new(&img, &p.daisy);
+    let len = ex.descriptor_len();
+    let mut points_px = Vec::with_capacity(corners.len());
+    let mut descriptors = Vec::with_capacity(corners.len() * len);
+    let mut d = vec![0f32; len];
+    for c in &corners {
+        if ex.describe(c.x_px, c.y_px, &mut d) {
+            points_px.push([c.x_px, c.y_px]);
+            descriptors.extend_from_slice(&d);
+        }
+    }
+    ViewFeatures {
+        view,
+        points_px,
+        descriptors,
+        len,
+        corners: corners.len(),
+    }
+}
+
+/// The points of one side, with its part of the counts.
+fn side_cloud(
+    side: StreetSide,
+    recs: [&Recording; 3],
+    panos: [&GrayImage; 3],
+    cams: &[PanoramaCamera; 3],
+    p: &SparseCloudParams,
+    stats: &mut SparseCloudStats,
+) -> Vec<SparsePoint> {
+    let deviations = p.yaw_deviations_deg(side);
+    let feats: Vec<ViewFeatures> = (0..3)
+        .into_par_iter()
+        .map(|i| {
+            let view = PerspectiveView::of_panorama(
+                &cams[i],
+                p.view_width_px,
+                p.vfov_deg,
+                recs[i].heading_deg + deviations[i],
+                p.pitch_deg,
+            );
+            view_features(view, panos[i], &cams[i], p)
+        })
+        .collect();
+    stats.views += 3;
+    stats.corners += feats.iter().map(|f| f.corners).sum::<usize>();
+    let len = feats[0].len;
+    let (m12, m23) = rayon::join(
+        || {
+            match_ratio(
+                &feats[0].descriptors,
+                &feats[1].descriptors,
+                len,
+                p.match_ratio,
+                p.mutual,
+            )
+        },
+        || {
+            match_ratio(
+                &feats[1].descriptors,
+                &feats[2].descriptors,
+                len,
+                p.match_ratio,
+                p.mutual,
+            )
+        },
+    );
+    // Lengths agree by construction; an error can only mean no descriptors at all.
+    let (m12, m23) = (m12.unwrap_or_default(), m23.unwrap_or_default());
+    stats.matches_12 += m12.len();
+    stats.matches_23 += m23.len();
+
+    // Link through view 2 (thesis 4.4.1): view-2 feature → its view-3 match.
+    let next: HashMap<usize, usize> = m23.iter().map(|m| (m.query, m.train)).collect();
+    let mut tracks: Vec<[usize; 3]> = m12
+        .iter()
+        .filter_map(|m| next.get(&m.train).map(|&k| [m.query, m.train, k]))
+        .collect();
+    tracks.sort_unstable();
+    stats.tracks += tracks.len();
+
+    // Trifocal point transfer 1, 2 → 3 in a local frame at the centre recording (world ≈ 10⁵ m).
+    let origin = LocalOrigin::new(cams[1].center_world);
+    let ms: Vec<_> = feats
+        .iter()
+        .map(|f| f.view.projection_matrix(&origin))
+        .collect();
+    let tensor = TrifocalTensor::from_cameras(&ms[0], &ms[1], &ms[2]);
+    let track_params = TrackTriangulation {
+        pano_sigma_px: p.pano_sigma_px,
+        max_ray_residual_m: p.max_ray_residual_m,
+        min_intersection_angle_deg: p.min_intersection_angle_deg,
+    };
+    let centre_id = &recs[1].image_id;
+    let results: Vec<Result<Option<crate::correspondence::MmTiePoint>, ()>> = tracks
+        .par_iter()
+        .map(|t| {
+            let px = |v: usize| feats[v].points_px[t[v]];
+            if !(tensor.transfer_error(px(0), px(1), px(2)) <= p.trifocal_tolerance_px) {
+                return Err(());
+            }
+            // Back to the original equirectangular pixels (thesis 4.4.1 last paragraph).
+            let obs: Vec<PanoObservation> = (0..3)
+                .map(|v| {
+                    let [x, y] = px(v);
+                    let (u_px, v_px) = feats[v].view.pixel_to_panorama(&cams[v], x, y);
+                    PanoObservation {
+                        image_id: recs[v].image_id.clone(),
+                        u_px,
+                        v_px,
+                    }
+                })
+                .collect();
+            // The centre first: the shared triangulation never drops its first ray.
+            let members = [
+                (&cams[1], obs[1].clone()),
+                (&cams[0], obs[0].clone()),
+                (&cams[2], obs[2].clone()),
+            ];
+            let Some(mut tie) = triangulate_track(String::new(), &members, &track_params) else {
+                return Ok(None);
+            };
+            let point = Vector3::from(tie.point_world);
+            if !((point - cams[1].center_world).norm() <= p.max_range_m) {
+                return Ok(None);
+            }
+            // Observations in trajectory order.
+            tie.observations
+                .sort_by_key(|o| recs.iter().position(|r| r.image_id == o.image_id));
+            Ok(Some(tie))
+        })
+        .collect();
+    let mut points = Vec::new();
+    for r in results {
+        match r {
+            Err(()) => stats.rejected_trifocal += 1,
+            Ok(None) => stats.rejected_triangulation += 1,
+            Ok(Some(mut tie)) => {
+                tie.id = format!("{centre_id}#{}#{}", &side.label()[..1], points.len());
+                points.push(SparsePoint { side, tie });
+            }
+        }
+    }
+    points
+}
+
+/// The sparse cloud of the triplet `recs` (trajectory order; `panos[i]` is the panorama of `recs[i]`).
+/// Parameters are assumed valid ([`SparseCloudParams::validate`]).
+pub fn sparse_cloud(
+    recs: [&Recording; 3],
+    panos: [&GrayImage; 3],
+    p: &SparseCloudParams,
+) -> SparseCloud {
+    let cams: [PanoramaCamera; 3] = std::array::from_fn(|i| {
+        PanoramaCamera::from_recording(recs[i], panos[i].width as u32, panos[i].height as u32)
+    });
+    let per_side: Vec<(Vec<SparsePoint>, SparseCloudStats)> = StreetSide::BOTH
+        .par_iter()
+        .map(|&side| {
+            let mut stats = SparseCloudStats::default();
+            let pts = side_cloud(side, recs, panos, &cams, p, &mut stats);
+            (pts, stats)
+        })
+        .collect();
+    let mut points = Vec::new();
+    let mut stats = SparseCloudStats::default();
+    for (pts, s) in per_side {
+        points.extend(pts);
+        stats.views += s.views;
+        stats.corners += s.corners;
+        stats.matches_12 += s.matches_12;
+        stats.matches_23 += s.matches_23;
+        stats.tracks += s.tracks;
+        stats.rejected_trifocal += s.rejected_trifocal;
+        stats.rejected_triangulation += s.rejected_triangulation;
+    }
+    stats.points = points.len();
+    SparseCloud {
+        recordings: std::array::from_fn(|i| recs[i].image_id.clone()),
+        points,
+        stats,
+    }
+}

@@ -144,6 +144,7 @@ pub fn match_window(
             .iter()
             .map(|n| pano_ok(n).then(|| tie_point::camera_of(n)))
             .collect();
+        let track = tie_point::TrackTriangulation::from(p);
         let results: Vec<Option<(crate::correspondence::MmTiePoint, [f64; 3])>> = corners
             .par_iter()
             .enumerate()
@@ -163,7 +164,7 @@ pub fn match_window(
                 if members.len() < 2 {
                     return None;
                 }
-                let tp = tie_point::triangulate_track(format!("{det_id}#{i}"), &members, p)?;
+                let tp = tie_point::triangulate_track(format!("{det_id}#{i}"), &members, &track)?;
                 let g = detecting.ortho.georef.pixel_to_world(c.u_px, c.v_px);
                 Some((tp, [g.x, g.y, g.z]))
             })

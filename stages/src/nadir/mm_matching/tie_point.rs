@@ -33,19 +33,40 @@ pub fn pano_observation(
     })
 }
 
+/// The settings of [`triangulate_track`] (shared by the nadir MM matching and the oblique sparse cloud).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TrackTriangulation {
+    /// Standard deviation of a panorama observation, panorama px (ray weights).
+    pub pano_sigma_px: f64,
+    /// A ray farther than this from the point rejects the track (after dropping the worst of ≥ 3 rays), m.
+    pub max_ray_residual_m: f64,
+    /// Smallest accepted maximum intersection angle, degrees.
+    pub min_intersection_angle_deg: f64,
+}
+
+impl From<&MmMatchParams> for TrackTriangulation {
+    fn from(p: &MmMatchParams) -> Self {
+        Self {
+            pano_sigma_px: p.pano_sigma_px,
+            max_ray_residual_m: p.max_ray_residual_m,
+            min_intersection_angle_deg: p.min_intersection_angle_deg,
+        }
+    }
+}
+
 /// Whether a triangulation passes the residual and angle checks.
-fn acceptable(t: &Triangulation, p: &MmMatchParams) -> bool {
+fn acceptable(t: &Triangulation, p: &TrackTriangulation) -> bool {
     t.residuals_m.iter().all(|&r| r <= p.max_ray_residual_m)
         && t.max_angle_deg >= p.min_intersection_angle_deg
         && t.point_world.iter().all(|v| v.is_finite())
 }
 
 /// Triangulate one track. `members[k]` = (camera, observation) with the detecting panorama first. Returns the
-/// tie point with the observations actually used.
+/// tie point with the observations actually used (`members[0]` is never dropped).
 pub fn triangulate_track(
     id: String,
     members: &[(&PanoramaCamera, PanoObservation)],
-    p: &MmMatchParams,
+    p: &TrackTriangulation,
 ) -> Option<MmTiePoint> {
     let solve = |keep: &[usize]| -> Option<Triangulation> {
         let rays: Vec<Ray> = keep
