@@ -23,6 +23,7 @@
 use super::aerial_patch::{aerial_ground_similarity, extract_patch};
 use super::ortho::{OrthoGeoref, OrthoImage};
 use super::registration::{InitialTransform, TransformOutcome};
+use super::translation_consensus::translation_consensus;
 use crate::campaign::{AerialImage, Recording};
 use crate::estimators::{mix_seed, ransac_filtered, RansacParams};
 use crate::features::kaze::{detect_and_describe, Features, KazeParams};
@@ -81,6 +82,18 @@ pub struct TransformParams {
     pub max_rotation_deg: f64,
     /// Seed of RANSAC; each (recording, aerial image) pair derives its own stream from it.
     pub seed: u64,
+    /// Estimate scale and rotation too (2-point RANSAC similarity within `max_scale_deviation` /
+    /// `max_rotation_deg`). Default `false`: the ortho image is made at the aerial GSD and orientation, so
+    /// scale and rotation are the recorded-pose ones and only the translation is estimated (exhaustive 1-point
+    /// consensus, [`super::translation_consensus`]) — far less prone to a random consensus and, with few or
+    /// clustered inliers, to extrapolation errors at the ortho border.
+    pub estimate_shape: bool,
+    /// Fewer inliers than this fraction of the descriptor matches reject the transform (a consensus that
+    /// explains only a small part of the matches is likely random).
+    pub min_inlier_ratio: f64,
+    /// The winning translation must have at least this many times the support of the best competing one
+    /// (> 2 × `ransac_threshold_px` away); ambiguous (repetitive) content is rejected. Translation mode only.
+    pub min_consensus_margin: f64,
 }
 
 impl Default for TransformParams {
@@ -109,6 +122,9 @@ impl Default for TransformParams {
             max_scale_deviation: 0.1,
             max_rotation_deg: 5.0,
             seed: 1,
+            estimate_shape: false,
+            min_inlier_ratio: 0.0,
+            min_consensus_margin: 1.0,
         }
     }
 }
@@ -213,6 +229,16 @@ impl TransformParams {
                 && self.max_rotation_deg <= 180.0,
             "max_rotation_deg",
             format!("must be in (0, 180] degrees, got {}", self.max_rotation_deg),
+        );
+        need(
+            self.min_inlier_ratio.is_finite() && (0.0..=1.0).contains(&self.min_inlier_ratio),
+            "min_inlier_ratio",
+            format!("must be in [0, 1], got {}", self.min_inlier_ratio),
+        );
+        need(
+            self.min_consensus_margin.is_finite() && self.min_consensus_margin >= 1.0,
+            "min_consensus_margin",
+            format!("must be ≥ 1, got {}", self.min_consensus_margin),
         );
         if errs.is_empty() {
             Ok(())
@@ -550,24 +576,47 @@ pub fn initial_transform(
         );
     }
 
-    // RANSAC similarity; only hypotheses close to the recorded-pose scale and rotation.
-    let ransac = RansacParams {
-        seed: pair_seed(p.seed, &rec.image_id, &aerial_row.image_id),
-        ..p.ransac()
+    let (model, n_inliers) = if p.estimate_shape {
+        // RANSAC similarity; only hypotheses close to the recorded-pose scale and rotation.
+        let ransac = RansacParams {
+            seed: pair_seed(p.seed, &rec.image_id, &aerial_row.image_id),
+            ..p.ransac()
+        };
+        let shape_ok = |m: &Similarity2| {
+            (m.scale / nominal.scale - 1.0).abs() <= p.max_scale_deviation
+                && wrap_deg((m.rotation_rad - nominal.rotation_rad).to_degrees()).abs()
+                    <= p.max_rotation_deg
+        };
+        let Some(fit) = ransac_filtered::<Similarity2>(&pairs, &ransac, shape_ok) else {
+            return reject(
+                format!("{n_matches} matches, RANSAC found no similarity within the scale/rotation tolerances"),
+                n_matches,
+                0,
+            );
+        };
+        (fit.model, fit.inliers.len())
+    } else {
+        // Scale and rotation from the recorded pose, translation by exhaustive consensus.
+        let Some(c) = translation_consensus(&pairs, &nominal, p.ransac_threshold_px) else {
+            return reject(
+                format!("{n_matches} matches, no translation consensus"),
+                n_matches,
+                0,
+            );
+        };
+        let n = c.inliers.len();
+        if (n as f64) < p.min_consensus_margin * c.runner_up as f64 {
+            return reject(
+                format!(
+                    "{n_matches} matches: ambiguous translation ({n} inliers, a competing one has {})",
+                    c.runner_up
+                ),
+                n_matches,
+                n,
+            );
+        }
+        (c.model, n)
     };
-    let shape_ok = |m: &Similarity2| {
-        (m.scale / nominal.scale - 1.0).abs() <= p.max_scale_deviation
-            && wrap_deg((m.rotation_rad - nominal.rotation_rad).to_degrees()).abs()
-                <= p.max_rotation_deg
-    };
-    let Some(fit) = ransac_filtered::<Similarity2>(&pairs, &ransac, shape_ok) else {
-        return reject(
-            format!("{n_matches} matches, RANSAC found no similarity within the scale/rotation tolerances"),
-            n_matches,
-            0,
-        );
-    };
-    let n_inliers = fit.inliers.len();
     if n_inliers < p.min_inliers {
         return reject(
             format!(
@@ -578,9 +627,19 @@ pub fn initial_transform(
             n_inliers,
         );
     }
+    if (n_inliers as f64) < p.min_inlier_ratio * n_matches as f64 {
+        return reject(
+            format!(
+                "{n_matches} matches, {n_inliers} inliers < {} of the matches",
+                p.min_inlier_ratio
+            ),
+            n_matches,
+            n_inliers,
+        );
+    }
 
     // Plausibility (thesis 3.4.5.2): the projected MM image centre must lie within the expected error.
-    let Some(offset) = centre_offset_world(&fit.model, georef, &cam) else {
+    let Some(offset) = centre_offset_world(&model, georef, &cam) else {
         return reject(
             "the transformed ortho centre does not meet the ground plane".into(),
             n_matches,
@@ -598,7 +657,7 @@ pub fn initial_transform(
     TransformOutcome::Accepted(InitialTransform {
         recording_id: rec.image_id.clone(),
         aerial_id: aerial_row.image_id.clone(),
-        ortho_to_aerial: fit.model,
+        ortho_to_aerial: model,
         matches: n_matches,
         inliers: n_inliers,
         centre_offset_m,

@@ -12,6 +12,7 @@ pub mod ortho;
 pub mod refine;
 pub mod registration;
 pub mod summary;
+pub mod translation_consensus;
 pub mod vehicle_mask;
 
 pub use ortho::{ortho_project, OrthoGeoref, OrthoImage, OrthoParams};
