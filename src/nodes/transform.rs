@@ -16,7 +16,7 @@ pub struct InitialTransformStage;
 
 impl Stage for InitialTransformStage {
     const NAME: &'static str = "transform";
-    const VERSION: &'static str = "1";
+    const VERSION: &'static str = "2";
     type Params = TransformParams;
     type Output = TransformOutcome;
     type Inputs = (
