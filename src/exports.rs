@@ -1,26 +1,34 @@
 //! Writing a run's user-facing files (issue 6 "Outputs") into `OUT/` (or `OUT/variants/<name>/` in a sweep)
 //! once the adjustment and verification nodes have produced their values: `trajectory_adjusted.csv`,
-//! `trajectory.geojson`, `tie_points.ply`, `checkpoints.csv`, `verification.csv` and a COLMAP text model in
-//! `colmap/`. The encoders live in `skytie_stages::export`; every file is written atomically. A failed export is
+//! `trajectory.geojson`, `tie_points.ply`, `checkpoints.csv`, `verification.csv`, `correspondences.csv` and a
+//! COLMAP text model in `colmap/`. The encoders live in `skytie_stages::export`; every file is written atomically. A failed export is
 //! a warning naming the file; the run's other outputs are still written.
 
 use crate::nodes::adjust::AdjustReport;
 use crate::nodes::campaign::CampaignSnapshot;
+use crate::nodes::consensus::ObliqueOutput;
 use skytie_stages::adjustment::verify::{
     render_verification_table, write_verification_csv, Verification,
 };
+use skytie_stages::correspondence::AerialControlPoint;
 use skytie_stages::export::{
-    write_adjusted_trajectory, write_checkpoint_errors_csv, write_colmap_model, write_run_geojson,
-    write_tie_points_ply,
+    write_adjusted_trajectory, write_checkpoint_errors_csv, write_colmap_model,
+    write_correspondences_csv, write_run_geojson, write_tie_points_ply,
 };
 use skytie_stages::imaging::io::dimensions;
+use skytie_stages::nadir::RecordingControl;
 use std::path::Path;
+use std::sync::Arc;
 
 /// The values one variant's exports are made of.
 pub struct ExportInputs<'a> {
     pub snapshot: &'a CampaignSnapshot,
     pub report: Option<&'a AdjustReport>,
     pub verification: Option<&'a Verification>,
+    /// The nadir chain's per-recording control points (trajectory order).
+    pub nadir_control: &'a [Arc<RecordingControl>],
+    /// The oblique chain's consensus output.
+    pub oblique: Option<&'a ObliqueOutput>,
 }
 
 /// Write every export that the values allow into `dir`; returns the problems (one line each).
@@ -34,6 +42,21 @@ pub fn write_exports(dir: &Path, x: &ExportInputs<'_>) -> Vec<String> {
     };
     if let Err(e) = std::fs::create_dir_all(dir) {
         return vec![format!("{}: cannot create the folder: {e}", dir.display())];
+    }
+    if !x.nadir_control.is_empty() || x.oblique.is_some() {
+        let nadir: Vec<AerialControlPoint> = x
+            .nadir_control
+            .iter()
+            .flat_map(|r| r.points.iter().cloned())
+            .collect();
+        let oblique: &[AerialControlPoint] = x.oblique.map_or(&[], |o| &o.result.control);
+        note(
+            "correspondences.csv",
+            write_correspondences_csv(
+                &dir.join("correspondences.csv"),
+                &[("nadir", &nadir), ("oblique", oblique)],
+            ),
+        );
     }
     if let Some(v) = x.verification {
         note(

@@ -2,7 +2,7 @@
 //!
 //! Layers: [`hashing`] / [`codec`] / [`store`] (content-addressed artifacts), [`workflow`] (TOML workflows
 //! and sweeps), [`dag`] (typed stages, graph building, keys, executor, sessions and pipelines),
-//! [`progress`] / [`metrics`] / [`provenance`] / [`plan`] / [`explain`] (what a run reports), [`cli`] (the
+//! [`progress`] / [`metrics`] / [`provenance`] / [`plan`] / [`explain`] (what a run reports), [`report`] (the HTML report), [`cli`] (the
 //! `skytie` command), [`testing`] (toy stages and the `toy` pipeline used by tests and benchmarks).
 pub mod cache_cmd;
 pub mod cli;
@@ -17,6 +17,7 @@ pub mod pipelines;
 pub mod plan;
 pub mod progress;
 pub mod provenance;
+pub mod report;
 pub mod store;
 pub mod testing;
 pub mod workflow;

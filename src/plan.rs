@@ -61,6 +61,22 @@ pub fn will_run_reasons(session: &Session<'_>, phase: &Phase, report: &NodeRepor
     why
 }
 
+/// At most this many reasons are listed for one node (a global node fed by hundreds of items has one
+/// "upstream will run" reason per input).
+pub const MAX_REASONS_LISTED: usize = 3;
+
+/// The reasons of one node on one line: the first [`MAX_REASONS_LISTED`], then "… and N more".
+pub fn reasons_line(reasons: &[String]) -> String {
+    if reasons.len() <= MAX_REASONS_LISTED + 1 {
+        return reasons.join("; ");
+    }
+    format!(
+        "{}; … and {} more",
+        reasons[..MAX_REASONS_LISTED].join("; "),
+        reasons.len() - MAX_REASONS_LISTED
+    )
+}
+
 /// The human-readable plan. `stopped` is the reason planning could not continue past the last phase.
 pub fn plan_text(session: &Session<'_>, stopped: Option<&PipelineError>) -> String {
     let mut out = String::new();
@@ -93,7 +109,7 @@ pub fn plan_text(session: &Session<'_>, stopped: Option<&PipelineError>) -> Stri
             );
             for r in will_run.iter().take(MAX_LISTED_PER_STAGE) {
                 let reasons = will_run_reasons(session, phase, r);
-                let _ = writeln!(out, "    {}: {}", r.identity, reasons.join("; "));
+                let _ = writeln!(out, "    {}: {}", r.identity, reasons_line(&reasons));
             }
             if will_run.len() > MAX_LISTED_PER_STAGE {
                 let _ = writeln!(
@@ -129,4 +145,17 @@ pub fn plan_text(session: &Session<'_>, stopped: Option<&PipelineError>) -> Stri
         let _ = writeln!(out, "note: {e}");
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn long_reason_lists_are_cut_with_a_count() {
+        let few: Vec<String> = (0..4).map(|i| format!("r{i}")).collect();
+        assert_eq!(reasons_line(&few), "r0; r1; r2; r3");
+        let many: Vec<String> = (0..250).map(|i| format!("r{i}")).collect();
+        assert_eq!(reasons_line(&many), "r0; r1; r2; … and 247 more");
+    }
 }

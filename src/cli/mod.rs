@@ -10,6 +10,7 @@ pub mod check;
 pub mod common;
 pub mod explain;
 pub mod plan;
+pub mod report;
 pub mod run;
 pub mod synth;
 pub mod tool;
@@ -33,6 +34,8 @@ pub struct Cli {
 pub enum Command {
     /// Run a workflow (only nodes whose inputs changed are recomputed).
     Run(run::RunArgs),
+    /// (Re)build the HTML report OUT/report/index.html of a run's output folder.
+    Report(report::ReportArgs),
     /// Say which nodes are cached and which will run, and why.
     Plan(plan::PlanArgs),
     /// Show one node's key ingredients and provenance.
@@ -53,6 +56,7 @@ pub fn main() -> i32 {
     let cli = Cli::parse();
     match &cli.command {
         Command::Run(a) => run::main(a),
+        Command::Report(a) => report::main(a),
         Command::Plan(a) => plan::main(a),
         Command::Explain(a) => explain::main(a),
         Command::Cache(a) => cache::main(a),

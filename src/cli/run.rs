@@ -102,6 +102,15 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
             format!("cannot write outputs to {}: {e}", out_dir.display()),
         )
     })?;
+    // The HTML report (a failure is a warning: the run's outputs are already written).
+    match crate::report::build_report(
+        &out_dir,
+        &crate::report::ReportOptions::standard(args.campaign.clone()),
+    ) {
+        Ok(r) if !args.quiet => println!("report: {}", r.index.display()),
+        Ok(_) => {}
+        Err(e) => progress.warn(&format!("the HTML report was not written: {e}")),
+    }
     print!("{}", summary.table(wall));
     print_problems(&session);
     let useful = produced_something(&session);

@@ -6,6 +6,7 @@
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use crate::nodes::campaign::CampaignSnapshot;
+use crate::nodes::consensus::ObliqueOutput;
 use serde::{Deserialize, Serialize};
 use skytie_stages::adjustment::campaign_checkpoints::{compare_checkpoints, CheckPointComparison};
 use skytie_stages::adjustment::config::AdjustConfig;
@@ -16,6 +17,7 @@ use skytie_stages::correspondence::{AerialControlPoint, MmTiePoint};
 use skytie_stages::export::{checkpoint_rows, CheckPointRow};
 use skytie_stages::imaging::io::dimensions;
 use skytie_stages::nadir::{MmWindowMatch, RecordingControl};
+use skytie_stages::oblique::SparseCloud;
 use std::sync::Arc;
 
 /// σ of a check-point observation in the panorama, pixels (the synthetic campaigns add N(0, 0.5 px)).
@@ -118,12 +120,13 @@ pub fn pano_sizes(panos: &[RawFileValue]) -> Result<Vec<(u32, u32)>, StageError>
 }
 
 /// The adjustment node. Inputs: snapshot, panorama files (snapshot order), the nadir windows' tie points and
-/// the recordings' aerial control points (empty lists for a source that is not used).
+/// the recordings' aerial control points, the oblique chain's sparse clouds (MM tie points) and its consensus
+/// output (oblique control points) — empty lists for a source that is not used.
 pub struct AdjustStage;
 
 impl Stage for AdjustStage {
     const NAME: &'static str = "adjust";
-    const VERSION: &'static str = "1";
+    const VERSION: &'static str = "2";
     type Params = AdjustConfig;
     type Output = AdjustReport;
     type Inputs = (
@@ -131,16 +134,20 @@ impl Stage for AdjustStage {
         Vec<RawFile>,
         Vec<Handle<MmWindowMatch>>,
         Vec<Handle<RecordingControl>>,
+        Vec<Handle<SparseCloud>>,
+        Vec<Handle<ObliqueOutput>>,
     );
 
     fn run(
         &self,
         config: &AdjustConfig,
-        (snap, panos, windows, control): (
+        (snap, panos, windows, control, clouds, oblique): (
             Arc<CampaignSnapshot>,
             Vec<RawFileValue>,
             Vec<Arc<MmWindowMatch>>,
             Vec<Arc<RecordingControl>>,
+            Vec<Arc<SparseCloud>>,
+            Vec<Arc<ObliqueOutput>>,
         ),
         _: &NodeCtx,
     ) -> Result<AdjustReport, StageError> {
@@ -149,10 +156,20 @@ impl Stage for AdjustStage {
         let tie_points: Vec<MmTiePoint> = windows
             .iter()
             .flat_map(|w| w.tie_points.iter().cloned())
+            .chain(
+                clouds
+                    .iter()
+                    .flat_map(|c| c.points.iter().map(|p| p.tie.clone())),
+            )
             .collect();
         let control_points: Vec<AerialControlPoint> = control
             .iter()
             .flat_map(|r| r.points.iter().cloned())
+            .chain(
+                oblique
+                    .iter()
+                    .flat_map(|o| o.result.control.iter().cloned()),
+            )
             .collect();
         let inputs = AdjustInputs {
             recordings: &c.recordings,

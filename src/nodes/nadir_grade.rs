@@ -5,7 +5,7 @@
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use crate::nodes::campaign::CampaignSnapshot;
 use crate::nodes::summary::SummaryParams;
-use skytie_stages::campaign::{read_aerial_csv, read_recordings_csv};
+use skytie_stages::campaign::{read_aerial_csv, read_recordings_csv, AerialImage};
 use skytie_stages::correspondence::{AerialControlPoint, MmTiePoint};
 use skytie_stages::imaging::io::dimensions;
 use skytie_stages::nadir::grading::{grade_nadir, NadirGrade, Truth};
@@ -36,6 +36,57 @@ pub fn grade_metrics(g: &NadirGrade) -> serde_json::Value {
             "median_vertical": c.median_vertical_m,
             "rms_vertical": c.rms_vertical_m,
         },
+    })
+}
+
+/// The [`Truth`] of a campaign: `truth_files[0]` is `truth/recordings.csv` (required), `truth_files[1]` the
+/// optional true aerial poses (`truth/aerial_nadir.csv` or `truth/aerial_oblique.csv`); without it the
+/// recorded `aerial_rows` are taken as true. `panos` (snapshot order) give the panorama sizes. `stage` names
+/// the caller in errors.
+pub fn load_truth(
+    snap: &CampaignSnapshot,
+    truth_files: &[RawFileValue],
+    panos: &[RawFileValue],
+    aerial_rows: &[AerialImage],
+    stage: &str,
+) -> Result<Truth, StageError> {
+    let Some(rec_file) = truth_files.first() else {
+        return Err(StageError::new(format!(
+            "internal: {stage} needs truth/recordings.csv"
+        )));
+    };
+    let (true_recs, problems) = read_recordings_csv(&rec_file.path);
+    if let Some(p) = problems.first() {
+        return Err(StageError::new(format!("truth is unreadable: {p}")));
+    }
+    let mut sizes = HashMap::new();
+    for (rec, pano) in snap.campaign.recordings.iter().zip(panos) {
+        let wh = dimensions(&pano.path).map_err(|e| StageError::new(e.to_string()))?;
+        sizes.insert(rec.image_id.clone(), wh);
+    }
+    let recordings = true_recs
+        .into_iter()
+        .filter_map(|r| {
+            let (w, h) = *sizes.get(&r.image_id)?;
+            Some((r.image_id.clone(), (r, w, h)))
+        })
+        .collect();
+    let aerial_rows = match truth_files.get(1) {
+        Some(f) => {
+            let (rows, problems) = read_aerial_csv(&f.path);
+            if let Some(p) = problems.first() {
+                return Err(StageError::new(format!("truth is unreadable: {p}")));
+            }
+            rows
+        }
+        None => aerial_rows.to_vec(),
+    };
+    Ok(Truth {
+        recordings,
+        aerial: aerial_rows
+            .into_iter()
+            .map(|a| (a.image_id.clone(), a))
+            .collect(),
     })
 }
 
@@ -70,44 +121,13 @@ impl Stage for GradeNadir {
         ),
         _: &NodeCtx,
     ) -> Result<NadirGrade, StageError> {
-        let Some(rec_file) = truth_files.first() else {
-            return Err(StageError::new(
-                "internal: grade_nadir needs truth/recordings.csv",
-            ));
-        };
-        let (true_recs, problems) = read_recordings_csv(&rec_file.path);
-        if let Some(p) = problems.first() {
-            return Err(StageError::new(format!("truth is unreadable: {p}")));
-        }
-        let mut sizes = HashMap::new();
-        for (rec, pano) in snap.campaign.recordings.iter().zip(&panos) {
-            let wh = dimensions(&pano.path).map_err(|e| StageError::new(e.to_string()))?;
-            sizes.insert(rec.image_id.clone(), wh);
-        }
-        let recordings = true_recs
-            .into_iter()
-            .filter_map(|r| {
-                let (w, h) = *sizes.get(&r.image_id)?;
-                Some((r.image_id.clone(), (r, w, h)))
-            })
-            .collect();
-        let aerial_rows = match truth_files.get(1) {
-            Some(f) => {
-                let (rows, problems) = read_aerial_csv(&f.path);
-                if let Some(p) = problems.first() {
-                    return Err(StageError::new(format!("truth is unreadable: {p}")));
-                }
-                rows
-            }
-            None => snap.campaign.nadir.clone(),
-        };
-        let truth = Truth {
-            recordings,
-            aerial: aerial_rows
-                .into_iter()
-                .map(|a| (a.image_id.clone(), a))
-                .collect(),
-        };
+        let truth = load_truth(
+            &snap,
+            &truth_files,
+            &panos,
+            &snap.campaign.nadir,
+            "grade_nadir",
+        )?;
         let tie_points: Vec<&MmTiePoint> = windows.iter().flat_map(|w| &w.tie_points).collect();
         let refs: Vec<&AerialRefinement> = refinements.iter().map(|r| r.as_ref()).collect();
         let cps: Vec<&AerialControlPoint> = control.iter().flat_map(|c| &c.points).collect();

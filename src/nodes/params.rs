@@ -10,6 +10,10 @@ use skytie_stages::nadir::initial_transform::TransformParams;
 use skytie_stages::nadir::mm_matching::MmMatchParams;
 use skytie_stages::nadir::refine::RefineParams;
 use skytie_stages::nadir::OrthoParams;
+use skytie_stages::oblique::consensus::ConsensusParams;
+use skytie_stages::oblique::facades::FacadeParams;
+use skytie_stages::oblique::patch_registration::PatchParams;
+use skytie_stages::oblique::sparse_cloud::SparseCloudParams;
 
 fn convert(errs: Vec<(String, String)>) -> Vec<ParamError> {
     errs.into_iter()
@@ -37,4 +41,8 @@ forward_validate!(
     BaselineParams,
     AdjustConfig,
     VerifyConfig,
+    SparseCloudParams,
+    FacadeParams,
+    PatchParams,
+    ConsensusParams,
 );

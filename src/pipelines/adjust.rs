@@ -3,6 +3,7 @@
 //! campaigns only) and the `verify` node (Table 5-13).
 
 use super::nadir::{NadirHandles, RecordingItem};
+use super::oblique::ObliqueHandles;
 use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::adjust::{AdjustReport, AdjustStage};
 use crate::nodes::adjust_grade::{AdjustGrade, GradeAdjust};
@@ -34,6 +35,7 @@ pub fn add_adjust(
     snap: Handle<CampaignSnapshot>,
     items: &[RecordingItem<'_>],
     nadir: Option<&NadirHandles>,
+    oblique: Option<&ObliqueHandles>,
 ) -> Result<AdjustHandles, PipelineError> {
     let on = |s: &str| wf.stages.iter().any(|x| x == s);
     let mut out = AdjustHandles {
@@ -43,23 +45,44 @@ pub fn add_adjust(
     if !(on("adjust") || on("verify") || on("grade_adjust")) {
         return Ok(out);
     }
-    let Some(nadir) = nadir.filter(|n| !n.control.is_empty() || !n.windows.is_empty()) else {
+    let nadir = nadir.filter(|n| !n.control.is_empty() || !n.windows.is_empty());
+    let oblique = oblique.filter(|o| o.result.is_some());
+    if nadir.is_none() && oblique.is_none() {
         return Err(wf_err(format!(
             "{}: 'adjust'/'verify' need correspondences: enable the nadir chain (ortho, mm_match, ortho_aerial, \
-             transform, refine, control) in `stages`",
+             transform, refine, control) and/or the oblique chain (sparse_cloud, facades, patches, consensus) in \
+             `stages`",
             wf.path.display()
         )));
-    };
+    }
     let panos: Vec<RawFile> = items.iter().map(|i| i.pano.clone()).collect();
     if on("adjust") {
         let config: AdjustConfig = wf.params("adjust", variant).map_err(wf_err)?;
-        if config.sources == Sources::Oblique {
+        let use_nadir = matches!(config.sources, Sources::Nadir | Sources::Combined);
+        let use_oblique = matches!(config.sources, Sources::Oblique | Sources::Combined);
+        let missing = match (
+            use_nadir && nadir.is_none(),
+            use_oblique && oblique.is_none(),
+        ) {
+            (true, _) => Some("the nadir chain"),
+            (_, true) => Some("the oblique chain"),
+            _ => None,
+        };
+        if let Some(chain) = missing {
             return Err(wf_err(format!(
-                "{}: [adjust] sources = \"oblique\": the oblique pipeline is not available in this skytie yet; \
-                 use \"nadir\" or \"combined\"",
-                wf.path.display()
+                "{}: [adjust] sources = \"{}\" needs {chain} in `stages`",
+                wf.path.display(),
+                config.sources.label()
             )));
         }
+        let (windows, control) = match nadir.filter(|_| use_nadir) {
+            Some(n) => (n.windows.clone(), n.control.clone()),
+            None => (Vec::new(), Vec::new()),
+        };
+        let (clouds, oblique_result) = match oblique.filter(|_| use_oblique) {
+            Some(o) => (o.clouds.clone(), o.result.into_iter().collect()),
+            None => (Vec::new(), Vec::new()),
+        };
         let report = b.add(
             AdjustStage,
             config.sources.label(),
@@ -67,8 +90,10 @@ pub fn add_adjust(
             (
                 snap,
                 panos.clone(),
-                nadir.windows.clone(),
-                nadir.control.clone(),
+                windows,
+                control,
+                clouds,
+                oblique_result,
             ),
         )?;
         b.metrics(report, "adjust", |r: &AdjustReport| r.metrics());
@@ -86,6 +111,12 @@ pub fn add_adjust(
     }
     if on("verify") {
         let config: VerifyConfig = wf.params("verify", variant).map_err(wf_err)?;
+        let Some(nadir) = nadir else {
+            return Err(wf_err(format!(
+                "{}: 'verify' compares aerial nadir control points with the MM data: enable the nadir chain",
+                wf.path.display()
+            )));
+        };
         let v = b.add(
             VerifyStage,
             "",

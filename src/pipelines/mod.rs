@@ -3,4 +3,5 @@
 
 pub mod adjust;
 pub mod nadir;
+pub mod oblique;
 pub mod skytie;

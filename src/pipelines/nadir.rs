@@ -48,7 +48,8 @@ pub const NADIR_STAGES: [&str; 7] = [
 pub struct RecordingItem<'a> {
     pub recording: &'a Recording,
     pub row: Handle<Recording>,
-    pub ortho: Handle<OrthoImage>,
+    /// The 3 cm ortho image (thesis 3.4.3); `None` when the workflow does not enable `ortho`.
+    pub ortho: Option<Handle<OrthoImage>>,
     pub pano: RawFile,
 }
 
@@ -120,6 +121,12 @@ pub fn add_nadir(
     let refine_params: RefineParams = wf.params("refine", variant).map_err(wf_err)?;
     let control_params: ControlParams = wf.params("control", variant).map_err(wf_err)?;
     let window_len = if options.triples { 2 } else { 1 };
+    let Some(orthos) = items.iter().map(|i| i.ortho).collect::<Option<Vec<_>>>() else {
+        return Err(wf_err(format!(
+            "{}: the nadir chain needs stage 'ortho' in `stages`",
+            wf.path.display()
+        )));
+    };
     let nadir_dir = root.join("aerial/nadir");
 
     let mut aerial_rows: BTreeMap<usize, Handle<AerialImage>> = BTreeMap::new();
@@ -140,13 +147,14 @@ pub fn add_nadir(
         }
         let label = format!("rec {}", item.recording.image_id);
         let members: Vec<&RecordingItem> = std::iter::once(item).chain(neighbours).collect();
+        let member_orthos = &orthos[i..i + members.len()];
         let window = b.add(
             MmMatch,
             &label,
             mm_params.clone(),
             (
                 members.iter().map(|m| m.row).collect::<Vec<_>>(),
-                members.iter().map(|m| m.ortho).collect::<Vec<_>>(),
+                member_orthos.to_vec(),
                 members.iter().map(|m| m.pano.clone()).collect::<Vec<_>>(),
             ),
         )?;

@@ -4,12 +4,13 @@
 //! 1. `campaign`: the synthetic generator node when the workflow says `campaign = "synth:<preset>"`;
 //! 2. `load`: read and validate the campaign;
 //! 3. `items`, per sweep variant: per recording `recording` → `ortho` (thesis 3.4.3), the nadir chain
-//!    (`pipelines::nadir`, thesis chapter 3), then the global `summary`.
+//!    (`pipelines::nadir`, thesis chapter 3), the oblique chain (`pipelines::oblique`, chapter 4), the
+//!    adjustment, grading and verification (`pipelines::adjust`, chapter 5), then the global `summary`.
 //!
-//! Stages not yet implemented (oblique chain, adjustment) are refused with a clear message when a workflow
-//! enables them, never silently skipped.
+//! After phase 3 the exports of every variant are written into `OUT` (`OUT/variants/<name>/` in a sweep).
+//! A stage name the pipeline does not know is refused with the list of available ones.
 
-use super::{adjust, nadir};
+use super::{adjust, nadir, oblique};
 use crate::dag::{DagBuilder, Pipeline, PipelineError, RawFile, Session};
 use crate::exports::{verification_table, write_exports, ExportInputs};
 use crate::nodes::campaign::{listing_hash, metadata_inputs};
@@ -25,7 +26,7 @@ use std::path::{Path, PathBuf};
 pub struct SkytiePipeline;
 
 /// Stage names a workflow may enable in `stages = [...]`.
-pub const STAGES: [&str; 15] = [
+pub const STAGES: [&str; 20] = [
     "synth",
     "load",
     "ortho",
@@ -41,6 +42,11 @@ pub const STAGES: [&str; 15] = [
     "grade_adjust",
     "verify",
     "baseline",
+    "sparse_cloud",
+    "facades",
+    "patches",
+    "oblique",
+    "grade_oblique",
 ];
 
 fn wf_err(e: impl std::fmt::Display) -> PipelineError {
@@ -118,8 +124,9 @@ impl Pipeline for SkytiePipeline {
         // Phase 3: per-recording stages and the summary, for every variant.
         let ortho_on = wf.stages.iter().any(|s| s == "ortho");
         let nadir_on = nadir::enabled(wf)?;
+        let oblique_on = oblique::enabled(wf)?;
         let mut b = DagBuilder::new();
-        let mut exports: Vec<(String, adjust::AdjustHandles)> = Vec::new();
+        let mut exports = Vec::new();
         for variant in wf.variants() {
             b.set_variant(&variant);
             let snap = b.add(LoadCampaign, "", load_params.clone(), inputs.clone())?;
@@ -136,20 +143,30 @@ impl Pipeline for SkytiePipeline {
                     },
                     snap,
                 )?;
-                if ortho_on {
-                    let pano = RawFile(root.join("mm/panoramas").join(&rec.file));
+                let pano = RawFile(root.join("mm/panoramas").join(&rec.file));
+                let ortho = if ortho_on {
                     let o = b.add(OrthoProject, &label, ortho.clone(), (row, pano.clone()))?;
                     orthos.push(o);
-                    items.push(nadir::RecordingItem {
-                        recording: rec,
-                        row,
-                        ortho: o,
-                        pano,
-                    });
-                }
+                    Some(o)
+                } else {
+                    None
+                };
+                items.push(nadir::RecordingItem {
+                    recording: rec,
+                    row,
+                    ortho,
+                    pano,
+                });
             }
             let nadir_handles = if nadir_on {
                 Some(nadir::add_nadir(
+                    &mut b, wf, &variant, &root, &snapshot, snap, &items,
+                )?)
+            } else {
+                None
+            };
+            let oblique_handles = if oblique_on {
+                Some(oblique::add_oblique(
                     &mut b, wf, &variant, &root, &snapshot, snap, &items,
                 )?)
             } else {
@@ -163,8 +180,14 @@ impl Pipeline for SkytiePipeline {
                 snap,
                 &items,
                 nadir_handles.as_ref(),
+                oblique_handles.as_ref(),
             )?;
-            exports.push((variant.clone(), adjust_handles));
+            exports.push((
+                variant.clone(),
+                adjust_handles,
+                nadir_handles.map(|n| n.control).unwrap_or_default(),
+                oblique_handles.and_then(|o| o.result),
+            ));
             let summary = b.add(
                 SummarizeCampaign,
                 "",
@@ -176,10 +199,19 @@ impl Pipeline for SkytiePipeline {
         }
         let values = session.execute("items", b.build());
         if let Some(out) = session.out_dir.clone() {
-            for (variant, h) in &exports {
+            for (variant, h, nadir_control, oblique_result) in &exports {
                 let report = h.report.and_then(|r| values.get(r));
                 let verification = h.verification.and_then(|v| values.get(v));
-                if report.is_none() && verification.is_none() {
+                let nadir_control: Vec<_> = nadir_control
+                    .iter()
+                    .filter_map(|c| values.get(*c))
+                    .collect();
+                let oblique = oblique_result.and_then(|o| values.get(o));
+                if report.is_none()
+                    && verification.is_none()
+                    && nadir_control.is_empty()
+                    && oblique.is_none()
+                {
                     continue;
                 }
                 let dir = if wf.is_sweep() {
@@ -191,6 +223,8 @@ impl Pipeline for SkytiePipeline {
                     snapshot: &snapshot,
                     report: report.as_deref(),
                     verification: verification.as_deref(),
+                    nadir_control: &nadir_control,
+                    oblique: oblique.as_deref(),
                 };
                 for problem in write_exports(&dir, &inputs) {
                     session.progress.warn(&problem);

@@ -67,6 +67,19 @@ impl VehicleMask {
         heading_deg: f64,
         point_world: &Vector3<f64>,
     ) -> bool {
+        let h = heading_deg.to_radians();
+        self.hides_with_heading(camera_world, h.sin_cos(), point_world)
+    }
+
+    /// [`Self::hides`] with the heading given as (sin, cos) of its angle, for callers testing many points of
+    /// one recording (no trigonometry per point).
+    #[inline]
+    pub fn hides_with_heading(
+        &self,
+        camera_world: &Vector3<f64>,
+        (sin_h, cos_h): (f64, f64),
+        point_world: &Vector3<f64>,
+    ) -> bool {
         if !self.enabled {
             return false;
         }
@@ -76,9 +89,8 @@ impl VehicleMask {
         }
         let t = self.roof_drop_m / -d.z;
         let (east, north) = (d.x * t, d.y * t);
-        let h = heading_deg.to_radians();
-        let forward = east * h.sin() + north * h.cos();
-        let left = -east * h.cos() + north * h.sin();
+        let forward = east * sin_h + north * cos_h;
+        let left = -east * cos_h + north * sin_h;
         forward <= self.front_m && forward >= -self.rear_m && left.abs() <= self.half_width_m
     }
 }

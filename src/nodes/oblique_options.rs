@@ -1,0 +1,71 @@
+//! `[oblique]`: options of the oblique pipeline that shape the DAG (which recordings form a triplet, which
+//! oblique images a recording's façades are registered with), and `[oblique.consensus]`, the parameters of the
+//! global `oblique` node (thesis 4.4.7 median consensus). Read by `pipelines::oblique`.
+
+use crate::workflow::{ParamError, StageParams};
+use serde::{Deserialize, Serialize};
+use skytie_stages::oblique::consensus::ConsensusParams;
+
+/// See the module documentation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ObliqueOptions {
+    /// Consecutive recordings further apart than this (recorded positions, horizontal, metres) do not form a
+    /// triplet (a gap in the trajectory, or the start of another street).
+    pub max_neighbour_distance_m: f64,
+    /// Façades are looked for up to this distance left and right of a recording, metres
+    /// (`skytie_stages::oblique::candidates`).
+    pub max_facade_distance_m: f64,
+    /// … and up to this height above the street, metres.
+    pub max_facade_height_m: f64,
+    /// The median consensus (thesis 4.4.7; Table 4-8 varies `threshold_m` and `tracking`).
+    pub consensus: ConsensusParams,
+}
+
+impl Default for ObliqueOptions {
+    fn default() -> Self {
+        Self {
+            max_neighbour_distance_m: 12.0,
+            max_facade_distance_m: 20.0,
+            max_facade_height_m: 15.0,
+            consensus: ConsensusParams::default(),
+        }
+    }
+}
+
+impl StageParams for ObliqueOptions {
+    fn validate(&self) -> Result<(), Vec<ParamError>> {
+        let mut errs = Vec::new();
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !positive(self.max_neighbour_distance_m) {
+            errs.push(ParamError::new(
+                "max_neighbour_distance_m",
+                "must be a distance > 0 m",
+            ));
+        }
+        if !positive(self.max_facade_distance_m) || self.max_facade_distance_m > 200.0 {
+            errs.push(ParamError::new(
+                "max_facade_distance_m",
+                "must be in (0, 200] m",
+            ));
+        }
+        if !positive(self.max_facade_height_m) || self.max_facade_height_m > 500.0 {
+            errs.push(ParamError::new(
+                "max_facade_height_m",
+                "must be in (0, 500] m",
+            ));
+        }
+        if let Err(problems) = self.consensus.validate() {
+            errs.extend(
+                problems
+                    .into_iter()
+                    .map(|(field, message)| ParamError::new(format!("consensus.{field}"), message)),
+            );
+        }
+        if errs.is_empty() {
+            Ok(())
+        } else {
+            Err(errs)
+        }
+    }
+}

@@ -1,0 +1,70 @@
+//! `patches`: per (triplet centre recording × candidate oblique image) the image-to-plane patches and their
+//! hierarchical registration (thesis 4.4.5–4.4.6, `skytie_stages::oblique::patch_registration`). An oblique
+//! image that the visibility hypothesis did not accept for any plane gives an empty set.
+
+use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use skytie_stages::campaign::{AerialImage, Recording};
+use skytie_stages::imaging::io::load_gray;
+use skytie_stages::oblique::patch_registration::{register_patches, PatchParams};
+use skytie_stages::oblique::{PatchRegistrationSet, PatchStats, SparseCloud, TripletFacades};
+use std::sync::Arc;
+
+crate::serde_artifact!(PatchRegistrationSet);
+
+/// The patch-registration node.
+pub struct PatchesStage;
+
+impl Stage for PatchesStage {
+    const NAME: &'static str = "patches";
+    const VERSION: &'static str = "1";
+    type Params = PatchParams;
+    type Output = PatchRegistrationSet;
+    type Inputs = (
+        Handle<Recording>,
+        RawFile,
+        Handle<AerialImage>,
+        RawFile,
+        Handle<SparseCloud>,
+        Handle<TripletFacades>,
+    );
+
+    fn run(
+        &self,
+        p: &PatchParams,
+        (rec, pano, oblique, oblique_file, cloud, facades): (
+            Arc<Recording>,
+            RawFileValue,
+            Arc<AerialImage>,
+            RawFileValue,
+            Arc<SparseCloud>,
+            Arc<TripletFacades>,
+        ),
+        _: &NodeCtx,
+    ) -> Result<PatchRegistrationSet, StageError> {
+        let sees = facades
+            .planes
+            .iter()
+            .any(|pl| pl.views.iter().any(|v| v.image_id == oblique.image_id));
+        if !sees {
+            return Ok(PatchRegistrationSet {
+                recording: rec.image_id.clone(),
+                oblique_image_id: oblique.image_id.clone(),
+                matches: Vec::new(),
+                stats: PatchStats::default(),
+            });
+        }
+        let load =
+            |f: &RawFileValue| load_gray(&f.path).map_err(|e| StageError::new(e.to_string()));
+        let pano_img = load(&pano)?;
+        let oblique_img = load(&oblique_file)?;
+        Ok(register_patches(
+            &rec,
+            &pano_img,
+            &oblique,
+            &oblique_img,
+            &cloud,
+            &facades,
+            p,
+        ))
+    }
+}

@@ -1,0 +1,219 @@
+//! The oblique part of the `skytie` pipeline (thesis chapter 4) for one variant: per panorama triplet the
+//! sparse cloud (`sparse_cloud`) and its façades (`facades`), per (triplet centre × candidate oblique image) the
+//! patch registration (`patches`), then the global `oblique` node (median consensus: correspondences, control points,
+//! `oblique.*` counts) and — on synthetic campaigns with `truth/` — the evaluation node `grade_oblique`.
+//!
+//! Shared work across a sweep comes from the keys: the sparse cloud's key does not depend on any façade,
+//! patch or consensus parameter, so an 18-variant sweep computes it once; `facades` once per distinct plane
+//! setting; `patches` once per distinct (façades, registration setting).
+
+use super::nadir::RecordingItem;
+use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
+use crate::nodes::aerial::{SelectAerial, SelectAerialParams};
+use crate::nodes::campaign::CampaignSnapshot;
+use crate::nodes::consensus::{ConsensusStage, ObliqueOutput};
+use crate::nodes::facades::FacadesStage;
+use crate::nodes::oblique_grade::{GradeOblique, TRUTH_AERIAL_OBLIQUE, TRUTH_RECORDINGS};
+use crate::nodes::oblique_options::ObliqueOptions;
+use crate::nodes::patches::PatchesStage;
+use crate::nodes::sparse_cloud::SparseCloudStage;
+use crate::nodes::summary::SummaryParams;
+use crate::workflow::Workflow;
+use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
+use skytie_stages::oblique::candidates::candidate_oblique;
+use skytie_stages::oblique::facades::FacadeParams;
+use skytie_stages::oblique::patch_registration::PatchParams;
+use skytie_stages::oblique::sparse_cloud::SparseCloudParams;
+use skytie_stages::oblique::{PatchRegistrationSet, SparseCloud, TripletFacades};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The stages of the oblique chain, in dependency order.
+pub const OBLIQUE_STAGES: [&str; 5] = [
+    "sparse_cloud",
+    "facades",
+    "patches",
+    "oblique",
+    "grade_oblique",
+];
+
+/// What the oblique chain hands to later stages (the adjustment, the exports).
+pub struct ObliqueHandles {
+    pub clouds: Vec<Handle<SparseCloud>>,
+    pub result: Option<Handle<ObliqueOutput>>,
+}
+
+fn wf_err(e: impl std::fmt::Display) -> PipelineError {
+    PipelineError::Workflow(e.to_string())
+}
+
+/// Whether the workflow enables the oblique chain; an enabled stage whose upstream is not enabled is an error.
+pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
+    let on = |s: &str| wf.stages.iter().any(|x| x == s);
+    let Some(last) = OBLIQUE_STAGES.iter().rposition(|s| on(s)) else {
+        return Ok(false);
+    };
+    let last_needed = if OBLIQUE_STAGES[last] == "grade_oblique" {
+        3
+    } else {
+        last
+    };
+    let missing: Vec<&str> = OBLIQUE_STAGES[..=last_needed]
+        .iter()
+        .copied()
+        .filter(|s| !on(s))
+        .collect();
+    if !missing.is_empty() {
+        return Err(wf_err(format!(
+            "{}: the oblique chain is enabled up to '{}' but its upstream stage(s) {} are not in `stages`; \
+             add them (order: {})",
+            wf.path.display(),
+            OBLIQUE_STAGES[last],
+            missing.join(", "),
+            OBLIQUE_STAGES.join(", ")
+        )));
+    }
+    Ok(true)
+}
+
+fn distance_m(a: &Recording, b: &Recording) -> f64 {
+    (a.x - b.x).hypot(a.y - b.y)
+}
+
+/// Add the oblique chain for `variant`. `items` are in trajectory (time) order.
+#[allow(clippy::too_many_arguments)]
+pub fn add_oblique(
+    b: &mut DagBuilder,
+    wf: &Workflow,
+    variant: &str,
+    root: &Path,
+    snapshot: &CampaignSnapshot,
+    snap: Handle<CampaignSnapshot>,
+    items: &[RecordingItem<'_>],
+) -> Result<ObliqueHandles, PipelineError> {
+    let on = |s: &str| wf.stages.iter().any(|x| x == s);
+    let options: ObliqueOptions = wf.params("oblique", variant).map_err(wf_err)?;
+    let cloud_params: SparseCloudParams = wf.params("sparse_cloud", variant).map_err(wf_err)?;
+    let facade_params: FacadeParams = wf.params("facades", variant).map_err(wf_err)?;
+    let patch_params: PatchParams = wf.params("patches", variant).map_err(wf_err)?;
+    let oblique_dir = root.join("aerial/oblique");
+    let oblique_rows = &snapshot.campaign.oblique;
+
+    let mut aerial_rows: BTreeMap<usize, Handle<AerialImage>> = BTreeMap::new();
+    let mut clouds = Vec::new();
+    let mut all_facades: Vec<Handle<TripletFacades>> = Vec::new();
+    let mut sets: Vec<Handle<PatchRegistrationSet>> = Vec::new();
+    for w in items.windows(3) {
+        let (first, centre, last) = (&w[0], &w[1], &w[2]);
+        if distance_m(first.recording, centre.recording) > options.max_neighbour_distance_m
+            || distance_m(centre.recording, last.recording) > options.max_neighbour_distance_m
+        {
+            continue;
+        }
+        let label = format!("rec {}", centre.recording.image_id);
+        let rows: Vec<Handle<Recording>> = w.iter().map(|m| m.row).collect();
+        let cloud = b.add(
+            SparseCloudStage,
+            &label,
+            cloud_params.clone(),
+            (
+                rows.clone(),
+                w.iter().map(|m| m.pano.clone()).collect::<Vec<_>>(),
+            ),
+        )?;
+        clouds.push(cloud);
+        if !on("facades") {
+            continue;
+        }
+        let candidates = candidate_oblique(
+            centre.recording,
+            oblique_rows,
+            options.max_facade_distance_m,
+            options.max_facade_height_m,
+        );
+        let mut aerials = Vec::with_capacity(candidates.len());
+        for &a in &candidates {
+            let row = &oblique_rows[a];
+            let h = match aerial_rows.get(&a) {
+                Some(h) => *h,
+                None => {
+                    let h = b.add(
+                        SelectAerial,
+                        &format!("oblique {}", row.image_id),
+                        SelectAerialParams {
+                            image_id: row.image_id.clone(),
+                            kind: AerialKind::Oblique,
+                        },
+                        snap,
+                    )?;
+                    aerial_rows.insert(a, h);
+                    h
+                }
+            };
+            aerials.push((a, h));
+        }
+        let facades = b.add(
+            FacadesStage,
+            &label,
+            facade_params.clone(),
+            (
+                cloud,
+                rows.clone(),
+                aerials.iter().map(|(_, h)| *h).collect::<Vec<_>>(),
+            ),
+        )?;
+        all_facades.push(facades);
+        if !on("patches") {
+            continue;
+        }
+        for (a, aerial) in aerials {
+            let row = &oblique_rows[a];
+            let pair = format!("rec {} × {}", centre.recording.image_id, row.image_id);
+            sets.push(b.add(
+                PatchesStage,
+                &pair,
+                patch_params.clone(),
+                (
+                    centre.row,
+                    centre.pano.clone(),
+                    aerial,
+                    RawFile(oblique_dir.join(&row.file)),
+                    cloud,
+                    facades,
+                ),
+            )?);
+        }
+    }
+    let mut out = ObliqueHandles {
+        clouds: clouds.clone(),
+        result: None,
+    };
+    if !on("oblique") {
+        return Ok(out);
+    }
+    let panos: Vec<RawFile> = items.iter().map(|i| i.pano.clone()).collect();
+    let result = b.add(
+        ConsensusStage,
+        "",
+        options.consensus.clone(),
+        (snap, panos.clone(), clouds.clone(), all_facades, sets),
+    )?;
+    b.metrics(result, "oblique", |o: &ObliqueOutput| o.summary.metrics());
+    out.result = Some(result);
+    let truth = root.join(TRUTH_RECORDINGS);
+    if on("grade_oblique") && truth.is_file() {
+        let mut truth_files = vec![RawFile(truth)];
+        let truth_aerial = root.join(TRUTH_AERIAL_OBLIQUE);
+        if truth_aerial.is_file() {
+            truth_files.push(RawFile(truth_aerial));
+        }
+        let grade = b.add(
+            GradeOblique,
+            "",
+            SummaryParams::default(),
+            (snap, truth_files, panos, clouds, result),
+        )?;
+        b.metrics(grade, "oblique", GradeOblique::metrics);
+    }
+    Ok(out)
+}

@@ -1,0 +1,218 @@
+//! Gathering the trajectory map's data from a result folder: recorded and adjusted positions and check
+//! points from `trajectory.geojson` (layers `recorded`, `adjusted`, `checkpoints`), else recorded positions
+//! from the campaign's `mm/recordings.csv`; true positions from the campaign's `truth/recordings.csv`
+//! (evaluation only); error vectors from `checkpoints.csv`; which recordings have nadir / oblique
+//! correspondences from `correspondences.csv`.
+
+use super::inputs::{read_csv_opt, CsvTable};
+use super::plots::trajectory::{CorrespondenceKind, MapCheckPoint, MapRecording};
+use serde_json::Value;
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+
+/// Point features of one geojson layer: id property → (x, y).
+fn geojson_layer(doc: &Value, layer: &str, id_key: &str) -> BTreeMap<String, [f64; 2]> {
+    let mut out = BTreeMap::new();
+    let Some(features) = doc.get("features").and_then(|f| f.as_array()) else {
+        return out;
+    };
+    for f in features {
+        let props = &f["properties"];
+        if props["layer"].as_str() != Some(layer) || f["geometry"]["type"].as_str() != Some("Point")
+        {
+            continue;
+        }
+        let c = &f["geometry"]["coordinates"];
+        let (Some(x), Some(y), Some(id)) = (c[0].as_f64(), c[1].as_f64(), props[id_key].as_str())
+        else {
+            continue;
+        };
+        out.insert(id.to_string(), [x, y]);
+    }
+    out
+}
+
+/// Recording image ids with at least one panorama observation of a nadir / oblique control point.
+pub fn correspondence_sets(corr: Option<&CsvTable>) -> (BTreeSet<String>, BTreeSet<String>) {
+    let (mut nadir, mut oblique) = (BTreeSet::new(), BTreeSet::new());
+    if let Some(t) = corr {
+        for r in &t.rows {
+            if t.text(r, "image_kind") != "panorama" {
+                continue;
+            }
+            let id = t.text(r, "image_id").to_string();
+            match t.text(r, "source") {
+                "nadir" => {
+                    nadir.insert(id);
+                }
+                "oblique" => {
+                    oblique.insert(id);
+                }
+                _ => {}
+            }
+        }
+    }
+    (nadir, oblique)
+}
+
+/// Positions by recording id read from a recordings.csv-like file (columns image_id, x, y).
+fn positions_csv(path: &Path) -> Result<BTreeMap<String, [f64; 2]>, String> {
+    let mut out = BTreeMap::new();
+    if let Some(t) = read_csv_opt(path)? {
+        for r in &t.rows {
+            if let (Some(x), Some(y)) = (t.num(r, "x"), t.num(r, "y")) {
+                out.insert(t.text(r, "image_id").to_string(), [x, y]);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Everything the map needs, plus the recording order (ids) for other sections.
+pub struct MapData {
+    pub ids: Vec<String>,
+    pub recordings: Vec<MapRecording>,
+    pub checkpoints: Vec<MapCheckPoint>,
+    pub has_truth: bool,
+}
+
+/// Reads the map data of one result folder. `campaign` is the campaign folder (for recorded positions
+/// without geojson and for `truth/`). Ok(None) when no positions are available at all.
+pub fn read_map_data(dir: &Path, campaign: Option<&Path>) -> Result<Option<MapData>, String> {
+    let gpath = dir.join("trajectory.geojson");
+    let geo = if gpath.exists() {
+        let bytes =
+            std::fs::read(&gpath).map_err(|e| format!("{}: cannot read: {e}", gpath.display()))?;
+        Some(
+            serde_json::from_slice::<Value>(&bytes)
+                .map_err(|e| format!("{}: not valid GeoJSON: {e}", gpath.display()))?,
+        )
+    } else {
+        None
+    };
+    let mut recorded = geo
+        .as_ref()
+        .map(|g| geojson_layer(g, "recorded", "image_id"))
+        .unwrap_or_default();
+    let mut adjusted = geo
+        .as_ref()
+        .map(|g| geojson_layer(g, "adjusted", "image_id"))
+        .unwrap_or_default();
+    if adjusted.is_empty() {
+        adjusted = positions_csv(&dir.join("trajectory_adjusted.csv"))?;
+    }
+    // Order: the campaign's recordings.csv order when available, else sorted ids.
+    let mut ids: Vec<String> = Vec::new();
+    if let Some(c) = campaign {
+        let p = c.join("mm/recordings.csv");
+        if let Some(t) = read_csv_opt(&p)? {
+            for r in &t.rows {
+                let id = t.text(r, "image_id").to_string();
+                if let (Some(x), Some(y)) = (t.num(r, "x"), t.num(r, "y")) {
+                    recorded.entry(id.clone()).or_insert([x, y]);
+                }
+                ids.push(id);
+            }
+        }
+    }
+    if ids.is_empty() {
+        ids = recorded.keys().cloned().collect();
+    }
+    ids.retain(|id| recorded.contains_key(id));
+    if ids.is_empty() {
+        return Ok(None);
+    }
+    let truth = match campaign {
+        Some(c) => positions_csv(&c.join("truth/recordings.csv"))?,
+        None => BTreeMap::new(),
+    };
+    let corr = read_csv_opt(&dir.join("correspondences.csv"))?;
+    let (nadir, oblique) = correspondence_sets(corr.as_ref());
+    let recordings = ids
+        .iter()
+        .map(|id| MapRecording {
+            recorded: recorded[id],
+            adjusted: adjusted.get(id).copied(),
+            truth: truth.get(id).copied(),
+            kind: CorrespondenceKind::from_flags(nadir.contains(id), oblique.contains(id)),
+        })
+        .collect();
+    let cp_pos = geo
+        .as_ref()
+        .map(|g| geojson_layer(g, "checkpoints", "point_id"))
+        .unwrap_or_default();
+    let mut checkpoints = Vec::new();
+    if let Some(t) = read_csv_opt(&dir.join("checkpoints.csv"))? {
+        for r in &t.rows {
+            let id = t.text(r, "point_id");
+            let Some(&position) = cp_pos.get(id) else {
+                continue;
+            };
+            let vec2 = |p: &str| Some([t.num(r, &format!("{p}_x"))?, t.num(r, &format!("{p}_y"))?]);
+            checkpoints.push(MapCheckPoint {
+                position,
+                error_before: vec2("before"),
+                error_after: vec2("after"),
+            });
+        }
+    }
+    Ok(Some(MapData {
+        ids,
+        recordings,
+        checkpoints,
+        has_truth: !truth.is_empty(),
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn correspondence_kinds_per_recording() {
+        let t = CsvTable {
+            header: [
+                "source",
+                "point_id",
+                "image_kind",
+                "image_id",
+                "u",
+                "v",
+                "score",
+            ]
+            .map(String::from)
+            .to_vec(),
+            rows: vec![
+                ["nadir", "p1", "panorama", "a", "1", "2", ""]
+                    .map(String::from)
+                    .to_vec(),
+                ["nadir", "p1", "nadir", "n1", "1", "2", "0.9"]
+                    .map(String::from)
+                    .to_vec(),
+                ["oblique", "p2", "panorama", "a", "1", "2", ""]
+                    .map(String::from)
+                    .to_vec(),
+                ["oblique", "p2", "panorama", "b", "1", "2", ""]
+                    .map(String::from)
+                    .to_vec(),
+            ],
+        };
+        let (n, o) = correspondence_sets(Some(&t));
+        assert_eq!(n.into_iter().collect::<Vec<_>>(), vec!["a"]);
+        assert_eq!(o.into_iter().collect::<Vec<_>>(), vec!["a", "b"]);
+    }
+
+    #[test]
+    fn geojson_points_by_layer() {
+        let doc = serde_json::json!({"features": [
+            {"geometry": {"type": "Point", "coordinates": [1.0, 2.0, 3.0]},
+             "properties": {"layer": "recorded", "image_id": "a"}},
+            {"geometry": {"type": "LineString", "coordinates": [[1.0, 2.0]]},
+             "properties": {"layer": "recorded"}},
+            {"geometry": {"type": "Point", "coordinates": [5.0, 6.0]},
+             "properties": {"layer": "adjusted", "image_id": "a"}}]});
+        let r = geojson_layer(&doc, "recorded", "image_id");
+        assert_eq!(r.len(), 1);
+        assert_eq!(r["a"], [1.0, 2.0]);
+    }
+}

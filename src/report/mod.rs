@@ -1,0 +1,214 @@
+//! The HTML report of a run (issue 7): `skytie report OUT [--campaign DIR]`, also written at the end of
+//! `skytie run`. A pure function of the output folder OUT (plus, optionally, the campaign folder for images
+//! and `truth/`): it never runs the pipeline.
+//!
+//! Writes `OUT/report/index.html` (summary, and for a plain run the result sections; for a sweep the sweep
+//! tables and charts plus one page `variant-<name>.html` per variant), figures as SVG / PNG files in
+//! `OUT/report/figures/`, and every table also as CSV and Markdown in `OUT/report/tables/`. The same OUT
+//! gives byte-identical files (no timestamps except those read from OUT).
+
+pub mod html;
+pub mod inputs;
+pub mod map_data;
+pub mod plots;
+pub mod registration;
+pub mod results;
+pub mod summary;
+pub mod sweep;
+pub mod tables;
+pub mod thesis_values;
+
+use html::Page;
+use inputs::RunOutputs;
+use skytie_stages::fsutil::atomic_write;
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use tables::Table;
+
+/// How to build a report.
+#[derive(Clone, Debug, Default)]
+pub struct ReportOptions {
+    /// Campaign folder (images, `truth/`); default: the one named in `OUT/provenance.json`.
+    pub campaign: Option<PathBuf>,
+    /// How many recordings get registration views (0 = none).
+    pub registration_views: usize,
+}
+
+impl ReportOptions {
+    /// The defaults used by `skytie run` and `skytie report`.
+    pub fn standard(campaign: Option<PathBuf>) -> Self {
+        Self {
+            campaign,
+            registration_views: 3,
+        }
+    }
+}
+
+/// What was written.
+#[derive(Debug)]
+pub struct ReportSummary {
+    /// `OUT/report/index.html`.
+    pub index: PathBuf,
+    /// Every page written (index first).
+    pub pages: Vec<PathBuf>,
+    /// Table ids (each written as `tables/<id>.csv` and `.md`).
+    pub tables: Vec<String>,
+    /// Figure files written.
+    pub figures: Vec<PathBuf>,
+    /// Sections left out or degraded, one line each (e.g. "no campaign folder: no true positions").
+    pub notes: Vec<String>,
+}
+
+/// Shared state while the pages are assembled: where files go, what has been written.
+pub struct Builder {
+    pub report_dir: PathBuf,
+    pub campaign: Option<PathBuf>,
+    pub options: ReportOptions,
+    tables: Vec<Table>,
+    table_ids: BTreeSet<String>,
+    pub figures: Vec<PathBuf>,
+    pub notes: Vec<String>,
+}
+
+/// Folder names inside `OUT/report/`.
+pub const TABLES_DIR: &str = "tables";
+pub const FIGURES_DIR: &str = "figures";
+
+impl Builder {
+    /// Adds a table to `page` and queues its CSV/Markdown files. Ids must be unique in the report.
+    pub fn table(&mut self, page: &mut Page, t: Table) {
+        debug_assert!(
+            !self.table_ids.contains(&t.id),
+            "duplicate table id {}",
+            t.id
+        );
+        page.raw(&t.to_html(TABLES_DIR));
+        self.table_ids.insert(t.id.clone());
+        self.tables.push(t);
+    }
+
+    /// The absolute path and the page-relative href of a figure file named `name`.
+    pub fn figure_path(&self, name: &str) -> (PathBuf, String) {
+        (
+            self.report_dir.join(FIGURES_DIR).join(name),
+            format!("{FIGURES_DIR}/{name}"),
+        )
+    }
+
+    /// Records a written figure.
+    pub fn wrote_figure(&mut self, path: PathBuf) {
+        self.figures.push(path);
+    }
+
+    /// A section that could not be drawn: a note on the page and in the summary.
+    pub fn note(&mut self, page: &mut Page, text: String) {
+        page.raw(&format!("<p class=\"note\">{}</p>\n", html::escape(&text)));
+        self.notes.push(text);
+    }
+}
+
+/// A file-name-safe version of a variant or recording name.
+pub fn slug(s: &str) -> String {
+    s.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// Builds `OUT/report/`. Err when OUT is not a run's output folder or a file cannot be written; sections
+/// whose inputs are missing are left out with a note (see [`ReportSummary::notes`]).
+pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSummary, String> {
+    let run = RunOutputs::read(out_dir)?;
+    let report_dir = out_dir.join("report");
+    for d in [report_dir.join(TABLES_DIR), report_dir.join(FIGURES_DIR)] {
+        std::fs::create_dir_all(&d)
+            .map_err(|e| format!("{}: cannot create the folder: {e}", d.display()))?;
+    }
+    let campaign = options
+        .campaign
+        .clone()
+        .or_else(|| run.campaign_dir())
+        .filter(|p| p.join("mm/recordings.csv").exists());
+    let mut b = Builder {
+        report_dir: report_dir.clone(),
+        campaign,
+        options: options.clone(),
+        tables: Vec::new(),
+        table_ids: BTreeSet::new(),
+        figures: Vec::new(),
+        notes: Vec::new(),
+    };
+    if b.campaign.is_none() {
+        b.notes.push(
+            "campaign folder not found (give --campaign DIR): no true positions, no registration views"
+                .to_string(),
+        );
+    }
+    let mut pages: Vec<(PathBuf, String)> = Vec::new();
+    let mut index = Page::new(&format!(
+        "skytie report: {}",
+        inputs::str_at(&run.metrics, "campaign.name")
+            .or_else(|| run
+                .sets
+                .first()
+                .and_then(|s| inputs::str_at(&s.metrics, "campaign.name")))
+            .unwrap_or("run")
+    ));
+    summary::summary_section(&mut b, &mut index, &run);
+    if run.is_sweep {
+        sweep::sweep_section(&mut b, &mut index, &run)?;
+        index.heading("variants", "Variants");
+        let mut list = String::from("<ul>\n");
+        for set in &run.sets {
+            let file = format!("variant-{}.html", slug(&set.name));
+            list.push_str(&format!(
+                "<li><a href=\"{}\">{}</a></li>\n",
+                html::escape(&file),
+                html::escape(&set.name)
+            ));
+            let mut page = Page::new(&format!("variant {}", set.name));
+            page.nav_link("index.html", "← report index");
+            results::results_sections(&mut b, &mut page, set, &run)?;
+            pages.push((report_dir.join(&file), page.render()));
+        }
+        list.push_str("</ul>\n");
+        index.raw(&list);
+    } else if let Some(set) = run.sets.first() {
+        results::results_sections(&mut b, &mut index, set, &run)?;
+    }
+    if !b.notes.is_empty() {
+        index.heading("notes", "Notes on this report");
+        let mut ul = String::from("<ul>\n");
+        for n in &b.notes {
+            ul.push_str(&format!("<li>{}</li>\n", html::escape(n)));
+        }
+        ul.push_str("</ul>\n");
+        index.raw(&ul);
+    }
+    let index_path = report_dir.join("index.html");
+    pages.insert(0, (index_path.clone(), index.render()));
+    for t in &b.tables {
+        let base = report_dir.join(TABLES_DIR).join(&t.id);
+        for (ext, text) in [("csv", t.to_csv()), ("md", t.to_markdown())] {
+            let p = base.with_extension(ext);
+            atomic_write(&p, text.as_bytes())
+                .map_err(|e| format!("{}: cannot write: {e}", p.display()))?;
+        }
+    }
+    for (p, text) in &pages {
+        atomic_write(p, text.as_bytes())
+            .map_err(|e| format!("{}: cannot write: {e}", p.display()))?;
+    }
+    Ok(ReportSummary {
+        index: index_path,
+        pages: pages.into_iter().map(|(p, _)| p).collect(),
+        tables: b.tables.iter().map(|t| t.id.clone()).collect(),
+        figures: b.figures,
+        notes: b.notes,
+    })
+}

@@ -1,0 +1,135 @@
+//! Raster drawing for the registration views: grey crops scaled to a display height, side-by-side
+//! composition, lines and ring markers in colour. Pixel coordinates are continuous (first pixel centre at
+//! (0.5, 0.5)) as everywhere in skytie.
+
+use skytie_stages::imaging::image::{GrayImage, RgbImage};
+
+pub type Rgb = [f32; 3];
+pub const GREEN: Rgb = [0.0, 0.85, 0.2];
+pub const RED: Rgb = [1.0, 0.1, 0.1];
+pub const YELLOW: Rgb = [1.0, 0.85, 0.0];
+
+/// A crop of `img` with top-left corner (x0, y0) and size (w, h) source pixels, scaled by `scale` with
+/// bilinear sampling; outside the source is black. Returns the RGB image.
+pub fn crop_scaled(img: &GrayImage, x0: f64, y0: f64, w: f64, h: f64, scale: f64) -> RgbImage {
+    let (ow, oh) = (
+        ((w * scale).round() as usize).max(1),
+        ((h * scale).round() as usize).max(1),
+    );
+    let mut out = RgbImage::filled(ow, oh, [0.0; 3]);
+    for row in 0..oh {
+        let sy = y0 + (row as f64 + 0.5) / scale - 0.5;
+        for col in 0..ow {
+            let sx = x0 + (col as f64 + 0.5) / scale - 0.5;
+            let v = bilinear(img, sx, sy);
+            out.set(col, row, [v, v, v]);
+        }
+    }
+    out
+}
+
+/// Bilinear sample at array coordinates (pixel centres at integers); 0 outside.
+fn bilinear(img: &GrayImage, x: f64, y: f64) -> f32 {
+    if !(x >= 0.0 && y >= 0.0) || x > (img.width - 1) as f64 || y > (img.height - 1) as f64 {
+        return 0.0;
+    }
+    let (x0, y0) = (x.floor() as usize, y.floor() as usize);
+    let (x1, y1) = ((x0 + 1).min(img.width - 1), (y0 + 1).min(img.height - 1));
+    let (fx, fy) = ((x - x0 as f64) as f32, (y - y0 as f64) as f32);
+    let top = img.get(x0, y0) * (1.0 - fx) + img.get(x1, y0) * fx;
+    let bottom = img.get(x0, y1) * (1.0 - fx) + img.get(x1, y1) * fx;
+    top * (1.0 - fy) + bottom * fy
+}
+
+/// `left` and `right` side by side with a `gap`-pixel white band; the taller height wins.
+pub fn side_by_side(left: &RgbImage, right: &RgbImage, gap: usize) -> RgbImage {
+    let w = left.width + gap + right.width;
+    let h = left.height.max(right.height);
+    let mut out = RgbImage::filled(w, h, [1.0; 3]);
+    for (img, x_off) in [(left, 0), (right, left.width + gap)] {
+        for row in 0..img.height {
+            for col in 0..img.width {
+                out.set(col + x_off, row, img.get(col, row));
+            }
+        }
+    }
+    out
+}
+
+fn put(img: &mut RgbImage, x: i64, y: i64, c: Rgb) {
+    if x >= 0 && y >= 0 && (x as usize) < img.width && (y as usize) < img.height {
+        img.set(x as usize, y as usize, c);
+    }
+}
+
+/// A line between two continuous pixel positions, `width` pixels thick (square brush).
+pub fn line(img: &mut RgbImage, a: (f64, f64), b: (f64, f64), c: Rgb, width: i64) {
+    let len = (b.0 - a.0).hypot(b.1 - a.1);
+    let steps = (len.ceil() as usize).max(1) * 2;
+    let r = width / 2;
+    for i in 0..=steps {
+        let t = i as f64 / steps as f64;
+        let x = (a.0 + (b.0 - a.0) * t - 0.5).round() as i64;
+        let y = (a.1 + (b.1 - a.1) * t - 0.5).round() as i64;
+        for dy in -r..=(width - 1 - r) {
+            for dx in -r..=(width - 1 - r) {
+                put(img, x + dx, y + dy, c);
+            }
+        }
+    }
+}
+
+/// A ring of radius `radius` px around a continuous pixel position, 2 px thick.
+pub fn ring(img: &mut RgbImage, centre: (f64, f64), radius: f64, c: Rgb) {
+    let (cx, cy) = (centre.0 - 0.5, centre.1 - 0.5);
+    let r = radius.ceil() as i64 + 2;
+    let (x0, y0) = (cx.round() as i64, cy.round() as i64);
+    for y in (y0 - r)..=(y0 + r) {
+        for x in (x0 - r)..=(x0 + r) {
+            let d = (x as f64 - cx).hypot(y as f64 - cy);
+            if (d - radius).abs() <= 1.0 {
+                put(img, x, y, c);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn crop_scales_and_pads_with_black() {
+        let mut g = GrayImage::filled(4, 4, 0.0);
+        g.set(1, 1, 1.0);
+        // Crop the 2×2 block at (1,1) scaled ×2: pixel (1,1) occupies the top-left 2×2 output block area.
+        let c = crop_scaled(&g, 1.0, 1.0, 2.0, 2.0, 2.0);
+        assert_eq!((c.width, c.height), (4, 4));
+        assert!(c.get(0, 0)[0] > 0.9);
+        assert!(c.get(3, 3)[0] < 0.1);
+        let outside = crop_scaled(&g, 10.0, 10.0, 2.0, 2.0, 1.0);
+        assert_eq!(outside.get(0, 0), [0.0; 3]);
+    }
+
+    #[test]
+    fn side_by_side_places_both() {
+        let a = RgbImage::filled(2, 3, [0.0; 3]);
+        let b = RgbImage::filled(3, 2, [0.5; 3]);
+        let s = side_by_side(&a, &b, 1);
+        assert_eq!((s.width, s.height), (6, 3));
+        assert_eq!(s.get(2, 0), [1.0; 3]);
+        assert_eq!(s.get(3, 1), [0.5; 3]);
+        assert_eq!(s.get(3, 2), [1.0; 3]);
+    }
+
+    #[test]
+    fn line_and_ring_draw_where_asked() {
+        let mut img = RgbImage::filled(20, 20, [0.0; 3]);
+        line(&mut img, (0.5, 10.5), (19.5, 10.5), RED, 1);
+        assert_eq!(img.get(5, 10), RED);
+        assert_eq!(img.get(5, 12), [0.0; 3]);
+        ring(&mut img, (10.5, 5.5), 3.0, GREEN);
+        assert_eq!(img.get(13, 5), GREEN);
+        assert_eq!(img.get(10, 5), [0.0; 3]);
+    }
+}

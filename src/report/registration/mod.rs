@@ -1,0 +1,499 @@
+//! Registration views (thesis Figs 3.6, 3.11, 3.12 for nadir, 4.9, 4.18 for oblique): for the few
+//! recordings with the most aerial control points, one image with the MM side on the left and the aerial
+//! side on the right, each correspondence a line between its two observations, green when correct and red
+//! when wrong by truth (yellow: no truth). Nadir: the recording's north-up MM ortho image (recorded pose,
+//! `ortho_project` at 3 cm) beside the crop of the aerial nadir image covering the same ground. Oblique: the
+//! panorama crop around the observations beside the oblique image crop around them. Inputs:
+//! `correspondences.csv` of the result folder, the campaign's images and (optionally) `truth/`.
+
+pub mod canvas;
+pub mod truth;
+
+use super::html::Page;
+use super::inputs::{read_csv_opt, CsvTable, ResultSet};
+use super::tables::{fmt_count, Origin, Table};
+use super::{slug, Builder};
+use canvas::{crop_scaled, line, ring, side_by_side, Rgb, GREEN, RED, YELLOW};
+use nalgebra::Vector3;
+use skytie_stages::campaign::{
+    read_campaign, read_recordings_csv, AerialImage, Campaign, Recording,
+};
+use skytie_stages::geometry::{FrameCamera, PanoramaCamera};
+use skytie_stages::imaging::image::{GrayImage, RgbImage};
+use skytie_stages::imaging::io::{dimensions, load_gray, save_rgb};
+use skytie_stages::nadir::{ortho_project, OrthoParams};
+use std::collections::BTreeMap;
+use std::path::Path;
+use truth::{true_point, verdict, TruePanoObservation, Verdict};
+
+/// One observation row of correspondences.csv.
+#[derive(Clone, Debug)]
+struct CorrObs {
+    kind: String,
+    image_id: String,
+    u_px: f64,
+    v_px: f64,
+}
+
+/// One control point: its source (nadir / oblique), panorama and aerial observations.
+#[derive(Default, Debug)]
+struct ControlPoint {
+    pano: Vec<CorrObs>,
+    aerial: Vec<CorrObs>,
+}
+
+type Points = BTreeMap<(String, String), ControlPoint>;
+
+fn parse_points(t: &CsvTable) -> Points {
+    let mut points: Points = BTreeMap::new();
+    for r in &t.rows {
+        let (Some(u), Some(v)) = (t.num(r, "u"), t.num(r, "v")) else {
+            continue;
+        };
+        let key = (
+            t.text(r, "source").to_string(),
+            t.text(r, "point_id").to_string(),
+        );
+        let o = CorrObs {
+            kind: t.text(r, "image_kind").to_string(),
+            image_id: t.text(r, "image_id").to_string(),
+            u_px: u,
+            v_px: v,
+        };
+        let p = points.entry(key).or_default();
+        if o.kind == "panorama" {
+            p.pano.push(o);
+        } else {
+            p.aerial.push(o);
+        }
+    }
+    points
+}
+
+/// Counts of one view's verdicts.
+#[derive(Default)]
+struct ViewCounts {
+    correct: usize,
+    wrong: usize,
+    ungraded: usize,
+}
+
+impl ViewCounts {
+    fn add(&mut self, v: Verdict) -> Rgb {
+        match v {
+            Verdict::Correct => {
+                self.correct += 1;
+                GREEN
+            }
+            Verdict::Wrong => {
+                self.wrong += 1;
+                RED
+            }
+            Verdict::Ungraded => {
+                self.ungraded += 1;
+                YELLOW
+            }
+        }
+    }
+}
+
+/// What the views need from the campaign.
+struct Context<'a> {
+    campaign: &'a Campaign,
+    truth: BTreeMap<String, Recording>,
+    pano_sizes: BTreeMap<String, (u32, u32)>,
+}
+
+impl Context<'_> {
+    fn recording(&self, id: &str) -> Option<&Recording> {
+        self.campaign.recordings.iter().find(|r| r.image_id == id)
+    }
+
+    fn aerial(&self, kind: &str, id: &str) -> Option<&AerialImage> {
+        let list = if kind == "nadir" {
+            &self.campaign.nadir
+        } else {
+            &self.campaign.oblique
+        };
+        list.iter().find(|a| a.image_id == id)
+    }
+
+    fn aerial_path(&self, kind: &str, a: &AerialImage) -> std::path::PathBuf {
+        self.campaign.root.join("aerial").join(kind).join(&a.file)
+    }
+
+    /// The control point's true object point (None without truth).
+    fn true_point(&self, p: &ControlPoint) -> Option<Vector3<f64>> {
+        let obs: Vec<TruePanoObservation> = p
+            .pano
+            .iter()
+            .filter_map(|o| {
+                Some(TruePanoObservation {
+                    truth: self.truth.get(&o.image_id)?,
+                    size_px: *self.pano_sizes.get(&o.image_id)?,
+                    u_px: o.u_px,
+                    v_px: o.v_px,
+                })
+            })
+            .collect();
+        if obs.len() != p.pano.len() {
+            return None;
+        }
+        true_point(&obs)
+    }
+}
+
+/// Appends the registration views of `set` to `page`.
+pub fn registration_section(
+    b: &mut Builder,
+    page: &mut Page,
+    set: &ResultSet,
+    prefix: &str,
+) -> Result<(), String> {
+    let n_views = b.options.registration_views;
+    if n_views == 0 {
+        return Ok(());
+    }
+    let Some(corr) = read_csv_opt(&set.dir.join("correspondences.csv"))? else {
+        return Ok(());
+    };
+    page.heading(&format!("{prefix}registration"), "Registration views");
+    let Some(root) = b.campaign.clone() else {
+        b.note(
+            page,
+            "registration views need the campaign folder (skytie report OUT --campaign DIR)".into(),
+        );
+        return Ok(());
+    };
+    let campaign = match read_campaign(&root) {
+        Ok((c, _)) => c,
+        Err(e) => {
+            b.note(
+                page,
+                format!("registration views: cannot read the campaign: {e}"),
+            );
+            return Ok(());
+        }
+    };
+    let truth_path = root.join("truth/recordings.csv");
+    let truth: BTreeMap<String, Recording> = if truth_path.exists() {
+        read_recordings_csv(&truth_path)
+            .0
+            .into_iter()
+            .map(|r| (r.image_id.clone(), r))
+            .collect()
+    } else {
+        BTreeMap::new()
+    };
+    let points = parse_points(&corr);
+    let mut pano_sizes = BTreeMap::new();
+    for r in &campaign.recordings {
+        if let Ok(d) = dimensions(&root.join("mm/panoramas").join(&r.file)) {
+            pano_sizes.insert(r.image_id.clone(), d);
+        }
+    }
+    let ctx = Context {
+        campaign: &campaign,
+        truth,
+        pano_sizes,
+    };
+    let mut t = Table::new(
+        &format!("{prefix}registration-views"),
+        "Correspondences shown in the registration views",
+        Origin::Skytie,
+        &["source", "recording", "aerial image", "control points", "correct", "wrong", "ungraded"],
+    )
+    .with_note(
+        "correct = within 1 aerial pixel of the point triangulated from the panorama observations with the \
+         true poses (truth/), projected into the aerial image; ungraded without truth.",
+    );
+    for source in ["nadir", "oblique"] {
+        // Recordings by number of control points of this source, most first.
+        let mut per_rec: BTreeMap<&str, usize> = BTreeMap::new();
+        for ((s, _), p) in &points {
+            if s != source || p.aerial.is_empty() {
+                continue;
+            }
+            for o in &p.pano {
+                *per_rec.entry(o.image_id.as_str()).or_default() += 1;
+            }
+        }
+        let mut ranked: Vec<(&str, usize)> = per_rec.into_iter().collect();
+        ranked.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(b.0)));
+        for (rec_id, _) in ranked.into_iter().take(n_views) {
+            let Some(rec) = ctx.recording(rec_id) else {
+                continue;
+            };
+            let mine: Vec<&ControlPoint> = points
+                .iter()
+                .filter(|((s, _), p)| s == source && p.pano.iter().any(|o| o.image_id == rec_id))
+                .map(|(_, p)| p)
+                .collect();
+            let name = format!("{prefix}registration-{source}-{}.png", slug(rec_id));
+            let (path, href) = b.figure_path(&name);
+            let made = if source == "nadir" {
+                nadir_view(&ctx, rec, &mine, &path)
+            } else {
+                oblique_view(&ctx, rec, &mine, &path)
+            };
+            match made {
+                Ok((aerial_id, c)) => {
+                    b.wrote_figure(path);
+                    page.figure(
+                        &href,
+                        &format!("{source} registration of {rec_id}"),
+                        &format!(
+                            "{rec_id} ({}) and {source} image {aerial_id}: {} correct (green), {} wrong (red), \
+                             {} ungraded (yellow).",
+                            if source == "nadir" {
+                                "MM ortho image, 3 cm, north up"
+                            } else {
+                                "panorama crop"
+                            },
+                            c.correct,
+                            c.wrong,
+                            c.ungraded
+                        ),
+                    );
+                    let n = c.correct + c.wrong + c.ungraded;
+                    t.push(vec![
+                        source.to_string(),
+                        rec_id.to_string(),
+                        aerial_id,
+                        fmt_count(Some(n as f64)),
+                        fmt_count(Some(c.correct as f64)),
+                        fmt_count(Some(c.wrong as f64)),
+                        fmt_count(Some(c.ungraded as f64)),
+                    ]);
+                }
+                Err(e) => b.note(page, format!("{source} registration view of {rec_id}: {e}")),
+            }
+        }
+    }
+    if t.rows.is_empty() {
+        page.para("No control point has both panorama and aerial observations.");
+    } else {
+        b.table(page, t);
+    }
+    Ok(())
+}
+
+/// The aerial image of `kind` observing most of `points` (ties: smallest id).
+fn best_aerial(points: &[&ControlPoint], kind: &str) -> Option<String> {
+    let mut count: BTreeMap<&str, usize> = BTreeMap::new();
+    for p in points {
+        for o in p.aerial.iter().filter(|o| o.kind == kind) {
+            *count.entry(o.image_id.as_str()).or_default() += 1;
+        }
+    }
+    let max = *count.values().max()?;
+    count
+        .into_iter()
+        .find(|(_, c)| *c == max)
+        .map(|(id, _)| id.to_string())
+}
+
+fn load(path: &Path) -> Result<GrayImage, String> {
+    load_gray(path).map_err(|e| e.to_string())
+}
+
+fn save(path: &Path, img: &RgbImage) -> Result<(), String> {
+    save_rgb(path, img, 90).map_err(|e| e.to_string())
+}
+
+/// Ortho image | aerial nadir crop of the same ground.
+fn nadir_view(
+    ctx: &Context<'_>,
+    rec: &Recording,
+    points: &[&ControlPoint],
+    out: &Path,
+) -> Result<(String, ViewCounts), String> {
+    let aerial_id = best_aerial(points, "nadir").ok_or("no nadir observation")?;
+    let aerial = ctx
+        .aerial("nadir", &aerial_id)
+        .ok_or_else(|| format!("nadir image {aerial_id} is not in the campaign"))?;
+    let pano = load(&ctx.campaign.root.join("mm/panoramas").join(&rec.file))?;
+    let ortho = ortho_project(&pano, rec, &OrthoParams::default());
+    let g = &ortho.georef;
+    let left = crop_scaled(
+        &ortho.image,
+        0.0,
+        0.0,
+        g.width_px as f64,
+        g.height_px as f64,
+        1.0,
+    );
+    let cam = FrameCamera::from_aerial(aerial);
+    let foot = Vector3::from(g.foot_world);
+    let (cu, cv) = cam
+        .project_world(&foot)
+        .ok_or("the recording is not in front of the aerial camera")?;
+    let (eu, ev) = cam
+        .project_world(&(foot + Vector3::new(1.0, 0.0, 0.0)))
+        .ok_or("the recording is not in front of the aerial camera")?;
+    let px_per_m = (eu - cu).hypot(ev - cv);
+    let side_px = g.width_px as f64 * g.gsd_m * px_per_m;
+    let (x0, y0) = (cu - side_px / 2.0, cv - side_px / 2.0);
+    let scale = g.height_px as f64 / side_px;
+    let aerial_img = load(&ctx.aerial_path("nadir", aerial))?;
+    let right = crop_scaled(&aerial_img, x0, y0, side_px, side_px, scale);
+    let gap = 12;
+    let mut img = side_by_side(&left, &right, gap);
+    let x_off = (left.width + gap) as f64;
+    let pano_cam = PanoramaCamera::from_recording(rec, pano.width as u32, pano.height as u32);
+    let ground_z = rec.z - rec.camera_height_m;
+    let mut counts = ViewCounts::default();
+    for p in points {
+        let Some(mo) = p.pano.iter().find(|o| o.image_id == rec.image_id) else {
+            continue;
+        };
+        let Some(ao) = p
+            .aerial
+            .iter()
+            .find(|o| o.kind == "nadir" && o.image_id == aerial_id)
+        else {
+            continue;
+        };
+        let Some(ground) =
+            truth::ground_intersection(&pano_cam.pixel_ray(mo.u_px, mo.v_px), ground_z)
+        else {
+            continue;
+        };
+        let a = g.world_to_pixel(&ground);
+        let bpt = (x_off + (ao.u_px - x0) * scale, (ao.v_px - y0) * scale);
+        let x = ctx.true_point(p);
+        let colour = counts.add(verdict(x.as_ref(), aerial, ao.u_px, ao.v_px));
+        line(&mut img, a, bpt, colour, 1);
+        ring(&mut img, a, 7.0, colour);
+        ring(&mut img, bpt, 7.0, colour);
+    }
+    save(out, &img)?;
+    Ok((aerial_id, counts))
+}
+
+/// Bounding box (x0, y0, w, h) of observations, padded, at least `min` pixels wide and high.
+fn bbox(obs: &[(f64, f64)], pad: f64, min: f64) -> (f64, f64, f64, f64) {
+    let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+    for &(u, v) in obs {
+        x0 = x0.min(u);
+        y0 = y0.min(v);
+        x1 = x1.max(u);
+        y1 = y1.max(v);
+    }
+    let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
+    let w = (x1 - x0 + 2.0 * pad).max(min);
+    let h = (y1 - y0 + 2.0 * pad).max(min);
+    (cx - w / 2.0, cy - h / 2.0, w, h)
+}
+
+/// Panorama crop | oblique image crop around the observations, both scaled to 420 px high.
+fn oblique_view(
+    ctx: &Context<'_>,
+    rec: &Recording,
+    points: &[&ControlPoint],
+    out: &Path,
+) -> Result<(String, ViewCounts), String> {
+    const HEIGHT: f64 = 420.0;
+    let aerial_id = best_aerial(points, "oblique").ok_or("no oblique observation")?;
+    let aerial = ctx
+        .aerial("oblique", &aerial_id)
+        .ok_or_else(|| format!("oblique image {aerial_id} is not in the campaign"))?;
+    let pairs: Vec<(&CorrObs, &CorrObs, &ControlPoint)> = points
+        .iter()
+        .filter_map(|p| {
+            let mo = p.pano.iter().find(|o| o.image_id == rec.image_id)?;
+            let ao = p
+                .aerial
+                .iter()
+                .find(|o| o.kind == "oblique" && o.image_id == aerial_id)?;
+            Some((mo, ao, *p))
+        })
+        .collect();
+    if pairs.is_empty() {
+        return Err("no control point seen in both images".into());
+    }
+    let pano = load(&ctx.campaign.root.join("mm/panoramas").join(&rec.file))?;
+    let aerial_img = load(&ctx.aerial_path("oblique", aerial))?;
+    let lb = bbox(
+        &pairs
+            .iter()
+            .map(|(m, _, _)| (m.u_px, m.v_px))
+            .collect::<Vec<_>>(),
+        60.0,
+        200.0,
+    );
+    let rb = bbox(
+        &pairs
+            .iter()
+            .map(|(_, a, _)| (a.u_px, a.v_px))
+            .collect::<Vec<_>>(),
+        40.0,
+        120.0,
+    );
+    let (ls, rs) = (HEIGHT / lb.3, HEIGHT / rb.3);
+    let left = crop_scaled(&pano, lb.0, lb.1, lb.2, lb.3, ls);
+    let right = crop_scaled(&aerial_img, rb.0, rb.1, rb.2, rb.3, rs);
+    let gap = 12;
+    let mut img = side_by_side(&left, &right, gap);
+    let x_off = (left.width + gap) as f64;
+    let mut counts = ViewCounts::default();
+    for (mo, ao, p) in pairs {
+        let a = ((mo.u_px - lb.0) * ls, (mo.v_px - lb.1) * ls);
+        let bpt = (x_off + (ao.u_px - rb.0) * rs, (ao.v_px - rb.1) * rs);
+        let x = ctx.true_point(p);
+        let colour = counts.add(verdict(x.as_ref(), aerial, ao.u_px, ao.v_px));
+        line(&mut img, a, bpt, colour, 1);
+        ring(&mut img, a, 7.0, colour);
+        ring(&mut img, bpt, 7.0, colour);
+    }
+    save(out, &img)?;
+    Ok((aerial_id, counts))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn points_group_observations_by_source_and_id() {
+        let t = CsvTable {
+            header: [
+                "source",
+                "point_id",
+                "image_kind",
+                "image_id",
+                "u",
+                "v",
+                "score",
+            ]
+            .map(String::from)
+            .to_vec(),
+            rows: vec![
+                ["nadir", "p1", "panorama", "a", "1", "2", ""]
+                    .map(String::from)
+                    .to_vec(),
+                ["nadir", "p1", "nadir", "n1", "3", "4", "0.9"]
+                    .map(String::from)
+                    .to_vec(),
+                ["nadir", "p1", "nadir", "n2", "3", "4", "0.9"]
+                    .map(String::from)
+                    .to_vec(),
+                ["oblique", "p1", "panorama", "a", "1", "2", ""]
+                    .map(String::from)
+                    .to_vec(),
+            ],
+        };
+        let p = parse_points(&t);
+        assert_eq!(p.len(), 2);
+        let n = &p[&("nadir".to_string(), "p1".to_string())];
+        assert_eq!((n.pano.len(), n.aerial.len()), (1, 2));
+        assert_eq!(best_aerial(&[n], "nadir").as_deref(), Some("n1"));
+    }
+
+    #[test]
+    fn bbox_pads_and_enforces_minimum() {
+        let (x0, y0, w, h) = bbox(&[(100.0, 100.0), (110.0, 300.0)], 10.0, 50.0);
+        assert_eq!((w, h), (50.0, 220.0));
+        assert_eq!((x0, y0), (80.0, 90.0));
+    }
+}

@@ -1,0 +1,150 @@
+//! Correct / wrong marks for the registration views, by truth (evaluation only, never the pipeline): the
+//! panorama observations of a control point are triangulated with the **true** recording poses
+//! (`truth/recordings.csv`) — one observation only: intersected with the horizontal plane at the true
+//! ground height below the camera — and the point is projected into the aerial image with its pose (aerial
+//! poses of synthetic campaigns are true). An aerial observation is correct when it lies within
+//! [`TOLERANCE_PX`] of that projection (the README's truth grading rule: 1 aerial pixel).
+
+use nalgebra::Vector3;
+use skytie_stages::campaign::{AerialImage, Recording};
+use skytie_stages::geometry::{triangulate_rays, FrameCamera, PanoramaCamera, Ray};
+
+/// Largest distance, aerial pixels, between an observation and the truth projection for "correct".
+pub const TOLERANCE_PX: f64 = 1.0;
+
+/// The truth verdict of one aerial observation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    Correct,
+    Wrong,
+    /// No truth available (or the point could not be reconstructed).
+    Ungraded,
+}
+
+/// One panorama observation: the true pose of its recording, the panorama size, the pixel.
+pub struct TruePanoObservation<'a> {
+    pub truth: &'a Recording,
+    pub size_px: (u32, u32),
+    pub u_px: f64,
+    pub v_px: f64,
+}
+
+/// The control point's true object point from its panorama observations (see the module documentation).
+pub fn true_point(obs: &[TruePanoObservation<'_>]) -> Option<Vector3<f64>> {
+    let rays: Vec<Ray> = obs
+        .iter()
+        .map(|o| {
+            PanoramaCamera::from_recording(o.truth, o.size_px.0, o.size_px.1)
+                .pixel_ray(o.u_px, o.v_px)
+        })
+        .collect();
+    match rays.len() {
+        0 => None,
+        1 => {
+            let r = &rays[0];
+            let ground_z = obs[0].truth.z - obs[0].truth.camera_height_m;
+            ground_intersection(r, ground_z)
+        }
+        n => triangulate_rays(&rays, &vec![1e-3; n])
+            .ok()
+            .map(|t| t.point_world),
+    }
+}
+
+/// Where a ray meets the horizontal plane z = `ground_z` (None if it points up or is parallel).
+pub fn ground_intersection(r: &Ray, ground_z: f64) -> Option<Vector3<f64>> {
+    let dz = r.dir_world.z;
+    if !(dz < -1e-9) {
+        return None;
+    }
+    let t = (ground_z - r.origin_world.z) / dz;
+    (t > 0.0).then(|| r.at(t))
+}
+
+/// The verdict of an observation (u, v) in `aerial` of the true point `x`.
+pub fn verdict(x: Option<&Vector3<f64>>, aerial: &AerialImage, u_px: f64, v_px: f64) -> Verdict {
+    let Some(x) = x else {
+        return Verdict::Ungraded;
+    };
+    match FrameCamera::from_aerial(aerial).project_world(x) {
+        Some((u, v)) if (u - u_px).hypot(v - v_px) <= TOLERANCE_PX => Verdict::Correct,
+        Some(_) => Verdict::Wrong,
+        None => Verdict::Ungraded,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn recording(x: f64, y: f64) -> Recording {
+        Recording {
+            image_id: "r".into(),
+            file: "r.jpg".into(),
+            time: String::new(),
+            time_s: 0.0,
+            x,
+            y,
+            z: 2.0,
+            heading_deg: 30.0,
+            camera_height_m: 2.0,
+            sigma_xy_m: None,
+            sigma_z_m: None,
+            yaw_deg: 0.0,
+            pitch_deg: 0.0,
+            roll_deg: 0.0,
+        }
+    }
+
+    fn nadir_camera() -> AerialImage {
+        AerialImage {
+            image_id: "n".into(),
+            file: "n.jpg".into(),
+            x: 5.0,
+            y: 5.0,
+            z: 500.0,
+            omega_deg: 0.0,
+            phi_deg: 0.0,
+            kappa_deg: 0.0,
+            focal_px: 5000.0,
+            cx_px: 500.0,
+            cy_px: 500.0,
+            width_px: 1000,
+            height_px: 1000,
+            k1: 0.0,
+            k2: 0.0,
+            p1: 0.0,
+            p2: 0.0,
+            sigma_px: 0.5,
+        }
+    }
+
+    #[test]
+    fn triangulated_point_grades_its_exact_projection_correct_and_a_shift_wrong() {
+        let x_true = Vector3::new(4.0, 6.0, 0.0);
+        let recs = [recording(0.0, 0.0), recording(8.0, 1.0)];
+        let obs: Vec<TruePanoObservation> = recs
+            .iter()
+            .map(|r| {
+                let cam = PanoramaCamera::from_recording(r, 2000, 1000);
+                let (u, v) = cam.project_world(&x_true).unwrap();
+                TruePanoObservation {
+                    truth: r,
+                    size_px: (2000, 1000),
+                    u_px: u,
+                    v_px: v,
+                }
+            })
+            .collect();
+        let x = true_point(&obs).unwrap();
+        assert!((x - x_true).norm() < 1e-6, "{x}");
+        let a = nadir_camera();
+        let (u, v) = FrameCamera::from_aerial(&a).project_world(&x_true).unwrap();
+        assert_eq!(verdict(Some(&x), &a, u + 0.5, v), Verdict::Correct);
+        assert_eq!(verdict(Some(&x), &a, u + 3.0, v), Verdict::Wrong);
+        assert_eq!(verdict(None, &a, u, v), Verdict::Ungraded);
+        // One observation: the ground-plane intersection gives the same point (it lies on the ground).
+        let one = true_point(&obs[..1]).unwrap();
+        assert!((one - x_true).norm() < 1e-6, "{one}");
+    }
+}

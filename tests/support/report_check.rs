@@ -1,0 +1,143 @@
+//! Helpers of the report test: the files a report page references, headless Chromium (find, render,
+//! read each image's natural size from the dumped DOM, screenshot) and folder snapshots.
+#![allow(dead_code)]
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Every value of `attr="…"` in `html` (attribute values are escaped by the report, never contain `"`).
+pub fn attr_values(html: &str, attr: &str) -> Vec<String> {
+    let pat = format!("{attr}=\"");
+    let mut out = Vec::new();
+    let mut rest = html;
+    while let Some(i) = rest.find(&pat) {
+        rest = &rest[i + pat.len()..];
+        if let Some(j) = rest.find('"') {
+            out.push(rest[..j].replace("&amp;", "&"));
+            rest = &rest[j..];
+        }
+    }
+    out
+}
+
+/// Local files referenced by `<img src>` and `<a href>` of a page (external and anchor links excluded).
+pub fn referenced_files(page: &Path) -> (Vec<PathBuf>, Vec<PathBuf>) {
+    let html = std::fs::read_to_string(page).unwrap();
+    let dir = page.parent().unwrap();
+    let imgs = attr_values(&html, "src")
+        .into_iter()
+        .map(|s| dir.join(s))
+        .collect();
+    let links = attr_values(&html, "href")
+        .into_iter()
+        .filter(|h| !h.starts_with('#') && !h.contains("://"))
+        .map(|s| dir.join(s))
+        .collect();
+    (imgs, links)
+}
+
+/// Every file under `root` with its bytes (relative path → bytes).
+pub fn snapshot(root: &Path) -> BTreeMap<String, Vec<u8>> {
+    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<String, Vec<u8>>) {
+        let mut entries: Vec<_> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        entries.sort();
+        for p in entries {
+            if p.is_dir() {
+                walk(root, &p, out);
+            } else {
+                out.insert(
+                    p.strip_prefix(root).unwrap().display().to_string(),
+                    std::fs::read(&p).unwrap(),
+                );
+            }
+        }
+    }
+    let mut out = BTreeMap::new();
+    walk(root, root, &mut out);
+    out
+}
+
+/// `chromium` or `chromium-browser` on PATH.
+pub fn find_chromium() -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    for dir in std::env::split_paths(&path) {
+        for name in ["chromium", "chromium-browser"] {
+            let p = dir.join(name);
+            if p.is_file() {
+                return Some(p);
+            }
+        }
+    }
+    None
+}
+
+fn headless(chromium: &Path, profile: &Path) -> Command {
+    let mut c = Command::new(chromium);
+    c.arg("--headless")
+        .arg("--disable-gpu")
+        .arg("--no-sandbox")
+        .arg("--no-first-run")
+        .arg("--disable-extensions")
+        .arg("--allow-file-access-from-files")
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg("--virtual-time-budget=8000");
+    c
+}
+
+/// The DOM of `page` after loading (scripts run), as Chromium dumps it.
+pub fn dump_dom(chromium: &Path, page: &Path, profile: &Path) -> String {
+    let out = headless(chromium, profile)
+        .arg("--dump-dom")
+        .arg(format!("file://{}", page.canonicalize().unwrap().display()))
+        .output()
+        .expect("start chromium");
+    assert!(
+        out.status.success(),
+        "chromium --dump-dom failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// Screenshot of `page` into `png` (window `width` × `height` px).
+pub fn screenshot(
+    chromium: &Path,
+    page: &Path,
+    png: &Path,
+    profile: &Path,
+    width: u32,
+    height: u32,
+) {
+    let out = headless(chromium, profile)
+        .arg(format!("--screenshot={}", png.display()))
+        .arg(format!("--window-size={width},{height}"))
+        .arg("--hide-scrollbars")
+        .arg(format!("file://{}", page.canonicalize().unwrap().display()))
+        .output()
+        .expect("start chromium");
+    assert!(
+        out.status.success(),
+        "chromium --screenshot failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Per `<img>` of a dumped DOM: (src, natural width, natural height) as recorded by the page's script.
+pub fn image_sizes(dom: &str) -> Vec<(String, u32, u32)> {
+    let mut out = Vec::new();
+    for tag in dom.split("<img").skip(1) {
+        let tag = &tag[..tag.find('>').unwrap_or(tag.len())];
+        let get = |a: &str| attr_values(tag, a).into_iter().next();
+        let num = |a: &str| get(a).and_then(|v| v.parse::<u32>().ok()).unwrap_or(0);
+        out.push((
+            get("src").unwrap_or_default(),
+            num("data-natural-width"),
+            num("data-natural-height"),
+        ));
+    }
+    out
+}
