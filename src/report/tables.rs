@@ -202,6 +202,7 @@ mod tests {
         assert_eq!(fmt_num(Some(f64::NAN), 3), "n/a");
         assert_eq!(fmt_num(None, 2), "n/a");
         assert_eq!(fmt_count(Some(41.0)), "41");
-        assert_eq!(fmt_percent(Some(0.9015)), "90.2");
+        assert_eq!(fmt_percent(Some(0.9016)), "90.2");
+        assert_eq!(fmt_percent(Some(0.9014)), "90.1");
     }
 }

@@ -100,13 +100,21 @@ mod tests {
 
     #[test]
     fn crop_scales_and_pads_with_black() {
+        // A ramp g = column index (array coordinates) is reproduced exactly by bilinear sampling.
         let mut g = GrayImage::filled(4, 4, 0.0);
-        g.set(1, 1, 1.0);
-        // Crop the 2×2 block at (1,1) scaled ×2: pixel (1,1) occupies the top-left 2×2 output block area.
+        for row in 0..4 {
+            for col in 0..4 {
+                g.set(col, row, col as f32);
+            }
+        }
+        // Continuous (1, 1)–(3, 3) at scale 2: output column c has its centre at continuous 1 + (c + 0.5) / 2,
+        // i.e. array coordinate 0.75 + c / 2.
         let c = crop_scaled(&g, 1.0, 1.0, 2.0, 2.0, 2.0);
         assert_eq!((c.width, c.height), (4, 4));
-        assert!(c.get(0, 0)[0] > 0.9);
-        assert!(c.get(3, 3)[0] < 0.1);
+        for col in 0..4 {
+            let want = 0.75 + col as f32 / 2.0;
+            assert!((c.get(col, 2)[0] - want).abs() < 1e-6, "col {col}");
+        }
         let outside = crop_scaled(&g, 10.0, 10.0, 2.0, 2.0, 1.0);
         assert_eq!(outside.get(0, 0), [0.0; 3]);
     }
