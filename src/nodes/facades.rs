@@ -1,7 +1,8 @@
 //! `facades`: per panorama triplet the façade planes of its sparse cloud with the visibility hypothesis for
 //! the candidate oblique images and box-grid thinning (thesis 4.4.2–4.4.4,
-//! `skytie_stages::oblique::facades`). Inputs: the triplet's sparse cloud, its three recording rows, and the
-//! rows of the oblique images that may see the centre recording's street
+//! `skytie_stages::oblique::facades`). Inputs: the triplet's sparse cloud followed by its neighbours' along
+//! the street (merged by [`neighbourhood_cloud`]: planes are fitted to the points of the whole stretch), its
+//! three recording rows, and the rows of the oblique images that may see the centre recording's street
 //! (`skytie_stages::oblique::candidates`).
 
 use crate::dag::{Handle, NodeCtx, Stage, StageError};
@@ -17,11 +18,11 @@ pub struct FacadesStage;
 
 impl Stage for FacadesStage {
     const NAME: &'static str = "facades";
-    const VERSION: &'static str = "1";
+    const VERSION: &'static str = "2";
     type Params = FacadeParams;
     type Output = TripletFacades;
     type Inputs = (
-        Handle<SparseCloud>,
+        Vec<Handle<SparseCloud>>,
         Vec<Handle<Recording>>,
         Vec<Handle<AerialImage>>,
     );
@@ -29,7 +30,11 @@ impl Stage for FacadesStage {
     fn run(
         &self,
         p: &FacadeParams,
-        (cloud, recs, oblique): (Arc<SparseCloud>, Vec<Arc<Recording>>, Vec<Arc<AerialImage>>),
+        (clouds, recs, oblique): (
+            Vec<Arc<SparseCloud>>,
+            Vec<Arc<Recording>>,
+            Vec<Arc<AerialImage>>,
+        ),
         _: &NodeCtx,
     ) -> Result<TripletFacades, StageError> {
         if recs.len() != 3 {
@@ -37,6 +42,7 @@ impl Stage for FacadesStage {
                 "internal: facades needs the triplet's three recordings",
             ));
         }
+        let cloud = neighbourhood_cloud(&clouds)?;
         let oblique: Vec<AerialImage> = oblique.iter().map(|a| (**a).clone()).collect();
         Ok(find_facades(
             &cloud,
@@ -45,4 +51,15 @@ impl Stage for FacadesStage {
             p,
         ))
     }
+}
+
+/// The triplet's own cloud (first) merged with its neighbours' (`SparseCloud::with_neighbours`); the
+/// `facades` and `patches` nodes merge the same list, so plane inlier indices refer to the same points.
+pub fn neighbourhood_cloud(clouds: &[Arc<SparseCloud>]) -> Result<SparseCloud, StageError> {
+    let Some((own, neighbours)) = clouds.split_first() else {
+        return Err(StageError::new(
+            "internal: facades/patches need the triplet's sparse cloud",
+        ));
+    };
+    Ok(own.with_neighbours(neighbours.iter().map(|c| c.as_ref())))
 }

@@ -13,6 +13,12 @@ pub struct ObliqueOptions {
     /// Consecutive recordings further apart than this (recorded positions, horizontal, metres) do not form a
     /// triplet (a gap in the trajectory, or the start of another street).
     pub max_neighbour_distance_m: f64,
+    /// Façade planes of a triplet are fitted to its own sparse points and those of up to this many
+    /// triplets before and after it along the trajectory (thesis 4.4.2 fits planes along the street; one
+    /// triplet's points span a few metres of façade). 0 = the triplet's own points only.
+    pub plane_neighbours: usize,
+    /// … whose centre recordings lie within this distance of the triplet's centre, metres.
+    pub max_plane_distance_m: f64,
     /// Façades are looked for up to this distance left and right of a recording, metres
     /// (`skytie_stages::oblique::candidates`).
     pub max_facade_distance_m: f64,
@@ -26,6 +32,8 @@ impl Default for ObliqueOptions {
     fn default() -> Self {
         Self {
             max_neighbour_distance_m: 12.0,
+            plane_neighbours: 2,
+            max_plane_distance_m: 15.0,
             max_facade_distance_m: 20.0,
             max_facade_height_m: 15.0,
             consensus: ConsensusParams::default(),
@@ -40,6 +48,18 @@ impl StageParams for ObliqueOptions {
         if !positive(self.max_neighbour_distance_m) {
             errs.push(ParamError::new(
                 "max_neighbour_distance_m",
+                "must be a distance > 0 m",
+            ));
+        }
+        if self.plane_neighbours > 10 {
+            errs.push(ParamError::new(
+                "plane_neighbours",
+                "must be at most 10 triplets on each side",
+            ));
+        }
+        if !positive(self.max_plane_distance_m) {
+            errs.push(ParamError::new(
+                "max_plane_distance_m",
                 "must be a distance > 0 m",
             ));
         }

@@ -1,8 +1,10 @@
 //! `patches`: per (triplet centre recording × candidate oblique image) the image-to-plane patches and their
 //! hierarchical registration (thesis 4.4.5–4.4.6, `skytie_stages::oblique::patch_registration`). An oblique
-//! image that the visibility hypothesis did not accept for any plane gives an empty set.
+//! image that the visibility hypothesis did not accept for any plane gives an empty set. The sparse clouds
+//! are the same list as the `facades` node's (the triplet's own first, then its neighbours).
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::nodes::facades::neighbourhood_cloud;
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::imaging::io::load_gray;
 use skytie_stages::oblique::patch_registration::{register_patches, PatchParams};
@@ -16,7 +18,7 @@ pub struct PatchesStage;
 
 impl Stage for PatchesStage {
     const NAME: &'static str = "patches";
-    const VERSION: &'static str = "1";
+    const VERSION: &'static str = "2";
     type Params = PatchParams;
     type Output = PatchRegistrationSet;
     type Inputs = (
@@ -24,19 +26,19 @@ impl Stage for PatchesStage {
         RawFile,
         Handle<AerialImage>,
         RawFile,
-        Handle<SparseCloud>,
+        Vec<Handle<SparseCloud>>,
         Handle<TripletFacades>,
     );
 
     fn run(
         &self,
         p: &PatchParams,
-        (rec, pano, oblique, oblique_file, cloud, facades): (
+        (rec, pano, oblique, oblique_file, clouds, facades): (
             Arc<Recording>,
             RawFileValue,
             Arc<AerialImage>,
             RawFileValue,
-            Arc<SparseCloud>,
+            Vec<Arc<SparseCloud>>,
             Arc<TripletFacades>,
         ),
         _: &NodeCtx,
@@ -53,6 +55,7 @@ impl Stage for PatchesStage {
                 stats: PatchStats::default(),
             });
         }
+        let cloud = neighbourhood_cloud(&clouds)?;
         let load =
             |f: &RawFileValue| load_gray(&f.path).map_err(|e| StageError::new(e.to_string()));
         let pano_img = load(&pano)?;

@@ -100,31 +100,56 @@ pub fn add_oblique(
     let oblique_rows = &snapshot.campaign.oblique;
 
     let mut aerial_rows: BTreeMap<usize, Handle<AerialImage>> = BTreeMap::new();
-    let mut clouds = Vec::new();
     let mut all_facades: Vec<Handle<TripletFacades>> = Vec::new();
     let mut sets: Vec<Handle<PatchRegistrationSet>> = Vec::new();
-    for w in items.windows(3) {
+    // Pass 1: the sparse cloud of every triplet (centre item index → cloud).
+    let mut triplets: Vec<(usize, Handle<SparseCloud>)> = Vec::new();
+    for (i, w) in items.windows(3).enumerate() {
         let (first, centre, last) = (&w[0], &w[1], &w[2]);
         if distance_m(first.recording, centre.recording) > options.max_neighbour_distance_m
             || distance_m(centre.recording, last.recording) > options.max_neighbour_distance_m
         {
             continue;
         }
-        let label = format!("rec {}", centre.recording.image_id);
-        let rows: Vec<Handle<Recording>> = w.iter().map(|m| m.row).collect();
         let cloud = b.add(
             SparseCloudStage,
-            &label,
+            &format!("rec {}", centre.recording.image_id),
             cloud_params.clone(),
             (
-                rows.clone(),
+                w.iter().map(|m| m.row).collect::<Vec<_>>(),
                 w.iter().map(|m| m.pano.clone()).collect::<Vec<_>>(),
             ),
         )?;
-        clouds.push(cloud);
+        triplets.push((i + 1, cloud));
+    }
+    let clouds: Vec<Handle<SparseCloud>> = triplets.iter().map(|(_, c)| *c).collect();
+    // Pass 2: per triplet its façades (fitted to its own and its neighbours' points) and patches.
+    for (t, &(centre_idx, cloud)) in triplets.iter().enumerate() {
         if !on("facades") {
-            continue;
+            break;
         }
+        let centre = &items[centre_idx];
+        let label = format!("rec {}", centre.recording.image_id);
+        let rows: Vec<Handle<Recording>> = items[centre_idx - 1..=centre_idx + 1]
+            .iter()
+            .map(|m| m.row)
+            .collect();
+        // Neighbouring triplets along the same street: consecutive, within `plane_neighbours` triplets and
+        // `max_plane_distance_m` of the centre (recorded positions).
+        let near = |&&(j, _): &&(usize, Handle<SparseCloud>)| {
+            j.abs_diff(centre_idx) <= options.plane_neighbours
+                && distance_m(items[j].recording, centre.recording) <= options.max_plane_distance_m
+        };
+        let neighbourhood: Vec<Handle<SparseCloud>> = std::iter::once(cloud)
+            .chain(
+                triplets[t.saturating_sub(options.plane_neighbours)..]
+                    .iter()
+                    .take(2 * options.plane_neighbours + 1)
+                    .filter(near)
+                    .filter(|(j, _)| *j != centre_idx)
+                    .map(|(_, c)| *c),
+            )
+            .collect();
         let candidates = candidate_oblique(
             centre.recording,
             oblique_rows,
@@ -157,8 +182,8 @@ pub fn add_oblique(
             &label,
             facade_params.clone(),
             (
-                cloud,
-                rows.clone(),
+                neighbourhood.clone(),
+                rows,
                 aerials.iter().map(|(_, h)| *h).collect::<Vec<_>>(),
             ),
         )?;
@@ -178,7 +203,7 @@ pub fn add_oblique(
                     centre.pano.clone(),
                     aerial,
                     RawFile(oblique_dir.join(&row.file)),
-                    cloud,
+                    neighbourhood.clone(),
                     facades,
                 ),
             )?);

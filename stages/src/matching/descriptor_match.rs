@@ -98,13 +98,37 @@ pub fn match_ratio(
     ratio: f32,
     mutual: bool,
 ) -> Result<Vec<DescriptorMatch>, MatchError> {
+    let nt = count("train", train, len)?;
+    match_restricted(query, train, len, ratio, mutual, |_| 0..nt)
+}
+
+/// [`match_ratio`] with the candidates of each query restricted: query `qi` is compared only with the train
+/// features `candidates(qi)` (ascending indices, e.g. those near its epipolar line — guided matching), the
+/// ratio test uses the second-nearest of those, and the mutual check asks whether the query is the nearest
+/// among the queries that have the train feature as a candidate. Sorted by query.
+pub fn match_restricted<C, I>(
+    query: &[f32],
+    train: &[f32],
+    len: usize,
+    ratio: f32,
+    mutual: bool,
+    candidates: C,
+) -> Result<Vec<DescriptorMatch>, MatchError>
+where
+    C: Fn(usize) -> I + Sync,
+    I: Iterator<Item = usize>,
+{
     let nq = count("query", query, len)?;
     let nt = count("train", train, len)?;
+    let lists: Vec<Vec<usize>> = (0..nq)
+        .into_par_iter()
+        .map(|qi| candidates(qi).filter(|&t| t < nt).collect())
+        .collect();
     let forward: Vec<Option<DescriptorMatch>> = (0..nq)
         .into_par_iter()
         .map(|qi| {
             let q = &query[qi * len..(qi + 1) * len];
-            let ((d1, t), d2) = two_nearest(q, train, len, 0..nt)?;
+            let ((d1, t), d2) = two_nearest(q, train, len, lists[qi].iter().copied())?;
             passes_ratio(d1, d2, ratio).then(|| DescriptorMatch {
                 query: qi,
                 train: t,
@@ -113,21 +137,37 @@ pub fn match_ratio(
             })
         })
         .collect();
-    let backward: Vec<Option<usize>> = if mutual {
-        (0..nt)
-            .into_par_iter()
-            .map(|ti| {
-                let t = &train[ti * len..(ti + 1) * len];
-                two_nearest(t, query, len, 0..nq).map(|((_, q), _)| q)
-            })
-            .collect()
-    } else {
-        Vec::new()
+    if !mutual {
+        return Ok(forward.into_iter().flatten().collect());
+    }
+    // Inverse candidate lists (ascending query indices), only for train features some query matched.
+    let mut inverse: Vec<Vec<usize>> = vec![Vec::new(); nt];
+    let matched: Vec<bool> = {
+        let mut m = vec![false; nt];
+        for f in forward.iter().flatten() {
+            m[f.train] = true;
+        }
+        m
     };
+    for (qi, list) in lists.iter().enumerate() {
+        for &t in list {
+            if matched[t] {
+                inverse[t].push(qi);
+            }
+        }
+    }
+    let backward: Vec<Option<usize>> = inverse
+        .par_iter()
+        .enumerate()
+        .map(|(ti, qs)| {
+            let t = &train[ti * len..(ti + 1) * len];
+            two_nearest(t, query, len, qs.iter().copied()).map(|((_, q), _)| q)
+        })
+        .collect();
     Ok(forward
         .into_iter()
         .flatten()
-        .filter(|m| !mutual || backward[m.train] == Some(m.query))
+        .filter(|m| backward[m.train] == Some(m.query))
         .collect())
 }
 

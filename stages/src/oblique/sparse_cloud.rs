@@ -8,8 +8,10 @@
 //! Deterministic: views and sides run in parallel with ordered results; tracks are sorted by their
 //! view-1/view-2 feature indices; no random sampling is involved (`seed` is kept for future estimators).
 
+pub mod guided;
 mod params;
 
+use guided::epipolar_candidates;
 pub use params::SparseCloudParams;
 
 use super::types::{SparseCloud, SparseCloudStats, SparsePoint, StreetSide};
@@ -21,7 +23,9 @@ use crate::geometry::perspective::PerspectiveView;
 use crate::geometry::trifocal::TrifocalTensor;
 use crate::geometry::{LocalOrigin, PanoramaCamera};
 use crate::imaging::GrayImage;
-use crate::matching::descriptor_match::match_ratio;
+use crate::matching::descriptor_match::{
+    match_ratio, match_restricted, DescriptorMatch, MatchError,
+};
 use crate::nadir::mm_matching::tie_point::{triangulate_track, TrackTriangulation};
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -66,6 +70,36 @@ fn view_features(
     }
 }
 
+/// Matches of view `a`'s features (query) with view `b`'s (train): ratio test and mutual check, among the
+/// candidates near each feature's epipolar segment when `epipolar_tolerance_px` is set ([`guided`]).
+fn match_pair(
+    a: &ViewFeatures,
+    b: &ViewFeatures,
+    len: usize,
+    p: &SparseCloudParams,
+) -> Result<Vec<DescriptorMatch>, MatchError> {
+    let Some(tol) = p.epipolar_tolerance_px else {
+        return match_ratio(&a.descriptors, &b.descriptors, len, p.match_ratio, p.mutual);
+    };
+    let candidates = epipolar_candidates(
+        &a.view,
+        &b.view,
+        &a.points_px,
+        &b.points_px,
+        p.min_depth_m,
+        p.max_range_m,
+        tol,
+    );
+    match_restricted(
+        &a.descriptors,
+        &b.descriptors,
+        len,
+        p.match_ratio,
+        p.mutual,
+        |qi| candidates[qi].iter().copied(),
+    )
+}
+
 /// The points of one side, with its part of the counts.
 fn side_cloud(
     side: StreetSide,
@@ -92,26 +126,8 @@ fn side_cloud(
     stats.views += 3;
     stats.corners += feats.iter().map(|f| f.corners).sum::<usize>();
     let len = feats[0].len;
-    let (m12, m23) = rayon::join(
-        || {
-            match_ratio(
-                &feats[0].descriptors,
-                &feats[1].descriptors,
-                len,
-                p.match_ratio,
-                p.mutual,
-            )
-        },
-        || {
-            match_ratio(
-                &feats[1].descriptors,
-                &feats[2].descriptors,
-                len,
-                p.match_ratio,
-                p.mutual,
-            )
-        },
-    );
+    let pair = |a: usize, b: usize| match_pair(&feats[a], &feats[b], len, p);
+    let (m12, m23) = rayon::join(|| pair(0, 1), || pair(1, 2));
     // Lengths agree by construction; an error can only mean no descriptors at all.
     let (m12, m23) = (m12.unwrap_or_default(), m23.unwrap_or_default());
     stats.matches_12 += m12.len();

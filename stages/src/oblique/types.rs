@@ -69,6 +69,23 @@ impl SparseCloud {
     pub fn centre(&self) -> &str {
         &self.recordings[1]
     }
+
+    /// The neighbourhood cloud of a triplet for plane fitting (thesis 4.4.2 fits façades to the points along
+    /// the trajectory; one triplet alone sees a façade stretch of a few metres with too few points for a
+    /// plane): `self`'s points followed by those of `neighbours` (other triplets along the same street), with
+    /// `self`'s recordings. Point order is input order, so plane inlier indices are reproducible; the stats
+    /// are `self`'s, except `points`.
+    pub fn with_neighbours<'a>(
+        &self,
+        neighbours: impl IntoIterator<Item = &'a SparseCloud>,
+    ) -> Self {
+        let mut merged = self.clone();
+        for n in neighbours {
+            merged.points.extend(n.points.iter().cloned());
+        }
+        merged.stats.points = merged.points.len();
+        merged
+    }
 }
 
 /// An oblique image that passed the visibility hypothesis for a façade plane (thesis 4.4.3).

@@ -28,6 +28,14 @@ pub struct SparseCloudParams {
     pub match_ratio: f32,
     /// Keep only mutual nearest neighbours (default true).
     pub mutual: bool,
+    /// Guided matching: a feature of view 2 (3) is a candidate for a feature of view 1 (2) only if it lies
+    /// within this distance of the segment of the epipolar line that holds the object points between
+    /// `min_depth_m` and `max_range_m` along the first feature's ray, view px; computed from the recorded
+    /// poses, so it must cover their relative error (≈ 0.14 m between neighbours at 10 m ≈ 4 px for the
+    /// default views). `None` compares every feature with every feature (plain ratio matching).
+    pub epipolar_tolerance_px: Option<f64>,
+    /// Nearest object distance considered by guided matching, metres (default 2 m).
+    pub min_depth_m: f64,
     /// Largest trifocal transfer error (1, 2 → 3) of a kept track, view px (default 2 px).
     pub trifocal_tolerance_px: f64,
     /// Smallest maximum ray intersection angle of a kept point, degrees (default 2°).
@@ -54,6 +62,8 @@ impl Default for SparseCloudParams {
             daisy: DaisyParams::default(),
             match_ratio: 0.8,
             mutual: true,
+            epipolar_tolerance_px: Some(8.0),
+            min_depth_m: 2.0,
             trifocal_tolerance_px: 2.0,
             min_intersection_angle_deg: 2.0,
             max_range_m: 30.0,
@@ -120,6 +130,22 @@ impl SparseCloudParams {
             self.match_ratio.is_finite() && self.match_ratio > 0.0 && self.match_ratio <= 1.0,
             "match_ratio",
             format!("must be in (0, 1], got {}", self.match_ratio),
+        );
+        check(
+            self.epipolar_tolerance_px.is_none_or(pos),
+            "epipolar_tolerance_px",
+            format!(
+                "must be finite and > 0 px (or left out for unguided matching), got {:?}",
+                self.epipolar_tolerance_px
+            ),
+        );
+        check(
+            pos(self.min_depth_m) && self.min_depth_m < self.max_range_m,
+            "min_depth_m",
+            format!(
+                "must be > 0 m and below max_range_m ({} m), got {}",
+                self.max_range_m, self.min_depth_m
+            ),
         );
         check(
             pos(self.trifocal_tolerance_px),
