@@ -32,7 +32,7 @@ impl GradeOblique {
 
 impl Stage for GradeOblique {
     const NAME: &'static str = "grade_oblique";
-    const VERSION: &'static str = "1";
+    const VERSION: &'static str = "2";
     type Params = SummaryParams;
     type Output = ObliqueGrade;
     type Inputs = (

@@ -11,7 +11,10 @@
 //!    more than `occlusion_max_points` are dropped (counted in `occluded`).
 //! 4. Visibility hypothesis per oblique image: θ, φ, theoretical resolution, centroid inside the image
 //!    ([`visibility`]).
-//! 5. Box-grid thinning of the inliers: the patch centres ([`thinning`]).
+//! 5. Box-grid thinning of the inliers that the centre recording observes: the patch centres ([`thinning`]).
+//!
+//! The cloud may hold the points of neighbouring triplets too (`SparseCloud::with_neighbours`): they help
+//! fit the planes, but only points observed by the centre panorama become patch centres.
 //!
 //! Deterministic: MLESAC and thinning seeds mix `seed` with a hash of the centre `image_id`, the side and the
 //! plane index. Never panics on user data: invalid params, a centre that is not the cloud's centre, or
@@ -150,8 +153,22 @@ pub fn find_facades(
                 stats.occluded += 1;
                 continue;
             }
+            // Patch centres are the inliers the centre panorama observes: a point of a neighbouring triplet
+            // that it does not observe would need a projected observation, which carries the recordings'
+            // relative pose error into the correspondence.
+            let observed: Vec<usize> = inliers
+                .iter()
+                .copied()
+                .filter(|&i| {
+                    cloud.points[i]
+                        .tie
+                        .observations
+                        .iter()
+                        .any(|o| o.image_id == recording)
+                })
+                .collect();
             // Thinning in the local frame, relative to the centroid (thesis 4.4.4).
-            let rel: Vec<[f64; 3]> = inliers
+            let rel: Vec<[f64; 3]> = observed
                 .iter()
                 .map(|&i| to_array(&(local[i] - lp.centroid)))
                 .collect();
@@ -162,7 +179,7 @@ pub fn find_facades(
                 p.thinning_split,
                 mix_seed(side_seed, 2 * k as u64 + 1),
             );
-            let thinned: Vec<usize> = kept.iter().map(|&j| inliers[j]).collect();
+            let thinned: Vec<usize> = kept.iter().map(|&j| observed[j]).collect();
             let centroid_world = origin.to_world(&lp.centroid);
             let mut views = Vec::new();
             for (img, cam) in &cameras {

@@ -70,8 +70,34 @@ pub struct ObliqueGrade {
     pub control_points_ungraded: usize,
     /// `None`: our campaigns cannot tell visibility (see the module doc).
     pub non_matchable: Option<usize>,
+    /// Reprojection error of the true point in the oblique image over the kept correspondences, px
+    /// (diagnostic: how far off the wrong ones are).
+    pub kept_reprojection_px: Quantiles,
     pub left: SideCounts,
     pub right: SideCounts,
+}
+
+/// Median, 75th and 90th percentile of a sample (0 when empty; infinite values sort last).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Quantiles {
+    pub median: f64,
+    pub p75: f64,
+    pub p90: f64,
+}
+
+impl Quantiles {
+    pub fn of(x: &mut [f64]) -> Self {
+        if x.is_empty() {
+            return Self::default();
+        }
+        x.sort_by(f64::total_cmp);
+        let at = |q: f64| x[((x.len() - 1) as f64 * q).round() as usize];
+        Self {
+            median: at(0.5),
+            p75: at(0.75),
+            p90: at(0.9),
+        }
+    }
 }
 
 fn ratio(a: usize, n: usize) -> f64 {
@@ -114,6 +140,11 @@ impl ObliqueGrade {
                 "ungraded": self.control_points_ungraded,
             },
             "non_matchable": self.non_matchable,
+            "kept_reprojection_px": {
+                "median": self.kept_reprojection_px.median,
+                "p75": self.kept_reprojection_px.p75,
+                "p90": self.kept_reprojection_px.p90,
+            },
             "sides": { "left": side(&self.left), "right": side(&self.right) },
         })
     }
@@ -122,24 +153,56 @@ impl ObliqueGrade {
 /// Grades one patch match by the rule of the module doc: `Some(correct)`, or `None` when its panorama or
 /// oblique image is not in the truth. `tie` is the match's sparse tie point (for the true object point).
 pub fn grade_match(truth: &Truth, tie: Option<&MmTiePoint>, m: &PatchMatch) -> Option<bool> {
+    match_errors(truth, tie, m).map(|e| e.correct())
+}
+
+/// The two quantities the grading rule tests, for diagnostics: closest approach of the panorama and oblique
+/// rays (m; infinite when they do not pass in front of both cameras) and the reprojection error of the best
+/// point in the oblique image (px; infinite when it does not project).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MatchErrors {
+    pub closest_approach_m: f64,
+    pub reprojection_px: f64,
+}
+
+impl MatchErrors {
+    /// The rule of the module doc.
+    pub fn correct(&self) -> bool {
+        self.closest_approach_m <= CLOSEST_APPROACH_TOLERANCE_M
+            && self.reprojection_px <= REPROJECTION_TOLERANCE_PX
+    }
+}
+
+/// [`MatchErrors`] of one patch match; `None` when its panorama or oblique image is not in the truth.
+pub fn match_errors(
+    truth: &Truth,
+    tie: Option<&MmTiePoint>,
+    m: &PatchMatch,
+) -> Option<MatchErrors> {
     let (rec, w, h) = truth.recordings.get(&m.mm.image_id)?;
     let pano = PanoramaCamera::from_recording(rec, *w, *h);
     let cam = FrameCamera::from_aerial(truth.aerial.get(&m.oblique_image_id)?);
     let [u, v] = m.oblique_px;
     let pano_ray = pano.pixel_ray(m.mm.u_px, m.mm.v_px);
     let oblique_ray = cam.pixel_ray(u, v);
-    let Some(ca) = closest_approach(&pano_ray, &oblique_ray) else {
-        return Some(false);
+    let far = MatchErrors {
+        closest_approach_m: f64::INFINITY,
+        reprojection_px: f64::INFINITY,
     };
-    if !(ca.in_front_of_both() && ca.distance_m <= CLOSEST_APPROACH_TOLERANCE_M) {
-        return Some(false);
+    let Some(ca) = closest_approach(&pano_ray, &oblique_ray) else {
+        return Some(far);
+    };
+    if !ca.in_front_of_both() {
+        return Some(far);
     }
     let best: Vector3<f64> = tie
         .and_then(|t| truth.true_point(&t.observations))
         .unwrap_or_else(|| ca.midpoint_world());
-    Some(match cam.project_world(&best) {
-        Some((pu, pv)) => (pu - u).hypot(pv - v) <= REPROJECTION_TOLERANCE_PX,
-        None => false,
+    Some(MatchErrors {
+        closest_approach_m: ca.distance_m,
+        reprojection_px: cam
+            .project_world(&best)
+            .map_or(f64::INFINITY, |(pu, pv)| (pu - u).hypot(pv - v)),
     })
 }
 
@@ -157,12 +220,17 @@ pub fn grade_oblique(
         .collect();
     let mut g = ObliqueGrade::default();
     let mut kept_graded = 0;
+    let mut kept_reprojection: Vec<f64> = Vec::new();
     for c in &result.correspondences {
         let m = &c.matched;
-        let Some(ok) = grade_match(truth, ties.get(m.point_id.as_str()).copied(), m) else {
+        let Some(errors) = match_errors(truth, ties.get(m.point_id.as_str()).copied(), m) else {
             g.ungraded += 1;
             continue;
         };
+        let ok = errors.correct();
+        if c.kept {
+            kept_reprojection.push(errors.reprojection_px);
+        }
         g.correspondences += 1;
         g.inliers += usize::from(ok);
         let side = match m.side {
@@ -182,6 +250,7 @@ pub fn grade_oblique(
     g.outliers_after_consensus = kept_graded - g.inliers_after_consensus;
     g.inlier_ratio = ratio(g.inliers, g.correspondences);
     g.inlier_ratio_after_consensus = ratio(g.inliers_after_consensus, kept_graded);
+    g.kept_reprojection_px = Quantiles::of(&mut kept_reprojection);
     let mut errors = Vec::new();
     for cp in &result.control {
         let Some(p) = cp.point_world else { continue };
