@@ -18,7 +18,7 @@ pub struct FacadesStage;
 
 impl Stage for FacadesStage {
     const NAME: &'static str = "facades";
-    const VERSION: &'static str = "3";
+    const VERSION: &'static str = "4";
     type Params = FacadeParams;
     type Output = TripletFacades;
     type Inputs = (

@@ -153,7 +153,8 @@ pub fn find_facades(
                 stats.occluded += 1;
                 continue;
             }
-            // Patch centres are the inliers the centre panorama observes: a point of a neighbouring triplet
+            // Patch centres are the inliers close to the plane (`max_centre_offset_m`) that the centre panorama
+            // observes: a point of a neighbouring triplet
             // that it does not observe would need a projected observation, which carries the recordings'
             // relative pose error into the correspondence.
             let observed: Vec<usize> = inliers
@@ -166,6 +167,7 @@ pub fn find_facades(
                         .iter()
                         .any(|o| o.image_id == recording)
                 })
+                .filter(|&i| !((local[i] - lp.centroid).dot(&lp.normal).abs() > p.max_centre_offset_m))
                 .collect();
             // Thinning in the local frame, relative to the centroid (thesis 4.4.4).
             let rel: Vec<[f64; 3]> = observed

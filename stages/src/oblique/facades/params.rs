@@ -61,6 +61,11 @@ pub struct FacadeParams {
     /// (default 0.08 m, thesis 4.4.3). Note: the synthetic campaigns' obliques have 0.10 m at the image centre
     /// (450 m at 45°), which this default rejects; use ≈ 0.15 m for them.
     pub max_resolution_m: f64,
+    /// Patch centres: only inliers within this distance of the fitted plane, metres (default 0.15 m). The patch
+    /// grid lies in the plane through its centre point parallel to the façade; a centre d off the façade puts
+    /// the façade texture at a wrong depth, and the MM and oblique views see it with a parallax of ≈ 1.5·d
+    /// (horizontal MM rays vs 45° oblique rays). Plane fitting still uses `inlier_band_m`.
+    pub max_centre_offset_m: f64,
     /// Box-grid thinning (thesis 4.4.4): a box with more points than this is split; one random point is kept
     /// per leaf box (default 8; the thesis gives no value, libpointmatcher uses 7, MATLAB requires ≥ 6).
     pub thinning_max_points_per_box: usize,
@@ -89,6 +94,7 @@ impl Default for FacadeParams {
             occlusion_max_points: 10,
             max_view_angle_deg: 70.0,
             max_resolution_m: 0.08,
+            max_centre_offset_m: 0.15,
             thinning_max_points_per_box: 8,
             thinning_max_box_m: 2.0,
             thinning_split: ThinningSplit::Midpoint,
@@ -116,6 +122,14 @@ impl FacadeParams {
             pos(self.inlier_band_m) && self.inlier_band_m <= 10.0,
             "inlier_band_m",
             format!("must be in (0, 10] m, got {}", self.inlier_band_m),
+        );
+        check(
+            pos(self.max_centre_offset_m),
+            "max_centre_offset_m",
+            format!(
+                "must be finite and > 0 m, got {}",
+                self.max_centre_offset_m
+            ),
         );
         check(
             self.min_points >= 3,
