@@ -4,7 +4,7 @@
 
 use nalgebra::Vector3;
 use skytie_stages::campaign::{AerialImage, Recording};
-use skytie_stages::correspondence::MmTiePoint;
+use skytie_stages::correspondence::{MmTiePoint, PanoObservation};
 use skytie_stages::estimators::SplitMix64;
 use skytie_stages::geometry::FrameCamera;
 use skytie_stages::oblique::facades::occlusion::OcclusionCorridor;
@@ -55,7 +55,16 @@ fn point(side: StreetSide, i: usize, local: [f64; 3]) -> SparsePoint {
         side,
         tie: MmTiePoint {
             id: format!("r1#{}#{i}", side.label()),
-            observations: Vec::new(),
+            // find_facades reads only which recordings observe a point (patch centres must be seen by the
+            // centre recording r1); the pixel values do not matter here.
+            observations: ["r0", "r1", "r2"]
+                .iter()
+                .map(|id| PanoObservation {
+                    image_id: (*id).to_string(),
+                    u_px: 0.0,
+                    v_px: 0.0,
+                })
+                .collect(),
             point_world: [X0 + local[0], Y0 + local[1], local[2]],
             covariance_m2: [[0.0; 3]; 3],
             max_angle_deg: 10.0,
@@ -728,4 +737,48 @@ fn thinning_degenerate_inputs_and_determinism() {
         box_grid_thin(&pts[8..40], 1, 2.0, ThinningSplit::Median, 1).len(),
         32
     );
+}
+
+/// Patch centres (`thinned`) are plane inliers that the centre recording observes and that lie within
+/// `max_centre_offset_m` of the plane; points of a neighbouring triplet and off-plane inliers still count for
+/// the plane fit.
+#[test]
+fn patch_centres_are_observed_by_the_centre_and_close_to_the_plane() {
+    let (mut pts, left, _) = street_scene(1);
+    let base = FacadeParams::default();
+    // Half of the left façade's points come from a neighbouring triplet that r1 does not see them in.
+    let unseen: Vec<usize> = left.clone().step_by(2).collect();
+    for &i in &unseen {
+        pts[i].tie.observations.retain(|o| o.image_id != "r1");
+    }
+    // One seen left point is pushed 0.3 m off the façade: still an inlier (band 0.5 m), never a centre.
+    let off = left.clone().find(|i| !unseen.contains(i)).unwrap();
+    pts[off].tie.point_world[1] -= 0.3;
+    let c = cloud(pts);
+    let t = east_triplet();
+    let params = FacadeParams {
+        thinning_max_points_per_box: 1_000_000, // no thinning: every eligible point is a centre
+        thinning_max_box_m: f64::INFINITY,
+        ..base
+    };
+    let f = find_facades(&c, [&t[0], &t[1], &t[2]], &[], &params);
+    let plane = f
+        .planes
+        .iter()
+        .find(|p| p.side == StreetSide::Left)
+        .expect("left plane");
+    assert!(plane.inliers.contains(&off), "the off-plane point is an inlier");
+    assert!(unseen.iter().all(|i| plane.inliers.contains(i)));
+    assert!(!plane.thinned.contains(&off));
+    assert!(plane.thinned.iter().all(|i| !unseen.contains(i)));
+    let near_seen = plane
+        .inliers
+        .iter()
+        .filter(|&&i| {
+            !unseen.contains(&i)
+                && (c.points[i].tie.point_world[1] - (Y0 + 8.0)).abs() <= params.max_centre_offset_m
+        })
+        .count();
+    assert!(near_seen > 0);
+    assert_eq!(plane.thinned.len(), near_seen, "{:?}", plane.thinned);
 }
