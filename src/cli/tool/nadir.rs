@@ -113,8 +113,8 @@ pub fn ortho(a: &OrthoArgs) -> Result<(), String> {
 
 pub fn kaze(a: &KazeArgs) -> Result<(), String> {
     let img = load_gray(&a.image).map_err(|e| e.to_string())?;
-    if a.octaves == 0 || a.octaves > 8 || !(a.threshold > 0.0) {
-        return Err("--octaves must be in 1..=8 and --threshold > 0".into());
+    if a.octaves == 0 || a.octaves > 8 || !(a.threshold.is_finite() && a.threshold > 0.0) {
+        return Err("--octaves must be in 1..=8 and --threshold finite and > 0".into());
     }
     let p = KazeParams {
         threshold: a.threshold,
