@@ -12,7 +12,11 @@
 //! where the vehicle hides the ground), `ortho_{gsd}cm.npy` (skytie's float32 output, for the agreement check)
 //! and `skytie_{gsd}cm.csv` (timings). Run: `cargo bench -p skytie-stages --bench ortho`.
 
-use std::path::{Path, PathBuf};
+#[path = "peer_support/mod.rs"]
+mod peer_support;
+
+use peer_support::{peer_dir, write_npy_f32};
+use std::path::Path;
 use std::time::Instant;
 
 use skytie_stages::campaign::Recording;
@@ -23,13 +27,6 @@ use skytie_stages::imaging::io::{load_gray, save_gray};
 use skytie_stages::imaging::resample::{remap, Interpolation};
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::{ortho_project, OrthoGeoref, OrthoParams};
-
-fn peer_dir() -> PathBuf {
-    std::env::var_os("SKYTIE_PEER_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| std::env::temp_dir().join("skytie_peers"))
-        .join("ortho")
-}
 
 /// Band-limited noise (uniform noise blurred with σ = 2 px, stretched to [0, 1]).
 fn textured(w: usize, h: usize, seed: u64) -> GrayImage {
@@ -69,25 +66,6 @@ fn recording() -> Recording {
         pitch_deg: -0.3,
         roll_deg: 0.2,
     }
-}
-
-/// Minimal NumPy `.npy` (format 1.0) writer for a row-major float32 array of shape (rows, cols).
-fn write_npy_f32(path: &Path, rows: usize, cols: usize, data: &[f32]) {
-    let mut header =
-        format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({rows}, {cols}), }}");
-    // Magic (6) + version (2) + header length (2) + header, padded with spaces to a multiple of 64, ending in \n.
-    while (10 + header.len() + 1) % 64 != 0 {
-        header.push(' ');
-    }
-    header.push('\n');
-    let mut bytes = Vec::with_capacity(10 + header.len() + 4 * data.len());
-    bytes.extend_from_slice(b"\x93NUMPY\x01\x00");
-    bytes.extend_from_slice(&(header.len() as u16).to_le_bytes());
-    bytes.extend_from_slice(header.as_bytes());
-    for v in data {
-        bytes.extend_from_slice(&v.to_le_bytes());
-    }
-    std::fs::write(path, bytes).expect("write .npy");
 }
 
 /// Median wall time (ms) of `reps` runs of `f` inside a rayon pool of `threads`.
@@ -209,7 +187,7 @@ fn bench_gsd(panorama: &GrayImage, gsd_cm: u32, dir: &Path) {
 }
 
 fn main() {
-    let dir = peer_dir();
+    let dir = peer_dir("ortho");
     std::fs::create_dir_all(&dir).expect("create the peer directory");
     let png = dir.join("panorama.png");
     save_gray(&png, &textured(4000, 2000, 7)).expect("write the panorama PNG");

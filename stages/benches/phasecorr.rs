@@ -12,9 +12,11 @@
 
 #[path = "../tests/imaging_support/mod.rs"]
 mod imaging_support;
+#[path = "peer_support/mod.rs"]
+mod peer_support;
 
-use std::path::{Path, PathBuf};
-use std::time::Instant;
+use peer_support::{median_round_ms, peer_dir};
+use std::path::Path;
 
 use imaging_support::{radiometric, SplitMix64, Texture};
 use skytie_stages::imaging::io::{load_gray, save_gray};
@@ -30,13 +32,6 @@ struct Pair {
     moving: GrayImage,
     tx_px: f64,
     ty_px: f64,
-}
-
-fn peer_dir() -> PathBuf {
-    std::env::var_os("SKYTIE_PEER_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| std::env::temp_dir().join("skytie_peers"))
-        .join("phasecorr")
 }
 
 /// Writes the pairs of one size as PNGs and returns them as re-loaded (8-bit quantised) images.
@@ -66,34 +61,9 @@ fn make_pairs(size: usize, dir: &Path) -> Vec<Pair> {
         .collect()
 }
 
-/// CPU time of the calling thread in ns (Linux `/proc/thread-self/schedstat`), robust against other processes
-/// sharing the cores; `None` where unavailable (then wall time is used).
-fn thread_cpu_ns() -> Option<u64> {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse()
-        .ok()
-}
-
 /// Median over `reps` rounds of the mean time per pair (ms; thread CPU time, else wall) of `f` on every pair.
 fn median_ms_per_call(pairs: &[Pair], reps: usize, mut f: impl FnMut(&Pair)) -> f64 {
-    let mut t: Vec<f64> = (0..reps)
-        .map(|_| {
-            let (c0, s) = (thread_cpu_ns(), Instant::now());
-            for p in pairs {
-                f(p);
-            }
-            let ms = match (c0, thread_cpu_ns()) {
-                (Some(a), Some(b)) if b > a => (b - a) as f64 * 1e-6,
-                _ => s.elapsed().as_secs_f64() * 1e3,
-            };
-            ms / pairs.len() as f64
-        })
-        .collect();
-    t.sort_by(f64::total_cmp);
-    t[reps / 2]
+    median_round_ms(reps, || pairs.iter().for_each(&mut f)) / pairs.len() as f64
 }
 
 fn bench_size(size: usize, dir: &Path) {
@@ -149,7 +119,7 @@ fn bench_size(size: usize, dir: &Path) {
 }
 
 fn main() {
-    let dir = peer_dir();
+    let dir = peer_dir("phasecorr");
     std::fs::create_dir_all(&dir).expect("create the peer directory");
     println!(
         "phase correlation, {PAIRS} pairs per size (8-bit PNG inputs, 1 thread, thread CPU time)"

@@ -4,11 +4,14 @@
 //! One file per pipeline: `nadir.rs` (thesis ch. 3), the oblique tools in their own files (ch. 4).
 
 mod nadir;
+mod oblique;
 
 use clap::Subcommand;
 use nadir::*;
+use oblique::*;
+use skytie_stages::campaign::{read_campaign, Recording};
 use skytie_stages::fsutil::atomic_write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The tools.
 #[derive(Subcommand, Debug)]
@@ -25,6 +28,15 @@ pub enum ToolCommand {
     Phasecorr(PairArgs),
     /// NCC template matching (TM_CCOEFF_NORMED): prints "x y score" of the template centre in IMAGE.
     Ncc(NccArgs),
+    /// AGAST (OAST 9-16) corners (x, y, score) as CSV (thesis 4.4.1).
+    Agast(AgastArgs),
+    /// DAISY descriptors at the points of a CSV (x, y columns): x, y, inside, d0… as CSV (thesis 4.4.1).
+    Daisy(DaisyArgs),
+    /// Mattes MI translation registration of MOVING to FIXED by the (1+1)-ES: prints "dx dy mi iterations"
+    /// (MOVING's content is FIXED's moved by (dx, dy) px; thesis 4.4.6).
+    MiRegister(MiRegisterArgs),
+    /// Perspective view of one recording's panorama (thesis 4.4.1, eq. 4/1–4/4).
+    Perspective(PerspectiveArgs),
 }
 
 /// Run a tool; returns the exit code (0 ok, 1 the computation failed, 2 bad input).
@@ -36,6 +48,10 @@ pub fn main(cmd: &ToolCommand) -> i32 {
         ToolCommand::Wallis(a) => wallis(a),
         ToolCommand::Phasecorr(a) => phasecorr(a),
         ToolCommand::Ncc(a) => ncc(a),
+        ToolCommand::Agast(a) => agast(a),
+        ToolCommand::Daisy(a) => daisy(a),
+        ToolCommand::MiRegister(a) => mi_register(a),
+        ToolCommand::Perspective(a) => perspective(a),
     };
     match result {
         Ok(()) => 0,
@@ -50,4 +66,43 @@ pub fn main(cmd: &ToolCommand) -> i32 {
 pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), String> {
     atomic_write(path, text.as_bytes())
         .map_err(|e| format!("{}: cannot write: {e}", path.display()))
+}
+
+/// The recording `id` of the campaign folder `campaign` and the path of its panorama file; a missing or rejected
+/// recording is an error naming `mm/recordings.csv` (or the problem that rejected the row).
+pub(crate) fn campaign_recording(
+    campaign: &Path,
+    id: &str,
+) -> Result<(Recording, PathBuf), String> {
+    let (c, problems) = read_campaign(campaign).map_err(|e| e.to_string())?;
+    let rec = c
+        .recordings
+        .into_iter()
+        .find(|r| r.image_id == id)
+        .ok_or_else(
+            || match problems.iter().find(|p| p.to_string().contains(id)) {
+                Some(p) => format!("recording '{id}' was rejected: {p}"),
+                None => format!(
+                "no recording '{id}' in {}/mm/recordings.csv; the ids are in its image_id column",
+                campaign.display()
+            ),
+            },
+        )?;
+    let pano = campaign.join("mm/panoramas").join(&rec.file);
+    Ok((rec, pano))
+}
+
+/// `(field, message)` range errors of a parameter struct as one line naming the command-line options: a field
+/// listed in `options` as `(field, option)` is reported as `--option`, any other as `--field` with `-` for `_`.
+pub(crate) fn option_errors(errs: &[(String, String)], options: &[(&str, &str)]) -> String {
+    errs.iter()
+        .map(|(f, m)| {
+            let opt = options
+                .iter()
+                .find(|(field, _)| field == f)
+                .map_or_else(|| f.replace('_', "-"), |(_, o)| (*o).to_string());
+            format!("--{opt}: {m}")
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }

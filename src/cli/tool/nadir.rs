@@ -1,9 +1,8 @@
 //! `skytie tool` building blocks of the nadir pipeline (thesis ch. 3): ortho, kaze, forstner, wallis, phasecorr,
 //! ncc.
 
-use super::write_text;
+use super::{campaign_recording, option_errors, write_text};
 use clap::Args;
-use skytie_stages::campaign::read_campaign;
 use skytie_stages::features::forstner::{forstner_corners, ForstnerParams};
 use skytie_stages::features::kaze::{detect_and_describe, KazeParams};
 use skytie_stages::imaging::io::{load_gray, save_gray};
@@ -84,26 +83,8 @@ pub struct NccArgs {
 }
 
 pub fn ortho(a: &OrthoArgs) -> Result<(), String> {
-    let (campaign, problems) = read_campaign(&a.campaign).map_err(|e| e.to_string())?;
-    let rec = campaign
-        .recordings
-        .iter()
-        .find(|r| r.image_id == a.recording)
-        .ok_or_else(|| {
-            let bad = problems
-                .iter()
-                .find(|p| p.to_string().contains(&a.recording));
-            match bad {
-                Some(p) => format!("recording '{}' was rejected: {p}", a.recording),
-                None => format!(
-                    "no recording '{}' in {}/mm/recordings.csv",
-                    a.recording,
-                    a.campaign.display()
-                ),
-            }
-        })?;
-    let pano =
-        load_gray(&a.campaign.join("mm/panoramas").join(&rec.file)).map_err(|e| e.to_string())?;
+    let (rec, pano_path) = campaign_recording(&a.campaign, &a.recording)?;
+    let pano = load_gray(&pano_path).map_err(|e| e.to_string())?;
     let mut params = OrthoParams {
         gsd_m: a.gsd,
         rotation_deg: a.rotate_deg,
@@ -111,12 +92,9 @@ pub fn ortho(a: &OrthoArgs) -> Result<(), String> {
     };
     params.vehicle.enabled = !a.no_mask;
     params.validate().map_err(|errs| {
-        errs.iter()
-            .map(|(f, m)| format!("--{f}: {m}"))
-            .collect::<Vec<_>>()
-            .join("; ")
+        option_errors(&errs, &[("gsd_m", "gsd"), ("rotation_deg", "rotate-deg")])
     })?;
-    let ortho = ortho_project(&pano, rec, &params);
+    let ortho = ortho_project(&pano, &rec, &params);
     save_gray(&a.out, &ortho.image).map_err(|e| e.to_string())?;
     let g = &ortho.georef;
     println!(
@@ -135,8 +113,8 @@ pub fn ortho(a: &OrthoArgs) -> Result<(), String> {
 
 pub fn kaze(a: &KazeArgs) -> Result<(), String> {
     let img = load_gray(&a.image).map_err(|e| e.to_string())?;
-    if a.octaves == 0 || a.octaves > 8 || !(a.threshold > 0.0) {
-        return Err("--octaves must be in 1..=8 and --threshold > 0".into());
+    if a.octaves == 0 || a.octaves > 8 || !(a.threshold.is_finite() && a.threshold > 0.0) {
+        return Err("--octaves must be in 1..=8 and --threshold finite and > 0".into());
     }
     let p = KazeParams {
         threshold: a.threshold,

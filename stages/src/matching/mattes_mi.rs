@@ -23,6 +23,7 @@
 
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+use crate::estimators::one_plus_one::{minimize, OnePlusOneParams};
 use crate::estimators::SplitMix64;
 use crate::imaging::GrayImage;
 use thiserror::Error;
@@ -322,13 +323,24 @@ pub fn register_translation(
     samples: Option<usize>,
     start_px: [f64; 2],
     max_offset_px: f64,
-    es: &crate::estimators::one_plus_one::OnePlusOneParams,
+    es: &OnePlusOneParams,
 ) -> Result<MiRegistration, MiError> {
-    let seed = es.seed;
-    let mut metric = MattesMi::new(fixed, moving, bins, samples, seed)?;
+    let mut metric = MattesMi::new(fixed, moving, bins, samples, es.seed)?;
+    maximize_translation(&mut metric, start_px, max_offset_px, es)
+}
+
+/// The (1+1)-ES part of [`register_translation`] on a prepared metric (so a caller that evaluates the metric
+/// elsewhere too, e.g. an integer scan for the start, builds it once): MI maximised from `start_px`,
+/// candidates farther than `max_offset_px` from the start (per axis) invalid. Errors if the start is invalid.
+pub fn maximize_translation(
+    metric: &mut MattesMi,
+    start_px: [f64; 2],
+    max_offset_px: f64,
+    es: &OnePlusOneParams,
+) -> Result<MiRegistration, MiError> {
     // The start must be valid: report its error rather than an ES failure.
     metric.evaluate(start_px[0], start_px[1])?;
-    let result = crate::estimators::one_plus_one::minimize(
+    let result = minimize(
         |x: &[f64]| {
             if (x[0] - start_px[0]).abs() > max_offset_px
                 || (x[1] - start_px[1]).abs() > max_offset_px

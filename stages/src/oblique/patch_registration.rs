@@ -172,7 +172,9 @@ impl Context<'_> {
                 radius_px,
                 Some(self.p.mi_scan_step_px),
                 &self.es(grid.spacing_m, seed),
-            )?,
+            )
+            .ok()?
+            .into(),
         };
         Some((grid.shift_px_to_plane_m(found.shift_px), found.score))
     }
@@ -253,7 +255,7 @@ impl Context<'_> {
         )?;
         let (fixed, moving) = self.patches(&grid, coarse_m)?;
         let window_px = p.fine_window_m / grid.spacing_m;
-        let found = match p.fine {
+        let found: Found = match p.fine {
             Similarity::Mi => mi_search(
                 &fixed,
                 &moving,
@@ -263,7 +265,9 @@ impl Context<'_> {
                 window_px,
                 None,
                 &self.es(grid.spacing_m, self.seed(&point.tie.id, "fine")),
-            )?,
+            )
+            .ok()?
+            .into(),
             Similarity::Ncc => ncc_search(
                 &fixed,
                 &moving,

@@ -5,9 +5,9 @@
 //! Shifts are patch translations in px with the Mattes MI convention: fixed pixel `x` is compared with the
 //! moving patch at `x + t` (see `matching::mattes_mi`). NaN pixels are masked in both patches.
 
-use crate::estimators::one_plus_one::{minimize, OnePlusOneParams};
+use crate::estimators::one_plus_one::OnePlusOneParams;
 use crate::imaging::GrayImage;
-use crate::matching::mattes_mi::MattesMi;
+use crate::matching::mattes_mi::{maximize_translation, MattesMi, MiError, MiRegistration};
 use crate::matching::subpixel::{refine_peak, PeakFit};
 
 /// A found translation.
@@ -127,10 +127,11 @@ pub fn ncc_search(
     })
 }
 
-/// Mattes MI maximised by the (1+1)-ES from `start_px`, candidates restricted to ±`window_px` (per axis)
-/// around `window_centre_px`. With `scan_step_px = Some(s)` the start is first replaced by the best of an
-/// exhaustive MI scan at the integer shifts `window_centre + s·(i, j)` inside the window (and the ES then
-/// searches ±s around it). `None` if the metric cannot be set up or no candidate is valid.
+/// Mattes MI maximised by the (1+1)-ES ([`maximize_translation`]) from `window_centre_px`, candidates
+/// restricted to ±`window_px` (per axis) around it. With `scan_step_px = Some(s)` the start is first replaced by
+/// the best of an exhaustive MI scan at the shifts `window_centre + s·(i, j)` inside the window (and the ES then
+/// searches ±s around it). Errors if the metric cannot be set up, or no scanned shift (without a scan: the
+/// window centre) is valid. This is the MI path of the patch registration and of `skytie tool mi-register`.
 #[allow(clippy::too_many_arguments)]
 pub fn mi_search(
     fixed: &GrayImage,
@@ -141,43 +142,47 @@ pub fn mi_search(
     window_px: f64,
     scan_step_px: Option<usize>,
     es: &OnePlusOneParams,
-) -> Option<Found> {
-    let mut metric = MattesMi::new(fixed, moving, bins, samples, es.seed).ok()?;
-    let (mut start, mut centre, mut half) = (window_centre_px, window_centre_px, window_px);
+) -> Result<MiRegistration, MiError> {
+    let mut metric = MattesMi::new(fixed, moving, bins, samples, es.seed)?;
+    let (mut start, mut half) = (window_centre_px, window_px);
     if let Some(step) = scan_step_px {
         let step = step.max(1) as f64;
         let k = (window_px / step).floor() as isize;
         let mut best: Option<([f64; 2], f64)> = None;
+        let mut last_err = None;
         for j in -k..=k {
             for i in -k..=k {
                 let t = [
                     window_centre_px[0] + i as f64 * step,
                     window_centre_px[1] + j as f64 * step,
                 ];
-                if let Ok(v) = metric.evaluate(t[0], t[1]) {
-                    if best.is_none_or(|(_, b)| v > b) {
-                        best = Some((t, v));
-                    }
+                match metric.evaluate(t[0], t[1]) {
+                    Ok(v) if best.is_none_or(|(_, b)| v > b) => best = Some((t, v)),
+                    Ok(_) => {}
+                    Err(e) => last_err = Some(e),
                 }
             }
         }
-        start = best?.0;
-        centre = start;
+        match (best, last_err) {
+            (Some((t, _)), _) => start = t,
+            (None, Some(e)) => return Err(e),
+            (None, None) => {
+                return Err(MiError::NonFiniteTranslation(
+                    window_centre_px[0],
+                    window_centre_px[1],
+                ))
+            }
+        }
         half = step;
     }
-    let result = minimize(
-        |x: &[f64]| {
-            if (x[0] - centre[0]).abs() > half || (x[1] - centre[1]).abs() > half {
-                return None;
-            }
-            metric.evaluate(x[0], x[1]).ok().map(|mi| -mi)
-        },
-        &start,
-        &[1.0, 1.0],
-        es,
-    )?;
-    Some(Found {
-        shift_px: [result.x[0], result.x[1]],
-        score: -result.value,
-    })
+    maximize_translation(&mut metric, start, half, es)
+}
+
+impl From<MiRegistration> for Found {
+    fn from(r: MiRegistration) -> Self {
+        Found {
+            shift_px: r.translation_px,
+            score: r.mi,
+        }
+    }
 }
