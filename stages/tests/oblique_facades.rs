@@ -767,7 +767,10 @@ fn patch_centres_are_observed_by_the_centre_and_close_to_the_plane() {
         .iter()
         .find(|p| p.side == StreetSide::Left)
         .expect("left plane");
-    assert!(plane.inliers.contains(&off), "the off-plane point is an inlier");
+    assert!(
+        plane.inliers.contains(&off),
+        "the off-plane point is an inlier"
+    );
     assert!(unseen.iter().all(|i| plane.inliers.contains(i)));
     assert!(!plane.thinned.contains(&off));
     assert!(plane.thinned.iter().all(|i| !unseen.contains(i)));

@@ -167,7 +167,9 @@ pub fn find_facades(
                         .iter()
                         .any(|o| o.image_id == recording)
                 })
-                .filter(|&i| !((local[i] - lp.centroid).dot(&lp.normal).abs() > p.max_centre_offset_m))
+                .filter(|&i| {
+                    !((local[i] - lp.centroid).dot(&lp.normal).abs() > p.max_centre_offset_m)
+                })
                 .collect();
             // Thinning in the local frame, relative to the centroid (thesis 4.4.4).
             let rel: Vec<[f64; 3]> = observed

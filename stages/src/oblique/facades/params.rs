@@ -126,10 +126,7 @@ impl FacadeParams {
         check(
             pos(self.max_centre_offset_m),
             "max_centre_offset_m",
-            format!(
-                "must be finite and > 0 m, got {}",
-                self.max_centre_offset_m
-            ),
+            format!("must be finite and > 0 m, got {}", self.max_centre_offset_m),
         );
         check(
             self.min_points >= 3,
