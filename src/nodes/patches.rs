@@ -18,7 +18,7 @@ pub struct PatchesStage;
 
 impl Stage for PatchesStage {
     const NAME: &'static str = "patches";
-    const VERSION: &'static str = "2";
+    const VERSION: &'static str = "3";
     type Params = PatchParams;
     type Output = PatchRegistrationSet;
     type Inputs = (

@@ -137,21 +137,53 @@ fn sample_inside(img: &GrayImage, u_px: f64, v_px: f64) -> Option<f32> {
     Some(v as f32)
 }
 
-/// The panorama patch: every grid pixel centre projected into the panorama (`cam`, whose `width_px` ×
-/// `height_px` may differ from the image's size: coordinates are scaled) and sampled bilinearly; NaN where
-/// there is no data.
+/// Most sub-samples per patch pixel and axis when a patch pixel covers several panorama pixels.
+pub const MAX_SUPERSAMPLING: usize = 4;
+
+/// Sub-samples per axis that make one patch pixel of `spacing_m` at `range_m` from the panorama centre average
+/// over the panorama pixels it covers (one panorama pixel spans `range · 2π / W` metres at right angles).
+fn supersampling(spacing_m: f64, range_m: f64, pano_width_px: u32) -> usize {
+    let footprint_m = range_m * std::f64::consts::TAU / f64::from(pano_width_px.max(1));
+    if !(footprint_m > 0.0) {
+        return 1;
+    }
+    ((spacing_m / footprint_m).ceil() as usize).clamp(1, MAX_SUPERSAMPLING)
+}
+
+/// The panorama patch: every grid pixel projected into the panorama (`cam`, whose `width_px` × `height_px`
+/// may differ from the image's size: coordinates are scaled) and sampled bilinearly; NaN where there is no
+/// data. The MM panorama resolves a façade 10 m away at ≈ 4 cm, finer than the oblique-resolution grid, so
+/// each patch pixel averages k × k bilinear samples spread over its cell (k from the panorama's pixel footprint
+/// at the patch centre, at most [`MAX_SUPERSAMPLING`]) instead of point-sampling — which would alias the
+/// façade texture and blur the MI optimum. A pixel whose sub-samples are partly missing averages the rest.
 pub fn fill_from_panorama(grid: &PatchGrid, cam: &PanoramaCamera, pano: &GrayImage) -> GrayImage {
     let n = grid.size_px;
     let mut out = GrayImage::filled(n, n, f32::NAN);
     let sx = pano.width as f64 / f64::from(cam.width_px);
     let sy = pano.height as f64 / f64::from(cam.height_px);
-    grid.for_each_pixel(|i, p| {
-        if let Some((u, v)) = cam.project_world(&p) {
-            if let Some(g) = sample_panorama(pano, u * sx, v * sy) {
-                out.data[i] = g;
+    let range_m = (grid.centre_world - cam.center_world).norm();
+    let k = supersampling(grid.spacing_m, range_m, cam.width_px);
+    let offsets: Vec<f64> = (0..k).map(|j| (j as f64 + 0.5) / k as f64).collect();
+    for row in 0..n {
+        for col in 0..n {
+            let (mut sum, mut count) = (0.0f64, 0usize);
+            for &oy in &offsets {
+                for &ox in &offsets {
+                    let p = grid.world_at(col as f64 + ox, row as f64 + oy);
+                    if let Some(g) = cam
+                        .project_world(&p)
+                        .and_then(|(u, v)| sample_panorama(pano, u * sx, v * sy))
+                    {
+                        sum += f64::from(g);
+                        count += 1;
+                    }
+                }
+            }
+            if count > 0 {
+                out.data[row * n + col] = (sum / count as f64) as f32;
             }
         }
-    });
+    }
     out
 }
 
@@ -255,4 +287,18 @@ pub fn real_resolution_ratio(
         return (0.0, fraction);
     }
     (count_distinct(&mut cells) as f64 / valid as f64, fraction)
+}
+
+#[cfg(test)]
+mod supersampling_tests {
+    use super::supersampling;
+
+    #[test]
+    fn sub_samples_follow_the_panorama_footprint() {
+        // 1600-px panorama: a pixel spans 2π·10/1600 ≈ 3.9 cm at 10 m.
+        assert_eq!(supersampling(0.10, 10.0, 1600), 3);
+        assert_eq!(supersampling(0.03, 10.0, 1600), 1);
+        assert_eq!(supersampling(0.20, 10.0, 1600), 4); // capped
+        assert_eq!(supersampling(0.10, 0.0, 1600), 1);
+    }
 }
