@@ -4,6 +4,7 @@
 
 use super::nadir::{NadirHandles, RecordingItem};
 use super::oblique::ObliqueHandles;
+use super::wf_err;
 use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::adjust::{AdjustReport, AdjustStage};
 use crate::nodes::adjust_grade::{AdjustGrade, GradeAdjust};
@@ -15,10 +16,6 @@ use crate::workflow::Workflow;
 use skytie_stages::adjustment::verify::{Verification, VerifyConfig};
 use skytie_stages::adjustment::{AdjustConfig, Sources};
 use std::path::Path;
-
-fn wf_err(e: impl std::fmt::Display) -> PipelineError {
-    PipelineError::Workflow(e.to_string())
-}
 
 /// Handles of the adjustment outputs (for the exports written after the run).
 pub struct AdjustHandles {

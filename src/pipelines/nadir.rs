@@ -4,6 +4,7 @@
 //! aerial control points (`control`), then the global `nadir` summary and — on synthetic campaigns with
 //! `truth/` — the evaluation node `grade_nadir`.
 
+use super::{distance_m, missing_upstream, wf_err};
 use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::aerial::{SelectAerial, SelectAerialParams};
 use crate::nodes::baseline::BaselineStage;
@@ -59,10 +60,6 @@ pub struct NadirHandles {
     pub control: Vec<Handle<RecordingControl>>,
 }
 
-fn wf_err(e: impl std::fmt::Display) -> PipelineError {
-    PipelineError::Workflow(e.to_string())
-}
-
 /// Which nadir stages the workflow enables; an enabled stage whose upstream is not enabled is an error.
 pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
     let on = |s: &str| wf.stages.iter().any(|x| x == s);
@@ -85,21 +82,15 @@ pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
     }
     let missing: Vec<&str> = needed.into_iter().filter(|s| !on(s)).collect();
     if !missing.is_empty() {
-        return Err(wf_err(format!(
-            "{}: the nadir chain is enabled up to '{}' but its upstream stage(s) {} are not in `stages`; \
-             add them (order: ortho, {})",
-            wf.path.display(),
+        return Err(missing_upstream(
+            wf,
+            "nadir",
             NADIR_STAGES[last],
-            missing.join(", "),
-            NADIR_STAGES.join(", ")
-        )));
+            &missing,
+            &format!("ortho, {}", NADIR_STAGES.join(", ")),
+        ));
     }
     Ok(true)
-}
-
-/// Horizontal distance between two recordings' recorded positions, metres.
-fn distance_m(a: &Recording, b: &Recording) -> f64 {
-    (a.x - b.x).hypot(a.y - b.y)
 }
 
 /// Add the nadir chain for `variant`. `items` are in trajectory (time) order.

@@ -8,6 +8,7 @@
 //! setting; `patches` once per distinct (façades, registration setting).
 
 use super::nadir::RecordingItem;
+use super::{distance_m, missing_upstream, wf_err};
 use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::aerial::{SelectAerial, SelectAerialParams};
 use crate::nodes::campaign::CampaignSnapshot;
@@ -43,10 +44,6 @@ pub struct ObliqueHandles {
     pub result: Option<Handle<ObliqueOutput>>,
 }
 
-fn wf_err(e: impl std::fmt::Display) -> PipelineError {
-    PipelineError::Workflow(e.to_string())
-}
-
 /// Whether the workflow enables the oblique chain; an enabled stage whose upstream is not enabled is an error.
 pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
     let on = |s: &str| wf.stages.iter().any(|x| x == s);
@@ -64,20 +61,15 @@ pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
         .filter(|s| !on(s))
         .collect();
     if !missing.is_empty() {
-        return Err(wf_err(format!(
-            "{}: the oblique chain is enabled up to '{}' but its upstream stage(s) {} are not in `stages`; \
-             add them (order: {})",
-            wf.path.display(),
+        return Err(missing_upstream(
+            wf,
+            "oblique",
             OBLIQUE_STAGES[last],
-            missing.join(", "),
-            OBLIQUE_STAGES.join(", ")
-        )));
+            &missing,
+            &OBLIQUE_STAGES.join(", "),
+        ));
     }
     Ok(true)
-}
-
-fn distance_m(a: &Recording, b: &Recording) -> f64 {
-    (a.x - b.x).hypot(a.y - b.y)
 }
 
 /// Add the oblique chain for `variant`. `items` are in trajectory (time) order.

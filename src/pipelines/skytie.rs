@@ -10,7 +10,7 @@
 //! After phase 3 the exports of every variant are written into `OUT` (`OUT/variants/<name>/` in a sweep).
 //! A stage name the pipeline does not know is refused with the list of available ones.
 
-use super::{adjust, nadir, oblique};
+use super::{adjust, nadir, oblique, wf_err};
 use crate::dag::{DagBuilder, Pipeline, PipelineError, RawFile, Session};
 use crate::exports::{verification_table, write_exports, ExportInputs};
 use crate::nodes::campaign::{listing_hash, metadata_inputs};
@@ -48,10 +48,6 @@ pub const STAGES: [&str; 20] = [
     "oblique",
     "grade_oblique",
 ];
-
-fn wf_err(e: impl std::fmt::Display) -> PipelineError {
-    PipelineError::Workflow(e.to_string())
-}
 
 /// Absolute form of a campaign folder (keys must not depend on the working directory's spelling).
 fn absolute(p: &Path) -> PathBuf {
@@ -182,6 +178,14 @@ impl Pipeline for SkytiePipeline {
                 nadir_handles.as_ref(),
                 oblique_handles.as_ref(),
             )?;
+            // The exports (correspondences.csv) read these values: request them, or cached runs would not
+            // load them.
+            for c in nadir_handles.iter().flat_map(|n| &n.control) {
+                b.request(*c);
+            }
+            if let Some(o) = oblique_handles.as_ref().and_then(|o| o.result) {
+                b.request(o);
+            }
             exports.push((
                 variant.clone(),
                 adjust_handles,

@@ -757,8 +757,7 @@ fn patch_centres_are_observed_by_the_centre_and_close_to_the_plane() {
     let c = cloud(pts);
     let t = east_triplet();
     let params = FacadeParams {
-        thinning_max_points_per_box: 1_000_000, // no thinning: every eligible point is a centre
-        thinning_max_box_m: f64::INFINITY,
+        thinning_max_points_per_box: 1, // boxes split down to single points: every eligible point is a centre
         ..base
     };
     let f = find_facades(&c, [&t[0], &t[1], &t[2]], &[], &params);

@@ -40,8 +40,9 @@ use crate::geometry::aerial_intersection::{
 };
 use crate::geometry::FrameCamera;
 
-/// What happens to the matches of a set smaller than `min_set_size`.
+/// What happens to the matches of a set smaller than `min_set_size` (`"keep"` or `"drop"` in a workflow).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum SmallSetPolicy {
     /// Kept unchanged (no consensus test).
     Keep,

@@ -140,7 +140,9 @@ impl SparseCloudParams {
             ),
         );
         check(
-            pos(self.min_depth_m) && self.min_depth_m < self.max_range_m,
+            // (a bad max_range_m is reported on its own)
+            pos(self.min_depth_m)
+                && (self.min_depth_m < self.max_range_m || !pos(self.max_range_m)),
             "min_depth_m",
             format!(
                 "must be > 0 m and below max_range_m ({} m), got {}",
