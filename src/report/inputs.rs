@@ -38,6 +38,15 @@ pub struct CsvTable {
 }
 
 impl CsvTable {
+    /// A table from literal cells (tests and fixtures).
+    pub fn from_cells(header: &[&str], rows: &[&[&str]]) -> Self {
+        let owned = |r: &[&str]| r.iter().map(|c| (*c).to_string()).collect::<Vec<_>>();
+        Self {
+            header: owned(header),
+            rows: rows.iter().map(|r| owned(r)).collect(),
+        }
+    }
+
     /// Index of a column.
     pub fn col(&self, name: &str) -> Option<usize> {
         self.header.iter().position(|h| h == name)

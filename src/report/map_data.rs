@@ -170,8 +170,8 @@ mod tests {
 
     #[test]
     fn correspondence_kinds_per_recording() {
-        let t = CsvTable {
-            header: [
+        let t = CsvTable::from_cells(
+            &[
                 "source",
                 "point_id",
                 "image_kind",
@@ -179,24 +179,14 @@ mod tests {
                 "u",
                 "v",
                 "score",
-            ]
-            .map(String::from)
-            .to_vec(),
-            rows: vec![
-                ["nadir", "p1", "panorama", "a", "1", "2", ""]
-                    .map(String::from)
-                    .to_vec(),
-                ["nadir", "p1", "nadir", "n1", "1", "2", "0.9"]
-                    .map(String::from)
-                    .to_vec(),
-                ["oblique", "p2", "panorama", "a", "1", "2", ""]
-                    .map(String::from)
-                    .to_vec(),
-                ["oblique", "p2", "panorama", "b", "1", "2", ""]
-                    .map(String::from)
-                    .to_vec(),
             ],
-        };
+            &[
+                &["nadir", "p1", "panorama", "a", "1", "2", ""],
+                &["nadir", "p1", "nadir", "n1", "1", "2", "0.9"],
+                &["oblique", "p2", "panorama", "a", "1", "2", ""],
+                &["oblique", "p2", "panorama", "b", "1", "2", ""],
+            ],
+        );
         let (n, o) = correspondence_sets(Some(&t));
         assert_eq!(n.into_iter().collect::<Vec<_>>(), vec!["a"]);
         assert_eq!(o.into_iter().collect::<Vec<_>>(), vec!["a", "b"]);

@@ -456,8 +456,8 @@ mod tests {
 
     #[test]
     fn points_group_observations_by_source_and_id() {
-        let t = CsvTable {
-            header: [
+        let t = CsvTable::from_cells(
+            &[
                 "source",
                 "point_id",
                 "image_kind",
@@ -465,24 +465,14 @@ mod tests {
                 "u",
                 "v",
                 "score",
-            ]
-            .map(String::from)
-            .to_vec(),
-            rows: vec![
-                ["nadir", "p1", "panorama", "a", "1", "2", ""]
-                    .map(String::from)
-                    .to_vec(),
-                ["nadir", "p1", "nadir", "n1", "3", "4", "0.9"]
-                    .map(String::from)
-                    .to_vec(),
-                ["nadir", "p1", "nadir", "n2", "3", "4", "0.9"]
-                    .map(String::from)
-                    .to_vec(),
-                ["oblique", "p1", "panorama", "a", "1", "2", ""]
-                    .map(String::from)
-                    .to_vec(),
             ],
-        };
+            &[
+                &["nadir", "p1", "panorama", "a", "1", "2", ""],
+                &["nadir", "p1", "nadir", "n1", "3", "4", "0.9"],
+                &["nadir", "p1", "nadir", "n2", "3", "4", "0.9"],
+                &["oblique", "p1", "panorama", "a", "1", "2", ""],
+            ],
+        );
         let p = parse_points(&t);
         assert_eq!(p.len(), 2);
         let n = &p[&("nadir".to_string(), "p1".to_string())];
