@@ -148,7 +148,7 @@ fn tiny_campaign_end_to_end() {
     assert_eq!(stage(&m, "ortho", "cached"), recordings - 1);
     assert_eq!(stage(&m, "summary", "executed"), 1);
 
-    // 4. The shipped full chain (workflows/tiny.toml: nadir registration, adjustment, verification) on the same
+    // 4. The shipped full chain (workflows/tiny.toml: nadir and oblique registration, adjustment, verification) on the same
     //    synthetic campaign: every stage ran without failures, the metrics sections and the exports exist, and
     //    a second run is served from the cache.
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("workflows/tiny.toml");
@@ -175,12 +175,26 @@ fn tiny_campaign_end_to_end() {
     );
     assert!(m["adjust"]["combined"]["checkpoints"]["before"]["2d"].is_number());
     assert!(m["verify"]["passed"].is_boolean(), "{m}");
+    // The oblique chain (thesis ch. 4): one sparse cloud and one façade node per triplet of the 6-recording
+    // street, façade planes from its points, the consensus and its grading.
+    let triplets = recordings - 2;
+    assert_eq!(m["oblique"]["triplets"].as_u64(), Some(triplets), "{m}");
+    assert_eq!(stage(&m, "sparse_cloud", "executed"), triplets);
+    assert_eq!(stage(&m, "facades", "executed"), triplets);
+    assert!(m["oblique"]["sparse_points"].as_u64().unwrap() > 0, "{m}");
+    assert!(m["oblique"]["planes"].as_u64().unwrap() > 0, "{m}");
+    assert!(stage(&m, "patches", "executed") >= 1, "{m}");
+    assert!(
+        m["oblique"]["inlier_ratio_after_consensus"].is_number(),
+        "{m}"
+    );
     for f in [
         "trajectory_adjusted.csv",
         "trajectory.geojson",
         "tie_points.ply",
         "checkpoints.csv",
         "verification.csv",
+        "correspondences.csv",
         "colmap/cameras.txt",
         "colmap/images.txt",
         "colmap/points3D.txt",
