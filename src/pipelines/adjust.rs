@@ -24,6 +24,7 @@ pub struct AdjustHandles {
 }
 
 /// Add `adjust`, `grade_adjust` and `verify` when the workflow enables them.
+#[allow(clippy::too_many_arguments)]
 pub fn add_adjust(
     b: &mut DagBuilder,
     wf: &Workflow,

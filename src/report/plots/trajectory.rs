@@ -4,6 +4,9 @@
 //! vector-scale bar. Equal metres per pixel on both axes; coordinates are shown relative to a round local
 //! origin named in the axis labels.
 
+// `!(x > t)` on purpose: it also rejects NaN, which `x <= t` would let through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use super::{
     nice_floor, plot_err, write_svg, BLUE, CAPTION_PX, DARK, FONT, GREY, LABEL_PX, ORANGE, PURPLE,
     TICK_PX, VERMILLION,

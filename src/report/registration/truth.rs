@@ -5,6 +5,9 @@
 //! poses of synthetic campaigns are true). An aerial observation is correct when it lies within
 //! [`TOLERANCE_PX`] of that projection (the README's truth grading rule: 1 aerial pixel).
 
+// `!(x > t)` on purpose: it also rejects NaN, which `x <= t` would let through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use nalgebra::Vector3;
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::geometry::{triangulate_rays, FrameCamera, PanoramaCamera, Ray};

@@ -51,7 +51,7 @@ fn count(which: &'static str, values: &[f32], len: usize) -> Result<usize, Match
     if len == 0 {
         return Err(MatchError::ZeroLength);
     }
-    if values.len() % len != 0 {
+    if !values.len().is_multiple_of(len) {
         return Err(MatchError::Ragged {
             which,
             values: values.len(),
