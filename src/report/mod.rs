@@ -20,6 +20,7 @@ pub mod thesis_values;
 
 use html::Page;
 use inputs::RunOutputs;
+use rayon::prelude::*;
 use skytie_stages::fsutil::atomic_write;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -100,6 +101,34 @@ impl Builder {
         self.figures.push(path);
     }
 
+    /// An empty builder writing into the same report (for one variant's pages, built in parallel).
+    fn child(&self) -> Builder {
+        Builder {
+            report_dir: self.report_dir.clone(),
+            campaign: self.campaign.clone(),
+            options: self.options.clone(),
+            tables: Vec::new(),
+            table_ids: BTreeSet::new(),
+            figures: Vec::new(),
+            notes: Vec::new(),
+        }
+    }
+
+    /// Takes over what a [`Builder::child`] collected (called in variant order: deterministic output).
+    fn absorb(&mut self, child: Builder) {
+        for t in child.tables {
+            debug_assert!(
+                !self.table_ids.contains(&t.id),
+                "duplicate table id {}",
+                t.id
+            );
+            self.table_ids.insert(t.id.clone());
+            self.tables.push(t);
+        }
+        self.figures.extend(child.figures);
+        self.notes.extend(child.notes);
+    }
+
     /// A section that could not be drawn: a note on the page and in the summary.
     pub fn note(&mut self, page: &mut Page, text: String) {
         page.raw(&format!("<p class=\"note\">{}</p>\n", html::escape(&text)));
@@ -163,18 +192,30 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
     if run.is_sweep {
         sweep::sweep_section(&mut b, &mut index, &run)?;
         index.heading("variants", "Variants");
+        // Variant pages are independent (figure names carry the variant's prefix): render them in parallel
+        // (registration views decode panoramas and aerial images), then merge in variant order.
+        let variant_pages: Vec<Result<(Builder, String, String), String>> = run
+            .sets
+            .par_iter()
+            .map(|set| {
+                let mut vb = b.child();
+                let file = format!("variant-{}.html", slug(&set.name));
+                let mut page = Page::new(&format!("variant {}", set.name));
+                page.nav_link("index.html", "← report index");
+                results::results_sections(&mut vb, &mut page, set, &run)?;
+                Ok((vb, file, page.render()))
+            })
+            .collect();
         let mut list = String::from("<ul>\n");
-        for set in &run.sets {
-            let file = format!("variant-{}.html", slug(&set.name));
+        for (set, made) in run.sets.iter().zip(variant_pages) {
+            let (vb, file, html_text) = made?;
+            b.absorb(vb);
             list.push_str(&format!(
                 "<li><a href=\"{}\">{}</a></li>\n",
                 html::escape(&file),
                 html::escape(&set.name)
             ));
-            let mut page = Page::new(&format!("variant {}", set.name));
-            page.nav_link("index.html", "← report index");
-            results::results_sections(&mut b, &mut page, set, &run)?;
-            pages.push((report_dir.join(&file), page.render()));
+            pages.push((report_dir.join(&file), html_text));
         }
         list.push_str("</ul>\n");
         index.raw(&list);
