@@ -143,7 +143,22 @@ pub struct MattesMi<'a> {
     fixed_counts: Vec<f64>,
     /// Moving marginal (scratch).
     moving_marginal: Vec<f64>,
+    /// Per moving pixel, its Parzen terms for integral translations (built on the first one; empty before).
+    pixel_parzen: Vec<PixelParzen>,
 }
+
+/// The moving-image Parzen terms of one moving pixel: `κ0` and the B-spline weights of the bins
+/// `κ0 − 1 … κ0 + 2`; `k0 == NO_BIN` for a masked pixel. At an integral translation every fixed sample (a pixel
+/// centre) lands exactly on a moving pixel centre, the bilinear interpolation returns that pixel's value, and
+/// these terms are what [`MattesMi::evaluate`] would compute for it — so the integer scans of the patch
+/// registration (thesis 4.4.6) skip the interpolation and the B-spline evaluation with identical results.
+#[derive(Clone, Copy, Debug)]
+struct PixelParzen {
+    k0: u32,
+    weights: [f64; 4],
+}
+
+const NO_BIN: u32 = u32::MAX;
 
 impl<'a> MattesMi<'a> {
     /// Prepare the metric: ranges of both images, the fixed sample set (`samples = None`: every valid fixed
@@ -199,6 +214,7 @@ impl<'a> MattesMi<'a> {
             joint: vec![0.0; bins * bins],
             fixed_counts: vec![0.0; bins],
             moving_marginal: vec![0.0; bins],
+            pixel_parzen: Vec::new(),
         })
     }
 
@@ -219,8 +235,9 @@ impl<'a> MattesMi<'a> {
         if !(x >= 0.0 && x <= xmax && y >= 0.0 && y <= ymax) {
             return None;
         }
-        let x0 = (x.floor() as usize).min(img.width - 1);
-        let y0 = (y.floor() as usize).min(img.height - 1);
+        // x, y ≥ 0 here, so truncation is the floor (without a libm call on baseline x86-64).
+        let x0 = (x as usize).min(img.width - 1);
+        let y0 = (y as usize).min(img.height - 1);
         let fx = x - x0 as f64;
         let fy = y - y0 as f64;
         let x1 = (x0 + 1).min(img.width - 1);
@@ -239,6 +256,59 @@ impl<'a> MattesMi<'a> {
         Some(v)
     }
 
+    /// `κ0` (the first bin of the B-spline window, clamped to the padded range) and the four weights of the
+    /// moving value `m` (already checked to lie in the moving range, so `τ ≥ P` and truncation is the floor).
+    #[inline]
+    fn parzen_terms(&self, m: f64) -> (usize, [f64; 4]) {
+        let tau = self.moving_scale.term(m);
+        let k0 = (tau as usize).clamp(PADDING_BINS, self.bins - PADDING_BINS - 1);
+        let mut weights = [0.0; 4];
+        for (i, w) in weights.iter_mut().enumerate() {
+            *w = bspline3((k0 + i - 1) as f64 - tau);
+        }
+        (k0, weights)
+    }
+
+    /// Fills [`Self::pixel_parzen`] (once).
+    fn build_pixel_parzen(&mut self) {
+        let (m_min, m_max) = (self.moving_scale.min, self.moving_scale.max);
+        let table: Vec<PixelParzen> = self
+            .moving
+            .data
+            .iter()
+            .map(|&v| {
+                let m = f64::from(v);
+                if v.is_finite() && m >= m_min && m <= m_max {
+                    let (k0, weights) = self.parzen_terms(m);
+                    PixelParzen {
+                        k0: k0 as u32,
+                        weights,
+                    }
+                } else {
+                    PixelParzen {
+                        k0: NO_BIN,
+                        weights: [0.0; 4],
+                    }
+                }
+            })
+            .collect();
+        self.pixel_parzen = table;
+    }
+
+    /// The Parzen terms of the moving pixel whose centre is `(u_px, v_px)` (an integral translation of a
+    /// sample), `None` outside the moving image or on a masked pixel — as `moving_value` decides.
+    #[inline]
+    fn pixel_terms(&self, u_px: f64, v_px: f64) -> Option<(usize, [f64; 4])> {
+        let img = self.moving;
+        let x = u_px - 0.5;
+        let y = v_px - 0.5;
+        if !(x >= 0.0 && x <= (img.width - 1) as f64 && y >= 0.0 && y <= (img.height - 1) as f64) {
+            return None;
+        }
+        let p = self.pixel_parzen[y as usize * img.width + x as usize];
+        (p.k0 != NO_BIN).then_some((p.k0 as usize, p.weights))
+    }
+
     /// Mattes MI (nats, ≥ 0; higher = more similar) with the moving image translated by `(tx, ty)` pixels.
     pub fn evaluate(&mut self, tx: f64, ty: f64) -> Result<f64, MiError> {
         if !(tx.is_finite() && ty.is_finite()) {
@@ -248,23 +318,29 @@ impl<'a> MattesMi<'a> {
         self.joint.fill(0.0);
         self.fixed_counts.fill(0.0);
         self.moving_marginal.fill(0.0);
-        let top = (bins - PADDING_BINS - 1) as f64;
         let (m_min, m_max) = (self.moving_scale.min, self.moving_scale.max);
+        // Every sample is a fixed pixel centre, so an integral translation lands on moving pixel centres.
+        let integral = tx.fract() == 0.0 && ty.fract() == 0.0;
+        if integral && self.pixel_parzen.is_empty() {
+            self.build_pixel_parzen();
+        }
         let mut landed = 0usize;
         for k in 0..self.samples.len() {
             let s = self.samples[k];
-            let Some(m) = self.moving_value(s.u_px + tx, s.v_px + ty) else {
+            let (u, v) = (s.u_px + tx, s.v_px + ty);
+            let terms = if integral {
+                self.pixel_terms(u, v)
+            } else {
+                self.moving_value(u, v)
+                    .filter(|&m| m >= m_min && m <= m_max)
+                    .map(|m| self.parzen_terms(m))
+            };
+            let Some((k0, weights)) = terms else {
                 continue;
             };
-            if !(m >= m_min && m <= m_max) {
-                continue;
-            }
-            let tau = self.moving_scale.term(m);
-            let k0 = tau.floor().clamp(PADDING_BINS as f64, top) as usize;
             let row = &mut self.joint[s.bin * bins..(s.bin + 1) * bins];
-            #[allow(clippy::needless_range_loop)]
-            for kappa in k0 - 1..=k0 + 2 {
-                row[kappa] += bspline3(kappa as f64 - tau);
+            for (cell, w) in row[k0 - 1..=k0 + 2].iter_mut().zip(weights) {
+                *cell += w;
             }
             self.fixed_counts[s.bin] += 1.0;
             landed += 1;
