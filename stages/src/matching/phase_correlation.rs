@@ -9,12 +9,18 @@
 //! integer peak, sub-pixel vertex of a second-order polynomial fitted to the 3 × 3 neighbourhood (on the
 //! logarithm by default, exact for the Gaussian-shaped peak). Shifts are only defined modulo the padded size;
 //! they are returned in `[−N/2, N/2)`. The estimate is then repeated with the moving image's window shifted
-//! by the current estimate (`refinements`), which removes the bias a fixed window causes.
+//! by the current estimate (`refinements`, default 1), which removes the bias a fixed window causes. A
+//! refinement pass needs the surface only next to the known peak: it evaluates the inverse DFT directly on the
+//! 3 × 3 pixels around the previous estimate (the matrix-multiply DFT of Guizar-Sicairos, Thurman & Fienup
+//! 2008, at upsampling 1; re-centred while a neighbour is higher), not a full inverse FFT and peak scan.
 //!
 //! For repeated use, [`PhaseCorrelator`] holds the rustfft plans, the window and low-pass tables and every
 //! buffer for one image size, so a call allocates nothing; the free functions [`phase_correlate`] and
 //! [`locate_template`] use a small per-thread cache of correlators, so concurrent calls from rayon are fine and
-//! deterministic. The 2-D FFTs run on the half spectrum of the real images (`real_fft_2d`).
+//! deterministic. The 2-D FFTs run on the half spectrum of the real images (`real_fft_2d`). Cost per call:
+//! three forward half-spectrum FFTs (reference, moving in pass 0 and in the refinement), one inverse, two
+//! cross-power normalisations and the 3 × 3 evaluation; measured against `cv2.phaseCorrelate` in
+//! `benches/README.md` (issue 4).
 
 mod real_fft_2d;
 
@@ -42,8 +48,12 @@ pub struct PhaseCorrelationParams {
     pub peak_fit: PeakFit,
     /// Re-estimations with the moving image's window re-centred on the content found so far. A window fixed
     /// in both frames correlates with itself and biases the shift towards zero (by ~10 % of the shift on
-    /// textured images); moving it with the estimate removes that. 0 = single pass. Ignored for
-    /// [`WindowKind::Rectangular`] (no taper: the images are treated as periodic).
+    /// textured images); moving it with the estimate removes that. 0 = single pass. Stops early once the
+    /// estimate changes by less than 1e-3 px. Ignored for [`WindowKind::Rectangular`] (no taper: the images are
+    /// treated as periodic). Default 1: on the `phasecorr` bench pairs a second re-estimation moves the result
+    /// by at most 0.0018 px at 64² and 0.00014 px at 128² (RMS error unchanged to 1e-4 px) and by at most
+    /// 0.018 px at 32² (RMS 0.0625 → 0.0612 px), i.e. each pass shrinks the remaining bias ~50× at 64², 10–20×
+    /// at 32².
     pub refinements: usize,
 }
 
