@@ -83,7 +83,7 @@ def main(folder):
     for size, name, err, ms, ratio in rows_out:
         r = f"{ratio:.2f}x" if ratio is not None else ""
         print(f"{size:>3}x{size:<3} | {name:<33} | {err:>10.4f} | {ms:>8.4f} | {r:>16}")
-    print("times: thread CPU time; skytie/peer uses the reused PhaseCorrelator (default, up to 4 passes)")
+    print("times: thread CPU time; skytie/peer uses the reused PhaseCorrelator (default: a pass and one refinement)")
 
 
 if __name__ == "__main__":

@@ -4,8 +4,8 @@
 //! gain 0.6, offset 0.25, gamma 0.7 and noise σ 0.01. The pairs are written as 8-bit PNGs and re-loaded, so the
 //! numbers below and `benches/peers/phasecorr.py` (OpenCV, scikit-image) see IDENTICAL inputs.
 //!
-//! Prints per size: RMS error against t, median time per call of `phase_correlate` (default parameters, up to
-//! 4 passes), of a reused `PhaseCorrelator`, and of a single pass. Writes to `$SKYTIE_PEER_DIR/phasecorr/`
+//! Prints per size: RMS error against t, median time per call of `phase_correlate` (default parameters: a
+//! pass and one refinement), of a reused `PhaseCorrelator`, and of a single pass. Writes to `$SKYTIE_PEER_DIR/phasecorr/`
 //! (default: `<temp>/skytie_peers/phasecorr/`): `pc{size}_{k}_ref.png`, `pc{size}_{k}_mov.png`,
 //! `truth_{size}.csv` (t, skytie's estimate) and `skytie_{size}.csv` (skytie's timings).
 //! Run: `cargo bench -p skytie-stages --bench phasecorr`.

@@ -20,6 +20,9 @@ pub(crate) type Cplx = Complex<Real>;
 
 const ZERO: Cplx = Complex::new(0.0, 0.0);
 
+/// Row pairs handled together when converting between the packed rows and the transposed half spectrum.
+const PAIR_BLOCK: usize = 4;
+
 pub(crate) struct RealFft2d {
     pw: usize,
     ph: usize,
@@ -56,6 +59,16 @@ impl RealFft2d {
         }
     }
 
+    /// Canvas width `pw`.
+    pub(crate) fn width(&self) -> usize {
+        self.pw
+    }
+
+    /// Canvas height `ph`.
+    pub(crate) fn height(&self) -> usize {
+        self.ph
+    }
+
     /// Number of stored column frequencies, `pw/2 + 1`.
     pub(crate) fn half_width(&self) -> usize {
         self.pw / 2 + 1
@@ -67,12 +80,14 @@ impl RealFft2d {
     }
 
     /// Zeroes the input canvas (see [`Self::set_row`]).
+    #[cfg(test)]
     pub(crate) fn clear_input(&mut self) {
         self.packed.fill(ZERO);
     }
 
     /// Writes `values` into row `y` of the real input canvas starting at column `x0` (`x0 + len ≤ pw`).
     /// Values yielded beyond the row's end are ignored.
+    #[cfg(test)]
     pub(crate) fn set_row(&mut self, y: usize, x0: usize, values: impl Iterator<Item = Real>) {
         let start = (y / 2) * self.pw + x0;
         let row = &mut self.packed[start..(y / 2 + 1) * self.pw];
@@ -83,6 +98,13 @@ impl RealFft2d {
         }
     }
 
+    /// Row pair `pair` of the real input canvas as one complex row of `pw` values: row `2·pair` in the real
+    /// parts, row `2·pair + 1` (if `< ph`; else keep it 0) in the imaginary parts. Every pair must be written
+    /// (or the canvas cleared) before [`Self::forward`].
+    pub(crate) fn input_pair_mut(&mut self, pair: usize) -> &mut [Cplx] {
+        &mut self.packed[pair * self.pw..(pair + 1) * self.pw]
+    }
+
     /// Half spectrum (transposed layout, see the module doc) of the canvas written with [`Self::set_row`].
     /// The canvas is consumed (left undefined).
     pub(crate) fn forward(&mut self, spec: &mut [Cplx]) {
@@ -90,16 +112,22 @@ impl RealFft2d {
         debug_assert_eq!(spec.len(), hw * ph);
         self.row_forward
             .process_with_scratch(&mut self.packed, &mut self.scratch);
-        for (pair, z) in self.packed.chunks_exact(pw).enumerate() {
-            let (y0, y1) = (2 * pair, 2 * pair + 1);
+        // Blocks of PAIR_BLOCK row pairs, so that each column of the transposed output is written in runs of
+        // 2·PAIR_BLOCK consecutive values instead of one scattered store per row.
+        for (block, rows) in self.packed.chunks(PAIR_BLOCK * pw).enumerate() {
+            let y_start = 2 * PAIR_BLOCK * block;
             for kx in 0..hw {
-                let a = z[kx];
-                let b = z[(pw - kx) % pw].conj();
-                // Spectrum of the real part: (Z[k] + conj Z[−k])/2; of the imaginary part: (Z[k] − conj Z[−k])/2i.
-                spec[kx * ph + y0] = (a + b) * 0.5;
-                if y1 < ph {
-                    let d = a - b;
-                    spec[kx * ph + y1] = Complex::new(d.im * 0.5, -d.re * 0.5);
+                let column = &mut spec[kx * ph..(kx + 1) * ph];
+                for (p, z) in rows.chunks_exact(pw).enumerate() {
+                    let (y0, y1) = (y_start + 2 * p, y_start + 2 * p + 1);
+                    let a = z[kx];
+                    let b = z[(pw - kx) % pw].conj();
+                    // Spectrum of the real part: (Z[k] + conj Z[−k])/2; of the imaginary part: (Z[k] − conj Z[−k])/2i.
+                    column[y0] = (a + b) * 0.5;
+                    if y1 < ph {
+                        let d = a - b;
+                        column[y1] = Complex::new(d.im * 0.5, -d.re * 0.5);
+                    }
                 }
             }
         }
@@ -115,19 +143,23 @@ impl RealFft2d {
         debug_assert_eq!(out.len(), pw * ph);
         self.col_inverse
             .process_with_scratch(spec, &mut self.scratch);
-        // Column-inverse rows y0, y1: A[k], B[k] for k < hw, conj(A[pw − k]) beyond; pack Z = A + iB.
-        for (pair, z) in self.packed.chunks_exact_mut(pw).enumerate() {
-            let (y0, y1) = (2 * pair, 2 * pair + 1);
-            let has_y1 = y1 < ph;
-            for (k, zk) in z.iter_mut().enumerate() {
+        // Column-inverse rows y0, y1: A[k], B[k] for k < hw, conj(A[pw − k]) beyond; pack Z = A + iB. Blocks of
+        // row pairs as in `forward`, so that each column is read in runs.
+        for (block, rows) in self.packed.chunks_mut(PAIR_BLOCK * pw).enumerate() {
+            let y_start = 2 * PAIR_BLOCK * block;
+            for k in 0..pw {
                 let (kk, mirrored) = if k < hw { (k, false) } else { (pw - k, true) };
-                let mut a = spec[kk * ph + y0];
-                let mut b = if has_y1 { spec[kk * ph + y1] } else { ZERO };
-                if mirrored {
-                    a = a.conj();
-                    b = b.conj();
+                let column = &spec[kk * ph..(kk + 1) * ph];
+                for (p, z) in rows.chunks_exact_mut(pw).enumerate() {
+                    let (y0, y1) = (y_start + 2 * p, y_start + 2 * p + 1);
+                    let mut a = column[y0];
+                    let mut b = if y1 < ph { column[y1] } else { ZERO };
+                    if mirrored {
+                        a = a.conj();
+                        b = b.conj();
+                    }
+                    z[k] = Complex::new(a.re - b.im, a.im + b.re);
                 }
-                *zk = Complex::new(a.re - b.im, a.im + b.re);
             }
         }
         self.row_inverse
