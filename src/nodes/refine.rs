@@ -19,7 +19,8 @@ pub struct RefineStage;
 
 impl Stage for RefineStage {
     const NAME: &'static str = "refine";
-    const VERSION: &'static str = "1";
+    // 2: phase correlation refines on the 3×3 direct-DFT surface and cuts near-zero bins relative to the RMS.
+    const VERSION: &'static str = "2";
     type Params = RefineParams;
     type Output = AerialRefinement;
     type Inputs = (
