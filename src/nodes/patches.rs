@@ -18,7 +18,8 @@ pub struct PatchesStage;
 
 impl Stage for PatchesStage {
     const NAME: &'static str = "patches";
-    const VERSION: &'static str = "3";
+    // 4: Mattes MI weights the bilinear samples with per-evaluation weights (scores differ in the last bits).
+    const VERSION: &'static str = "4";
     type Params = PatchParams;
     type Output = PatchRegistrationSet;
     type Inputs = (

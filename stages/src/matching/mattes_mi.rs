@@ -124,9 +124,47 @@ impl BinScale {
 /// One fixed-image sample: its pixel-centre position and its (box-window) fixed bin.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct FixedSample {
-    u_px: f64,
-    v_px: f64,
+    /// The fixed pixel (its centre is the sample position).
+    col: usize,
+    row: usize,
     bin: usize,
+}
+
+/// A translation split into whole pixels and the bilinear weights of its fractional part. Every sample is a
+/// fixed pixel centre, so every sample lands at the same fractional position between moving pixel centres:
+/// the weights are computed once per evaluation.
+#[derive(Clone, Copy, Debug)]
+struct Shift {
+    dx: i64,
+    dy: i64,
+    /// 1 when the translation has a fractional part along the axis (the next pixel gets weight), else 0.
+    step_x: i64,
+    step_y: i64,
+    /// Weights of the moving pixels (c, r), (c + 1, r), (c, r + 1), (c + 1, r + 1).
+    weights: [f64; 4],
+}
+
+impl Shift {
+    fn new(tx: f64, ty: f64) -> Self {
+        let (ix, iy) = (tx.floor(), ty.floor());
+        let (fx, fy) = (tx - ix, ty - iy);
+        Self {
+            dx: ix as i64,
+            dy: iy as i64,
+            step_x: i64::from(fx > 0.0),
+            step_y: i64::from(fy > 0.0),
+            weights: [
+                (1.0 - fx) * (1.0 - fy),
+                fx * (1.0 - fy),
+                (1.0 - fx) * fy,
+                fx * fy,
+            ],
+        }
+    }
+
+    fn is_integral(&self) -> bool {
+        self.step_x == 0 && self.step_y == 0
+    }
 }
 
 /// Mattes MI of a fixed image against a moving image under translations; built once per image pair, then
@@ -200,8 +238,8 @@ impl<'a> MattesMi<'a> {
                 let tau = fixed_scale.term(f64::from(fixed.data[i]));
                 let bin = tau.floor().clamp(PADDING_BINS as f64, top) as usize;
                 FixedSample {
-                    u_px: (i % fixed.width) as f64 + 0.5,
-                    v_px: (i / fixed.width) as f64 + 0.5,
+                    col: i % fixed.width,
+                    row: i / fixed.width,
                     bin,
                 }
             })
@@ -223,25 +261,22 @@ impl<'a> MattesMi<'a> {
         self.samples.len()
     }
 
-    /// Bilinear value of the moving image at a continuous pixel, `None` outside the pixel-centre grid or when
-    /// a pixel with non-zero weight is masked (NaN).
+    /// The moving pixel (column, row) under the sample `s` moved by `shift` (the top-left of its bilinear
+    /// neighbourhood), `None` when the position is outside the pixel-centre grid `[0.5, W − 0.5] × [0.5, H − 0.5]`.
     #[inline]
-    fn moving_value(&self, u_px: f64, v_px: f64) -> Option<f64> {
+    fn landing(&self, s: &FixedSample, shift: &Shift) -> Option<(usize, usize)> {
+        let (c, r) = (s.col as i64 + shift.dx, s.row as i64 + shift.dy);
+        let (w, h) = (self.moving.width as i64, self.moving.height as i64);
+        (c >= 0 && r >= 0 && c + shift.step_x < w && r + shift.step_y < h)
+            .then_some((c as usize, r as usize))
+    }
+
+    /// Bilinear moving value at the sample `s` moved by `shift`; `None` outside the moving image or when a pixel
+    /// with non-zero weight is masked (NaN).
+    #[inline]
+    fn moving_value(&self, s: &FixedSample, shift: &Shift) -> Option<f64> {
+        let (c, r) = self.landing(s, shift)?;
         let img = self.moving;
-        let x = u_px - 0.5;
-        let y = v_px - 0.5;
-        let xmax = (img.width - 1) as f64;
-        let ymax = (img.height - 1) as f64;
-        if !(x >= 0.0 && x <= xmax && y >= 0.0 && y <= ymax) {
-            return None;
-        }
-        // x, y ≥ 0 here, so truncation is the floor (without a libm call on baseline x86-64).
-        let x0 = (x as usize).min(img.width - 1);
-        let y0 = (y as usize).min(img.height - 1);
-        let fx = x - x0 as f64;
-        let fy = y - y0 as f64;
-        let x1 = (x0 + 1).min(img.width - 1);
-        let y1 = (y0 + 1).min(img.height - 1);
         let p = |c: usize, r: usize, w: f64| -> Option<f64> {
             if w == 0.0 {
                 return Some(0.0);
@@ -249,11 +284,8 @@ impl<'a> MattesMi<'a> {
             let v = img.data[r * img.width + c];
             v.is_finite().then(|| w * f64::from(v))
         };
-        let v = p(x0, y0, (1.0 - fx) * (1.0 - fy))?
-            + p(x1, y0, fx * (1.0 - fy))?
-            + p(x0, y1, (1.0 - fx) * fy)?
-            + p(x1, y1, fx * fy)?;
-        Some(v)
+        let w = &shift.weights;
+        Some(p(c, r, w[0])? + p(c + 1, r, w[1])? + p(c, r + 1, w[2])? + p(c + 1, r + 1, w[3])?)
     }
 
     /// `κ0` (the first bin of the B-spline window, clamped to the padded range) and the four weights of the
@@ -295,17 +327,12 @@ impl<'a> MattesMi<'a> {
         self.pixel_parzen = table;
     }
 
-    /// The Parzen terms of the moving pixel whose centre is `(u_px, v_px)` (an integral translation of a
-    /// sample), `None` outside the moving image or on a masked pixel — as `moving_value` decides.
+    /// The Parzen terms of the moving pixel the sample `s` lands on under the integral `shift`, `None` outside
+    /// the moving image or on a masked pixel — as [`Self::moving_value`] decides.
     #[inline]
-    fn pixel_terms(&self, u_px: f64, v_px: f64) -> Option<(usize, [f64; 4])> {
-        let img = self.moving;
-        let x = u_px - 0.5;
-        let y = v_px - 0.5;
-        if !(x >= 0.0 && x <= (img.width - 1) as f64 && y >= 0.0 && y <= (img.height - 1) as f64) {
-            return None;
-        }
-        let p = self.pixel_parzen[y as usize * img.width + x as usize];
+    fn pixel_terms(&self, s: &FixedSample, shift: &Shift) -> Option<(usize, [f64; 4])> {
+        let (c, r) = self.landing(s, shift)?;
+        let p = self.pixel_parzen[r * self.moving.width + c];
         (p.k0 != NO_BIN).then_some((p.k0 as usize, p.weights))
     }
 
@@ -320,18 +347,18 @@ impl<'a> MattesMi<'a> {
         self.moving_marginal.fill(0.0);
         let (m_min, m_max) = (self.moving_scale.min, self.moving_scale.max);
         // Every sample is a fixed pixel centre, so an integral translation lands on moving pixel centres.
-        let integral = tx.fract() == 0.0 && ty.fract() == 0.0;
+        let shift = Shift::new(tx, ty);
+        let integral = shift.is_integral();
         if integral && self.pixel_parzen.is_empty() {
             self.build_pixel_parzen();
         }
         let mut landed = 0usize;
         for k in 0..self.samples.len() {
             let s = self.samples[k];
-            let (u, v) = (s.u_px + tx, s.v_px + ty);
             let terms = if integral {
-                self.pixel_terms(u, v)
+                self.pixel_terms(&s, &shift)
             } else {
-                self.moving_value(u, v)
+                self.moving_value(&s, &shift)
                     .filter(|&m| m >= m_min && m <= m_max)
                     .map(|m| self.parzen_terms(m))
             };

@@ -595,17 +595,18 @@ impl WindowTable {
             let (so1, co1) = (theta * origin).sin_cos();
             let (so2, co2) = (2.0 * theta * origin).sin_cos();
             let last = (size - 1) as f64;
-            self.values.extend(self.trig.iter().enumerate().map(|(c, t)| {
-                let u = c as f64 - origin;
-                if !(u >= 0.0 && u <= last) {
-                    return 0.0;
-                }
-                let cos1 = t[0] * co1 + t[1] * so1;
-                match kind {
-                    WindowKind::Hann => 0.5 * (1.0 - cos1),
-                    _ => (0.42 - 0.5 * cos1 + 0.08 * (t[2] * co2 + t[3] * so2)).max(0.0),
-                }
-            }));
+            self.values
+                .extend(self.trig.iter().enumerate().map(|(c, t)| {
+                    let u = c as f64 - origin;
+                    if !(u >= 0.0 && u <= last) {
+                        return 0.0;
+                    }
+                    let cos1 = t[0] * co1 + t[1] * so1;
+                    match kind {
+                        WindowKind::Hann => 0.5 * (1.0 - cos1),
+                        _ => (0.42 - 0.5 * cos1 + 0.08 * (t[2] * co2 + t[3] * so2)).max(0.0),
+                    }
+                }));
         }
         self.sum = self.values.iter().sum();
         self.key = key;
