@@ -8,6 +8,7 @@
 //! gives byte-identical files (no timestamps except those read from OUT).
 
 pub mod html;
+pub mod image_cache;
 pub mod inputs;
 pub mod map_data;
 pub mod plots;
@@ -69,6 +70,8 @@ pub struct Builder {
     table_ids: BTreeSet<String>,
     pub figures: Vec<PathBuf>,
     pub notes: Vec<String>,
+    /// Campaign images decoded for the registration views, shared with the variants' builders.
+    pub images: std::sync::Arc<image_cache::ImageCache>,
 }
 
 /// Folder names inside `OUT/report/`.
@@ -111,6 +114,7 @@ impl Builder {
             table_ids: BTreeSet::new(),
             figures: Vec::new(),
             notes: Vec::new(),
+            images: std::sync::Arc::clone(&self.images),
         }
     }
 
@@ -171,6 +175,7 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
         table_ids: BTreeSet::new(),
         figures: Vec::new(),
         notes: Vec::new(),
+        images: Default::default(),
     };
     if b.campaign.is_none() {
         b.notes.push(

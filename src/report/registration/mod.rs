@@ -10,6 +10,7 @@ pub mod canvas;
 pub mod truth;
 
 use super::html::Page;
+use super::image_cache::ImageCache;
 use super::inputs::{read_csv_opt, CsvTable, ResultSet};
 use super::tables::{fmt_count, Origin, Table};
 use super::{slug, Builder};
@@ -19,8 +20,8 @@ use skytie_stages::campaign::{
     read_campaign, read_recordings_csv, AerialImage, Campaign, Recording,
 };
 use skytie_stages::geometry::{FrameCamera, PanoramaCamera};
-use skytie_stages::imaging::image::{GrayImage, RgbImage};
-use skytie_stages::imaging::io::{dimensions, load_gray, save_rgb};
+use skytie_stages::imaging::image::RgbImage;
+use skytie_stages::imaging::io::{dimensions, save_rgb};
 use skytie_stages::nadir::{ortho_project, OrthoParams};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -100,6 +101,7 @@ impl ViewCounts {
 /// What the views need from the campaign.
 struct Context<'a> {
     campaign: &'a Campaign,
+    images: &'a ImageCache,
     truth: BTreeMap<String, Recording>,
     pano_sizes: BTreeMap<String, (u32, u32)>,
 }
@@ -192,8 +194,10 @@ pub fn registration_section(
             pano_sizes.insert(r.image_id.clone(), d);
         }
     }
+    let images = std::sync::Arc::clone(&b.images);
     let ctx = Context {
         campaign: &campaign,
+        images: &images,
         truth,
         pano_sizes,
     };
@@ -293,10 +297,6 @@ fn best_aerial(points: &[&ControlPoint], kind: &str) -> Option<String> {
         .map(|(id, _)| id.to_string())
 }
 
-fn load(path: &Path) -> Result<GrayImage, String> {
-    load_gray(path).map_err(|e| e.to_string())
-}
-
 fn save(path: &Path, img: &RgbImage) -> Result<(), String> {
     save_rgb(path, img, 90).map_err(|e| e.to_string())
 }
@@ -312,7 +312,9 @@ fn nadir_view(
     let aerial = ctx
         .aerial("nadir", &aerial_id)
         .ok_or_else(|| format!("nadir image {aerial_id} is not in the campaign"))?;
-    let pano = load(&ctx.campaign.root.join("mm/panoramas").join(&rec.file))?;
+    let pano = ctx
+        .images
+        .gray(&ctx.campaign.root.join("mm/panoramas").join(&rec.file))?;
     let ortho = ortho_project(&pano, rec, &OrthoParams::default());
     let g = &ortho.georef;
     let left = crop_scaled(
@@ -335,7 +337,7 @@ fn nadir_view(
     let side_px = g.width_px as f64 * g.gsd_m * px_per_m;
     let (x0, y0) = (cu - side_px / 2.0, cv - side_px / 2.0);
     let scale = g.height_px as f64 / side_px;
-    let aerial_img = load(&ctx.aerial_path("nadir", aerial))?;
+    let aerial_img = ctx.images.gray(&ctx.aerial_path("nadir", aerial))?;
     let right = crop_scaled(&aerial_img, x0, y0, side_px, side_px, scale);
     let gap = 12;
     let mut img = side_by_side(&left, &right, gap);
@@ -412,8 +414,10 @@ fn oblique_view(
     if pairs.is_empty() {
         return Err("no control point seen in both images".into());
     }
-    let pano = load(&ctx.campaign.root.join("mm/panoramas").join(&rec.file))?;
-    let aerial_img = load(&ctx.aerial_path("oblique", aerial))?;
+    let pano = ctx
+        .images
+        .gray(&ctx.campaign.root.join("mm/panoramas").join(&rec.file))?;
+    let aerial_img = ctx.images.gray(&ctx.aerial_path("oblique", aerial))?;
     let lb = bbox(
         &pairs
             .iter()
