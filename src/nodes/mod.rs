@@ -9,6 +9,7 @@ pub mod baseline;
 pub mod campaign;
 pub mod consensus;
 pub mod control;
+pub mod decoded_images;
 pub mod facades;
 pub mod mm_match;
 pub mod nadir_grade;

@@ -3,10 +3,10 @@
 //! image that the visibility hypothesis did not accept for any plane gives an empty set. The sparse clouds
 //! are the same list as the `facades` node's (the triplet's own first, then its neighbours).
 
+use super::decoded_images;
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use crate::nodes::facades::neighbourhood_cloud;
 use skytie_stages::campaign::{AerialImage, Recording};
-use skytie_stages::imaging::io::load_gray;
 use skytie_stages::oblique::patch_registration::{register_patches, PatchParams};
 use skytie_stages::oblique::{PatchRegistrationSet, PatchStats, SparseCloud, TripletFacades};
 use std::sync::Arc;
@@ -57,10 +57,8 @@ impl Stage for PatchesStage {
             });
         }
         let cloud = neighbourhood_cloud(&clouds)?;
-        let load =
-            |f: &RawFileValue| load_gray(&f.path).map_err(|e| StageError::new(e.to_string()));
-        let pano_img = load(&pano)?;
-        let oblique_img = load(&oblique_file)?;
+        let pano_img = decoded_images::gray(&pano)?;
+        let oblique_img = decoded_images::gray(&oblique_file)?;
         Ok(register_patches(
             &rec,
             &pano_img,

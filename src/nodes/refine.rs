@@ -2,9 +2,9 @@
 //! recording's window located in the aerial image by phase correlation (thesis 3.4.5.3,
 //! `skytie_stages::nadir::refine`). A rejected transform gives an empty refinement.
 
+use super::decoded_images;
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use skytie_stages::campaign::AerialImage;
-use skytie_stages::imaging::io::load_gray;
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::refine::{refine_in_aerial, RefineParams};
 use skytie_stages::nadir::{
@@ -66,6 +66,6 @@ pub fn locate_with_accepted(
             matches: Vec::new(),
         });
     };
-    let image = load_gray(&aerial_file.path).map_err(|e| StageError::new(e.to_string()))?;
+    let image = decoded_images::gray(aerial_file)?;
     Ok(locate(t, &image))
 }

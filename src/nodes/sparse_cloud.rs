@@ -3,9 +3,9 @@
 //! outlier removal, triangulation in the original equirectangular geometry. Inputs: the three recording rows
 //! and panorama files (hashed by content).
 
+use super::decoded_images;
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use skytie_stages::campaign::Recording;
-use skytie_stages::imaging::io::load_gray;
 use skytie_stages::oblique::sparse_cloud::{sparse_cloud, SparseCloudParams};
 use skytie_stages::oblique::SparseCloud;
 use std::sync::Arc;
@@ -35,7 +35,7 @@ impl Stage for SparseCloudStage {
         }
         let images = panos
             .iter()
-            .map(|f| load_gray(&f.path).map_err(|e| StageError::new(e.to_string())))
+            .map(decoded_images::gray)
             .collect::<Result<Vec<_>, _>>()?;
         Ok(sparse_cloud(
             [&recs[0], &recs[1], &recs[2]],

@@ -2,9 +2,9 @@
 //! oriented ortho image and the aerial image (thesis 3.4.5.2, `skytie_stages::nadir::initial_transform`).
 //! A rejected transform is a normal output (with its reason), not a failure.
 
+use super::decoded_images;
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use skytie_stages::campaign::{AerialImage, Recording};
-use skytie_stages::imaging::io::load_gray;
 use skytie_stages::nadir::initial_transform::{initial_transform, TransformParams};
 use skytie_stages::nadir::{OrthoImage, TransformOutcome};
 use std::sync::Arc;
@@ -37,7 +37,7 @@ impl Stage for InitialTransformStage {
         ),
         _: &NodeCtx,
     ) -> Result<TransformOutcome, StageError> {
-        let image = load_gray(&aerial_file.path).map_err(|e| StageError::new(e.to_string()))?;
+        let image = decoded_images::gray(&aerial_file)?;
         Ok(initial_transform(&rec, &ortho, &image, &aerial, p))
     }
 }
