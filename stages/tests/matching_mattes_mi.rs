@@ -416,3 +416,25 @@ fn integral_translations_match_the_definition() {
         );
     }
 }
+
+/// A huge but finite translation lands no sample (an error), neither wrapping around nor panicking.
+#[test]
+fn huge_translations_land_nothing() {
+    let tex = Texture::new(12, 32.0);
+    let fixed = tex.render(32, [0.0, 0.0], |v| v);
+    let mut metric = MattesMi::new(&fixed, &fixed, 50, None, 0).unwrap();
+    for t in [
+        [1e300, 0.0],
+        [0.0, -1e300],
+        [9.3e18, 9.3e18],
+        [-9.3e18, 0.5],
+    ] {
+        assert!(
+            matches!(
+                metric.evaluate(t[0], t[1]),
+                Err(MiError::TooFewSamplesLanded { landed: 0, .. })
+            ),
+            "translation {t:?}"
+        );
+    }
+}

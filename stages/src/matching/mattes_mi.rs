@@ -265,9 +265,13 @@ impl<'a> MattesMi<'a> {
     /// neighbourhood), `None` when the position is outside the pixel-centre grid `[0.5, W − 0.5] × [0.5, H − 0.5]`.
     #[inline]
     fn landing(&self, s: &FixedSample, shift: &Shift) -> Option<(usize, usize)> {
-        let (c, r) = (s.col as i64 + shift.dx, s.row as i64 + shift.dy);
+        // Saturating: a huge (finite) translation must land outside, not wrap around.
+        let (c, r) = (
+            (s.col as i64).saturating_add(shift.dx),
+            (s.row as i64).saturating_add(shift.dy),
+        );
         let (w, h) = (self.moving.width as i64, self.moving.height as i64);
-        (c >= 0 && r >= 0 && c + shift.step_x < w && r + shift.step_y < h)
+        (c >= 0 && r >= 0 && c < w - shift.step_x && r < h - shift.step_y)
             .then_some((c as usize, r as usize))
     }
 
