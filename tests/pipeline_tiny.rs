@@ -188,6 +188,13 @@ fn tiny_campaign_end_to_end() {
         m["oblique"]["inlier_ratio_after_consensus"].is_number(),
         "{m}"
     );
+    // The generator wrote truth/scene.toml, so the grading compares with the seen surface and can tell
+    // non-matchable correspondences (a count, not null).
+    assert_eq!(
+        m["oblique"]["truth_reference"], "scene surface point",
+        "{m}"
+    );
+    assert!(m["oblique"]["non_matchable"].is_u64(), "{m}");
     for f in [
         "trajectory_adjusted.csv",
         "trajectory.geojson",

@@ -10,6 +10,7 @@ use crate::nodes::nadir_grade::load_truth;
 use crate::nodes::summary::SummaryParams;
 use skytie_stages::oblique::grading::{grade_oblique, ObliqueGrade};
 use skytie_stages::oblique::SparseCloud;
+use skytie_stages::synth::scene_truth::SceneTruth;
 use std::sync::Arc;
 
 crate::serde_artifact!(ObliqueGrade);
@@ -18,9 +19,12 @@ pub use crate::nodes::nadir_grade::TRUTH_RECORDINGS;
 /// True oblique poses, when the campaign perturbed them (optional).
 pub const TRUTH_AERIAL_OBLIQUE: &str = "truth/aerial_oblique.csv";
 
+pub use skytie_stages::synth::scene_truth::SCENE_TRUTH_FILE;
+
 /// The oblique grading node. Inputs: snapshot, truth files (`truth/recordings.csv` first, then optionally
-/// `truth/aerial_oblique.csv`), the panorama files in snapshot order (for their size), the sparse clouds (for
-/// the tie points' true object points) and the consensus output.
+/// `truth/aerial_oblique.csv`), `truth/scene.toml` when the campaign has one (zero or one file: the scene for
+/// surface points and visibility), the panorama files in snapshot order (for their size), the sparse clouds
+/// (for the tie points' true object points) and the consensus output.
 pub struct GradeOblique;
 
 impl GradeOblique {
@@ -32,11 +36,12 @@ impl GradeOblique {
 
 impl Stage for GradeOblique {
     const NAME: &'static str = "grade_oblique";
-    const VERSION: &'static str = "2";
+    const VERSION: &'static str = "3";
     type Params = SummaryParams;
     type Output = ObliqueGrade;
     type Inputs = (
         Handle<CampaignSnapshot>,
+        Vec<RawFile>,
         Vec<RawFile>,
         Vec<RawFile>,
         Vec<Handle<SparseCloud>>,
@@ -46,8 +51,9 @@ impl Stage for GradeOblique {
     fn run(
         &self,
         _: &SummaryParams,
-        (snap, truth_files, panos, clouds, result): (
+        (snap, truth_files, scene_files, panos, clouds, result): (
             Arc<CampaignSnapshot>,
+            Vec<RawFileValue>,
             Vec<RawFileValue>,
             Vec<RawFileValue>,
             Vec<Arc<SparseCloud>>,
@@ -62,7 +68,23 @@ impl Stage for GradeOblique {
             &snap.campaign.oblique,
             "grade_oblique",
         )?;
+        let scene = match scene_files.first() {
+            Some(f) => {
+                let text = std::fs::read_to_string(&f.path)
+                    .map_err(|e| StageError::new(format!("{}: {e}", f.path.display())))?;
+                let oracle = SceneTruth::parse(&text)
+                    .and_then(|t| t.rebuild())
+                    .map_err(|e| StageError::new(format!("{}: {e}", f.path.display())))?;
+                Some(oracle)
+            }
+            None => None,
+        };
         let clouds: Vec<SparseCloud> = clouds.iter().map(|c| (**c).clone()).collect();
-        Ok(grade_oblique(&truth, &clouds, &result.result))
+        Ok(grade_oblique(
+            &truth,
+            scene.as_ref(),
+            &clouds,
+            &result.result,
+        ))
     }
 }

@@ -14,7 +14,9 @@ use crate::nodes::aerial::{SelectAerial, SelectAerialParams};
 use crate::nodes::campaign::CampaignSnapshot;
 use crate::nodes::consensus::{ConsensusStage, ObliqueOutput};
 use crate::nodes::facades::FacadesStage;
-use crate::nodes::oblique_grade::{GradeOblique, TRUTH_AERIAL_OBLIQUE, TRUTH_RECORDINGS};
+use crate::nodes::oblique_grade::{
+    GradeOblique, SCENE_TRUTH_FILE, TRUTH_AERIAL_OBLIQUE, TRUTH_RECORDINGS,
+};
 use crate::nodes::oblique_options::ObliqueOptions;
 use crate::nodes::patches::PatchesStage;
 use crate::nodes::sparse_cloud::SparseCloudStage;
@@ -224,11 +226,17 @@ pub fn add_oblique(
         if truth_aerial.is_file() {
             truth_files.push(RawFile(truth_aerial));
         }
+        let scene_file = root.join(SCENE_TRUTH_FILE);
+        let scene_files: Vec<RawFile> = if scene_file.is_file() {
+            vec![RawFile(scene_file)]
+        } else {
+            Vec::new()
+        };
         let grade = b.add(
             GradeOblique,
             "",
             SummaryParams::default(),
-            (snap, truth_files, panos, clouds, result),
+            (snap, truth_files, scene_files, panos, clouds, result),
         )?;
         b.metrics(grade, "oblique", GradeOblique::metrics);
     }

@@ -9,11 +9,13 @@ use skytie_stages::correspondence::{
     AerialControlPoint, AerialObservation, MmTiePoint, PanoObservation,
 };
 use skytie_stages::geometry::{matrix_to_opk, FrameCamera, PanoramaCamera};
-use skytie_stages::oblique::grading::{grade_match, grade_oblique, Truth};
+use skytie_stages::oblique::grading::{grade_match, grade_oblique, SceneOracle, Truth, Verdict};
 use skytie_stages::oblique::{
     ConsensusStats, ObliqueCorrespondence, ObliqueResult, PatchMatch, SparseCloud,
     SparseCloudStats, SparsePoint, StreetSide,
 };
+use skytie_stages::synth::preset::Preset;
+use skytie_stages::synth::scene_truth::{along_polyline, build_scenes};
 
 const E0: f64 = 500_000.0;
 const N0: f64 = 5_400_000.0;
@@ -171,19 +173,24 @@ fn exact_correspondences_are_correct_and_five_pixels_off_is_wrong() {
     let s = scene();
     for m in &s.matches {
         assert_eq!(
-            grade_match(&s.truth, tie(&s, m), m),
-            Some(true),
+            grade_match(&s.truth, None, tie(&s, m), m),
+            Some(Verdict::Correct),
             "{}",
             m.point_id
         );
         // Also without the tie point (closest-approach midpoint as the best point).
-        assert_eq!(grade_match(&s.truth, None, m), Some(true), "{}", m.point_id);
+        assert_eq!(
+            grade_match(&s.truth, None, None, m),
+            Some(Verdict::Correct),
+            "{}",
+            m.point_id
+        );
         for (du, dv) in [(5.0, 0.0), (0.0, 5.0), (-3.0, 4.0)] {
             let mut moved = m.clone();
             moved.oblique_px = [m.oblique_px[0] + du, m.oblique_px[1] + dv];
             assert_eq!(
-                grade_match(&s.truth, tie(&s, m), &moved),
-                Some(false),
+                grade_match(&s.truth, None, tie(&s, m), &moved),
+                Some(Verdict::Wrong),
                 "{} moved by ({du}, {dv}) px",
                 m.point_id
             );
@@ -191,7 +198,7 @@ fn exact_correspondences_are_correct_and_five_pixels_off_is_wrong() {
     }
     let mut unknown = s.matches[0].clone();
     unknown.oblique_image_id = "nope".into();
-    assert_eq!(grade_match(&s.truth, None, &unknown), None);
+    assert_eq!(grade_match(&s.truth, None, None, &unknown), None);
 }
 
 #[test]
@@ -231,7 +238,7 @@ fn grade_counts_before_and_after_consensus_per_side() {
         control,
         stats: ConsensusStats::default(),
     };
-    let g = grade_oblique(&s.truth, std::slice::from_ref(&s.cloud), &result);
+    let g = grade_oblique(&s.truth, None, std::slice::from_ref(&s.cloud), &result);
     assert_eq!((g.correspondences, g.inliers, g.outliers), (6, 4, 2));
     assert!((g.inlier_ratio - 4.0 / 6.0).abs() < 1e-12);
     assert_eq!(
@@ -256,4 +263,99 @@ fn grade_counts_before_and_after_consensus_per_side() {
     assert!((m["control_point_error_m"].as_f64().unwrap() - 0.05).abs() < 1e-4);
     assert!(m["non_matchable"].is_null());
     assert_eq!(m["sides"]["right"]["kept"], 3);
+}
+
+/// A match of panorama observation `(u, v)` of `rec` with oblique pixel `px` of image `o1`.
+fn pano_match(rec: &Recording, u: f64, v: f64, px: [f64; 2]) -> PatchMatch {
+    PatchMatch {
+        point_id: "p".into(),
+        side: StreetSide::Left,
+        object_point_world: [0.0; 3],
+        mm: PanoObservation {
+            image_id: rec.image_id.clone(),
+            u_px: u,
+            v_px: v,
+        },
+        oblique_image_id: "o1".into(),
+        shift_plane_m: [0.0, 0.0],
+        coarse_shift_plane_m: None,
+        matched_point_world: [0.0; 3],
+        oblique_px: px,
+        score: 1.0,
+        real_resolution_ratio: 1.0,
+        rejected_coarse: false,
+    }
+}
+
+#[test]
+fn with_the_scene_the_reference_is_the_seen_surface_and_hidden_points_are_non_matchable() {
+    // The tiny preset's scene; a panorama on its route looking sideways at a façade 2 m above the road.
+    let scenes = build_scenes(Preset::Tiny, 3);
+    let route = along_polyline(scenes[0].route_world(), 5.0);
+    let (p, q) = (route[route.len() / 2], route[route.len() / 2 + 1]);
+    let ground = scenes[0].ground_height_m(p[0], p[1]);
+    let oracle = SceneOracle::new(scenes);
+    let heading_deg = (q[0] - p[0]).atan2(q[1] - p[1]).to_degrees();
+    let rec = Recording {
+        x: p[0],
+        y: p[1],
+        z: ground + 2.2,
+        heading_deg,
+        camera_height_m: 2.2,
+        ..recording("r1", 0)
+    };
+    let pano = PanoramaCamera::from_recording(&rec, W, H);
+    // Find a panorama column, on the horizon row, that sees a surface within 40 m (a façade).
+    let v = f64::from(H) / 2.0 + 0.5;
+    let (u, x) = (0..W)
+        .step_by(8)
+        .find_map(|u| {
+            let u = f64::from(u) + 0.5;
+            let ray = pano.pixel_ray(u, v);
+            oracle
+                .mm_surface_point(&ray)
+                .filter(|x| (x - ray.origin_world).norm() < 40.0)
+                .map(|x| (u, x))
+        })
+        .expect("a façade beside the tiny route");
+    // An oblique camera on the panorama's side of the façade looking at the point, high enough to see over
+    // the buildings across the street.
+    let out = (Vector3::new(p[0], p[1], x.z) - x).normalize();
+    let up = Vector3::new(0.0, 0.0, 1.0);
+    let seeing = oblique_image("o1", x + out * 150.0 + up * 900.0, x);
+    // The same camera behind the façade: the building hides the point.
+    let hidden = oblique_image("o1", x - out * 150.0 + up * 900.0, x);
+    let truth_with = |img: &AerialImage| Truth {
+        recordings: HashMap::from([("r1".to_string(), (rec.clone(), W, H))]),
+        aerial: HashMap::from([("o1".to_string(), img.clone())]),
+    };
+    let truth = truth_with(&seeing);
+    let (ou, ov) = FrameCamera::from_aerial(&seeing).project_world(&x).unwrap();
+    let exact = pano_match(&rec, u, v, [ou, ov]);
+    assert_eq!(
+        grade_match(&truth, Some(&oracle), None, &exact),
+        Some(Verdict::Correct)
+    );
+    let off = pano_match(&rec, u, v, [ou, ov + 3.0]);
+    assert_eq!(
+        grade_match(&truth, Some(&oracle), None, &off),
+        Some(Verdict::Wrong)
+    );
+    // Looking straight up: sky, nothing to match.
+    let sky = pano_match(&rec, u, 0.5, [ou, ov]);
+    assert_eq!(
+        grade_match(&truth, Some(&oracle), None, &sky),
+        Some(Verdict::NonMatchable)
+    );
+    let truth = truth_with(&hidden);
+    let (hu, hv) = FrameCamera::from_aerial(&hidden).project_world(&x).unwrap();
+    assert_eq!(
+        grade_match(
+            &truth,
+            Some(&oracle),
+            None,
+            &pano_match(&rec, u, v, [hu, hv])
+        ),
+        Some(Verdict::NonMatchable)
+    );
 }

@@ -5,22 +5,32 @@
 //! `oblique_px`). With the TRUE panorama pose (`truth/recordings.csv`) and the (exact) oblique orientation:
 //! 1. the panorama ray through `mm` and the oblique ray through `oblique_px` pass each other within
 //!    [`CLOSEST_APPROACH_TOLERANCE_M`] = 0.15 m, in front of both cameras; and
-//! 2. the best point reprojects into the oblique image within [`REPROJECTION_TOLERANCE_PX`] = 1.5 px of
-//!    `oblique_px`. The best point is the sparse tie point's TRUE object point (all its panorama
-//!    observations triangulated with the true poses) when the tie point is known and triangulates; otherwise
-//!    the midpoint of the two rays' closest approach.
+//! 2. the reference point reprojects into the oblique image within [`REPROJECTION_TOLERANCE_PX`] = 1.5 px of
+//!    `oblique_px`.
 //!
-//! Test 2 with the true tie point matters: a wrong match displaced along the epipolar line still meets the
-//! panorama ray (test 1 alone would pass it); the true point pins the position along the ray.
+//! The **reference point** is what the panorama observation depicts:
+//! - with the campaign's scene (`truth/scene.toml` of skytie's generator, [`SceneOracle`]): the first surface
+//!   the true panorama ray through `mm` hits. A correspondence whose surface point does not exist (sky), is
+//!   hidden from the oblique camera (trees, a balcony, another building, a car that has left before the
+//!   flight) or falls outside the oblique image is **non-matchable** (thesis 4.4.3, Fig. 4.7): neither inlier
+//!   nor outlier, counted apart;
+//! - without it (campaigns rendered by other software): the sparse tie point's object point (all its panorama
+//!   observations triangulated with the true poses) when the tie point is known and triangulates, else the
+//!   midpoint of the two rays' closest approach; `non_matchable` is then null. The triangulated point carries
+//!   the errors of the tie point's other observations (a few centimetres to decimetres along the ray), so this
+//!   reference is stricter than the surface point.
+//!
+//! Test 2 matters: a wrong match displaced along the epipolar line still meets the panorama ray (test 1 alone
+//! would pass it); the reference point pins the position along the ray.
+//!
+//! Ratios follow the thesis' tables (4-2…4-8): `inlier_ratio` = inliers / (inliers + outliers), i.e. "without
+//! non-matchable"; `inlier_ratio_incl_non_matchable` = inliers / all graded correspondences. The same pair
+//! exists after the consensus.
 //!
 //! **Control point error**: a control point's `point_world` (triangulated from the oblique rays) minus the
 //! true point of its MM observations (true-pose triangulation). Points whose MM rays do not triangulate
 //! (degenerate) are not graded and are counted in `control_points_ungraded` — the alternative, the oblique
 //! rays' own point, would compare the estimate with itself because the oblique poses are exact.
-//!
-//! **non_matchable** is `None`: deciding whether a patch centre is visible in an oblique image at all needs
-//! the scene's occlusion geometry, which the synthetic generator does not export (it would need to write
-//! per (point, oblique image) visibility into `truth/`).
 
 use std::collections::HashMap;
 
@@ -32,6 +42,7 @@ use super::types::{ObliqueResult, PatchMatch, SparseCloud, StreetSide};
 use crate::correspondence::MmTiePoint;
 use crate::geometry::{closest_approach, FrameCamera, PanoramaCamera};
 pub use crate::nadir::grading::{ErrorStats, Truth};
+pub use crate::synth::scene_truth::SceneOracle;
 
 /// Largest closest-approach distance of the panorama and oblique rays of a correct correspondence, m.
 pub const CLOSEST_APPROACH_TOLERANCE_M: f64 = 0.15;
@@ -47,6 +58,9 @@ pub struct SideCounts {
     /// Kept by the consensus / kept and correct.
     pub kept: usize,
     pub inliers_after_consensus: usize,
+    /// Graded / kept correspondences that are non-matchable (0 without the scene).
+    pub non_matchable: usize,
+    pub non_matchable_after_consensus: usize,
 }
 
 /// The truth grades of one run of the oblique pipeline.
@@ -56,22 +70,30 @@ pub struct ObliqueGrade {
     pub correspondences: usize,
     /// Correspondences that could not be graded (panorama or oblique image missing from the truth).
     pub ungraded: usize,
+    /// inliers + outliers + non-matchable = correspondences.
     pub inliers: usize,
     pub outliers: usize,
-    /// inliers / correspondences (0 when none).
+    /// inliers / (inliers + outliers), "without non-matchable" (0 when none).
     pub inlier_ratio: f64,
+    /// inliers / correspondences.
+    pub inlier_ratio_incl_non_matchable: f64,
     /// Among the correspondences kept by the consensus.
     pub inliers_after_consensus: usize,
     pub outliers_after_consensus: usize,
     pub inlier_ratio_after_consensus: f64,
+    pub inlier_ratio_after_consensus_incl_non_matchable: f64,
+    /// Kept correspondences that are non-matchable (`None` without the scene).
+    pub non_matchable_after_consensus: Option<usize>,
+    /// What the correspondences were compared with: `"scene surface point"` or `"tie point"`.
+    pub reference: String,
     /// Triangulated control points vs truth.
     pub control_points: ErrorStats,
     /// Triangulated control points whose MM rays do not triangulate with the true poses.
     pub control_points_ungraded: usize,
-    /// `None`: our campaigns cannot tell visibility (see the module doc).
+    /// Graded correspondences that are non-matchable (`None` without the scene: see the module doc).
     pub non_matchable: Option<usize>,
-    /// Reprojection error of the true point in the oblique image over the kept correspondences, px
-    /// (diagnostic: how far off the wrong ones are).
+    /// Reprojection error of the reference point in the oblique image over the kept matchable correspondences,
+    /// px (diagnostic: how far off the wrong ones are).
     pub kept_reprojection_px: Quantiles,
     pub left: SideCounts,
     pub right: SideCounts,
@@ -117,6 +139,8 @@ impl ObliqueGrade {
                 "inliers": s.inliers,
                 "kept": s.kept,
                 "inliers_after_consensus": s.inliers_after_consensus,
+                "non_matchable": s.non_matchable,
+                "non_matchable_after_consensus": s.non_matchable_after_consensus,
             })
         };
         let cp = &self.control_points;
@@ -127,9 +151,14 @@ impl ObliqueGrade {
             "inliers": self.inliers,
             "outliers": self.outliers,
             "inlier_ratio": self.inlier_ratio,
+            "inlier_ratio_incl_non_matchable": self.inlier_ratio_incl_non_matchable,
             "inliers_after_consensus": self.inliers_after_consensus,
             "outliers_after_consensus": self.outliers_after_consensus,
             "inlier_ratio_after_consensus": self.inlier_ratio_after_consensus,
+            "inlier_ratio_after_consensus_incl_non_matchable":
+                self.inlier_ratio_after_consensus_incl_non_matchable,
+            "non_matchable_after_consensus": self.non_matchable_after_consensus,
+            "truth_reference": self.reference,
             "control_point_error_m": if cp.count > 0 { json!(error_3d_rms) } else { serde_json::Value::Null },
             "control_point_error": {
                 "count": cp.count,
@@ -150,32 +179,56 @@ impl ObliqueGrade {
     }
 }
 
-/// Grades one patch match by the rule of the module doc: `Some(correct)`, or `None` when its panorama or
-/// oblique image is not in the truth. `tie` is the match's sparse tie point (for the true object point).
-pub fn grade_match(truth: &Truth, tie: Option<&MmTiePoint>, m: &PatchMatch) -> Option<bool> {
-    match_errors(truth, tie, m).map(|e| e.correct())
+/// The truth verdict of one oblique correspondence (module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    Correct,
+    Wrong,
+    /// The panorama observation's surface point is sky, hidden from the oblique camera or outside its image.
+    NonMatchable,
+}
+
+/// Grades one patch match by the rule of the module doc, or `None` when its panorama or oblique image is not
+/// in the truth. `tie` is the match's sparse tie point (the reference without a scene).
+pub fn grade_match(
+    truth: &Truth,
+    scene: Option<&SceneOracle>,
+    tie: Option<&MmTiePoint>,
+    m: &PatchMatch,
+) -> Option<Verdict> {
+    match_errors(truth, scene, tie, m).map(|e| e.verdict())
 }
 
 /// The two quantities the grading rule tests, for diagnostics: closest approach of the panorama and oblique
-/// rays (m; infinite when they do not pass in front of both cameras) and the reprojection error of the best
-/// point in the oblique image (px; infinite when it does not project).
+/// rays (m; infinite when they do not pass in front of both cameras) and the reprojection error of the
+/// reference point in the oblique image (px; infinite when it does not project); `matchable` is false for a
+/// non-matchable correspondence.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MatchErrors {
     pub closest_approach_m: f64,
     pub reprojection_px: f64,
+    pub matchable: bool,
 }
 
 impl MatchErrors {
     /// The rule of the module doc.
-    pub fn correct(&self) -> bool {
-        self.closest_approach_m <= CLOSEST_APPROACH_TOLERANCE_M
+    pub fn verdict(&self) -> Verdict {
+        if !self.matchable {
+            Verdict::NonMatchable
+        } else if self.closest_approach_m <= CLOSEST_APPROACH_TOLERANCE_M
             && self.reprojection_px <= REPROJECTION_TOLERANCE_PX
+        {
+            Verdict::Correct
+        } else {
+            Verdict::Wrong
+        }
     }
 }
 
 /// [`MatchErrors`] of one patch match; `None` when its panorama or oblique image is not in the truth.
 pub fn match_errors(
     truth: &Truth,
+    scene: Option<&SceneOracle>,
     tie: Option<&MmTiePoint>,
     m: &PatchMatch,
 ) -> Option<MatchErrors> {
@@ -184,32 +237,54 @@ pub fn match_errors(
     let cam = FrameCamera::from_aerial(truth.aerial.get(&m.oblique_image_id)?);
     let [u, v] = m.oblique_px;
     let pano_ray = pano.pixel_ray(m.mm.u_px, m.mm.v_px);
-    let oblique_ray = cam.pixel_ray(u, v);
     let far = MatchErrors {
         closest_approach_m: f64::INFINITY,
         reprojection_px: f64::INFINITY,
+        matchable: true,
     };
+    let surface = match scene {
+        Some(scene) => {
+            let seen = scene.mm_surface_point(&pano_ray).filter(|x| {
+                scene.visible_from_aerial(&cam.center_world, x)
+                    && cam
+                        .project_world(x)
+                        .is_some_and(|(pu, pv)| cam.contains(pu, pv))
+            });
+            if seen.is_none() {
+                return Some(MatchErrors {
+                    matchable: false,
+                    ..far
+                });
+            }
+            seen
+        }
+        None => None,
+    };
+    let oblique_ray = cam.pixel_ray(u, v);
     let Some(ca) = closest_approach(&pano_ray, &oblique_ray) else {
         return Some(far);
     };
     if !ca.in_front_of_both() {
         return Some(far);
     }
-    let best: Vector3<f64> = tie
-        .and_then(|t| truth.true_point(&t.observations))
+    let reference: Vector3<f64> = surface
+        .or_else(|| tie.and_then(|t| truth.true_point(&t.observations)))
         .unwrap_or_else(|| ca.midpoint_world());
     Some(MatchErrors {
         closest_approach_m: ca.distance_m,
         reprojection_px: cam
-            .project_world(&best)
+            .project_world(&reference)
             .map_or(f64::INFINITY, |(pu, pv)| (pu - u).hypot(pv - v)),
+        matchable: true,
     })
 }
 
 /// Grades every correspondence of `result` (before and after the consensus, per side) and its control
-/// points against the truth. `clouds` gives the sparse tie points (true object points).
+/// points against the truth. `clouds` gives the sparse tie points (true object points); `scene`, when the
+/// campaign's scene can be rebuilt, the surface points and visibility (module doc).
 pub fn grade_oblique(
     truth: &Truth,
+    scene: Option<&SceneOracle>,
     clouds: &[SparseCloud],
     result: &ObliqueResult,
 ) -> ObliqueGrade {
@@ -218,38 +293,64 @@ pub fn grade_oblique(
         .flat_map(|c| c.points.iter())
         .map(|p| (p.tie.id.as_str(), &p.tie))
         .collect();
-    let mut g = ObliqueGrade::default();
+    let mut g = ObliqueGrade {
+        reference: if scene.is_some() {
+            "scene surface point"
+        } else {
+            "tie point"
+        }
+        .into(),
+        ..ObliqueGrade::default()
+    };
     let mut kept_graded = 0;
+    let (mut non_matchable, mut non_matchable_kept) = (0, 0);
     let mut kept_reprojection: Vec<f64> = Vec::new();
     for c in &result.correspondences {
         let m = &c.matched;
-        let Some(errors) = match_errors(truth, ties.get(m.point_id.as_str()).copied(), m) else {
+        let Some(errors) = match_errors(truth, scene, ties.get(m.point_id.as_str()).copied(), m)
+        else {
             g.ungraded += 1;
             continue;
         };
-        let ok = errors.correct();
-        if c.kept {
+        let verdict = errors.verdict();
+        let ok = verdict == Verdict::Correct;
+        let nm = verdict == Verdict::NonMatchable;
+        if c.kept && !nm {
             kept_reprojection.push(errors.reprojection_px);
         }
         g.correspondences += 1;
         g.inliers += usize::from(ok);
+        non_matchable += usize::from(nm);
         let side = match m.side {
             StreetSide::Left => &mut g.left,
             StreetSide::Right => &mut g.right,
         };
         side.correspondences += 1;
         side.inliers += usize::from(ok);
+        side.non_matchable += usize::from(nm);
         if c.kept {
             kept_graded += 1;
             side.kept += 1;
             side.inliers_after_consensus += usize::from(ok);
+            side.non_matchable_after_consensus += usize::from(nm);
             g.inliers_after_consensus += usize::from(ok);
+            non_matchable_kept += usize::from(nm);
         }
     }
-    g.outliers = g.correspondences - g.inliers;
-    g.outliers_after_consensus = kept_graded - g.inliers_after_consensus;
-    g.inlier_ratio = ratio(g.inliers, g.correspondences);
-    g.inlier_ratio_after_consensus = ratio(g.inliers_after_consensus, kept_graded);
+    g.outliers = g.correspondences - g.inliers - non_matchable;
+    g.outliers_after_consensus = kept_graded - g.inliers_after_consensus - non_matchable_kept;
+    g.inlier_ratio = ratio(g.inliers, g.inliers + g.outliers);
+    g.inlier_ratio_incl_non_matchable = ratio(g.inliers, g.correspondences);
+    g.inlier_ratio_after_consensus = ratio(
+        g.inliers_after_consensus,
+        g.inliers_after_consensus + g.outliers_after_consensus,
+    );
+    g.inlier_ratio_after_consensus_incl_non_matchable =
+        ratio(g.inliers_after_consensus, kept_graded);
+    if scene.is_some() {
+        g.non_matchable = Some(non_matchable);
+        g.non_matchable_after_consensus = Some(non_matchable_kept);
+    }
     g.kept_reprojection_px = Quantiles::of(&mut kept_reprojection);
     let mut errors = Vec::new();
     for cp in &result.control {

@@ -187,7 +187,10 @@ impl DeteriorationModel {
             "\nHeadings, camera heights, yaw/pitch/roll and all aerial poses are true (not perturbed); no \
              `truth/aerial_*.csv` is therefore written. Check points in `control/checkpoints.csv` are exact; \
              their observations in `control/observations.csv` are the true projections plus N(0, 0.5 px) per \
-             axis.\n",
+             axis.\n\n\
+             `truth/scene.toml` names the generator, preset and seed and a fingerprint of the scene, so that an \
+             evaluator can rebuild the scene and ask what a camera sees (the oblique grading uses it for the true \
+             surface point of a panorama observation and for `non_matchable`).\n",
         );
         t
     }

@@ -14,6 +14,7 @@ use super::preset::{Preset, PresetParams};
 use super::render::{primary_rays, render_frame, render_panorama_with_vehicle};
 use super::rng::hash_str;
 use super::scene::{Epoch, Scene};
+use super::scene_truth::{build_scenes, SceneTruth, SCENE_TRUTH_FILE};
 use super::trajectory::{sample_route, true_recordings};
 use super::vehicle::VehicleBody;
 use super::SynthError;
@@ -151,6 +152,8 @@ pub struct CampaignPlan {
     pub areas: Vec<AreaPlan>,
     /// Recorded (deteriorated) poses of all areas, in the order of the truth.
     pub recorded: Vec<Recording>,
+    /// What `truth/scene.toml` records (how to rebuild the scenes for evaluation).
+    pub scene_truth: SceneTruth,
 }
 
 impl CampaignPlan {
@@ -163,12 +166,6 @@ impl CampaignPlan {
     }
 }
 
-/// Seed of the scene of area `area` (area 0 uses the campaign seed itself).
-fn scene_seed(seed: u64, area: usize) -> u64 {
-    seed ^ ((area as u64) << 48)
-}
-
-/// Plan a campaign without rendering: scenes, true and recorded trajectory, aerial flight plans, check points.
 /// Whether any of `recordings`' projection centres projects into the aerial frame `img`.
 fn sees_any(img: &AerialImage, recordings: &[Recording]) -> bool {
     let cam = crate::geometry::FrameCamera::from_aerial(img);
@@ -178,12 +175,14 @@ fn sees_any(img: &AerialImage, recordings: &[Recording]) -> bool {
     })
 }
 
+/// Plan a campaign without rendering: scenes, true and recorded trajectory, aerial flight plans, check points.
 pub fn plan_campaign(options: &SynthOptions) -> Result<CampaignPlan, SynthError> {
     let params = options.params()?;
     let seed = options.seed;
     let mut areas = Vec::new();
-    for (area, spec) in options.preset.scene_specs().iter().enumerate() {
-        let scene = Scene::generate(spec, scene_seed(seed, area));
+    let scenes = build_scenes(options.preset, seed);
+    let scene_truth = SceneTruth::of(options.preset, seed, &scenes);
+    for (area, scene) in scenes.into_iter().enumerate() {
         let samples = sample_route(
             scene.route_world(),
             params.recording_spacing_m,
@@ -250,6 +249,7 @@ pub fn plan_campaign(options: &SynthOptions) -> Result<CampaignPlan, SynthError>
         deterioration,
         areas,
         recorded,
+        scene_truth,
     })
 }
 
@@ -369,6 +369,8 @@ fn write_campaign(plan: &CampaignPlan, root: &Path) -> Result<u64, SynthError> {
         .readme(&plan.name, plan.seed, plan.recorded.len());
     let path = root.join("truth/README.md");
     crate::fsutil::atomic_write(&path, readme.as_bytes()).map_err(io(path))?;
+    let path = root.join(SCENE_TRUTH_FILE);
+    crate::fsutil::atomic_write(&path, plan.scene_truth.to_toml().as_bytes()).map_err(io(path))?;
     Ok(rays)
 }
 

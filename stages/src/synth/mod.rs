@@ -19,6 +19,7 @@ pub mod postprocess;
 pub mod preset;
 pub mod render;
 pub mod rng;
+pub mod scene_truth;
 pub mod trajectory;
 pub mod vehicle;
 
