@@ -182,7 +182,9 @@ fn variant_metrics(tie: u32, correct: u32, after_3d: f64, inl: u32, outl: u32, n
         "nadir": {"tie_points": tie, "correct_tie_points": correct,
                   "inlier_ratio": correct as f64 / tie as f64, "transforms_accepted": 10,
                   "control_points": 5},
-        "oblique": {"inliers": inl, "outliers": outl, "non_matchable": nm},
+        "oblique": {"inliers": inl, "outliers": outl, "non_matchable": nm,
+                    "inliers_after_consensus": inl, "outliers_after_consensus": outl / 2,
+                    "non_matchable_after_consensus": nm / 2},
         "adjust": {"nadir": {"checkpoints": {
             "before": {"x": 0.5, "y": 0.4, "z": 0.1, "2d": 0.64, "3d": 0.65, "count": 4},
             "after": {"x": 0.1, "y": 0.1, "z": 0.05, "2d": 0.14, "3d": after_3d, "count": 4}}}},
@@ -237,11 +239,13 @@ fn sweep_report_from_a_fixture_has_known_tables() {
         table("sweep-table-2-10"),
         "variant,matches,inliers,matches/tile,inliers/tile,ratio %\nw1,100,90,10.0,9.0,90.0\nw2,50,20,5.0,2.0,40.0\n"
     );
-    // Oblique: inlier % of all and of matchable correspondences.
+    // Oblique: inlier % of all and of matchable correspondences, before and after the consensus (the fixture
+    // keeps every inlier and half the outliers and non-matchable ones: w1 30/(30+5+5), 30/35; w2 10/25).
     assert_eq!(
         table("sweep-oblique"),
-        "variant,inliers,outliers,non-matchable,inlier %,inlier % without non-matchable\n\
-         w1,30,10,10,60.0,75.0\nw2,10,30,0,25.0,25.0\n"
+        "variant,inliers,outliers,non-matchable,inlier %,inlier % without non-matchable,\
+         inlier % after outlier removal,inlier % after outlier removal without non-matchable\n\
+         w1,30,10,10,60.0,75.0,75.0,85.7\nw2,10,30,0,25.0,25.0,40.0,40.0\n"
     );
     // Tables 5-11 structure: one column per weighting method, before from the recorded poses.
     let adj = table("sweep-adjust-nadir-horizontal");

@@ -19,6 +19,21 @@ use serde_json::Value;
 pub const OBLIQUE_INLIERS: &str = "oblique.inliers";
 pub const OBLIQUE_OUTLIERS: &str = "oblique.outliers";
 pub const OBLIQUE_NON_MATCHABLE: &str = "oblique.non_matchable";
+pub const OBLIQUE_INLIERS_KEPT: &str = "oblique.inliers_after_consensus";
+pub const OBLIQUE_OUTLIERS_KEPT: &str = "oblique.outliers_after_consensus";
+pub const OBLIQUE_NON_MATCHABLE_KEPT: &str = "oblique.non_matchable_after_consensus";
+
+/// The thesis' two inlier percentages of a (inliers, outliers, non-matchable) count: over all, and without the
+/// non-matchable ones (Tables 4-2…4-8). A missing non-matchable count (campaign without scene) counts as 0.
+fn inlier_percentages(m: &Value, keys: [&str; 3]) -> (Option<f64>, Option<f64>) {
+    let [i, o, n] = keys.map(|k| num_at(m, k));
+    let ratio = |d: Option<f64>| i.zip(d.filter(|d| *d > 0.0)).map(|(i, d)| i / d);
+    let matchable = i.zip(o).map(|(i, o)| i + o);
+    (
+        ratio(matchable.map(|t| t + n.unwrap_or(0.0))),
+        ratio(matchable),
+    )
+}
 
 /// The single adjustment configuration of a variant: (name, section).
 fn adjust_config(m: &Value) -> Option<(&String, &Value)> {
@@ -208,25 +223,33 @@ fn oblique_tables(b: &mut Builder, page: &mut Page, sets: &[ResultSet]) -> Resul
             "non-matchable",
             "inlier %",
             "inlier % without non-matchable",
+            "inlier % after outlier removal",
+            "inlier % after outlier removal without non-matchable",
         ],
     );
     for s in sets {
         let m = &s.metrics;
-        let (i, o, n) = (
-            num_at(m, OBLIQUE_INLIERS),
-            num_at(m, OBLIQUE_OUTLIERS),
-            num_at(m, OBLIQUE_NON_MATCHABLE),
+        let before = inlier_percentages(
+            m,
+            [OBLIQUE_INLIERS, OBLIQUE_OUTLIERS, OBLIQUE_NON_MATCHABLE],
         );
-        let total = i.zip(o).map(|(i, o)| i + o + n.unwrap_or(0.0));
-        let matchable = i.zip(o).map(|(i, o)| i + o);
-        let ratio = |d: Option<f64>| i.zip(d.filter(|d| *d > 0.0)).map(|(i, d)| i / d);
+        let after = inlier_percentages(
+            m,
+            [
+                OBLIQUE_INLIERS_KEPT,
+                OBLIQUE_OUTLIERS_KEPT,
+                OBLIQUE_NON_MATCHABLE_KEPT,
+            ],
+        );
         t.push(vec![
             s.name.clone(),
-            fmt_count(i),
-            fmt_count(o),
-            fmt_count(n),
-            fmt_percent(ratio(total)),
-            fmt_percent(ratio(matchable)),
+            fmt_count(num_at(m, OBLIQUE_INLIERS)),
+            fmt_count(num_at(m, OBLIQUE_OUTLIERS)),
+            fmt_count(num_at(m, OBLIQUE_NON_MATCHABLE)),
+            fmt_percent(before.0),
+            fmt_percent(before.1),
+            fmt_percent(after.0),
+            fmt_percent(after.1),
         ]);
     }
     b.table(page, t);
