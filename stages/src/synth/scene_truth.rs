@@ -112,10 +112,11 @@ impl SceneTruth {
 
     /// The file's text (a comment saying what it is for, then the keys).
     pub fn to_toml(&self) -> String {
-        let body = toml::to_string(self).unwrap_or_default();
         format!(
             "# Rebuilds this synthetic campaign's scene for evaluation (visibility, true surface points).\n\
-             # Never read by the pipeline. Written by skytie's generator; other software leaves it out.\n{body}"
+             # Never read by the pipeline. Written by skytie's generator; other software leaves it out.\n\
+             generator = {:?}\npreset = {:?}\nseed = {}\nfingerprint = {:?}\n",
+            self.generator, self.preset, self.seed, self.fingerprint
         )
     }
 
