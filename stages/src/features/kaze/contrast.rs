@@ -2,7 +2,7 @@
 //! gradient-magnitude histogram of the Gaussian-smoothed base level.
 
 use crate::imaging::gaussian::gaussian_blur;
-use crate::imaging::gradient::scharr_gradient;
+use crate::imaging::gradient::{scharr_gradient, Gradient};
 use crate::imaging::GrayImage;
 
 /// Histogram bins of the magnitude histogram (OpenCV `KCONTRAST_NBINS`).
@@ -22,7 +22,16 @@ pub fn contrast_factor(base: &GrayImage, derivative_sigma: f32, percentile: f32)
         return FALLBACK_CONTRAST;
     }
     let smoothed = gaussian_blur(base, derivative_sigma);
-    let g = scharr_gradient(&smoothed);
+    contrast_factor_from_gradient(&scharr_gradient(&smoothed), percentile)
+}
+
+/// [`contrast_factor`] from the unit-gain Scharr gradient `g` of G(derivative_sigma) * L0 (the scale space
+/// computes that gradient once for the contrast factor and the first conductance).
+pub fn contrast_factor_from_gradient(g: &Gradient, percentile: f32) -> f32 {
+    let (w, h) = (g.dx.width, g.dx.height);
+    if w < 3 || h < 3 {
+        return FALLBACK_CONTRAST;
+    }
     let magnitude = |col: usize, row: usize| {
         let i = row * w + col;
         (g.dx.data[i] * g.dx.data[i] + g.dy.data[i] * g.dy.data[i]).sqrt()

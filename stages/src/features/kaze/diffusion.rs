@@ -9,26 +9,19 @@
 use rayon::prelude::*;
 
 use super::params::Diffusivity;
-use crate::imaging::gradient::scharr_gradient;
+use crate::imaging::gradient::{scharr_gradient, Gradient};
 use crate::imaging::GrayImage;
 
 /// Conductance image g(|∇Lσ|²/k²) from an already smoothed level `smoothed` = Lσ = G(derivative σ) * L,
 /// gradient by unit-gain Scharr (same operator as [`super::contrast::contrast_factor`], so k is consistent).
 pub fn conductance(smoothed: &GrayImage, k: f32, diffusivity: Diffusivity) -> GrayImage {
-    let grad = scharr_gradient(smoothed);
+    conductance_from_gradient(&scharr_gradient(smoothed), k, diffusivity)
+}
+
+/// [`conductance`] from the unit-gain Scharr gradient of Lσ.
+pub fn conductance_from_gradient(grad: &Gradient, k: f32, diffusivity: Diffusivity) -> GrayImage {
     let inv_k2 = 1.0 / (k * k);
-    let data = grad
-        .dx
-        .data
-        .iter()
-        .zip(&grad.dy.data)
-        .map(|(&dx, &dy)| conductance_value((dx * dx + dy * dy) * inv_k2, diffusivity))
-        .collect();
-    GrayImage {
-        width: smoothed.width,
-        height: smoothed.height,
-        data,
-    }
+    super::filters::map_gradient(grad, |m2| conductance_value(m2 * inv_k2, diffusivity))
 }
 
 /// g(m) for m = |∇Lσ|²/k² ≥ 0.
@@ -207,13 +200,16 @@ fn is_prime(n: usize) -> bool {
     n >= 2 && (2..).take_while(|d| d * d <= n).all(|d| n % d != 0)
 }
 
-/// One explicit step L ← L + τ · Σ_q ½(g_p + g_q)(L_q − L_p), written into `out`.
+/// One explicit step L ← L + τ · Σ_q ½(g_p + g_q)(L_q − L_p), written into `out`. Per pixel the flux sums
+/// the left, right, upper and lower neighbour in that order, starting from 0 (neighbours outside the image
+/// are left out); interior pixels run through a branch-free loop with the same order.
 fn explicit_step(level: &[f32], g: &[f32], width: usize, height: usize, tau: f32, out: &mut [f32]) {
+    let half_tau = tau * 0.5;
     out.par_chunks_mut(width)
         .enumerate()
         .for_each(|(row, out_row)| {
             let base = row * width;
-            for (col, o) in out_row.iter_mut().enumerate() {
+            let pixel = |col: usize| {
                 let p = base + col;
                 let (lp, gp) = (level[p], g[p]);
                 let mut flux = 0.0f32;
@@ -229,7 +225,33 @@ fn explicit_step(level: &[f32], g: &[f32], width: usize, height: usize, tau: f32
                 if row + 1 < height {
                     flux += (gp + g[p + width]) * (level[p + width] - lp);
                 }
-                *o = lp + tau * 0.5 * flux;
+                lp + half_tau * flux
+            };
+            if row == 0 || row + 1 >= height || width < 3 {
+                for (col, o) in out_row.iter_mut().enumerate() {
+                    *o = pixel(col);
+                }
+                return;
+            }
+            out_row[0] = pixel(0);
+            out_row[width - 1] = pixel(width - 1);
+            let n = width - 2;
+            let lc = &level[base..base + width];
+            let gc = &g[base..base + width];
+            let (lu, gu) = (&level[base - width + 1..][..n], &g[base - width + 1..][..n]);
+            let (ld, gd) = (&level[base + width + 1..][..n], &g[base + width + 1..][..n]);
+            let (ll, gl) = (&lc[..n], &gc[..n]);
+            let (lm, gm) = (&lc[1..n + 1], &gc[1..n + 1]);
+            let (lr, gr) = (&lc[2..n + 2], &gc[2..n + 2]);
+            let o = &mut out_row[1..n + 1];
+            for i in 0..n {
+                let (lp, gp) = (lm[i], gm[i]);
+                let flux = 0.0f32
+                    + (gp + gl[i]) * (ll[i] - lp)
+                    + (gp + gr[i]) * (lr[i] - lp)
+                    + (gp + gu[i]) * (lu[i] - lp)
+                    + (gp + gd[i]) * (ld[i] - lp);
+                o[i] = lp + half_tau * flux;
             }
         });
 }

@@ -11,6 +11,7 @@ pub mod contrast;
 pub mod descriptor;
 pub mod detector;
 pub mod diffusion;
+pub mod filters;
 pub mod orientation;
 pub mod params;
 pub mod scale_space;

@@ -8,12 +8,11 @@
 //! Lx·s, Ly·s, Lxx·s², Lyy·s², Lxy·s². Gaussian blurs use `imaging::gaussian` (radius ⌈3σ⌉, reflective
 //! border), not OpenCV's kernel-size rule, so values differ slightly from OpenCV near the kernel tails.
 
-use super::contrast::contrast_factor;
-use super::diffusion::{aos_step, conductance, fed_diffuse};
+use super::contrast::contrast_factor_from_gradient;
+use super::diffusion::{aos_step, conductance_from_gradient, fed_diffuse};
+use super::filters::{level_derivatives, scharr_gradient, Scratch};
 use super::params::{KazeParams, Scheme};
-use crate::imaging::convolve::convolve_separable;
 use crate::imaging::gaussian::gaussian_blur;
-use crate::imaging::gradient::scharr_kernels;
 use crate::imaging::GrayImage;
 
 /// One evolution level with what later stages need.
@@ -41,24 +40,33 @@ pub struct ScaleSpace {
 }
 
 /// Build the scale space of `img` (grey, 0..1). An empty image or zero levels gives no levels.
+///
+/// Lσ = G(derivative σ) * L of each diffused level is computed once: for L0 it serves the contrast factor,
+/// level 0's and level 1's derivatives and level 1's conductance (with the same Scharr gradient); level 1
+/// reuses level 0's derivative images when both have the same tap spacing (identical inputs).
 pub fn build_scale_space(img: &GrayImage, p: &KazeParams) -> ScaleSpace {
     let n = p.levels();
     let base = gaussian_blur(img, p.sigma0);
-    let contrast_k = contrast_factor(&base, p.derivative_sigma, p.k_percentile);
-    let mut levels = Vec::with_capacity(n);
+    let mut scratch = Scratch::default();
+    // Lσ of the current level and its Scharr gradient (for the contrast factor and the next conductance).
+    let mut smoothed = gaussian_blur(&base, p.derivative_sigma);
+    let mut gradient = scharr_gradient(&smoothed, &mut scratch);
+    let contrast_k = contrast_factor_from_gradient(&gradient, p.k_percentile);
+    let mut levels: Vec<Level> = Vec::with_capacity(n);
     if img.width == 0 || img.height == 0 {
         return ScaleSpace { levels, contrast_k };
     }
     let mut current = base;
     let mut prev_time = 0.5 * p.sigma0 * p.sigma0;
+    // Whether `smoothed` is the one the previous level's derivatives were computed from.
+    let mut smoothed_reused = false;
     for i in 0..n {
         let (octave, sublevel) = (i / p.sublevels, i % p.sublevels);
         let sigma_px = p.sigma_of(octave, sublevel as f32);
         let time = 0.5 * sigma_px * sigma_px;
-        // Lσ of the previous level (level 0: of L0): feeds the conductance and the derivatives.
-        let smoothed = gaussian_blur(&current, p.derivative_sigma);
+        // `smoothed` = Lσ of the previous level (level 0: of L0): feeds the conductance and the derivatives.
         if i > 0 {
-            let g = conductance(&smoothed, contrast_k, p.diffusivity);
+            let g = conductance_from_gradient(&gradient, contrast_k, p.diffusivity);
             let dt = time - prev_time;
             current = match p.scheme {
                 Scheme::Fed => fed_diffuse(&current, &g, dt),
@@ -67,48 +75,27 @@ pub fn build_scale_space(img: &GrayImage, p: &KazeParams) -> ScaleSpace {
         }
         prev_time = time;
         let step_px = (sigma_px.round() as usize).max(1);
-        levels.push(derivatives(&smoothed, octave, sublevel, sigma_px, step_px));
+        let (lx, ly, det) = match levels.last() {
+            Some(prev) if smoothed_reused && prev.step_px == step_px => {
+                (prev.lx.clone(), prev.ly.clone(), prev.det.clone())
+            }
+            _ => level_derivatives(&smoothed, step_px, &mut scratch),
+        };
+        levels.push(Level {
+            octave,
+            sublevel,
+            sigma_px,
+            step_px,
+            lx,
+            ly,
+            det,
+        });
+        // Level i + 1 uses Lσ of level i; level 0 is not diffused, so level 1 uses the same Lσ as level 0.
+        smoothed_reused = i == 0;
+        if i > 0 && i + 1 < n {
+            smoothed = gaussian_blur(&current, p.derivative_sigma);
+            gradient = scharr_gradient(&smoothed, &mut scratch);
+        }
     }
     ScaleSpace { levels, contrast_k }
-}
-
-fn derivatives(
-    smoothed: &GrayImage,
-    octave: usize,
-    sublevel: usize,
-    sigma_px: f32,
-    step_px: usize,
-) -> Level {
-    let (deriv, smooth) = scharr_kernels(step_px);
-    let lx = convolve_separable(smoothed, &deriv, &smooth);
-    let ly = convolve_separable(smoothed, &smooth, &deriv);
-    let lxx = convolve_separable(&lx, &deriv, &smooth);
-    let lxy = convolve_separable(&lx, &smooth, &deriv);
-    let lyy = convolve_separable(&ly, &smooth, &deriv);
-    let s = step_px as f32;
-    let s4 = s * s * s * s;
-    let det_data = lxx
-        .data
-        .iter()
-        .zip(&lyy.data)
-        .zip(&lxy.data)
-        .map(|((&xx, &yy), &xy)| (xx * yy - xy * xy) * s4)
-        .collect();
-    let scale = |mut img: GrayImage| {
-        img.data.iter_mut().for_each(|v| *v *= s);
-        img
-    };
-    Level {
-        octave,
-        sublevel,
-        sigma_px,
-        step_px,
-        det: GrayImage {
-            width: smoothed.width,
-            height: smoothed.height,
-            data: det_data,
-        },
-        lx: scale(lx),
-        ly: scale(ly),
-    }
 }
