@@ -19,7 +19,7 @@ pub struct PatchesStage;
 impl Stage for PatchesStage {
     const NAME: &'static str = "patches";
     // 4: Mattes MI weights the bilinear samples with per-evaluation weights (scores differ in the last bits).
-    const VERSION: &'static str = "4";
+    const VERSION: &'static str = "6";
     type Params = PatchParams;
     type Output = PatchRegistrationSet;
     type Inputs = (

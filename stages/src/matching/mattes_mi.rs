@@ -47,6 +47,8 @@ pub enum MiError {
     TooFewSamplesLanded { landed: usize, samples: usize },
     #[error("translation ({0}, {1}) is not finite")]
     NonFiniteTranslation(f64, f64),
+    #[error("the best scanned shift ({0}, {1}) px lies on the border of the search window: the similarity still grows outwards, so the true shift is probably larger than the window (enlarge it if that is plausible)")]
+    MaximumOnBorder(f64, f64),
 }
 
 /// Cubic B-spline kernel β3(u) (ALGORITHMS.md §5).

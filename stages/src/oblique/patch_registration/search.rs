@@ -101,6 +101,11 @@ pub fn ncc_search(
     }
     let (k, score) = best?;
     let (bi, bj) = ((k % side) as isize, (k / side) as isize);
+    // A maximum on the border of the search window is no peak: the similarity still grows outwards, so the
+    // best match lies outside the searched range (beyond the expected error) and the registration failed.
+    if bi == 0 || bj == 0 || bi + 1 == side as isize || bj + 1 == side as isize {
+        return None;
+    }
     let mut shift = [
         (centre_px[0] + bi - r) as f64,
         (centre_px[1] + bj - r) as f64,
@@ -164,6 +169,16 @@ pub fn mi_search(
             }
         }
         match (best, last_err) {
+            // As in `ncc_search`: a scan maximum on the window's border is no peak.
+            (Some((t, _)), _)
+                if (t[0] - window_centre_px[0]).abs() >= k as f64 * step
+                    || (t[1] - window_centre_px[1]).abs() >= k as f64 * step =>
+            {
+                return Err(MiError::MaximumOnBorder(
+                    t[0] - window_centre_px[0],
+                    t[1] - window_centre_px[1],
+                ))
+            }
             (Some((t, _)), _) => start = t,
             (None, Some(e)) => return Err(e),
             (None, None) => {
@@ -183,6 +198,64 @@ impl From<MiRegistration> for Found {
         Found {
             shift_px: r.translation_px,
             score: r.mi,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::matching::mattes_mi::MiError;
+
+    /// A smooth random texture (sum of a few seeded sinusoids) sampled at `(x + dx, y + dy)`.
+    fn texture(w: usize, h: usize, dx: f64, dy: f64) -> GrayImage {
+        let waves = [
+            (0.31, 0.17, 0.3),
+            (-0.23, 0.41, 1.1),
+            (0.53, -0.29, 2.0),
+            (0.11, 0.61, 0.7),
+            (-0.47, -0.37, 2.9),
+        ];
+        let data = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x as f64 + dx, y as f64 + dy)))
+            .map(|(x, y)| {
+                waves
+                    .iter()
+                    .map(|(a, b, p)| (a * x + b * y + p).sin())
+                    .sum::<f64>() as f32
+            })
+            .collect();
+        GrayImage::from_vec(w, h, data).expect("size")
+    }
+
+    #[test]
+    fn ncc_finds_a_shift_inside_the_window_and_refuses_a_maximum_on_its_border() {
+        // moving(x + t) = fixed(x) for t = (3, −2).
+        let fixed = texture(40, 40, 0.0, 0.0);
+        let moving = texture(40, 40, -3.0, 2.0);
+        let found = ncc_search(&fixed, &moving, [0, 0], 5, 100).expect("inside the window");
+        let [dx, dy] = found.shift_px;
+        assert!((dx - 3.0).abs() < 0.05 && (dy + 2.0).abs() < 0.05, "{dx} {dy}");
+        assert!(found.score > 0.999);
+        // Radius 2: the best shift inside the window is (2, −2), on its border, where the NCC still grows
+        // outwards; that is no peak and must not be reported as a match.
+        assert!(ncc_search(&fixed, &moving, [0, 0], 2, 100).is_none());
+    }
+
+    #[test]
+    fn mi_scan_refuses_a_maximum_on_the_window_border() {
+        let fixed = texture(48, 48, 0.0, 0.0);
+        let moving = texture(48, 48, -4.0, 1.0);
+        let es = OnePlusOneParams {
+            seed: 7,
+            ..OnePlusOneParams::default()
+        };
+        let r = mi_search(&fixed, &moving, 32, None, [0.0, 0.0], 6.0, Some(2), &es)
+            .expect("inside the window");
+        assert!((r.translation_px[0] - 4.0).abs() < 0.2 && (r.translation_px[1] + 1.0).abs() < 0.2);
+        match mi_search(&fixed, &moving, 32, None, [0.0, 0.0], 2.0, Some(2), &es) {
+            Err(MiError::MaximumOnBorder(dx, _)) => assert_eq!(dx, 2.0),
+            other => panic!("expected MaximumOnBorder, got {other:?}"),
         }
     }
 }
