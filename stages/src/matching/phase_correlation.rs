@@ -172,9 +172,6 @@ pub struct PhaseCorrelator {
     ref_spectrum: Vec<Cplx>,
     ref_energy: Real,
     spectrum: Vec<Cplx>,
-    /// Per-bin scale of the cross-power normalisation (a separate real array, so that its square roots and
-    /// divisions vectorise).
-    scale: Vec<Real>,
     surface: Vec<Real>,
     /// Tapers of the reference, of the first pass on the moving image and of the passes that follow the
     /// estimate: separate tables, so the first two are computed once per correlator, not per call.
@@ -228,7 +225,6 @@ impl PhaseCorrelator {
             ref_spectrum: vec![zero; fft.spectrum_len()],
             ref_energy: 0.0,
             spectrum: vec![zero; fft.spectrum_len()],
-            scale: vec![0.0; fft.spectrum_len()],
             surface: vec![0.0; pw * ph],
             ref_taper: TaperTables::new(width),
             first_taper: TaperTables::new(width),
@@ -255,6 +251,32 @@ impl PhaseCorrelator {
     /// Shift t of `moving` relative to `reference` (both `width × height`): `moving(x) ≈ reference(x − t)`.
     /// Same result as [`phase_correlate`].
     pub fn correlate(
+        &mut self,
+        reference: &GrayImage,
+        moving: &GrayImage,
+    ) -> Result<PhaseShift, PhaseCorrelationError> {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            return unsafe { self.correlate_avx2(reference, moving) };
+        }
+        self.correlate_impl(reference, moving)
+    }
+
+    /// [`Self::correlate`] compiled with AVX2 (wider vectors for the loading, packing, normalisation and
+    /// 3 × 3 loops; no FMA, so every operation and hence every result is the same as without).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn correlate_avx2(
+        &mut self,
+        reference: &GrayImage,
+        moving: &GrayImage,
+    ) -> Result<PhaseShift, PhaseCorrelationError> {
+        self.correlate_impl(reference, moving)
+    }
+
+    #[inline(always)]
+    fn correlate_impl(
         &mut self,
         reference: &GrayImage,
         moving: &GrayImage,
@@ -287,6 +309,31 @@ impl PhaseCorrelator {
     /// Centre of `template` (at most `width × height`) in `search` (`width × height`); same result as
     /// [`locate_template`].
     pub fn locate_template(
+        &mut self,
+        template: &GrayImage,
+        search: &GrayImage,
+    ) -> Result<TemplateLocation, PhaseCorrelationError> {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            return unsafe { self.locate_template_avx2(template, search) };
+        }
+        self.locate_template_impl(template, search)
+    }
+
+    /// [`Self::locate_template`] compiled with AVX2 (see [`Self::correlate_avx2`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn locate_template_avx2(
+        &mut self,
+        template: &GrayImage,
+        search: &GrayImage,
+    ) -> Result<TemplateLocation, PhaseCorrelationError> {
+        self.locate_template_impl(template, search)
+    }
+
+    #[inline(always)]
+    fn locate_template_impl(
         &mut self,
         template: &GrayImage,
         search: &GrayImage,
@@ -349,6 +396,7 @@ impl PhaseCorrelator {
     }
 
     /// Transforms the tapered reference (placed at (x0, y0) in the canvas) into `ref_spectrum`.
+    #[inline(always)]
     fn set_reference(&mut self, img: &GrayImage, taper: Taper, x0: usize, y0: usize) {
         self.ref_energy = load(&mut self.fft, &mut self.ref_taper, img, taper, x0, y0);
         self.fft.forward(&mut self.ref_spectrum);
@@ -359,6 +407,7 @@ impl PhaseCorrelator {
     /// `follow(dx, dy)` re-centred on the shift found so far, until it changes by less than 1e-3 px; these only
     /// evaluate the surface on the 3 × 3 pixels around the expected peak by a direct inverse DFT
     /// ([`LocalSurface`]), walking to a higher neighbour if the centre is not the maximum.
+    #[inline(always)]
     fn estimate(
         &mut self,
         moving: &GrayImage,
@@ -392,31 +441,27 @@ impl PhaseCorrelator {
     /// `spectrum ← P·lowpass/|P|`, `P = F_mov·conj(F_ref)` (thesis eq. 3/1). Bins with `|P|` not above 1e-12 of
     /// the product of both spectra's RMS bin magnitudes (`sqrt(energy)`, Parseval) are set to 0. Magnitudes via
     /// `sqrt(re² + im²)` (no `hypot`: the spectra are far from overflow, and `hypot` dominated the run time).
+    #[inline(always)]
     fn cross_power(&mut self, energy: Real) {
         self.fft.forward(&mut self.spectrum);
         let floor_sq = energy * self.ref_energy * 1e-24;
-        for ((m, r), q) in self
+        for ((m, r), &weight) in self
             .spectrum
             .iter_mut()
             .zip(&self.ref_spectrum)
-            .zip(&mut self.scale)
+            .zip(&self.lowpass)
         {
-            *m *= r.conj();
-            *q = m.norm_sqr();
-        }
-        // Branch-free select on plain real arrays, so that square root and division vectorise.
-        for (q, &weight) in self.scale.iter_mut().zip(&self.lowpass) {
+            let p = *m * r.conj();
+            let q = p.norm_sqr();
             let s = weight / q.sqrt();
-            *q = if *q > floor_sq { s } else { 0.0 };
-        }
-        for (m, &q) in self.spectrum.iter_mut().zip(&self.scale) {
-            *m *= q;
+            *m = p * if q > floor_sq { s } else { 0.0 };
         }
     }
 
     /// Peak of the current cross-power spectrum near `guess` (a previous estimate of the same shift): the
     /// surface on the 3 × 3 pixels around the rounded guess, re-centred on the highest of them until the
     /// centre is the maximum (at most 4 steps, else the full surface as in pass 0).
+    #[inline(always)]
     fn local_peak(&mut self, guess: PhaseShift) -> PhaseShift {
         let (pw, ph) = (self.pw, self.ph);
         let to_index = |v: f64, n: usize| (v.round() as i64).rem_euclid(n as i64) as usize;
@@ -463,6 +508,7 @@ impl TaperTables {
 
 /// Writes the windowed copy of `img` with the window-weighted mean removed at (x0, y0) into the FFT canvas
 /// (everything else 0); returns the canvas energy Σ v² (= the mean squared bin magnitude of its spectrum).
+#[inline(always)]
 fn load(
     fft: &mut RealFft2d,
     tables: &mut TaperTables,
@@ -527,35 +573,53 @@ fn load(
     energy
 }
 
-/// Σ v² with four partial sums (vectorises).
+/// Partial sums of [`sum_of_squares`] and [`weighted_sum`]: 16 independent lanes, so that the additions do not
+/// wait on each other (four AVX / eight SSE2 registers); the lanes are added pairwise at the end.
+const LANES: usize = 16;
+
+#[inline(always)]
+fn reduce_lanes(mut acc: [f64; LANES]) -> f64 {
+    let mut n = LANES;
+    while n > 1 {
+        n /= 2;
+        for i in 0..n {
+            acc[i] += acc[i + n];
+        }
+    }
+    acc[0]
+}
+
+/// Σ v² with [`LANES`] partial sums (vectorises).
+#[inline(always)]
 fn sum_of_squares(v: &[f64]) -> f64 {
-    let chunks = v.chunks_exact(4);
+    let chunks = v.chunks_exact(LANES);
     let tail: f64 = chunks.remainder().iter().map(|x| x * x).sum();
-    let mut acc = [0.0f64; 4];
+    let mut acc = [0.0f64; LANES];
     for c in chunks {
-        for i in 0..4 {
+        for i in 0..LANES {
             acc[i] += c[i] * c[i];
         }
     }
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+    reduce_lanes(acc) + tail
 }
 
-/// Σ g·w in f64 with four partial sums (vectorises).
+/// Σ g·w in f64 with [`LANES`] partial sums (vectorises).
+#[inline(always)]
 fn weighted_sum(g: &[f32], w: &[f64]) -> f64 {
-    let (gc, wc) = (g.chunks_exact(4), w.chunks_exact(4));
+    let (gc, wc) = (g.chunks_exact(LANES), w.chunks_exact(LANES));
     let tail: f64 = gc
         .remainder()
         .iter()
         .zip(wc.remainder())
         .map(|(&a, &b)| a as f64 * b)
         .sum();
-    let mut acc = [0.0f64; 4];
+    let mut acc = [0.0f64; LANES];
     for (a, b) in gc.zip(wc) {
-        for i in 0..4 {
+        for i in 0..LANES {
             acc[i] += a[i] as f64 * b[i];
         }
     }
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+    reduce_lanes(acc) + tail
 }
 
 /// A 1-D window table `values[c] = window(c − origin)`, `c ∈ [0, n)` (0 outside the window), remembering what it
@@ -653,6 +717,7 @@ impl LocalSurface {
 
     /// `n[j][i]` = surface at ((cx + i − 1) mod pw, (cy + j − 1) mod ph) of the half spectrum `spec`
     /// (transposed layout, see `real_fft_2d`).
+    #[inline(always)]
     fn surface_3x3(&mut self, spec: &[Cplx], cx: usize, cy: usize) -> [[f64; 3]; 3] {
         let (pw, ph) = (self.pw, self.ph);
         for (j, row) in self.rows.iter_mut().enumerate() {
@@ -688,6 +753,7 @@ impl LocalSurface {
 }
 
 /// Index of the first maximum in raster order (the maximum found with four partial maxima, which vectorises).
+#[inline(always)]
 fn first_max_index(r: &[Real]) -> usize {
     let chunks = r.chunks_exact(4);
     let mut top = chunks
@@ -707,6 +773,7 @@ fn first_max_index(r: &[Real]) -> usize {
 }
 
 /// Integer peak (first maximum in raster order) and its sub-pixel refinement, wrapped to `[−N/2, N/2)`.
+#[inline(always)]
 fn find_peak(r: &[Real], pw: usize, ph: usize, fit: PeakFit) -> PhaseShift {
     let best = first_max_index(r);
     let (px, py) = (best % pw, best / pw);
@@ -722,6 +789,7 @@ fn find_peak(r: &[Real], pw: usize, ph: usize, fit: PeakFit) -> PhaseShift {
 }
 
 /// Sub-pixel peak from the 3 × 3 neighbourhood `n` of the integer peak (px, py), wrapped to `[−N/2, N/2)`.
+#[inline(always)]
 fn peak_from_neighbourhood(
     n: &[[f64; 3]; 3],
     px: usize,
@@ -745,18 +813,14 @@ fn peak_from_neighbourhood(
     }
 }
 
+#[inline(always)]
 fn check_finite(img: &GrayImage) -> Result<(), PhaseCorrelationError> {
-    // v − v is 0 for finite v and NaN for NaN/±inf; eight partial sums so that the loop vectorises.
-    let chunks = img.data.chunks_exact(8);
-    let mut acc = chunks.remainder().iter().fold(0.0f32, |a, &v| a + (v - v));
-    let mut lanes = [0.0f32; 8];
-    for c in chunks {
-        for i in 0..8 {
-            lanes[i] += c[i] - c[i];
-        }
-    }
-    acc += lanes.iter().sum::<f32>();
-    if acc == 0.0 {
+    // A value is NaN or ±inf iff all its exponent bits are set; an integer OR over 0/1 flags vectorises.
+    const EXPONENT: u32 = 0x7f80_0000;
+    let non_finite = img.data.iter().fold(0u32, |acc, v| {
+        acc | u32::from(v.to_bits() & EXPONENT == EXPONENT)
+    });
+    if non_finite == 0 {
         Ok(())
     } else {
         Err(PhaseCorrelationError::NonFinite)

@@ -107,6 +107,7 @@ impl RealFft2d {
 
     /// Half spectrum (transposed layout, see the module doc) of the canvas written with [`Self::set_row`].
     /// The canvas is consumed (left undefined).
+    #[inline(always)]
     pub(crate) fn forward(&mut self, spec: &mut [Cplx]) {
         let (pw, ph, hw) = (self.pw, self.ph, self.half_width());
         debug_assert_eq!(spec.len(), hw * ph);
@@ -137,6 +138,7 @@ impl RealFft2d {
 
     /// Unnormalised inverse (no 1/(pw·ph)) of a Hermitian half spectrum; `spec` is consumed, the real
     /// `pw × ph` row-major result goes to `out`.
+    #[inline(always)]
     pub(crate) fn inverse(&mut self, spec: &mut [Cplx], out: &mut [Real]) {
         let (pw, ph, hw) = (self.pw, self.ph, self.half_width());
         debug_assert_eq!(spec.len(), hw * ph);
