@@ -9,7 +9,9 @@
 //! the fine level rebuilds the oblique patch around the coarse shift (`fine_extent_m`, theoretical resolution)
 //! and refines within ±`fine_window_m` (MI by the (1+1)-ES from the coarse shift, or NCC). Non-hierarchical:
 //! one level with the `fine` similarity on `single_extent_m` patches over ±`search_radius_m`; MI then scans the
-//! integer shifts at `mi_scan_step_px` and refines the best by the ES within ± one step.
+//! integer shifts at `mi_scan_step_px` and refines the best by the ES within ± one step. A full-radius search
+//! whose best shift lies on the border of the window found no peak (the similarity still grows outwards, e.g.
+//! towards the next window bay of a periodic façade): the registration counts as `failed` (`search` module).
 //!
 //! Shift sign: a patch translation (dx, dy) px means the MM patch content at patch pixel x appears in the
 //! oblique patch at x + (dx, dy); it converts to the plane shift (dx·s, −dy·s) along (`axis_u`, `axis_v`)

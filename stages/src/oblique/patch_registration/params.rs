@@ -31,7 +31,8 @@ pub struct PatchParams {
     /// Patch extent of the single level (non-hierarchical), metres (default 8 m).
     pub single_extent_m: f64,
     /// Largest shift searched by the coarse (or single) level, per axis, metres (default 2 m: expected
-    /// MM position error plus façade relief).
+    /// MM position error plus façade relief). A best shift on the border of this window is no peak: the
+    /// registration fails.
     pub search_radius_m: f64,
     /// The coarse level samples its patches at this multiple of the theoretical resolution (default 2: "larger
     /// patches with a lower resolution").
