@@ -9,7 +9,8 @@ Setup (never part of the test path; see benches/README.md):
     /tmp/peers/bin/python benches/peers/kaze.py [<temp>/skytie_peers/kaze]
 
 Setting as skytie's bench (thesis 3.4.5.2): threshold 0.001, 1 octave, 4 sublevels, PM G2 diffusivity, upright,
-extended. Repeatability: share of A's keypoints whose position minus the shift lies >= border px inside B that
+extended. Times: one untimed warm-up call, then the median of 5 calls (wall and process CPU), as the Rust
+bench does. Repeatability: share of A's keypoints whose position minus the shift lies >= border px inside B that
 have a B keypoint within match_radius px (values from shift.csv, the rule skytie's bench applies). Agreement:
 share of skytie's keypoints on A with an OpenCV keypoint within 1.5 px, and vice versa. OpenCV's pixel centres
 are at integers, skytie's at +0.5: OpenCV positions are shifted by +0.5 before comparing.
@@ -30,14 +31,24 @@ def kaze_create():
                            diffusivity=getattr(mod, "KAZE_DIFF_PM_G2", getattr(cv2, "KAZE_DIFF_PM_G2", 1)))
 
 
-def detect(img, threads):
+RUNS = 5
+
+
+def detect(img, threads, runs=RUNS):
+    """Keypoints of img and the median wall / process CPU time of `runs` timed calls after one untimed warm-up
+    (as skytie's bench: first-touch allocation and lazy initialisation are not timed on either side)."""
     cv2.setNumThreads(threads)
     kaze = kaze_create()
-    c0, w0 = time.process_time(), time.perf_counter()
-    kps, desc = kaze.detectAndCompute(img, None)
-    wall, cpu = time.perf_counter() - w0, time.process_time() - c0
+    kps, _ = kaze.detectAndCompute(img, None)
+    walls, cpus = [], []
+    for _ in range(runs):
+        c0, w0 = time.process_time(), time.perf_counter()
+        kps, desc = kaze.detectAndCompute(img, None)
+        walls.append(time.perf_counter() - w0)
+        cpus.append(time.process_time() - c0)
     pts = np.array([[k.pt[0] + 0.5, k.pt[1] + 0.5] for k in kps], dtype=np.float64).reshape(-1, 2)
-    return pts, wall, cpu
+    med = lambda v: float(np.median(v)) if v else float("nan")
+    return pts, med(walls), med(cpus)
 
 
 def read_points(path):
@@ -82,7 +93,7 @@ def main(folder):
     cv_results = {}
     for threads in (1, os.cpu_count() or 1):
         pa, wall, cpu = detect(img_a, threads)
-        pb, _, _ = detect(img_b, threads)
+        pb, _, _ = detect(img_b, threads, runs=0)
         rep, _ = repeatability(pa, pb, shift, border, radius, size)
         cv_results[threads] = (pa, wall, cpu, rep)
     for row in sky:
