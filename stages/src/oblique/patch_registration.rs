@@ -172,7 +172,7 @@ impl Context<'_> {
                 self.p.mi_samples,
                 [0.0, 0.0],
                 radius_px,
-                Some(self.p.mi_scan_step_px),
+                (self.p.mi_scan_step_px > 0).then_some(self.p.mi_scan_step_px),
                 &self.es(grid.spacing_m, seed),
             )
             .ok()?

@@ -49,7 +49,8 @@ pub struct PatchParams {
     /// Mattes MI fixed samples per patch; `None` = every valid pixel (default, MATLAB's UseAllPixels).
     pub mi_samples: Option<usize>,
     /// Step of the exhaustive integer MI scan that seeds the ES when MI searches the full radius (coarse = MI,
-    /// or single level with MI), patch px (default 2).
+    /// or single level with MI), patch px (default 2). 0 = no scan: the ES alone from zero shift, as in the
+    /// thesis, where the MI of the initial transformation used the fine registration's parameters (4.5.3).
     pub mi_scan_step_px: usize,
     /// (1+1)-ES iteration limit (default 200).
     pub es_max_iterations: usize,
@@ -159,9 +160,12 @@ impl PatchParams {
             ),
         );
         check(
-            (1..=64).contains(&self.mi_scan_step_px),
+            self.mi_scan_step_px <= 64,
             "mi_scan_step_px",
-            format!("must be in [1, 64], got {}", self.mi_scan_step_px),
+            format!(
+                "must be in [0, 64] (0 = no scan), got {}",
+                self.mi_scan_step_px
+            ),
         );
         check(
             (1..=100_000).contains(&self.es_max_iterations),
