@@ -933,4 +933,29 @@ mod tests {
         let s = phase_correlate(&a, &a, &p).unwrap();
         assert!(s.dx_px.is_finite() && s.dy_px.is_finite() && s.peak.is_finite());
     }
+
+    #[test]
+    fn avx2_and_baseline_builds_give_identical_results() {
+        let img = |w: usize, h: usize, phase: f32| {
+            let data = (0..w * h)
+                .map(|k| {
+                    let (x, y) = ((k % w) as f32, (k / w) as f32);
+                    0.5 + 0.2 * (0.31 * x + 0.17 * y + phase).sin() + 0.1 * (0.07 * x * y).cos()
+                })
+                .collect();
+            GrayImage::from_vec(w, h, data).unwrap()
+        };
+        let p = PhaseCorrelationParams::default();
+        for (w, h) in [(32, 32), (45, 37), (64, 48)] {
+            let (a, b) = (img(w, h, 0.0), img(w, h, 0.9));
+            let mut c = PhaseCorrelator::new(w, h, p).unwrap();
+            let dispatched = c.correlate(&a, &b).unwrap();
+            let baseline = c.correlate_impl(&a, &b).unwrap();
+            assert_eq!(dispatched, baseline, "{w}x{h}");
+            let t = img(w / 2, h / 2, 0.4);
+            let dispatched = c.locate_template(&t, &b).unwrap();
+            let baseline = c.locate_template_impl(&t, &b).unwrap();
+            assert_eq!(dispatched, baseline, "{w}x{h} template");
+        }
+    }
 }
