@@ -8,6 +8,7 @@ pub type Rgb = [f32; 3];
 pub const GREEN: Rgb = [0.0, 0.85, 0.2];
 pub const RED: Rgb = [1.0, 0.1, 0.1];
 pub const YELLOW: Rgb = [1.0, 0.85, 0.0];
+pub const BLUE: Rgb = [0.15, 0.45, 1.0];
 
 /// A crop of `img` with top-left corner (x0, y0) and size (w, h) source pixels, scaled by `scale` with
 /// bilinear sampling; outside the source is black. Returns the RGB image.

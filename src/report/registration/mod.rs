@@ -1,7 +1,8 @@
 //! Registration views (thesis Figs 3.6, 3.11, 3.12 for nadir, 4.9, 4.18 for oblique): for the few
 //! recordings with the most aerial control points, one image with the MM side on the left and the aerial
 //! side on the right, each correspondence a line between its two observations, green when correct and red
-//! when wrong by truth (yellow: no truth). Nadir: the recording's north-up MM ortho image (recorded pose,
+//! when wrong by truth, blue when non-matchable (oblique, with `truth/scene.toml`), yellow without truth
+//! (`truth` module: nadir and oblique rules). Nadir: the recording's north-up MM ortho image (recorded pose,
 //! `ortho_project` at 3 cm) beside the crop of the aerial nadir image covering the same ground. Oblique: the
 //! panorama crop around the observations beside the oblique image crop around them. Inputs:
 //! `correspondences.csv` of the result folder, the campaign's images and (optionally) `truth/`.
@@ -14,18 +15,22 @@ use super::image_cache::ImageCache;
 use super::inputs::{read_csv_opt, CsvTable, ResultSet};
 use super::tables::{fmt_count, Origin, Table};
 use super::{slug, Builder};
-use canvas::{crop_scaled, line, ring, side_by_side, Rgb, GREEN, RED, YELLOW};
+use canvas::{crop_scaled, line, ring, side_by_side, Rgb, BLUE, GREEN, RED, YELLOW};
 use nalgebra::Vector3;
+use skytie_stages::campaign::read_aerial_csv;
 use skytie_stages::campaign::{
     read_campaign, read_recordings_csv, AerialImage, Campaign, Recording,
 };
+use skytie_stages::correspondence::PanoObservation;
 use skytie_stages::geometry::{FrameCamera, PanoramaCamera};
 use skytie_stages::imaging::image::RgbImage;
 use skytie_stages::imaging::io::{dimensions, save_rgb};
 use skytie_stages::nadir::{ortho_project, OrthoParams};
+use skytie_stages::oblique::grading::Truth as StageTruth;
+use skytie_stages::synth::scene_truth::{SceneTruth, SCENE_TRUTH_FILE};
 use std::collections::BTreeMap;
 use std::path::Path;
-use truth::{true_point, verdict, TruePanoObservation, Verdict};
+use truth::{oblique_verdict, true_point, verdict, ObliqueTruth, TruePanoObservation, Verdict};
 
 /// One observation row of correspondences.csv.
 #[derive(Clone, Debug)]
@@ -77,6 +82,7 @@ struct ViewCounts {
     correct: usize,
     wrong: usize,
     ungraded: usize,
+    non_matchable: usize,
 }
 
 impl ViewCounts {
@@ -94,6 +100,10 @@ impl ViewCounts {
                 self.ungraded += 1;
                 YELLOW
             }
+            Verdict::NonMatchable => {
+                self.non_matchable += 1;
+                BLUE
+            }
         }
     }
 }
@@ -104,6 +114,8 @@ struct Context<'a> {
     images: &'a ImageCache,
     truth: BTreeMap<String, Recording>,
     pano_sizes: BTreeMap<String, (u32, u32)>,
+    /// The oblique grading rule's truth (None without `truth/recordings.csv`).
+    oblique_truth: Option<ObliqueTruth>,
 }
 
 impl Context<'_> {
@@ -194,22 +206,50 @@ pub fn registration_section(
             pano_sizes.insert(r.image_id.clone(), d);
         }
     }
+    let has_oblique = points.keys().any(|(s, _)| s == "oblique");
+    let oblique_truth = if has_oblique && !truth.is_empty() {
+        match load_oblique_truth(&root, &campaign, &truth, &pano_sizes) {
+            Ok(t) => Some(t),
+            Err(e) => {
+                b.note(
+                    page,
+                    format!("oblique registration views graded without the scene: {e}"),
+                );
+                load_oblique_truth_without_scene(&root, &campaign, &truth, &pano_sizes).ok()
+            }
+        }
+    } else {
+        None
+    };
     let images = std::sync::Arc::clone(&b.images);
     let ctx = Context {
         campaign: &campaign,
         images: &images,
         truth,
         pano_sizes,
+        oblique_truth,
     };
     let mut t = Table::new(
         &format!("{prefix}registration-views"),
         "Correspondences shown in the registration views",
         Origin::Skytie,
-        &["source", "recording", "aerial image", "control points", "correct", "wrong", "ungraded"],
+        &[
+            "source",
+            "recording",
+            "aerial image",
+            "control points",
+            "correct",
+            "wrong",
+            "non-matchable",
+            "ungraded",
+        ],
     )
     .with_note(
-        "correct = within 1 aerial pixel of the point triangulated from the panorama observations with the \
-         true poses (truth/), projected into the aerial image; ungraded without truth.",
+        "nadir: correct = within 1 aerial pixel of the point triangulated from the panorama observations with \
+         the true poses (truth/), projected into the aerial image. Oblique: the README's oblique rule (as \
+         oblique.* in metrics.json): rays within 0.15 m and the seen surface point (truth/scene.toml; else the \
+         triangulated point) within 1.5 px; non-matchable = sky, hidden from the oblique camera or outside it. \
+         Ungraded without truth.",
     );
     for source in ["nadir", "oblique"] {
         // Recordings by number of control points of this source, most first.
@@ -248,7 +288,7 @@ pub fn registration_section(
                         &format!("{source} registration of {rec_id}"),
                         &format!(
                             "{rec_id} ({}) and {source} image {aerial_id}: {} correct (green), {} wrong (red), \
-                             {} ungraded (yellow).",
+                             {} non-matchable (blue), {} ungraded (yellow).",
                             if source == "nadir" {
                                 "MM ortho image, 3 cm, north up"
                             } else {
@@ -256,10 +296,11 @@ pub fn registration_section(
                             },
                             c.correct,
                             c.wrong,
+                            c.non_matchable,
                             c.ungraded
                         ),
                     );
-                    let n = c.correct + c.wrong + c.ungraded;
+                    let n = c.correct + c.wrong + c.non_matchable + c.ungraded;
                     t.push(vec![
                         source.to_string(),
                         rec_id.to_string(),
@@ -267,6 +308,7 @@ pub fn registration_section(
                         fmt_count(Some(n as f64)),
                         fmt_count(Some(c.correct as f64)),
                         fmt_count(Some(c.wrong as f64)),
+                        fmt_count(Some(c.non_matchable as f64)),
                         fmt_count(Some(c.ungraded as f64)),
                     ]);
                 }
@@ -444,14 +486,91 @@ fn oblique_view(
     for (mo, ao, p) in pairs {
         let a = ((mo.u_px - lb.0) * ls, (mo.v_px - lb.1) * ls);
         let bpt = (x_off + (ao.u_px - rb.0) * rs, (ao.v_px - rb.1) * rs);
-        let x = ctx.true_point(p);
-        let colour = counts.add(verdict(x.as_ref(), aerial, ao.u_px, ao.v_px));
+        let v = match &ctx.oblique_truth {
+            Some(t) => {
+                let tie: Vec<PanoObservation> = p.pano.iter().map(pano_observation).collect();
+                oblique_verdict(
+                    t,
+                    &tie,
+                    &pano_observation(mo),
+                    &aerial_id,
+                    [ao.u_px, ao.v_px],
+                )
+            }
+            None => Verdict::Ungraded,
+        };
+        let colour = counts.add(v);
         line(&mut img, a, bpt, colour, 1);
         ring(&mut img, a, 7.0, colour);
         ring(&mut img, bpt, 7.0, colour);
     }
     save(out, &img)?;
     Ok((aerial_id, counts))
+}
+
+fn pano_observation(o: &CorrObs) -> PanoObservation {
+    PanoObservation {
+        image_id: o.image_id.clone(),
+        u_px: o.u_px,
+        v_px: o.v_px,
+    }
+}
+
+/// The oblique grading rule's truth without the scene: true poses (`truth/recordings.csv`, panorama sizes) and
+/// true oblique poses (`truth/aerial_oblique.csv`, else the campaign's, which synthetic campaigns keep true).
+fn load_oblique_truth_without_scene(
+    root: &Path,
+    campaign: &Campaign,
+    truth: &BTreeMap<String, Recording>,
+    pano_sizes: &BTreeMap<String, (u32, u32)>,
+) -> Result<ObliqueTruth, String> {
+    let aerial_path = root.join("truth/aerial_oblique.csv");
+    let aerial: Vec<AerialImage> = if aerial_path.exists() {
+        let (rows, problems) = read_aerial_csv(&aerial_path);
+        if let Some(p) = problems.first() {
+            return Err(format!("truth is unreadable: {p}"));
+        }
+        rows
+    } else {
+        campaign.oblique.clone()
+    };
+    Ok(ObliqueTruth {
+        truth: StageTruth {
+            recordings: truth
+                .iter()
+                .filter_map(|(id, r)| {
+                    let (w, h) = *pano_sizes.get(id)?;
+                    Some((id.clone(), (r.clone(), w, h)))
+                })
+                .collect(),
+            aerial: aerial
+                .into_iter()
+                .map(|a| (a.image_id.clone(), a))
+                .collect(),
+        },
+        scene: None,
+    })
+}
+
+/// [`load_oblique_truth_without_scene`] plus the scene of `truth/scene.toml` when the campaign has one (an
+/// error when it cannot be rebuilt, e.g. written by another generator version).
+fn load_oblique_truth(
+    root: &Path,
+    campaign: &Campaign,
+    truth: &BTreeMap<String, Recording>,
+    pano_sizes: &BTreeMap<String, (u32, u32)>,
+) -> Result<ObliqueTruth, String> {
+    let mut t = load_oblique_truth_without_scene(root, campaign, truth, pano_sizes)?;
+    let scene_path = root.join(SCENE_TRUTH_FILE);
+    if scene_path.exists() {
+        let text = std::fs::read_to_string(&scene_path)
+            .map_err(|e| format!("{}: {e}", scene_path.display()))?;
+        let oracle = SceneTruth::parse(&text)
+            .and_then(|s| s.rebuild())
+            .map_err(|e| format!("{}: {e}", scene_path.display()))?;
+        t.scene = Some(oracle);
+    }
+    Ok(t)
 }
 
 #[cfg(test)]

@@ -39,7 +39,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 use super::types::{ObliqueResult, PatchMatch, SparseCloud, StreetSide};
-use crate::correspondence::MmTiePoint;
+use crate::correspondence::{MmTiePoint, PanoObservation};
 use crate::geometry::{closest_approach, FrameCamera, PanoramaCamera};
 pub use crate::nadir::grading::{ErrorStats, Truth};
 pub use crate::synth::scene_truth::SceneOracle;
@@ -232,11 +232,33 @@ pub fn match_errors(
     tie: Option<&MmTiePoint>,
     m: &PatchMatch,
 ) -> Option<MatchErrors> {
-    let (rec, w, h) = truth.recordings.get(&m.mm.image_id)?;
+    observation_errors(
+        truth,
+        scene,
+        tie.map(|t| t.observations.as_slice()),
+        &m.mm,
+        &m.oblique_image_id,
+        m.oblique_px,
+    )
+}
+
+/// [`MatchErrors`] of one correspondence given as observations: the panorama observation `mm`, the oblique
+/// observation `oblique_px` in `oblique_image_id`, and the sparse tie point's panorama observations
+/// `tie_observations` (the reference without a scene). The rule of the module doc; shared with the report's
+/// registration views. `None` when the panorama or the oblique image is not in the truth.
+pub fn observation_errors(
+    truth: &Truth,
+    scene: Option<&SceneOracle>,
+    tie_observations: Option<&[PanoObservation]>,
+    mm: &PanoObservation,
+    oblique_image_id: &str,
+    oblique_px: [f64; 2],
+) -> Option<MatchErrors> {
+    let (rec, w, h) = truth.recordings.get(&mm.image_id)?;
     let pano = PanoramaCamera::from_recording(rec, *w, *h);
-    let cam = FrameCamera::from_aerial(truth.aerial.get(&m.oblique_image_id)?);
-    let [u, v] = m.oblique_px;
-    let pano_ray = pano.pixel_ray(m.mm.u_px, m.mm.v_px);
+    let cam = FrameCamera::from_aerial(truth.aerial.get(oblique_image_id)?);
+    let [u, v] = oblique_px;
+    let pano_ray = pano.pixel_ray(mm.u_px, mm.v_px);
     let far = MatchErrors {
         closest_approach_m: f64::INFINITY,
         reprojection_px: f64::INFINITY,
@@ -268,7 +290,7 @@ pub fn match_errors(
         return Some(far);
     }
     let reference: Vector3<f64> = surface
-        .or_else(|| tie.and_then(|t| truth.true_point(&t.observations)))
+        .or_else(|| tie_observations.and_then(|o| truth.true_point(o)))
         .unwrap_or_else(|| ca.midpoint_world());
     Some(MatchErrors {
         closest_approach_m: ca.distance_m,

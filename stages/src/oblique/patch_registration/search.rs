@@ -235,7 +235,10 @@ mod tests {
         let moving = texture(40, 40, -3.0, 2.0);
         let found = ncc_search(&fixed, &moving, [0, 0], 5, 100).expect("inside the window");
         let [dx, dy] = found.shift_px;
-        assert!((dx - 3.0).abs() < 0.05 && (dy + 2.0).abs() < 0.05, "{dx} {dy}");
+        assert!(
+            (dx - 3.0).abs() < 0.05 && (dy + 2.0).abs() < 0.05,
+            "{dx} {dy}"
+        );
         assert!(found.score > 0.999);
         // Radius 2: the best shift inside the window is (2, −2), on its border, where the NCC still grows
         // outwards; that is no peak and must not be reported as a match.
