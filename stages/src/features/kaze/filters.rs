@@ -62,16 +62,7 @@ fn row_pass(src: &[f32], out: &mut [f32], t: Taps3) {
     if w > 2 * s {
         let n = w - 2 * s;
         let (l, m, r) = (&src[..n], &src[s..s + n], &src[2 * s..2 * s + n]);
-        let o = &mut out[s..s + n];
-        if t.k[1] != 0.0 {
-            for i in 0..n {
-                o[i] = 0.0 + t.k[0] * l[i] + t.k[1] * m[i] + t.k[2] * r[i];
-            }
-        } else {
-            for i in 0..n {
-                o[i] = 0.0 + t.k[0] * l[i] + t.k[2] * r[i];
-            }
-        }
+        taps3_line([l, m, r], &mut out[s..s + n], t);
         for c in (0..s).chain(w - s..w) {
             edge_pixel(c, out);
         }
@@ -99,8 +90,10 @@ fn col_rows(src: &[f32], width: usize, height: usize, row: usize, s: usize) -> [
     [r(-(s as isize)), r(0), r(s as isize)]
 }
 
+/// `out[i] = k0·l[i] + k1·m[i] + k2·r[i]` (the middle tap skipped when it is zero), the interior of both
+/// passes.
 #[inline(always)]
-fn col_pass_row(src: [&[f32]; 3], out: &mut [f32], t: Taps3) {
+fn taps3_line(src: [&[f32]; 3], out: &mut [f32], t: Taps3) {
     let [l, m, r] = src;
     let n = out.len();
     let (l, m, r) = (&l[..n], &m[..n], &r[..n]);
@@ -119,7 +112,7 @@ fn col_pass_row(src: [&[f32]; 3], out: &mut [f32], t: Taps3) {
 fn cols(src: &[f32], out: &mut [f32], width: usize, height: usize, t: Taps3) {
     out.par_chunks_mut(width)
         .enumerate()
-        .for_each(|(row, o)| col_pass_row(col_rows(src, width, height, row, t.step), o, t));
+        .for_each(|(row, o)| taps3_line(col_rows(src, width, height, row, t.step), o, t));
 }
 
 /// `convolve_separable(img, kx, ky)` for [`Taps3`] kernels, using `tmp` (same size) for the row pass.
@@ -216,9 +209,9 @@ pub fn level_derivatives(
     det.par_chunks_mut(w).enumerate().for_each_init(
         || (vec![0.0f32; w], vec![0.0f32; w], vec![0.0f32; w]),
         |(xx, xy, yy), (row, out)| {
-            col_pass_row(col_rows(ta, w, h, row, smooth.step), xx, smooth);
-            col_pass_row(col_rows(tb, w, h, row, deriv.step), xy, deriv);
-            col_pass_row(col_rows(tc, w, h, row, deriv.step), yy, deriv);
+            taps3_line(col_rows(ta, w, h, row, smooth.step), xx, smooth);
+            taps3_line(col_rows(tb, w, h, row, deriv.step), xy, deriv);
+            taps3_line(col_rows(tc, w, h, row, deriv.step), yy, deriv);
             for (((o, &xx), &yy), &xy) in out.iter_mut().zip(&*xx).zip(&*yy).zip(&*xy) {
                 *o = (xx * yy - xy * xy) * s4;
             }
