@@ -27,7 +27,7 @@ use skytie_stages::imaging::image::RgbImage;
 use skytie_stages::imaging::io::{dimensions, save_rgb};
 use skytie_stages::nadir::{ortho_project, OrthoParams};
 use skytie_stages::oblique::grading::Truth as StageTruth;
-use skytie_stages::synth::scene_truth::{SceneTruth, SCENE_TRUTH_FILE};
+use skytie_stages::synth::scene_truth::{SceneOracle, SceneTruth, SCENE_TRUTH_FILE};
 use std::collections::BTreeMap;
 use std::path::Path;
 use truth::{oblique_verdict, true_point, verdict, ObliqueTruth, TruePanoObservation, Verdict};
@@ -209,13 +209,19 @@ pub fn registration_section(
     let has_oblique = points.keys().any(|(s, _)| s == "oblique");
     let oblique_truth = if has_oblique && !truth.is_empty() {
         match load_oblique_truth(&root, &campaign, &truth, &pano_sizes) {
-            Ok(t) => Some(t),
+            Ok(mut t) => {
+                match load_scene(&root) {
+                    Ok(scene) => t.scene = scene,
+                    Err(e) => b.note(
+                        page,
+                        format!("oblique registration views graded without the scene: {e}"),
+                    ),
+                }
+                Some(t)
+            }
             Err(e) => {
-                b.note(
-                    page,
-                    format!("oblique registration views graded without the scene: {e}"),
-                );
-                load_oblique_truth_without_scene(&root, &campaign, &truth, &pano_sizes).ok()
+                b.note(page, format!("oblique registration views ungraded: {e}"));
+                None
             }
         }
     } else {
@@ -516,9 +522,10 @@ fn pano_observation(o: &CorrObs) -> PanoObservation {
     }
 }
 
-/// The oblique grading rule's truth without the scene: true poses (`truth/recordings.csv`, panorama sizes) and
+/// The oblique grading rule's truth without the scene ([`load_scene`] adds it): true poses
+/// (`truth/recordings.csv`, panorama sizes) and
 /// true oblique poses (`truth/aerial_oblique.csv`, else the campaign's, which synthetic campaigns keep true).
-fn load_oblique_truth_without_scene(
+fn load_oblique_truth(
     root: &Path,
     campaign: &Campaign,
     truth: &BTreeMap<String, Recording>,
@@ -552,25 +559,19 @@ fn load_oblique_truth_without_scene(
     })
 }
 
-/// [`load_oblique_truth_without_scene`] plus the scene of `truth/scene.toml` when the campaign has one (an
-/// error when it cannot be rebuilt, e.g. written by another generator version).
-fn load_oblique_truth(
-    root: &Path,
-    campaign: &Campaign,
-    truth: &BTreeMap<String, Recording>,
-    pano_sizes: &BTreeMap<String, (u32, u32)>,
-) -> Result<ObliqueTruth, String> {
-    let mut t = load_oblique_truth_without_scene(root, campaign, truth, pano_sizes)?;
+/// The scene of the campaign's `truth/scene.toml` (None without that file; an error when it cannot be rebuilt,
+/// e.g. written by another generator version).
+fn load_scene(root: &Path) -> Result<Option<SceneOracle>, String> {
     let scene_path = root.join(SCENE_TRUTH_FILE);
-    if scene_path.exists() {
-        let text = std::fs::read_to_string(&scene_path)
-            .map_err(|e| format!("{}: {e}", scene_path.display()))?;
-        let oracle = SceneTruth::parse(&text)
-            .and_then(|s| s.rebuild())
-            .map_err(|e| format!("{}: {e}", scene_path.display()))?;
-        t.scene = Some(oracle);
+    if !scene_path.exists() {
+        return Ok(None);
     }
-    Ok(t)
+    let text = std::fs::read_to_string(&scene_path)
+        .map_err(|e| format!("{}: {e}", scene_path.display()))?;
+    SceneTruth::parse(&text)
+        .and_then(|s| s.rebuild())
+        .map(Some)
+        .map_err(|e| format!("{}: {e}", scene_path.display()))
 }
 
 #[cfg(test)]
