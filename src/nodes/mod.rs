@@ -26,6 +26,7 @@ pub mod sparse_cloud;
 pub mod summary;
 pub mod synth;
 pub mod transform;
+pub mod transform_agreement;
 pub mod verify;
 
 pub use campaign::{

@@ -16,7 +16,8 @@ pub struct InitialTransformStage;
 
 impl Stage for InitialTransformStage {
     const NAME: &'static str = "transform";
-    const VERSION: &'static str = "2";
+    // 3: accepted transforms carry the implied offset as a vector (`centre_offset_world_m`).
+    const VERSION: &'static str = "3";
     type Params = TransformParams;
     type Output = TransformOutcome;
     type Inputs = (

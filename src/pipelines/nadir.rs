@@ -18,6 +18,7 @@ use crate::nodes::ortho_aerial::OrthoForAerial;
 use crate::nodes::refine::RefineStage;
 use crate::nodes::summary::SummaryParams;
 use crate::nodes::transform::InitialTransformStage;
+use crate::nodes::transform_agreement::TransformAgreementStage;
 use crate::workflow::Workflow;
 use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
 use skytie_stages::nadir::aerial_overlap::overlapping_nadir;
@@ -155,6 +156,8 @@ pub fn add_nadir(
         }
         let mut rec_refinements = Vec::new();
         let mut rec_aerials = Vec::new();
+        // Per overlapping nadir image: (aerial row, file, label, ortho, transform outcome).
+        let mut pairs = Vec::new();
         for a in overlapping_nadir(
             item.recording,
             &snapshot.campaign.nadir,
@@ -193,6 +196,17 @@ pub fn add_nadir(
                 &pair,
                 transform_params.clone(),
                 (item.row, ortho, aerial_file.clone(), aerial),
+            )?;
+            pairs.push((aerial, aerial_file, pair, ortho, outcome));
+        }
+        // The recording's transforms must agree with each other (`nadir::transform_agreement`).
+        let outcomes: Vec<Handle<TransformOutcome>> = pairs.iter().map(|p| p.4).collect();
+        for (aerial, aerial_file, pair, ortho, outcome) in pairs {
+            let outcome = b.add(
+                TransformAgreementStage,
+                &pair,
+                transform_params.clone(),
+                (outcome, outcomes.clone()),
             )?;
             transforms.push(outcome);
             if !on("refine") {

@@ -184,6 +184,7 @@ fn transform(t: Similarity2) -> InitialTransform {
         matches: 0,
         inliers: 0,
         centre_offset_m: 0.0,
+        centre_offset_world_m: [0.0, 0.0],
         reused_from: None,
     }
 }

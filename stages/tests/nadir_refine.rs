@@ -198,6 +198,7 @@ fn transform(t: Similarity2) -> InitialTransform {
         matches: 0,
         inliers: 0,
         centre_offset_m: 0.0,
+        centre_offset_world_m: [0.0, 0.0],
         reused_from: None,
     }
 }
@@ -795,6 +796,7 @@ mod e2e {
                         matches: 0,
                         inliers: 0,
                         centre_offset_m: 0.0,
+                        centre_offset_world_m: [0.0, 0.0],
                         reused_from: None,
                     };
                     let r = refine_in_aerial(&ortho, &aerial, row, &t, &window, params);

@@ -12,6 +12,7 @@ pub mod ortho;
 pub mod refine;
 pub mod registration;
 pub mod summary;
+pub mod transform_agreement;
 pub mod translation_consensus;
 pub mod vehicle_mask;
 

@@ -60,6 +60,10 @@ pub struct InitialTransform {
     /// Distance between the MM ortho centre mapped by the transform and by the recorded pose, metres (the
     /// plausibility check: must not exceed the expected maximum localisation error).
     pub centre_offset_m: f64,
+    /// The same offset as a vector (x, y), world frame, metres: the correction of the recording's recorded
+    /// position this transform implies (compared across the recording's nadir images by
+    /// `nadir::transform_agreement`).
+    pub centre_offset_world_m: [f64; 2],
     /// `true` when this transform was taken from a neighbouring recording (option `reuse_neighbour`).
     pub reused_from: Option<String>,
 }
