@@ -16,7 +16,8 @@ pub struct MmMatch;
 
 impl Stage for MmMatch {
     const NAME: &'static str = "mm_match";
-    const VERSION: &'static str = "1";
+    // 2: windows carry each neighbour view's corner on its ortho ground plane (the parallax check of `refine`).
+    const VERSION: &'static str = "2";
     type Params = MmMatchParams;
     type Output = MmWindowMatch;
     type Inputs = (

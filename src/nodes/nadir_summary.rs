@@ -15,7 +15,8 @@ pub struct SummarizeNadir;
 
 impl Stage for SummarizeNadir {
     const NAME: &'static str = "nadir";
-    const VERSION: &'static str = "1";
+    // 2: counts `parallax_rejected`.
+    const VERSION: &'static str = "2";
     type Params = SummaryParams;
     type Output = NadirSummary;
     type Inputs = (

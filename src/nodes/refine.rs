@@ -1,12 +1,13 @@
 //! `refine`: per (recording × nadir image) with an accepted initial transform, every MM tie point of the
 //! recording's window located in the aerial image by phase correlation (thesis 3.4.5.3,
-//! `skytie_stages::nadir::refine`). A rejected transform gives an empty refinement.
+//! `skytie_stages::nadir::refine`), each template first compared with the window's neighbouring recordings' views
+//! (their orthos for the same aerial image, `skytie_stages::nadir::parallax_check`). A rejected transform gives an empty refinement.
 
 use super::decoded_images;
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use skytie_stages::campaign::AerialImage;
 use skytie_stages::imaging::GrayImage;
-use skytie_stages::nadir::refine::{refine_in_aerial, RefineParams};
+use skytie_stages::nadir::refine::{refine_in_aerial, NeighbourOrtho, RefineParams};
 use skytie_stages::nadir::{
     AerialRefinement, InitialTransform, MmWindowMatch, OrthoImage, TransformOutcome,
 };
@@ -20,7 +21,8 @@ pub struct RefineStage;
 impl Stage for RefineStage {
     const NAME: &'static str = "refine";
     // 2: phase correlation refines on the 3×3 direct-DFT surface and cuts near-zero bins relative to the RMS.
-    const VERSION: &'static str = "2";
+    // 3: the parallax check against the window's neighbouring recordings (their orthos are inputs).
+    const VERSION: &'static str = "3";
     type Params = RefineParams;
     type Output = AerialRefinement;
     type Inputs = (
@@ -29,22 +31,34 @@ impl Stage for RefineStage {
         Handle<AerialImage>,
         Handle<TransformOutcome>,
         Handle<MmWindowMatch>,
+        Vec<Handle<OrthoImage>>,
     );
 
     fn run(
         &self,
         p: &RefineParams,
-        (ortho, aerial_file, aerial, outcome, window): (
+        (ortho, aerial_file, aerial, outcome, window, neighbour_orthos): (
             Arc<OrthoImage>,
             RawFileValue,
             Arc<AerialImage>,
             Arc<TransformOutcome>,
             Arc<MmWindowMatch>,
+            Vec<Arc<OrthoImage>>,
         ),
         _: &NodeCtx,
     ) -> Result<AerialRefinement, StageError> {
+        // The neighbours' orthos come in the window's neighbour order (`window.pairs`).
+        let neighbours: Vec<NeighbourOrtho> = window
+            .pairs
+            .iter()
+            .zip(&neighbour_orthos)
+            .map(|(pair, o)| NeighbourOrtho {
+                recording_id: &pair.to_id,
+                ortho: o,
+            })
+            .collect();
         locate_with_accepted(&outcome, &window, &aerial, &aerial_file, |t, image| {
-            refine_in_aerial(&ortho, image, &aerial, t, &window, p)
+            refine_in_aerial(&ortho, image, &aerial, t, &window, &neighbours, p)
         })
     }
 }
@@ -63,6 +77,7 @@ pub fn locate_with_accepted(
             recording_id: window.recording_id.clone(),
             aerial_id: aerial.image_id.clone(),
             tried: 0,
+            parallax_rejected: 0,
             matches: Vec::new(),
         });
     };

@@ -197,11 +197,18 @@ pub fn add_nadir(
                 transform_params.clone(),
                 (item.row, ortho, aerial_file.clone(), aerial),
             )?;
-            pairs.push((aerial, aerial_file, pair, ortho, outcome));
+            pairs.push((
+                aerial,
+                aerial_file,
+                pair,
+                ortho,
+                outcome,
+                row.image_id.clone(),
+            ));
         }
         // The recording's transforms must agree with each other (`nadir::transform_agreement`).
         let outcomes: Vec<Handle<TransformOutcome>> = pairs.iter().map(|p| p.4).collect();
-        for (aerial, aerial_file, pair, ortho, outcome) in pairs {
+        for (aerial, aerial_file, pair, ortho, outcome, aerial_id) in pairs {
             let outcome = b.add(
                 TransformAgreementStage,
                 &pair,
@@ -215,7 +222,26 @@ pub fn add_nadir(
             let inputs = (ortho, aerial_file, aerial, outcome, window);
             let refined = match options.matcher {
                 Matcher::PhaseCorrelation => {
-                    b.add(RefineStage, &pair, refine_params.clone(), inputs)?
+                    // The neighbours' orthos for this aerial image (the same nodes their own pairs use), in
+                    // the window's neighbour order, for the parallax check.
+                    let neighbour_orthos = members[1..]
+                        .iter()
+                        .map(|n| {
+                            b.add(
+                                OrthoForAerial,
+                                &format!("rec {} × {}", n.recording.image_id, aerial_id),
+                                ortho_base.clone(),
+                                (n.row, n.pano.clone(), aerial),
+                            )
+                        })
+                        .collect::<Result<Vec<_>, _>>()?;
+                    let (o, f, a, t, w) = inputs;
+                    b.add(
+                        RefineStage,
+                        &pair,
+                        refine_params.clone(),
+                        (o, f, a, t, w, neighbour_orthos),
+                    )?
                 }
                 Matcher::Baseline => {
                     let p: BaselineParams = wf.params("baseline", variant).map_err(wf_err)?;

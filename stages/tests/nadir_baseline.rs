@@ -143,6 +143,7 @@ fn scene() -> Scene {
         pairs: vec![],
         corners_detected: corners.len(),
         ground_world: corners.iter().map(|c| [c[0], c[1], foot[2]]).collect(),
+        neighbour_ground_world: Vec::new(),
         tie_points,
     };
     // A nadir camera whose GSD at the ground is 0.1 m (only the GSD is used by the isolation test).

@@ -186,6 +186,7 @@ fn make_pair_g(seed: u64, noise_sigma: f64, gamma: f64) -> Pair {
             corners_detected: tie_points.len(),
             tie_points,
             ground_world,
+            neighbour_ground_world: Vec::new(),
         },
     }
 }
@@ -245,6 +246,7 @@ fn refinement_recovers_a_subpixel_offset_under_radiometric_change_and_noise() {
         &row,
         &transform(initial),
         &pair.window,
+        &[],
         &p,
     );
     let (rms_before, _) = {
@@ -288,6 +290,7 @@ fn refinement_recovers_a_subpixel_offset_under_radiometric_change_and_noise() {
         &row,
         &transform(initial),
         &pair.window,
+        &[],
         &p,
     );
     assert_eq!(r, again);
@@ -317,6 +320,7 @@ fn refinement_handles_larger_offsets_within_the_margin() {
         &row,
         &transform(off.compose(&pair.truth)),
         &pair.window,
+        &[],
         &params_at_peak_05(),
     );
     let (rms, _) = errors_px(&pair, &r);
@@ -335,6 +339,7 @@ fn unrelated_aerial_content_gives_weak_peaks_that_are_rejected() {
         &row,
         &transform(pair.truth),
         &pair.window,
+        &[],
         &params_at_peak_05(),
     );
     println!("unrelated: {} of {} accepted", r.matches.len(), r.tried);
@@ -361,6 +366,7 @@ fn tie_points_outside_the_aerial_image_are_not_tried_and_bad_transforms_give_not
         &row,
         &transform(far),
         &pair.window,
+        &[],
         &p,
     );
     assert_eq!((r.tried, r.matches.len()), (0, 0));
@@ -374,6 +380,7 @@ fn tie_points_outside_the_aerial_image_are_not_tried_and_bad_transforms_give_not
         &row,
         &transform(nan),
         &pair.window,
+        &[],
         &p,
     );
     assert_eq!((r.tried, r.matches.len()), (0, 0));
@@ -435,6 +442,7 @@ fn refinement_of(row: &AerialImage, obs: &[(String, (f64, f64))]) -> AerialRefin
         recording_id: "rec".into(),
         aerial_id: row.image_id.clone(),
         tried: obs.len(),
+        parallax_rejected: 0,
         matches: obs
             .iter()
             .map(|(id, (u, v))| AerialMatch {
@@ -464,6 +472,7 @@ fn window_of(points: &[Vector3<f64>]) -> MmWindowMatch {
             .map(|(i, p)| tie_point(&format!("rec#{i}"), [p.x, p.y, p.z]))
             .collect(),
         ground_world: points.iter().map(|p| [p.x, p.y, p.z]).collect(),
+        neighbour_ground_world: Vec::new(),
     }
 }
 
@@ -767,6 +776,7 @@ mod e2e {
                     corners_detected: corners.len(),
                     tie_points,
                     ground_world,
+                    neighbour_ground_world: Vec::new(),
                 };
                 // Every nadir image that sees the recording.
                 let centre = Vector3::new(rec.x, rec.y, rec.z - rec.camera_height_m);
@@ -799,7 +809,7 @@ mod e2e {
                         centre_offset_world_m: [0.0, 0.0],
                         reused_from: None,
                     };
-                    let r = refine_in_aerial(&ortho, &aerial, row, &t, &window, params);
+                    let r = refine_in_aerial(&ortho, &aerial, row, &t, &window, &[], params);
                     stats.pairs += 1;
                     stats.tried += r.tried;
                     stats.located += r.matches.len();

@@ -246,6 +246,7 @@ pub fn baseline_matches(
         recording_id: t.recording_id.clone(),
         aerial_id: aerial_row.image_id.clone(),
         tried: 0,
+        parallax_rejected: 0,
         matches: Vec::new(),
     };
     let tf = t.ortho_to_aerial;

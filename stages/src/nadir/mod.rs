@@ -9,6 +9,7 @@ pub mod grading;
 pub mod initial_transform;
 pub mod mm_matching;
 pub mod ortho;
+pub mod parallax_check;
 pub mod refine;
 pub mod registration;
 pub mod summary;
@@ -19,6 +20,6 @@ pub mod vehicle_mask;
 pub use ortho::{ortho_project, OrthoGeoref, OrthoImage, OrthoParams};
 pub use registration::{
     AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch, PairMethod, PairReport,
-    RecordingControl, TransformOutcome,
+    RecordingControl, TransformOutcome, ViewGround,
 };
 pub use vehicle_mask::VehicleMask;

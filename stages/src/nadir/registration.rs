@@ -44,6 +44,19 @@ pub struct MmWindowMatch {
     /// For each tie point (same order): its corner position on the detecting recording's ortho ground plane,
     /// world frame, metres — where the aerial stages look for it.
     pub ground_world: Vec<[f64; 3]>,
+    /// For each tie point (same order): the same corner as seen by the neighbouring recordings the
+    /// triangulation kept, each on that neighbour's own ortho ground plane — what the parallax check of the
+    /// aerial refinement (`refine`) looks for in the neighbours' ortho images.
+    pub neighbour_ground_world: Vec<Vec<ViewGround>>,
+}
+
+/// One neighbouring recording's view of a tie point's corner: the point on its ortho ground plane, world
+/// frame, metres.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ViewGround {
+    /// The neighbour's `image_id`.
+    pub recording_id: String,
+    pub ground_world: [f64; 3],
 }
 
 /// The initial transform between a recording's MM ortho image (aerial GSD, aerial orientation) and one aerial
@@ -101,6 +114,9 @@ pub struct AerialRefinement {
     pub aerial_id: String,
     /// Tie points tried (inside the aerial image) and located (peak accepted).
     pub tried: usize,
+    /// Of `tried`: not located because a neighbouring recording shows the template differently (parallax
+    /// check, `nadir::parallax_check`).
+    pub parallax_rejected: usize,
     pub matches: Vec<AerialMatch>,
 }
 

@@ -26,6 +26,9 @@ pub struct NadirSummary {
     pub transforms_rejected: BTreeMap<String, usize>,
     /// MM tie point × aerial image correspondences (as Table 3-1 counts them).
     pub tie_points: usize,
+    /// Tie points × aerial images not located because a neighbouring recording shows the template differently
+    /// (`nadir::parallax_check`).
+    pub parallax_rejected: usize,
     /// Recordings with at least one MM–aerial correspondence.
     pub recordings_with_aerial: usize,
     /// Mean number of distinct aerial images with correspondences per such recording.
@@ -101,6 +104,7 @@ impl NadirSummary {
         let mut images_per_recording: BTreeMap<&str, BTreeSet<&str>> = BTreeMap::new();
         for r in refinements {
             s.tie_points += r.matches.len();
+            s.parallax_rejected += r.parallax_rejected;
             if !r.matches.is_empty() {
                 images_per_recording
                     .entry(r.recording_id.as_str())
@@ -140,6 +144,7 @@ impl NadirSummary {
             "recordings_with_aerial": self.recordings_with_aerial,
             "recordings_with_aerial_fraction": frac,
             "tie_points": self.tie_points,
+            "parallax_rejected": self.parallax_rejected,
             "mean_aerial_images_per_recording": self.mean_aerial_images_per_recording,
             "control_points": self.control_points,
             "single_aerial_points": self.single_aerial_points,

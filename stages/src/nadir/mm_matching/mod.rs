@@ -29,7 +29,7 @@ use crate::campaign::Recording;
 use crate::correspondence::PanoObservation;
 use crate::estimators::mix_seed;
 use crate::geometry::PanoramaCamera;
-use crate::nadir::{MmWindowMatch, OrthoImage, PairMethod, PairReport};
+use crate::nadir::{MmWindowMatch, OrthoImage, PairMethod, PairReport, ViewGround};
 use prepared::PreparedOrtho;
 use rayon::prelude::*;
 
@@ -77,6 +77,7 @@ fn invalid_window(detecting: &OrthoView, neighbours: &[OrthoView], reason: &str)
         corners_detected: 0,
         tie_points: Vec::new(),
         ground_world: Vec::new(),
+        neighbour_ground_world: Vec::new(),
     }
 }
 
@@ -138,6 +139,7 @@ pub fn match_window(
     let pano_ok = |v: &OrthoView| v.pano_width_px > 0 && v.pano_height_px > 0;
     let mut tie_points = Vec::new();
     let mut ground_world = Vec::new();
+    let mut neighbour_ground_world = Vec::new();
     if pano_ok(detecting) {
         let det_cam = tie_point::camera_of(detecting);
         let nb_cams: Vec<Option<PanoramaCamera>> = neighbours
@@ -145,13 +147,15 @@ pub fn match_window(
             .map(|n| pano_ok(n).then(|| tie_point::camera_of(n)))
             .collect();
         let track = tie_point::TrackTriangulation::from(p);
-        let results: Vec<Option<(crate::correspondence::MmTiePoint, [f64; 3])>> = corners
+        type Located = (crate::correspondence::MmTiePoint, [f64; 3], Vec<ViewGround>);
+        let results: Vec<Option<Located>> = corners
             .par_iter()
             .enumerate()
             .map(|(i, c)| {
                 let first = tie_point::pano_observation(detecting, &det_cam, c.u_px, c.v_px)?;
                 let mut members: Vec<(&PanoramaCamera, PanoObservation)> =
                     Vec::with_capacity(1 + neighbours.len());
+                let mut views = Vec::with_capacity(neighbours.len());
                 members.push((&det_cam, first));
                 for (k, nb) in neighbours.iter().enumerate() {
                     let (Some(cam), Some(loc)) = (&nb_cams[k], located[k][i]) else {
@@ -159,19 +163,27 @@ pub fn match_window(
                     };
                     if let Some(obs) = tie_point::pano_observation(nb, cam, loc.u_px, loc.v_px) {
                         members.push((cam, obs));
+                        let g = nb.ortho.georef.pixel_to_world(loc.u_px, loc.v_px);
+                        views.push(ViewGround {
+                            recording_id: nb.recording.image_id.clone(),
+                            ground_world: [g.x, g.y, g.z],
+                        });
                     }
                 }
                 if members.len() < 2 {
                     return None;
                 }
                 let tp = tie_point::triangulate_track(format!("{det_id}#{i}"), &members, &track)?;
+                // Only the neighbour views the triangulation kept.
+                views.retain(|v| tp.observations.iter().any(|o| o.image_id == v.recording_id));
                 let g = detecting.ortho.georef.pixel_to_world(c.u_px, c.v_px);
-                Some((tp, [g.x, g.y, g.z]))
+                Some((tp, [g.x, g.y, g.z], views))
             })
             .collect();
-        for (tp, g) in results.into_iter().flatten() {
+        for (tp, g, views) in results.into_iter().flatten() {
             tie_points.push(tp);
             ground_world.push(g);
+            neighbour_ground_world.push(views);
         }
     }
     MmWindowMatch {
@@ -180,5 +192,6 @@ pub fn match_window(
         corners_detected: corners.len(),
         tie_points,
         ground_world,
+        neighbour_ground_world,
     }
 }
