@@ -6,6 +6,8 @@
 //! 1. ground point → MM ortho pixel (`OrthoGeoref::world_to_pixel`) → predicted aerial pixel (the transform);
 //! 2. MM template: `template_px²` ortho pixels around the corner; skipped if it leaves the ortho image, touches a
 //!    pixel masked by the vehicle, or is nearly flat (phase correlation of a flat patch is noise);
+//!    It is also compared with the neighbouring recordings' views of the same corner (`parallax_check`): a
+//!    template showing content at another height than the corner (a kerb) is left out;
 //! 3. aerial window: the aerial image is **resampled onto the MM ortho grid** (bicubic, through the transform)
 //!    over the template region enlarged by `search_margin_px` on every side. Resampling the aerial side keeps the
 //!    MM template exactly as ortho-projected, and both images then share orientation and pixel size, so only a
@@ -273,7 +275,8 @@ enum Outcome {
     Outside,
     /// Tried but not located (template unusable, window outside, weak peak, shift too large).
     Rejected,
-    /// Not tried: a neighbouring view shows the template's structure differently (parallax check).
+    /// Tried, but left out before phase correlation: a neighbouring view shows the template's structure
+    /// differently (parallax check).
     Parallax,
     Located(AerialMatch),
 }
