@@ -27,6 +27,16 @@ use super::ortho::OrthoImage;
 /// deviations of the template.
 pub const DISAGREEMENT_STD: f64 = 0.6;
 
+/// Reusable buffers of [`parallax_share`] (one per worker thread, so the check allocates nothing per call).
+#[derive(Default)]
+pub struct ParallaxScratch {
+    mine: Vec<f64>,
+    other: Vec<f64>,
+    known: Vec<bool>,
+    a: Vec<f64>,
+    b: Vec<f64>,
+}
+
 /// Share (0..1, gradient-weighted) of the structure of `template` that the neighbour's ortho image `neighbour`
 /// shows differently, with the template's top-left pixel corner at (`nx0`, `ny0`) in the neighbour's ortho
 /// (continuous pixels). Neighbour pixels outside its image or masked give no vote; `None` when fewer than half
@@ -36,14 +46,22 @@ pub fn parallax_share(
     neighbour: &OrthoImage,
     nx0: f64,
     ny0: f64,
+    scratch: &mut ParallaxScratch,
 ) -> Option<f64> {
     let (w, h) = (template.width, template.height);
     if w < 3 || h < 3 || template.data.len() != w * h {
         return None;
     }
     let (nw, nh) = (neighbour.image.width, neighbour.image.height);
-    let mut other = Vec::with_capacity(w * h);
-    let mut known = Vec::with_capacity(w * h);
+    let ParallaxScratch {
+        mine,
+        other,
+        known,
+        a,
+        b,
+    } = scratch;
+    other.clear();
+    known.clear();
     for r in 0..h {
         for c in 0..w {
             let (x, y) = (nx0 + c as f64 + 0.5, ny0 + r as f64 + 0.5);
@@ -73,9 +91,12 @@ pub fn parallax_share(
         .iter_mut()
         .filter(|v| !v.is_finite())
         .for_each(|v| *v = fill);
-    let mine: Vec<f64> = template.data.iter().map(|&g| g as f64).collect();
-    let a = normalised(&box3(&mine, w, h));
-    let b = normalised(&box3(&other, w, h));
+    mine.clear();
+    mine.extend(template.data.iter().map(|&g| g as f64));
+    box3(mine, w, h, a);
+    normalise(a);
+    box3(other, w, h, b);
+    normalise(b);
     let (mut differing, mut total) = (0.0, 0.0);
     for r in 1..h - 1 {
         for c in 1..w - 1 {
@@ -93,9 +114,10 @@ pub fn parallax_share(
     (total > 0.0).then(|| differing / total)
 }
 
-/// 3 × 3 box filter (border pixels copied).
-fn box3(v: &[f64], w: usize, h: usize) -> Vec<f64> {
-    let mut out = v.to_vec();
+/// 3 × 3 box filter of `v` into `out` (border pixels copied).
+fn box3(v: &[f64], w: usize, h: usize, out: &mut Vec<f64>) {
+    out.clear();
+    out.extend_from_slice(v);
     for r in 1..h - 1 {
         for c in 1..w - 1 {
             let mut acc = 0.0;
@@ -106,16 +128,15 @@ fn box3(v: &[f64], w: usize, h: usize) -> Vec<f64> {
             out[r * w + c] = acc / 9.0;
         }
     }
-    out
 }
 
-/// Zero mean, unit standard deviation (a flat input stays flat).
-fn normalised(v: &[f64]) -> Vec<f64> {
+/// Zero mean, unit standard deviation, in place (a flat input stays flat).
+fn normalise(v: &mut [f64]) {
     let n = v.len().max(1) as f64;
     let mean = v.iter().sum::<f64>() / n;
     let sd = (v.iter().map(|a| (a - mean).powi(2)).sum::<f64>() / n).sqrt();
     let sd = if sd > 1e-9 { sd } else { 1.0 };
-    v.iter().map(|a| (a - mean) / sd).collect()
+    v.iter_mut().for_each(|a| *a = (*a - mean) / sd);
 }
 
 #[cfg(test)]
@@ -173,11 +194,13 @@ mod tests {
         let t = template(&scene(size, 48.0, (0.0, 0.0)), size, 32, 32, 32);
         // The other view sees the same single-height scene (shifted as a whole: the alignment takes it out).
         let same = ortho(scene(size, 48.0, (0.0, 0.0)), size);
-        let share_same = parallax_share(&t, &same, 32.0, 32.0).unwrap();
+        let share_same =
+            parallax_share(&t, &same, 32.0, 32.0, &mut ParallaxScratch::default()).unwrap();
         // The other view displaces the raised square (and its corner, where the views are aligned) by 2 px
         // against the road stripes.
         let moved = ortho(scene(size, 48.0, (2.0, 0.0)), size);
-        let share_moved = parallax_share(&t, &moved, 34.0, 32.0).unwrap();
+        let share_moved =
+            parallax_share(&t, &moved, 34.0, 32.0, &mut ParallaxScratch::default()).unwrap();
         assert!(share_same < 0.01, "{share_same}");
         assert!(share_moved > 0.3, "{share_moved}");
     }
@@ -189,8 +212,14 @@ mod tests {
         let t = template(&img, size, 32, 32, 32);
         let mut masked = ortho(img, size);
         masked.valid.iter_mut().for_each(|v| *v = 0);
-        assert_eq!(parallax_share(&t, &masked, 32.0, 32.0), None);
+        assert_eq!(
+            parallax_share(&t, &masked, 32.0, 32.0, &mut ParallaxScratch::default()),
+            None
+        );
         let inside = ortho(scene(size, 48.0, (0.0, 0.0)), size);
-        assert_eq!(parallax_share(&t, &inside, 80.0, 80.0), None);
+        assert_eq!(
+            parallax_share(&t, &inside, 80.0, 80.0, &mut ParallaxScratch::default()),
+            None
+        );
     }
 }

@@ -23,7 +23,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::ortho::OrthoImage;
-use super::parallax_check::parallax_share;
+use super::parallax_check::{parallax_share, ParallaxScratch};
 use super::registration::{AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch};
 use crate::campaign::{AerialImage, AerialKind};
 use crate::correspondence::AerialObservation;
@@ -260,12 +260,14 @@ pub fn grey_std(img: &GrayImage) -> f64 {
 struct Buffers {
     template: GrayImage,
     search: GrayImage,
+    parallax: ParallaxScratch,
 }
 
 fn new_buffers() -> Buffers {
     Buffers {
         template: GrayImage::filled(0, 0, 0.0),
         search: GrayImage::filled(0, 0, 0.0),
+        parallax: ParallaxScratch::default(),
     }
 }
 
@@ -431,7 +433,7 @@ pub fn refine_in_aerial(
                         .world_to_pixel(&Vector3::new(gv[0], gv[1], gv[2]));
                     // The template's top-left corner, placed relative to the corner as the neighbour saw it.
                     let (nx0, ny0) = (u_n - (u_o - corner.0), v_n - (v_o - corner.1));
-                    if parallax_share(&buf.template, nb.ortho, nx0, ny0)
+                    if parallax_share(&buf.template, nb.ortho, nx0, ny0, &mut buf.parallax)
                         .is_some_and(|share| share > p.max_parallax_share)
                     {
                         return Outcome::Parallax;
