@@ -1,7 +1,8 @@
 //! `refine`: per (recording × nadir image) with an accepted initial transform, every MM tie point of the
 //! recording's window located in the aerial image by phase correlation (thesis 3.4.5.3,
-//! `skytie_stages::nadir::refine`), each template first compared with the window's neighbouring recordings' views
-//! (their orthos for the same aerial image, `skytie_stages::nadir::parallax_check`). A rejected transform gives an empty refinement.
+//! `skytie_stages::nadir::refine`), each template first compared with the window's neighbouring recordings'
+//! views (their orthos for the same aerial image, `skytie_stages::nadir::parallax_check`). A rejected transform
+//! gives an empty refinement.
 
 use super::decoded_images;
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};

@@ -156,7 +156,7 @@ pub fn add_nadir(
         }
         let mut rec_refinements = Vec::new();
         let mut rec_aerials = Vec::new();
-        // Per overlapping nadir image: (aerial row, file, label, ortho, transform outcome).
+        // Per overlapping nadir image: (aerial handle, file, pair label, ortho, transform outcome, aerial image_id).
         let mut pairs = Vec::new();
         for a in overlapping_nadir(
             item.recording,
@@ -180,7 +180,7 @@ pub fn add_nadir(
                     h
                 }
             };
-            let pair = format!("rec {} × {}", item.recording.image_id, row.image_id);
+            let pair = pair_label(&item.recording.image_id, &row.image_id);
             let aerial_file = RawFile(nadir_dir.join(&row.file));
             let ortho = b.add(
                 OrthoForAerial,
@@ -229,7 +229,7 @@ pub fn add_nadir(
                         .map(|n| {
                             b.add(
                                 OrthoForAerial,
-                                &format!("rec {} × {}", n.recording.image_id, aerial_id),
+                                &pair_label(&n.recording.image_id, &aerial_id),
                                 ortho_base.clone(),
                                 (n.row, n.pano.clone(), aerial),
                             )
@@ -299,4 +299,10 @@ pub fn add_nadir(
         b.metrics(grade, "nadir", |g: &NadirGrade| grade_metrics(g));
     }
     Ok(NadirHandles { windows, control })
+}
+
+/// The item label of a (recording × nadir image) node; the neighbours' orthos for the parallax check reuse the
+/// neighbour's own pair nodes through it.
+fn pair_label(recording_id: &str, aerial_id: &str) -> String {
+    format!("rec {recording_id} × {aerial_id}")
 }
