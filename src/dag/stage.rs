@@ -117,6 +117,13 @@ impl NodeCtx {
         std::fs::create_dir_all(&p)?;
         Ok(p)
     }
+
+    /// A folder for work in progress that must survive an interrupted run of this node (e.g. the finished images
+    /// of a long synthetic render), `<cache>/dirs/.partial-<key>`: not emptied at the start, unlike
+    /// [`NodeCtx::output_dir_tmp`]. The stage removes it when it has finished.
+    pub fn partial_dir(&self) -> PathBuf {
+        dirs_root(&self.cache_root).join(format!(".partial-{}", self.key))
+    }
 }
 
 pub(crate) fn dirs_root(cache_root: &Path) -> PathBuf {

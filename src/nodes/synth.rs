@@ -1,13 +1,15 @@
 //! `synth`: the synthetic campaign generator as a cached node (`campaign = "synth:<preset>"` in a workflow).
 //!
 //! The node writes the whole campaign folder into its own cache folder (`<cache>/dirs/<key>/campaign`), so a
-//! second run — or any workflow naming the same preset, seed and options — reuses it. The output records every
-//! file's size; a cached folder whose files went missing or changed size is regenerated.
+//! second run — or any workflow naming the same preset, seed and options — reuses it. Finished images are kept
+//! in the node's partial folder (`<cache>/dirs/.partial-<key>`) until the campaign is complete, so an interrupted
+//! generation resumes (`skytie_stages::synth::render_store`). The output records every file's size; a cached
+//! folder whose files went missing or changed size is regenerated.
 
 use crate::dag::{NodeCtx, Stage, StageError};
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
-use skytie_stages::synth::{generate, Deterioration, Preset, SynthOptions, SynthSummary};
+use skytie_stages::synth::{generate_resumable, Deterioration, Preset, SynthOptions, SynthSummary};
 use std::path::{Path, PathBuf};
 
 /// Parameters of the `[synth]` workflow table (preset and seed come from `campaign = "synth:<preset>"` and `seed`).
@@ -128,8 +130,20 @@ impl Stage for SynthCampaign {
     fn run(&self, p: &SynthParams, _: (), ctx: &NodeCtx) -> Result<GeneratedCampaign, StageError> {
         let options = p.options().map_err(StageError::new)?;
         let tmp = ctx.output_dir_tmp()?;
-        let summary = generate(&options, &tmp.join("campaign"))
-            .map_err(|e| StageError::new(format!("synthetic campaign generation failed: {e}")))?;
+        let (summary, reused) =
+            generate_resumable(&options, &tmp.join("campaign"), &ctx.partial_dir()).map_err(|e| {
+                StageError::new(format!(
+                    "synthetic campaign generation failed: {e} (the images rendered so far are kept in {}; \
+                     the next run resumes from them)",
+                    ctx.partial_dir().display()
+                ))
+            })?;
+        if reused > 0 {
+            eprintln!(
+                "synth: resumed an interrupted generation: {reused} images taken from {}",
+                ctx.partial_dir().display()
+            );
+        }
         let files = list_files(&tmp.join("campaign"))?;
         let dir = ctx.output_dir().join("campaign");
         Ok(GeneratedCampaign {

@@ -1,8 +1,12 @@
 //! The synthetic campaign is deterministic: `tiny` with seed 1 generated twice, and with 1 vs 2 rayon
 //! threads, gives byte-identical folders (every file compared); the folder follows the campaign format;
-//! regenerating over a previous synthetic campaign replaces it, while a foreign folder is refused.
+//! regenerating over a previous synthetic campaign replaces it, while a foreign folder is refused; a generation
+//! resumed from the render store of an interrupted one gives the same folder.
 
-use skytie_stages::synth::{generate, Preset, SynthError, SynthOptions, SynthSummary};
+use skytie_stages::synth::render_store::RenderStore;
+use skytie_stages::synth::{
+    generate, generate_resumable, Preset, SynthError, SynthOptions, SynthSummary,
+};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -158,4 +162,46 @@ fn seeds_change_the_campaign() {
         skytie_stages::synth::generate::plan_campaign(&SynthOptions::new(Preset::Tiny, 2)).unwrap();
     assert_ne!(a.recorded[0].x, b.recorded[0].x);
     assert_eq!(a.name, "synth-tiny-seed1");
+}
+
+#[test]
+fn a_resumed_generation_takes_the_stored_images_and_gives_the_same_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let options = SynthOptions::new(Preset::Tiny, 1);
+    let full = dir.path().join("full");
+    let store_dir = dir.path().join("store");
+    let (first, reused) = generate_resumable(&options, &full, &store_dir).unwrap();
+    assert_eq!(reused, 0);
+    assert!(!store_dir.exists(), "the store is removed once the campaign is installed");
+    let expected = read_tree(&full);
+
+    // What an interrupted generation leaves: some finished images (with their hashes), one image whose bytes
+    // were damaged afterwards, and a stray file of an unfinished write.
+    let store = RenderStore::open(&store_dir, &options.store_identity().unwrap()).unwrap();
+    let images: Vec<&PathBuf> = expected
+        .keys()
+        .filter(|k| k.extension().is_some_and(|e| e == "jpg"))
+        .collect();
+    assert!(images.len() >= 6, "{images:?}");
+    let rel = |p: &Path| p.to_string_lossy().replace('\\', "/");
+    for p in &images[..4] {
+        store.keep(&rel(p), &full.join(p)).unwrap();
+    }
+    std::fs::write(store_dir.join(rel(images[3])), b"damaged").unwrap();
+    std::fs::write(store_dir.join(format!("{}.tmp", rel(images[4]))), b"half").unwrap();
+
+    let resumed = dir.path().join("resumed");
+    let (second, reused) = generate_resumable(&options, &resumed, &store_dir).unwrap();
+    assert_eq!(reused, 3, "three intact images are reused, the damaged one is rendered again");
+    assert!(second.primary_rays < first.primary_rays, "{second:?}");
+    assert_same_tree(&expected, &read_tree(&resumed), "resumed vs uninterrupted");
+    assert!(!store_dir.exists());
+
+    // A store left by other options (another seed) is not used.
+    let other = RenderStore::open(&store_dir, &SynthOptions::new(Preset::Tiny, 2).store_identity().unwrap())
+        .unwrap();
+    other.keep(&rel(images[0]), &full.join(images[0])).unwrap();
+    let third = dir.path().join("third");
+    let (_, reused) = generate_resumable(&options, &third, &store_dir).unwrap();
+    assert_eq!(reused, 0);
 }

@@ -12,6 +12,7 @@ use super::deteriorate::{Deterioration, DeteriorationModel};
 use super::postprocess::{apply_look, EpochLook};
 use super::preset::{Preset, PresetParams};
 use super::render::{primary_rays, render_frame, render_panorama_with_vehicle};
+use super::render_store::RenderStore;
 use super::rng::hash_str;
 use super::scene::{Epoch, Scene};
 use super::scene_truth::{build_scenes, SceneTruth, SCENE_TRUTH_FILE};
@@ -56,6 +57,15 @@ impl SynthOptions {
             panorama_width_px: None,
             max_recordings_per_route: None,
         }
+    }
+
+    /// What identifies the images of a generation with these options in a [`RenderStore`] (the options as
+    /// JSON).
+    pub fn store_identity(&self) -> Result<String, SynthError> {
+        serde_json::to_string(self).map_err(|e| SynthError::InvalidOption {
+            option: "options".into(),
+            message: format!("cannot serialise the options ({e})"),
+        })
     }
 
     /// The preset's parameters with this option set's overrides applied and checked.
@@ -116,7 +126,8 @@ pub struct SynthSummary {
     pub oblique_images: usize,
     pub checkpoints: usize,
     pub observations: usize,
-    /// Primary (camera) rays traced for all images (shadow rays of the shading are not counted).
+    /// Primary (camera) rays traced for the images rendered by this generation (shadow rays of the shading are
+    /// not counted; images taken from the render store of an interrupted generation are not either).
     pub primary_rays: u64,
     /// Wall time spent rendering (ray casting + post-processing), s.
     pub render_seconds: f64,
@@ -308,9 +319,14 @@ fn write_aerial(
     Ok(primary_rays(a.width_px, a.height_px, p.aerial_spp_axis))
 }
 
-/// Write every file of the planned campaign into `root` (which must exist and be empty); returns the primary
-/// rays traced.
-fn write_campaign(plan: &CampaignPlan, root: &Path) -> Result<u64, SynthError> {
+/// Write every file of the planned campaign into `root` (which must exist and be empty), taking the images an
+/// interrupted generation left in `store` and keeping the new ones there; returns the primary rays traced and
+/// the number of images taken from the store.
+fn write_campaign(
+    plan: &CampaignPlan,
+    root: &Path,
+    store: &RenderStore,
+) -> Result<(u64, usize), SynthError> {
     let p = &plan.params;
     let io = |path: PathBuf| move |e: std::io::Error| SynthError::io(&path, e);
     let mut rays = 0u64;
@@ -319,15 +335,32 @@ fn write_campaign(plan: &CampaignPlan, root: &Path) -> Result<u64, SynthError> {
         root.join("aerial/nadir"),
         root.join("aerial/oblique"),
     );
+    let mut reused = 0usize;
+    // One image: taken from the store when an interrupted generation finished it, else rendered and kept.
+    let mut image = |rel: String, render: &dyn Fn() -> Result<u64, SynthError>| {
+        let path = root.join(&rel);
+        if store.fetch(&rel, &path)? {
+            reused += 1;
+            return Ok::<(), SynthError>(());
+        }
+        rays += render()?;
+        store.keep(&rel, &path)
+    };
     for area in &plan.areas {
         for rec in &area.truth {
-            rays += write_panorama(&area.scene, rec, p, plan.seed, &pano_dir)?;
+            image(format!("mm/panoramas/{}", rec.file), &|| {
+                write_panorama(&area.scene, rec, p, plan.seed, &pano_dir)
+            })?;
         }
         for a in &area.nadir {
-            rays += write_aerial(&area.scene, a, p, plan.seed, &nadir_dir)?;
+            image(format!("aerial/nadir/{}", a.file), &|| {
+                write_aerial(&area.scene, a, p, plan.seed, &nadir_dir)
+            })?;
         }
         for a in &area.oblique {
-            rays += write_aerial(&area.scene, a, p, plan.seed, &oblique_dir)?;
+            image(format!("aerial/oblique/{}", a.file), &|| {
+                write_aerial(&area.scene, a, p, plan.seed, &oblique_dir)
+            })?;
         }
     }
     let path = root.join("campaign.toml");
@@ -371,7 +404,7 @@ fn write_campaign(plan: &CampaignPlan, root: &Path) -> Result<u64, SynthError> {
     crate::fsutil::atomic_write(&path, readme.as_bytes()).map_err(io(path))?;
     let path = root.join(SCENE_TRUTH_FILE);
     crate::fsutil::atomic_write(&path, plan.scene_truth.to_toml().as_bytes()).map_err(io(path))?;
-    Ok(rays)
+    Ok((rays, reused))
 }
 
 static TMP_COUNTER: AtomicU64 = AtomicU64::new(0);
@@ -420,8 +453,25 @@ fn install(tmp: &Path, out: &Path) -> Result<(), SynthError> {
 
 /// Generate the whole campaign described by `options` into the folder `out` (created, or replacing a previous
 /// synthetic campaign; any other existing folder is refused). Written into a temporary sibling first, then
-/// renamed, so `out` is never half-written.
+/// renamed, so `out` is never half-written. Finished images are kept in the render store
+/// `.<out name>.render-store` beside `out` until the campaign is installed, so an interrupted generation
+/// resumes ([`RenderStore`]).
 pub fn generate(options: &SynthOptions, out: &Path) -> Result<SynthSummary, SynthError> {
+    let name = out
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "campaign".into());
+    let store = out.with_file_name(format!(".{name}.render-store"));
+    generate_resumable(options, out, &store).map(|(summary, _)| summary)
+}
+
+/// [`generate`] with the render store at `store_dir`; also returns how many images were taken from the store
+/// (rendered by an interrupted generation with the same options) instead of being rendered.
+pub fn generate_resumable(
+    options: &SynthOptions,
+    out: &Path,
+    store_dir: &Path,
+) -> Result<(SynthSummary, usize), SynthError> {
     let start = Instant::now();
     if out.exists() && !replaceable(out) {
         return Err(SynthError::OutputExists {
@@ -432,19 +482,21 @@ pub fn generate(options: &SynthOptions, out: &Path) -> Result<SynthSummary, Synt
     if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent).map_err(|e| SynthError::io(parent, e))?;
     }
+    let store = RenderStore::open(store_dir, &options.store_identity()?)?;
     let tmp = sibling(out, "tmp");
     std::fs::create_dir_all(&tmp).map_err(|e| SynthError::io(&tmp, e))?;
     let render_start = Instant::now();
-    let written = write_campaign(&plan, &tmp);
+    let written = write_campaign(&plan, &tmp, &store);
     let render_seconds = render_start.elapsed().as_secs_f64();
-    let rays = match written.and_then(|rays| install(&tmp, out).map(|_| rays)) {
-        Ok(r) => r,
+    let (rays, reused) = match written.and_then(|w| install(&tmp, out).map(|_| w)) {
+        Ok(w) => w,
         Err(e) => {
             let _ = std::fs::remove_dir_all(&tmp);
             return Err(e);
         }
     };
-    Ok(SynthSummary {
+    store.remove()?;
+    let summary = SynthSummary {
         name: plan.name.clone(),
         recordings: plan.recorded.len(),
         nadir_images: plan.areas.iter().map(|a| a.nadir.len()).sum(),
@@ -458,7 +510,8 @@ pub fn generate(options: &SynthOptions, out: &Path) -> Result<SynthSummary, Synt
         primary_rays: rays,
         render_seconds,
         seconds: start.elapsed().as_secs_f64(),
-    })
+    };
+    Ok((summary, reused))
 }
 
 /// Generate preset `preset` (`tiny`, `demo`, `paper`) with seed `seed` and the thesis deterioration.

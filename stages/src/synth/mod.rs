@@ -18,6 +18,7 @@ pub mod generate;
 pub mod postprocess;
 pub mod preset;
 pub mod render;
+pub mod render_store;
 pub mod rng;
 pub mod scene_truth;
 pub mod trajectory;
@@ -25,6 +26,6 @@ pub mod vehicle;
 
 pub use deteriorate::{Deterioration, DeteriorationModel, DriftProfile};
 pub use error::SynthError;
-pub use generate::{generate, generate_preset, SynthOptions, SynthSummary};
+pub use generate::{generate, generate_preset, generate_resumable, SynthOptions, SynthSummary};
 pub use preset::{Preset, PresetParams};
 pub use render::{render_frame, render_panorama, render_panorama_with_vehicle};
