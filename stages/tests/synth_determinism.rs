@@ -172,7 +172,10 @@ fn a_resumed_generation_takes_the_stored_images_and_gives_the_same_folder() {
     let store_dir = dir.path().join("store");
     let (first, reused) = generate_resumable(&options, &full, &store_dir).unwrap();
     assert_eq!(reused, 0);
-    assert!(!store_dir.exists(), "the store is removed once the campaign is installed");
+    assert!(
+        !store_dir.exists(),
+        "the store is removed once the campaign is installed"
+    );
     let expected = read_tree(&full);
 
     // What an interrupted generation leaves: some finished images (with their hashes), one image whose bytes
@@ -192,14 +195,20 @@ fn a_resumed_generation_takes_the_stored_images_and_gives_the_same_folder() {
 
     let resumed = dir.path().join("resumed");
     let (second, reused) = generate_resumable(&options, &resumed, &store_dir).unwrap();
-    assert_eq!(reused, 3, "three intact images are reused, the damaged one is rendered again");
+    assert_eq!(
+        reused, 3,
+        "three intact images are reused, the damaged one is rendered again"
+    );
     assert!(second.primary_rays < first.primary_rays, "{second:?}");
     assert_same_tree(&expected, &read_tree(&resumed), "resumed vs uninterrupted");
     assert!(!store_dir.exists());
 
     // A store left by other options (another seed) is not used.
-    let other = RenderStore::open(&store_dir, &SynthOptions::new(Preset::Tiny, 2).store_identity().unwrap())
-        .unwrap();
+    let other = RenderStore::open(
+        &store_dir,
+        &SynthOptions::new(Preset::Tiny, 2).store_identity().unwrap(),
+    )
+    .unwrap();
     other.keep(&rel(images[0]), &full.join(images[0])).unwrap();
     let third = dir.path().join("third");
     let (_, reused) = generate_resumable(&options, &third, &store_dir).unwrap();

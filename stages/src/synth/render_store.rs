@@ -56,7 +56,8 @@ impl RenderStore {
     /// hash; returns whether it did. A stored image whose hash does not match is removed.
     pub fn fetch(&self, rel: &str, dest: &Path) -> Result<bool, SynthError> {
         let (image, hash) = self.paths(rel);
-        let (Ok(bytes), Ok(expected)) = (std::fs::read(&image), std::fs::read_to_string(&hash)) else {
+        let (Ok(bytes), Ok(expected)) = (std::fs::read(&image), std::fs::read_to_string(&hash))
+        else {
             return Ok(false);
         };
         if blake3::hash(&bytes).to_hex().as_str() != expected.trim() {
