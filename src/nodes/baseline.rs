@@ -14,7 +14,7 @@ pub struct BaselineStage;
 
 impl Stage for BaselineStage {
     const NAME: &'static str = "baseline";
-    const VERSION: &'static str = "2";
+    const VERSION: &'static str = "3";
     type Params = BaselineParams;
     type Output = AerialRefinement;
     type Inputs = (

@@ -29,6 +29,18 @@ pub fn grade_metrics(g: &NadirGrade) -> serde_json::Value {
         "inlier_ratio": g.inlier_ratio(),
         "mm_tie_points_graded": g.mm_tie_points,
         "mm_tie_points_correct": g.mm_tie_points_correct,
+        "correspondence_error_px": {
+            "median": g.correspondence_error_px[0],
+            "p90": g.correspondence_error_px[1],
+            "max": g.correspondence_error_px[2],
+        },
+        "wrong_correspondences": g.wrong.iter().map(|w| serde_json::json!({
+            "tie_point": w.tie_point_id,
+            "aerial_image": w.aerial_id,
+            "error_px": w.error_px,
+            "offset_px": w.offset_px,
+            "aerial_images": w.aerial_images,
+        })).collect::<Vec<_>>(),
         "control_point_error_m": {
             "count": c.count,
             "median_horizontal": c.median_horizontal_m,
@@ -96,7 +108,7 @@ pub struct GradeNadir;
 
 impl Stage for GradeNadir {
     const NAME: &'static str = "grade_nadir";
-    const VERSION: &'static str = "1";
+    const VERSION: &'static str = "2";
     type Params = SummaryParams;
     type Output = NadirGrade;
     type Inputs = (

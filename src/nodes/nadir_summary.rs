@@ -15,8 +15,8 @@ pub struct SummarizeNadir;
 
 impl Stage for SummarizeNadir {
     const NAME: &'static str = "nadir";
-    // 2: counts `parallax_rejected`.
-    const VERSION: &'static str = "2";
+    // 2: counts `parallax_rejected`. 3: counts `unconfirmed`.
+    const VERSION: &'static str = "3";
     type Params = SummaryParams;
     type Output = NadirSummary;
     type Inputs = (

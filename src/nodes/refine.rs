@@ -23,7 +23,7 @@ impl Stage for RefineStage {
     const NAME: &'static str = "refine";
     // 2: phase correlation refines on the 3×3 direct-DFT surface and cuts near-zero bins relative to the RMS.
     // 3: the parallax check against the window's neighbouring recordings (their orthos are inputs).
-    const VERSION: &'static str = "3";
+    const VERSION: &'static str = "4";
     type Params = RefineParams;
     type Output = AerialRefinement;
     type Inputs = (
@@ -74,13 +74,10 @@ pub fn locate_with_accepted(
     locate: impl FnOnce(&InitialTransform, &GrayImage) -> AerialRefinement,
 ) -> Result<AerialRefinement, StageError> {
     let TransformOutcome::Accepted(t) = outcome else {
-        return Ok(AerialRefinement {
-            recording_id: window.recording_id.clone(),
-            aerial_id: aerial.image_id.clone(),
-            tried: 0,
-            parallax_rejected: 0,
-            matches: Vec::new(),
-        });
+        return Ok(AerialRefinement::empty(
+            &window.recording_id,
+            &aerial.image_id,
+        ));
     };
     let image = decoded_images::gray(aerial_file)?;
     Ok(locate(t, &image))

@@ -387,6 +387,65 @@ fn tie_points_outside_the_aerial_image_are_not_tried_and_bad_transforms_give_not
 }
 
 #[test]
+fn a_tie_point_located_alone_in_an_image_is_not_kept_unless_min_located_is_1() {
+    let pair = make_pair(11, 0.01);
+    let row = aerial_row("aer", 400, 360);
+    let p = params_at_peak_05();
+    let all = refine_in_aerial(
+        &pair.ortho,
+        &pair.aerial,
+        &row,
+        &transform(pair.truth),
+        &pair.window,
+        &[],
+        &p,
+    );
+    assert_eq!(all.unconfirmed, 0);
+    // Keep only the window's first two locatable tie points.
+    let keep: Vec<usize> = all
+        .matches
+        .iter()
+        .take(2)
+        .map(|m| m.tie_point_id.split('#').nth(1).unwrap().parse().unwrap())
+        .collect();
+    let window_of_ids = |ids: &[usize]| {
+        let mut w = pair.window.clone();
+        w.tie_points = ids
+            .iter()
+            .map(|&i| pair.window.tie_points[i].clone())
+            .collect();
+        w.ground_world = ids.iter().map(|&i| pair.window.ground_world[i]).collect();
+        w.neighbour_ground_world = ids.iter().map(|_| Vec::new()).collect();
+        w
+    };
+    let run = |ids: &[usize], min_located: usize| {
+        let q = RefineParams {
+            min_located,
+            ..p.clone()
+        };
+        refine_in_aerial(
+            &pair.ortho,
+            &pair.aerial,
+            &row,
+            &transform(pair.truth),
+            &window_of_ids(ids),
+            &[],
+            &q,
+        )
+    };
+    let two = run(&keep, 2);
+    assert_eq!((two.tried, two.matches.len(), two.unconfirmed), (2, 2, 0));
+    let one = run(&keep[..1], 2);
+    assert_eq!((one.tried, one.matches.len(), one.unconfirmed), (1, 0, 1));
+    let one_kept = run(&keep[..1], 1);
+    assert_eq!((one_kept.matches.len(), one_kept.unconfirmed), (1, 0));
+    assert_eq!(
+        one_kept.matches[0], two.matches[0],
+        "the same location either way"
+    );
+}
+
+#[test]
 fn refine_params_validate_and_reject_unknown_keys() {
     assert!(RefineParams::default().validate().is_ok());
     let bad = RefineParams {
@@ -443,6 +502,7 @@ fn refinement_of(row: &AerialImage, obs: &[(String, (f64, f64))]) -> AerialRefin
         aerial_id: row.image_id.clone(),
         tried: obs.len(),
         parallax_rejected: 0,
+        unconfirmed: 0,
         matches: obs
             .iter()
             .map(|(id, (u, v))| AerialMatch {

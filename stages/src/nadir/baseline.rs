@@ -242,13 +242,7 @@ pub fn baseline_matches(
     window: &MmWindowMatch,
     p: &BaselineParams,
 ) -> AerialRefinement {
-    let mut result = AerialRefinement {
-        recording_id: t.recording_id.clone(),
-        aerial_id: aerial_row.image_id.clone(),
-        tried: 0,
-        parallax_rejected: 0,
-        matches: Vec::new(),
-    };
+    let mut result = AerialRefinement::empty(&t.recording_id, &aerial_row.image_id);
     let tf = t.ortho_to_aerial;
     let transform_ok = [tf.scale, tf.rotation_rad, tf.tx, tf.ty]
         .iter()

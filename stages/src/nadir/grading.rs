@@ -83,6 +83,24 @@ pub struct NadirGrade {
     pub mm_tie_points_correct: usize,
     /// Aerial control points (≥ 2 aerial images) vs their true points.
     pub control_points: ErrorStats,
+    /// Error (aerial px) of the graded correspondences: median, 90th percentile, largest.
+    pub correspondence_error_px: [f64; 3],
+    /// The wrong correspondences (error above [`CORRECT_TOLERANCE_PX`]), largest error first, so a user can
+    /// look at each one (`skytie tool ortho`, the report's registration views).
+    pub wrong: Vec<WrongCorrespondence>,
+}
+
+/// One MM tie point × aerial image correspondence that is wrong by the truth.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WrongCorrespondence {
+    pub tie_point_id: String,
+    pub aerial_id: String,
+    /// Distance between the aerial observation and the true point's projection, aerial px.
+    pub error_px: f64,
+    /// The observation minus the true projection (u, v), aerial px.
+    pub offset_px: [f64; 2],
+    /// Aerial images the tie point was located in (this one included).
+    pub aerial_images: usize,
 }
 
 impl NadirGrade {
@@ -113,17 +131,17 @@ impl Truth {
         triangulate_rays(&rays, &sigmas).ok().map(|t| t.point_world)
     }
 
-    /// Distance (aerial px) between the true projection of `x_world` into aerial image `aerial_id` and (u, v).
-    fn aerial_error_px(
+    /// (u, v) minus the true projection of `x_world` into aerial image `aerial_id`, aerial px.
+    fn aerial_offset_px(
         &self,
         aerial_id: &str,
         x_world: &Vector3<f64>,
         u: f64,
         v: f64,
-    ) -> Option<f64> {
+    ) -> Option<[f64; 2]> {
         let cam = FrameCamera::from_aerial(self.aerial.get(aerial_id)?);
         let (pu, pv) = cam.project_world(x_world)?;
-        Some((pu - u).hypot(pv - v))
+        Some([u - pu, v - pv])
     }
 }
 
@@ -153,20 +171,47 @@ pub fn grade_nadir(
         }
         true_points.insert(tp.id.as_str(), x);
     }
+    let mut located_in: HashMap<&str, usize> = HashMap::new();
+    for m in refinements.iter().flat_map(|r| &r.matches) {
+        *located_in.entry(m.tie_point_id.as_str()).or_default() += 1;
+    }
+    let mut errors_px = Vec::new();
     for r in refinements {
         for m in &r.matches {
             let x = true_points.get(m.tie_point_id.as_str()).copied().flatten();
-            let err = x.and_then(|x| {
-                truth.aerial_error_px(&r.aerial_id, &x, m.observation.u_px, m.observation.v_px)
-            });
+            let (u, v) = (m.observation.u_px, m.observation.v_px);
+            let err = x.and_then(|x| truth.aerial_offset_px(&r.aerial_id, &x, u, v));
             match err {
-                Some(e) => {
+                Some(offset) => {
+                    let e = offset[0].hypot(offset[1]);
                     g.tie_points += 1;
-                    g.correct_tie_points += usize::from(e <= CORRECT_TOLERANCE_PX);
+                    errors_px.push(e);
+                    if e <= CORRECT_TOLERANCE_PX {
+                        g.correct_tie_points += 1;
+                    } else {
+                        g.wrong.push(WrongCorrespondence {
+                            tie_point_id: m.tie_point_id.clone(),
+                            aerial_id: r.aerial_id.clone(),
+                            error_px: e,
+                            offset_px: offset,
+                            aerial_images: located_in[m.tie_point_id.as_str()],
+                        });
+                    }
                 }
                 None => g.ungraded += 1,
             }
         }
+    }
+    g.wrong.sort_by(|a, b| {
+        b.error_px
+            .total_cmp(&a.error_px)
+            .then_with(|| a.tie_point_id.cmp(&b.tie_point_id))
+            .then_with(|| a.aerial_id.cmp(&b.aerial_id))
+    });
+    if !errors_px.is_empty() {
+        let mid = median(&mut errors_px); // sorts
+        let at = |q: f64| errors_px[((errors_px.len() - 1) as f64 * q).round() as usize];
+        g.correspondence_error_px = [mid, at(0.9), at(1.0)];
     }
     let errors: Vec<Vector3<f64>> = control
         .iter()

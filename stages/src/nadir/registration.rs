@@ -117,7 +117,24 @@ pub struct AerialRefinement {
     /// Of `tried`: not located because a neighbouring recording shows the template differently (parallax
     /// check, `nadir::parallax_check`).
     pub parallax_rejected: usize,
+    /// Of `tried`: located, but dropped because fewer than `RefineParams::min_located` tie points were located
+    /// in this image (a lone located template has no other to confirm the pair's registration).
+    pub unconfirmed: usize,
     pub matches: Vec<AerialMatch>,
+}
+
+impl AerialRefinement {
+    /// No tie point tried yet.
+    pub fn empty(recording_id: &str, aerial_id: &str) -> Self {
+        Self {
+            recording_id: recording_id.to_string(),
+            aerial_id: aerial_id.to_string(),
+            tried: 0,
+            parallax_rejected: 0,
+            unconfirmed: 0,
+            matches: Vec::new(),
+        }
+    }
 }
 
 /// The aerial control points of one recording (thesis 3.4.5.4): its window's tie points located in ≥ 1 aerial

@@ -29,6 +29,8 @@ pub struct NadirSummary {
     /// Tie points × aerial images not located because a neighbouring recording shows the template differently
     /// (`nadir::parallax_check`).
     pub parallax_rejected: usize,
+    /// Tie points × aerial images located but dropped: too few located in that image (`RefineParams::min_located`).
+    pub unconfirmed: usize,
     /// Recordings with at least one MM–aerial correspondence.
     pub recordings_with_aerial: usize,
     /// Mean number of distinct aerial images with correspondences per such recording.
@@ -105,6 +107,7 @@ impl NadirSummary {
         for r in refinements {
             s.tie_points += r.matches.len();
             s.parallax_rejected += r.parallax_rejected;
+            s.unconfirmed += r.unconfirmed;
             if !r.matches.is_empty() {
                 images_per_recording
                     .entry(r.recording_id.as_str())
@@ -145,6 +148,7 @@ impl NadirSummary {
             "recordings_with_aerial_fraction": frac,
             "tie_points": self.tie_points,
             "parallax_rejected": self.parallax_rejected,
+            "unconfirmed": self.unconfirmed,
             "mean_aerial_images_per_recording": self.mean_aerial_images_per_recording,
             "control_points": self.control_points,
             "single_aerial_points": self.single_aerial_points,

@@ -1,0 +1,134 @@
+//! Known-answer test of the nadir truth grading (`nadir::grading`): a point seen exactly by two panoramas and
+//! observed in two aerial images, once exactly and once 3 px off, gives one correct and one wrong
+//! correspondence, the wrong one listed with its error and offset.
+
+use nalgebra::Vector3;
+use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
+use skytie_stages::correspondence::{AerialObservation, MmTiePoint, PanoObservation};
+use skytie_stages::geometry::{FrameCamera, PanoramaCamera};
+use skytie_stages::nadir::grading::{grade_nadir, Truth};
+use skytie_stages::nadir::{AerialMatch, AerialRefinement};
+use std::collections::HashMap;
+
+const PANO_W: u32 = 4000;
+const PANO_H: u32 = 2000;
+
+fn recording(id: &str, x: f64, y: f64) -> Recording {
+    Recording {
+        image_id: id.into(),
+        file: format!("{id}.jpg"),
+        time: "2020-01-01T00:00:00Z".into(),
+        time_s: 0.0,
+        x,
+        y,
+        z: 2.4,
+        heading_deg: 90.0,
+        camera_height_m: 2.4,
+        sigma_xy_m: None,
+        sigma_z_m: None,
+        yaw_deg: 0.0,
+        pitch_deg: 0.0,
+        roll_deg: 0.0,
+    }
+}
+
+fn nadir_camera(id: &str, x: f64) -> AerialImage {
+    AerialImage {
+        image_id: id.into(),
+        file: format!("{id}.jpg"),
+        x,
+        y: 0.0,
+        z: 450.0,
+        omega_deg: 0.0,
+        phi_deg: 0.0,
+        kappa_deg: 0.0,
+        focal_px: 4500.0,
+        cx_px: 1000.0,
+        cy_px: 1000.0,
+        width_px: 2000,
+        height_px: 2000,
+        k1: 0.0,
+        k2: 0.0,
+        p1: 0.0,
+        p2: 0.0,
+        sigma_px: 0.5,
+    }
+}
+
+#[test]
+fn a_shifted_aerial_observation_is_graded_wrong_and_listed() {
+    let point = Vector3::new(4.0, 3.0, 0.0);
+    let recs = [recording("r0", 0.0, 0.0), recording("r1", 5.0, 0.0)];
+    let observations: Vec<PanoObservation> = recs
+        .iter()
+        .map(|r| {
+            let (u, v) = PanoramaCamera::from_recording(r, PANO_W, PANO_H)
+                .project_world(&point)
+                .unwrap();
+            PanoObservation {
+                image_id: r.image_id.clone(),
+                u_px: u,
+                v_px: v,
+            }
+        })
+        .collect();
+    let tie_point = MmTiePoint {
+        id: "r0#1".into(),
+        observations,
+        point_world: [point.x, point.y, point.z],
+        covariance_m2: [[0.0; 3]; 3],
+        max_angle_deg: 30.0,
+    };
+    let cams = [nadir_camera("a", -20.0), nadir_camera("b", 20.0)];
+    let refinement = |cam: &AerialImage, shift_u: f64| {
+        let (u, v) = FrameCamera::from_aerial(cam).project_world(&point).unwrap();
+        let mut r = AerialRefinement::empty("r0", &cam.image_id);
+        r.tried = 1;
+        r.matches.push(AerialMatch {
+            tie_point_id: tie_point.id.clone(),
+            observation: AerialObservation {
+                image_id: cam.image_id.clone(),
+                kind: AerialKind::Nadir,
+                u_px: u + shift_u,
+                v_px: v,
+                score: 0.9,
+            },
+            predicted_u_px: u,
+            predicted_v_px: v,
+        });
+        r
+    };
+    let (exact, shifted) = (refinement(&cams[0], 0.0), refinement(&cams[1], 3.0));
+    let truth = Truth {
+        recordings: recs
+            .iter()
+            .map(|r| (r.image_id.clone(), (r.clone(), PANO_W, PANO_H)))
+            .collect(),
+        aerial: cams
+            .iter()
+            .map(|c| (c.image_id.clone(), c.clone()))
+            .collect::<HashMap<_, _>>(),
+    };
+    let g = grade_nadir(&truth, &[&tie_point], &[&exact, &shifted], &[]);
+    assert_eq!((g.tie_points, g.correct_tie_points, g.ungraded), (2, 1, 0));
+    assert_eq!((g.mm_tie_points, g.mm_tie_points_correct), (1, 1));
+    assert!((g.inlier_ratio() - 0.5).abs() < 1e-12);
+    assert_eq!(g.wrong.len(), 1);
+    let w = &g.wrong[0];
+    assert_eq!(
+        (
+            w.tie_point_id.as_str(),
+            w.aerial_id.as_str(),
+            w.aerial_images
+        ),
+        ("r0#1", "b", 2)
+    );
+    assert!((w.error_px - 3.0).abs() < 1e-6, "{w:?}");
+    assert!(
+        (w.offset_px[0] - 3.0).abs() < 1e-6 && w.offset_px[1].abs() < 1e-6,
+        "{w:?}"
+    );
+    // Median, 90th percentile and largest error over the two graded correspondences.
+    assert!((g.correspondence_error_px[2] - 3.0).abs() < 1e-6);
+    assert!(g.correspondence_error_px[0] > 1.4 && g.correspondence_error_px[0] < 1.6);
+}
