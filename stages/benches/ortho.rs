@@ -127,8 +127,14 @@ fn bench_gsd(panorama: &GrayImage, gsd_cm: u32, dir: &Path) {
 
     // skytie's generic remap with the same (f32) map; the seam column is wrapped like ortho_project does.
     let wrap_u = |u: f32| {
-        let pw = panorama.width as f64;
-        (u as f64).rem_euclid(pw)
+        let (u, pw) = (u as f64, panorama.width as f64);
+        if u < 0.0 {
+            u + pw
+        } else if u >= pw {
+            u - pw
+        } else {
+            u
+        }
     };
     let map = |col: usize, row: usize| {
         let i = row * w + col;

@@ -15,7 +15,7 @@ use super::vehicle_mask::VehicleMask;
 use crate::campaign::Recording;
 use crate::geometry::PanoramaCamera;
 use crate::imaging::border::Border;
-use crate::imaging::sample::sample_bilinear;
+use crate::imaging::sample::{floor_fast, sample_bilinear};
 use crate::imaging::GrayImage;
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -174,7 +174,7 @@ pub struct OrthoImage {
 fn sample_panorama(pano: &GrayImage, u_px: f64, v_px: f64) -> f32 {
     let (w, h) = (pano.width, pano.height);
     let x = u_px - 0.5;
-    let x0f = x.floor();
+    let x0f = floor_fast(x);
     let x0 = x0f as isize;
     if x0 >= 0 && (x0 as usize) + 1 < w {
         return sample_bilinear(pano, u_px, v_px, Border::Clamp);
@@ -185,7 +185,7 @@ fn sample_panorama(pano: &GrayImage, u_px: f64, v_px: f64) -> f32 {
     let wrap = |c: isize| c.rem_euclid(w as isize) as usize;
     let (c0, c1) = (wrap(x0), wrap(x0 + 1));
     let y = (v_px - 0.5).clamp(0.0, (h - 1) as f64);
-    let y0 = (y.floor() as usize).min(h - 1);
+    let y0 = (floor_fast(y) as usize).min(h - 1);
     let y1 = (y0 + 1).min(h - 1);
     let (fx, fy) = ((x - x0f) as f32, (y - y0 as f64) as f32);
     let at = |c: usize, r: usize| pano.data[r * w + c];
