@@ -27,6 +27,9 @@ pub fn grade_metrics(g: &NadirGrade) -> serde_json::Value {
         "graded_tie_points": g.tie_points,
         "ungraded_tie_points": g.ungraded,
         "inlier_ratio": g.inlier_ratio(),
+        "delivered_tie_points": g.delivered_tie_points,
+        "delivered_correct": g.delivered_correct,
+        "delivered_inlier_ratio": g.delivered_inlier_ratio(),
         "mm_tie_points_graded": g.mm_tie_points,
         "mm_tie_points_correct": g.mm_tie_points_correct,
         "correspondence_error_px": {
@@ -108,7 +111,7 @@ pub struct GradeNadir;
 
 impl Stage for GradeNadir {
     const NAME: &'static str = "grade_nadir";
-    const VERSION: &'static str = "2";
+    const VERSION: &'static str = "3";
     type Params = SummaryParams;
     type Output = NadirGrade;
     type Inputs = (

@@ -4,7 +4,9 @@
 
 use nalgebra::Vector3;
 use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
-use skytie_stages::correspondence::{AerialObservation, MmTiePoint, PanoObservation};
+use skytie_stages::correspondence::{
+    AerialControlPoint, AerialObservation, MmTiePoint, PanoObservation,
+};
 use skytie_stages::geometry::{FrameCamera, PanoramaCamera};
 use skytie_stages::nadir::grading::{grade_nadir, Truth};
 use skytie_stages::nadir::{AerialMatch, AerialRefinement};
@@ -109,7 +111,18 @@ fn a_shifted_aerial_observation_is_graded_wrong_and_listed() {
             .map(|c| (c.image_id.clone(), c.clone()))
             .collect::<HashMap<_, _>>(),
     };
-    let g = grade_nadir(&truth, &[&tie_point], &[&exact, &shifted], &[]);
+    // The control point keeps only the exact observation (as if the consistency check had dropped the other).
+    let control = AerialControlPoint {
+        tie_point_id: tie_point.id.clone(),
+        mm: tie_point.observations.clone(),
+        aerial: vec![exact.matches[0].observation.clone()],
+        point_world: None,
+        covariance_m2: None,
+    };
+    let g = grade_nadir(&truth, &[&tie_point], &[&exact, &shifted], &[&control]);
+    assert_eq!((g.delivered_tie_points, g.delivered_correct), (1, 1));
+    assert_eq!(g.delivered_inlier_ratio(), 1.0);
+    assert_eq!(g.control_points.count, 0, "no triangulated control point");
     assert_eq!((g.tie_points, g.correct_tie_points, g.ungraded), (2, 1, 0));
     assert_eq!((g.mm_tie_points, g.mm_tie_points_correct), (1, 1));
     assert!((g.inlier_ratio() - 0.5).abs() < 1e-12);

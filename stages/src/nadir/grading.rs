@@ -83,6 +83,10 @@ pub struct NadirGrade {
     pub mm_tie_points_correct: usize,
     /// Aerial control points (≥ 2 aerial images) vs their true points.
     pub control_points: ErrorStats,
+    /// The correspondences the pipeline delivers — the aerial observations of the control points, after their
+    /// multi-image consistency check (3.4.5.4) — graded / correct by the same rule.
+    pub delivered_tie_points: usize,
+    pub delivered_correct: usize,
     /// Error (aerial px) of the graded correspondences: median, 90th percentile, largest.
     pub correspondence_error_px: [f64; 3],
     /// The wrong correspondences (error above [`CORRECT_TOLERANCE_PX`]), largest error first, so a user can
@@ -110,6 +114,15 @@ impl NadirGrade {
             0.0
         } else {
             self.correct_tie_points as f64 / self.tie_points as f64
+        }
+    }
+
+    /// correct / graded delivered correspondences (0 when there are none).
+    pub fn delivered_inlier_ratio(&self) -> f64 {
+        if self.delivered_tie_points == 0 {
+            0.0
+        } else {
+            self.delivered_correct as f64 / self.delivered_tie_points as f64
         }
     }
 }
@@ -212,6 +225,17 @@ pub fn grade_nadir(
         let mid = median(&mut errors_px); // sorts
         let at = |q: f64| errors_px[((errors_px.len() - 1) as f64 * q).round() as usize];
         g.correspondence_error_px = [mid, at(0.9), at(1.0)];
+    }
+    for c in control {
+        let x = truth.true_point(&c.mm);
+        for o in &c.aerial {
+            if let Some(off) =
+                x.and_then(|x| truth.aerial_offset_px(&o.image_id, &x, o.u_px, o.v_px))
+            {
+                g.delivered_tie_points += 1;
+                g.delivered_correct += usize::from(off[0].hypot(off[1]) <= CORRECT_TOLERANCE_PX);
+            }
+        }
     }
     let errors: Vec<Vector3<f64>> = control
         .iter()
