@@ -69,6 +69,14 @@ fn report_of_a_tiny_run() {
         index.display()
     );
     let first = snapshot(&report);
+    // A figure and a table an earlier build left (e.g. of a removed variant) are stale: the rebuild removes them.
+    let stale = [
+        report.join("figures/registration-nadir-gone-000000000000.png"),
+        report.join("tables/gone-variant-accuracy.csv"),
+    ];
+    for s in &stale {
+        std::fs::write(s, b"stale").unwrap();
+    }
 
     // Rebuild from OUT alone: byte-identical, fast.
     let t0 = Instant::now();
@@ -76,6 +84,9 @@ fn report_of_a_tiny_run() {
     let rebuild_s = t0.elapsed().as_secs_f64();
     println!("report rebuild: {rebuild_s:.2} s");
     assert!(rebuild_s <= 10.0, "report rebuild took {rebuild_s:.1} s");
+    for s in &stale {
+        assert!(!s.exists(), "{} was not removed", s.display());
+    }
     let second = snapshot(&report);
     let differing: Vec<&String> = first
         .keys()

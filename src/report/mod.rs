@@ -72,6 +72,8 @@ pub struct Builder {
     pub notes: Vec<String>,
     /// Campaign images decoded for the registration views, shared with the variants' builders.
     pub images: std::sync::Arc<image_cache::ImageCache>,
+    /// The registration views' campaign, truth and drawn views, shared with the variants' builders.
+    pub views: std::sync::Arc<registration::SharedViews>,
 }
 
 /// Folder names inside `OUT/report/`.
@@ -115,6 +117,7 @@ impl Builder {
             figures: Vec::new(),
             notes: Vec::new(),
             images: std::sync::Arc::clone(&self.images),
+            views: std::sync::Arc::clone(&self.views),
         }
     }
 
@@ -176,6 +179,7 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
         figures: Vec::new(),
         notes: Vec::new(),
         images: Default::default(),
+        views: Default::default(),
     };
     if b.campaign.is_none() {
         b.notes.push(
@@ -249,6 +253,24 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
     for (p, text) in &pages {
         atomic_write(p, text.as_bytes())
             .map_err(|e| format!("{}: cannot write: {e}", p.display()))?;
+    }
+    // Files of an earlier build that this one did not write (renamed views, removed variants) would be stale.
+    let mut current: BTreeSet<PathBuf> = b.figures.iter().cloned().collect();
+    for t in &b.tables {
+        let base = report_dir.join(TABLES_DIR).join(&t.id);
+        current.insert(base.with_extension("csv"));
+        current.insert(base.with_extension("md"));
+    }
+    for dir in [TABLES_DIR, FIGURES_DIR] {
+        let Ok(entries) = std::fs::read_dir(report_dir.join(dir)) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let p = e.path();
+            if p.is_file() && !current.contains(&p) {
+                let _ = std::fs::remove_file(&p);
+            }
+        }
     }
     Ok(ReportSummary {
         index: index_path,

@@ -28,8 +28,9 @@ use skytie_stages::imaging::io::{dimensions, save_rgb};
 use skytie_stages::nadir::{ortho_project, OrthoParams};
 use skytie_stages::oblique::grading::Truth as StageTruth;
 use skytie_stages::synth::scene_truth::{SceneOracle, SceneTruth, SCENE_TRUTH_FILE};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
+use std::sync::{Arc, Mutex};
 use truth::{oblique_verdict, true_point, verdict, ObliqueTruth, TruePanoObservation, Verdict};
 
 /// One observation row of correspondences.csv.
@@ -77,7 +78,7 @@ fn parse_points(t: &CsvTable) -> Points {
 }
 
 /// Counts of one view's verdicts.
-#[derive(Default)]
+#[derive(Clone, Default)]
 struct ViewCounts {
     correct: usize,
     wrong: usize,
@@ -112,10 +113,70 @@ impl ViewCounts {
 struct Context<'a> {
     campaign: &'a Campaign,
     images: &'a ImageCache,
+    truth: &'a BTreeMap<String, Recording>,
+    pano_sizes: &'a BTreeMap<String, (u32, u32)>,
+    /// The oblique grading rule's truth (None without `truth/recordings.csv`).
+    oblique_truth: Option<&'a ObliqueTruth>,
+}
+
+/// The campaign as the views read it: rows, true poses (empty without `truth/`), panorama sizes.
+struct CampaignViews {
+    campaign: Campaign,
     truth: BTreeMap<String, Recording>,
     pano_sizes: BTreeMap<String, (u32, u32)>,
-    /// The oblique grading rule's truth (None without `truth/recordings.csv`).
-    oblique_truth: Option<ObliqueTruth>,
+}
+
+/// A drawn view: the aerial image shown and the verdict counts.
+type Drawn = Result<(String, ViewCounts), String>;
+
+/// What the registration views of all pages of one report share, each computed once: the campaign, the
+/// oblique truth, and the views already drawn. The variants of a sweep mostly show the same correspondences
+/// (every oblique variant the same nadir ones), so a view is named after what it shows and drawn once.
+/// Values are computed outside the locks (a rayon worker may pick up another page meanwhile); when two pages
+/// compute the same value at once, both results are identical and the first is kept.
+#[derive(Default)]
+pub struct SharedViews {
+    campaign: Mutex<Option<Arc<Result<CampaignViews, String>>>>,
+    /// (truth, notes) of the oblique grading rule.
+    oblique: Mutex<Option<Arc<(Option<ObliqueTruth>, Vec<String>)>>>,
+    drawn: Mutex<HashMap<String, Drawn>>,
+}
+
+/// Get the value in `slot`, computing it with `make` (outside the lock) when it is empty.
+fn once<T>(slot: &Mutex<Option<Arc<T>>>, make: impl FnOnce() -> T) -> Arc<T> {
+    if let Some(v) = slot.lock().unwrap_or_else(|p| p.into_inner()).as_ref() {
+        return Arc::clone(v);
+    }
+    let made = Arc::new(make());
+    let mut guard = slot.lock().unwrap_or_else(|p| p.into_inner());
+    Arc::clone(guard.get_or_insert(made))
+}
+
+fn read_campaign_views(root: &Path) -> Result<CampaignViews, String> {
+    let campaign = read_campaign(root)
+        .map(|(c, _)| c)
+        .map_err(|e| e.to_string())?;
+    let truth_path = root.join("truth/recordings.csv");
+    let truth: BTreeMap<String, Recording> = if truth_path.exists() {
+        read_recordings_csv(&truth_path)
+            .0
+            .into_iter()
+            .map(|r| (r.image_id.clone(), r))
+            .collect()
+    } else {
+        BTreeMap::new()
+    };
+    let mut pano_sizes = BTreeMap::new();
+    for r in &campaign.recordings {
+        if let Ok(d) = dimensions(&root.join("mm/panoramas").join(&r.file)) {
+            pano_sizes.insert(r.image_id.clone(), d);
+        }
+    }
+    Ok(CampaignViews {
+        campaign,
+        truth,
+        pano_sizes,
+    })
 }
 
 impl Context<'_> {
@@ -179,8 +240,10 @@ pub fn registration_section(
         );
         return Ok(());
     };
-    let campaign = match read_campaign(&root) {
-        Ok((c, _)) => c,
+    let shared = Arc::clone(&b.views);
+    let views = once(&shared.campaign, || read_campaign_views(&root));
+    let cv = match views.as_ref() {
+        Ok(cv) => cv,
         Err(e) => {
             b.note(
                 page,
@@ -189,51 +252,40 @@ pub fn registration_section(
             return Ok(());
         }
     };
-    let truth_path = root.join("truth/recordings.csv");
-    let truth: BTreeMap<String, Recording> = if truth_path.exists() {
-        read_recordings_csv(&truth_path)
-            .0
-            .into_iter()
-            .map(|r| (r.image_id.clone(), r))
-            .collect()
-    } else {
-        BTreeMap::new()
-    };
     let points = parse_points(&corr);
-    let mut pano_sizes = BTreeMap::new();
-    for r in &campaign.recordings {
-        if let Ok(d) = dimensions(&root.join("mm/panoramas").join(&r.file)) {
-            pano_sizes.insert(r.image_id.clone(), d);
+    let has_oblique = points.keys().any(|(s, _)| s == "oblique");
+    let oblique = (has_oblique && !cv.truth.is_empty()).then(|| {
+        once(&shared.oblique, || {
+            match load_oblique_truth(&root, &cv.campaign, &cv.truth, &cv.pano_sizes) {
+                Ok(mut t) => {
+                    let mut notes = Vec::new();
+                    match load_scene(&root) {
+                        Ok(scene) => t.scene = scene,
+                        Err(e) => notes.push(format!(
+                            "oblique registration views graded without the scene: {e}"
+                        )),
+                    }
+                    (Some(t), notes)
+                }
+                Err(e) => (
+                    None,
+                    vec![format!("oblique registration views ungraded: {e}")],
+                ),
+            }
+        })
+    });
+    if let Some(o) = &oblique {
+        for n in &o.1 {
+            b.note(page, n.clone());
         }
     }
-    let has_oblique = points.keys().any(|(s, _)| s == "oblique");
-    let oblique_truth = if has_oblique && !truth.is_empty() {
-        match load_oblique_truth(&root, &campaign, &truth, &pano_sizes) {
-            Ok(mut t) => {
-                match load_scene(&root) {
-                    Ok(scene) => t.scene = scene,
-                    Err(e) => b.note(
-                        page,
-                        format!("oblique registration views graded without the scene: {e}"),
-                    ),
-                }
-                Some(t)
-            }
-            Err(e) => {
-                b.note(page, format!("oblique registration views ungraded: {e}"));
-                None
-            }
-        }
-    } else {
-        None
-    };
-    let images = std::sync::Arc::clone(&b.images);
+    let images = Arc::clone(&b.images);
     let ctx = Context {
-        campaign: &campaign,
+        campaign: &cv.campaign,
         images: &images,
-        truth,
-        pano_sizes,
-        oblique_truth,
+        truth: &cv.truth,
+        pano_sizes: &cv.pano_sizes,
+        oblique_truth: oblique.as_ref().and_then(|o| o.0.as_ref()),
     };
     let mut t = Table::new(
         &format!("{prefix}registration-views"),
@@ -279,16 +331,40 @@ pub fn registration_section(
                 .filter(|((s, _), p)| s == source && p.pano.iter().any(|o| o.image_id == rec_id))
                 .map(|(_, p)| p)
                 .collect();
-            let name = format!("{prefix}registration-{source}-{}.png", slug(rec_id));
+            // Named after what it shows, so pages showing the same correspondences share one file.
+            let shown = blake3::hash(format!("{source}|{rec_id}|{mine:?}").as_bytes());
+            let name = format!(
+                "registration-{source}-{}-{}.png",
+                slug(rec_id),
+                &shown.to_hex()[..12]
+            );
             let (path, href) = b.figure_path(&name);
-            let made = if source == "nadir" {
-                nadir_view(&ctx, rec, &mine, &path)
-            } else {
-                oblique_view(&ctx, rec, &mine, &path)
+            let known = shared
+                .drawn
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .get(&name)
+                .cloned();
+            let made = match known {
+                Some(d) => d,
+                None => {
+                    let d = if source == "nadir" {
+                        nadir_view(&ctx, rec, &mine, &path)
+                    } else {
+                        oblique_view(&ctx, rec, &mine, &path)
+                    };
+                    let mut drawn = shared.drawn.lock().unwrap_or_else(|p| p.into_inner());
+                    if !drawn.contains_key(&name) {
+                        drawn.insert(name.clone(), d.clone());
+                        if d.is_ok() {
+                            b.wrote_figure(path);
+                        }
+                    }
+                    d
+                }
             };
             match made {
                 Ok((aerial_id, c)) => {
-                    b.wrote_figure(path);
                     page.figure(
                         &href,
                         &format!("{source} registration of {rec_id}"),
