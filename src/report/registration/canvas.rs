@@ -29,6 +29,26 @@ pub fn crop_scaled(img: &GrayImage, x0: f64, y0: f64, w: f64, h: f64, scale: f64
     out
 }
 
+/// A `w × h` image whose pixel (col, row) samples `img` at `source(col + 0.5, row + 0.5)` (continuous pixel
+/// coordinates, centres at +0.5) bilinearly; black where `source` is `None` or outside `img`.
+pub fn resample_on_ground(
+    img: &GrayImage,
+    w: usize,
+    h: usize,
+    source: impl Fn(f64, f64) -> Option<(f64, f64)>,
+) -> RgbImage {
+    let mut out = RgbImage::filled(w.max(1), h.max(1), [0.0; 3]);
+    for row in 0..h {
+        for col in 0..w {
+            if let Some((u, v)) = source(col as f64 + 0.5, row as f64 + 0.5) {
+                let s = bilinear(img, u - 0.5, v - 0.5);
+                out.set(col, row, [s, s, s]);
+            }
+        }
+    }
+    out
+}
+
 /// Bilinear sample at array coordinates (pixel centres at integers); 0 outside.
 fn bilinear(img: &GrayImage, x: f64, y: f64) -> f32 {
     if !(x >= 0.0 && y >= 0.0) || x > (img.width - 1) as f64 || y > (img.height - 1) as f64 {

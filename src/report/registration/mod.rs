@@ -3,7 +3,8 @@
 //! side on the right, each correspondence a line between its two observations, green when correct and red
 //! when wrong by truth, blue when non-matchable (oblique, with `truth/scene.toml`), yellow without truth
 //! (`truth` module: nadir and oblique rules). Nadir: the recording's north-up MM ortho image (recorded pose,
-//! `ortho_project` at 3 cm) beside the crop of the aerial nadir image covering the same ground. Oblique: the
+//! `ortho_project` at 3 cm) beside the aerial nadir image resampled onto the same north-up ground grid (so both
+//! halves share orientation and scale). Oblique: the
 //! panorama crop around the observations beside the oblique image crop around them. Inputs:
 //! `correspondences.csv` of the result folder, the campaign's images and (optionally) `truth/`.
 
@@ -15,7 +16,9 @@ use super::image_cache::ImageCache;
 use super::inputs::{read_csv_opt, CsvTable, ResultSet};
 use super::tables::{fmt_count, Origin, Table};
 use super::{slug, Builder};
-use canvas::{crop_scaled, line, ring, side_by_side, Rgb, BLUE, GREEN, RED, YELLOW};
+use canvas::{
+    crop_scaled, line, resample_on_ground, ring, side_by_side, Rgb, BLUE, GREEN, RED, YELLOW,
+};
 use nalgebra::Vector3;
 use skytie_stages::campaign::read_aerial_csv;
 use skytie_stages::campaign::{
@@ -450,19 +453,14 @@ fn nadir_view(
         1.0,
     );
     let cam = FrameCamera::from_aerial(aerial);
-    let foot = Vector3::from(g.foot_world);
-    let (cu, cv) = cam
-        .project_world(&foot)
+    cam.project_world(&Vector3::from(g.foot_world))
         .ok_or("the recording is not in front of the aerial camera")?;
-    let (eu, ev) = cam
-        .project_world(&(foot + Vector3::new(1.0, 0.0, 0.0)))
-        .ok_or("the recording is not in front of the aerial camera")?;
-    let px_per_m = (eu - cu).hypot(ev - cv);
-    let side_px = g.width_px as f64 * g.gsd_m * px_per_m;
-    let (x0, y0) = (cu - side_px / 2.0, cv - side_px / 2.0);
-    let scale = g.height_px as f64 / side_px;
+    // The aerial side on the same north-up ground grid as the ortho image (each pixel's ground point projected
+    // into the aerial image), so both halves share orientation and scale and the lines run side to side.
     let aerial_img = ctx.images.gray(&ctx.aerial_path("nadir", aerial))?;
-    let right = crop_scaled(&aerial_img, x0, y0, side_px, side_px, scale);
+    let right = resample_on_ground(&aerial_img, g.width_px, g.height_px, |c, r| {
+        cam.project_world(&g.pixel_to_world(c, r))
+    });
     let gap = 12;
     let mut img = side_by_side(&left, &right, gap);
     let x_off = (left.width + gap) as f64;
@@ -486,7 +484,14 @@ fn nadir_view(
             continue;
         };
         let a = g.world_to_pixel(&ground);
-        let bpt = (x_off + (ao.u_px - x0) * scale, (ao.v_px - y0) * scale);
+        // The aerial observation on the same ground grid: its ray meets the ortho plane.
+        let Some(aerial_ground) =
+            truth::ground_intersection(&cam.pixel_ray(ao.u_px, ao.v_px), g.foot_world[2])
+        else {
+            continue;
+        };
+        let (bu, bv) = g.world_to_pixel(&aerial_ground);
+        let bpt = (x_off + bu, bv);
         let x = ctx.true_point(p);
         let colour = counts.add(verdict(x.as_ref(), aerial, ao.u_px, ao.v_px));
         line(&mut img, a, bpt, colour, 1);
