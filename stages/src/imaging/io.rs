@@ -3,6 +3,7 @@
 //! 8-bit files map to 0..1 (value / 255); 16-bit files to 0..1 (value / 65535). Writing clamps to 0..1 and
 //! rounds to 8 bits. Writes are atomic (see [`crate::fsutil`]).
 
+use super::huge_pages::collect_f32;
 use super::{GrayImage, RgbImage};
 use std::path::Path;
 
@@ -44,17 +45,15 @@ pub fn load_gray(path: &Path) -> Result<GrayImage, ImageIoError> {
     let img = open(path)?;
     let (w, h) = (img.width() as usize, img.height() as usize);
     let data = match img {
-        image::DynamicImage::ImageLuma16(b) => b
-            .into_raw()
-            .into_iter()
-            .map(|v| v as f32 / 65535.0)
-            .collect(),
+        image::DynamicImage::ImageLuma16(b) => {
+            collect_f32(w * h, b.into_raw().into_iter().map(|v| v as f32 / 65535.0))
+        }
         other => {
-            let rgb = other.to_rgb32f();
-            rgb.into_raw()
+            let rgb = other.to_rgb32f().into_raw();
+            let grey = rgb
                 .chunks_exact(3)
-                .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
-                .collect()
+                .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]);
+            collect_f32(w * h, grey)
         }
     };
     Ok(GrayImage {
