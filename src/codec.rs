@@ -343,29 +343,13 @@ fn zeroed_samples(count: usize) -> Vec<f32> {
     samples
 }
 
-#[cfg(target_os = "linux")]
+/// Huge pages for a mapped or allocated buffer (`skytie_stages::imaging::huge_pages`).
 fn advise_huge_pages(memory: &mut [u8]) {
-    const HUGE: usize = 2 << 20;
-    let start = memory.as_mut_ptr() as usize;
-    let end = start + memory.len();
-    let first = start.next_multiple_of(HUGE);
-    let last = end - end % HUGE;
-    if last > first {
-        // SAFETY: [first, last) lies inside `memory`, which this function borrows mutably; MADV_HUGEPAGE only
-        // changes how the kernel backs those pages (contents and validity are unaffected), and a failure
-        // (e.g. THP disabled) is harmless, so its result is ignored.
-        unsafe {
-            libc::madvise(
-                first as *mut libc::c_void,
-                last - first,
-                libc::MADV_HUGEPAGE,
-            );
-        }
-    }
+    skytie_stages::imaging::huge_pages::advise_huge_pages(
+        memory.as_mut_ptr() as usize,
+        memory.len(),
+    );
 }
-
-#[cfg(not(target_os = "linux"))]
-fn advise_huge_pages(_memory: &mut [u8]) {}
 
 /// Turns samples whose memory holds little-endian `f32` bytes into native values (a no-op on little-endian
 /// targets).

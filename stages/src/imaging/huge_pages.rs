@@ -11,17 +11,19 @@ const MIN_BYTES: usize = 4 << 20;
 /// Collect `n` values from `values` into a vector whose memory is advised to use huge pages when large.
 pub fn collect_f32(n: usize, values: impl Iterator<Item = f32>) -> Vec<f32> {
     let mut v: Vec<f32> = Vec::with_capacity(n);
-    advise_huge_pages(v.as_mut_ptr() as usize, n * std::mem::size_of::<f32>());
+    let bytes = n * std::mem::size_of::<f32>();
+    if bytes >= MIN_BYTES {
+        advise_huge_pages(v.as_mut_ptr() as usize, bytes);
+    }
     v.extend(values);
     v
 }
 
+/// Advise huge pages for the whole 2 MiB pages inside the `bytes` bytes at address `start`, memory the caller
+/// owns (advice only: contents are unaffected, a failure is ignored).
 #[cfg(target_os = "linux")]
-fn advise_huge_pages(start: usize, bytes: usize) {
+pub fn advise_huge_pages(start: usize, bytes: usize) {
     const HUGE: usize = 2 << 20;
-    if bytes < MIN_BYTES {
-        return;
-    }
     let aligned = (start + HUGE - 1) & !(HUGE - 1);
     let end = (start + bytes) & !(HUGE - 1);
     if end > aligned {
@@ -38,7 +40,7 @@ fn advise_huge_pages(start: usize, bytes: usize) {
 }
 
 #[cfg(not(target_os = "linux"))]
-fn advise_huge_pages(_start: usize, _bytes: usize) {}
+pub fn advise_huge_pages(_start: usize, _bytes: usize) {}
 
 #[cfg(test)]
 mod tests {
