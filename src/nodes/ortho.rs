@@ -14,7 +14,7 @@ pub struct OrthoProject;
 
 impl Stage for OrthoProject {
     const NAME: &'static str = "ortho";
-    const VERSION: &'static str = "2";
+    const VERSION: &'static str = "3";
     type Params = OrthoParams;
     type Output = OrthoImage;
     type Inputs = (Handle<Recording>, RawFile);

@@ -17,7 +17,7 @@ pub struct OrthoForAerial;
 
 impl Stage for OrthoForAerial {
     const NAME: &'static str = "ortho_aerial";
-    const VERSION: &'static str = "2";
+    const VERSION: &'static str = "3";
     type Params = OrthoParams;
     type Output = OrthoImage;
     type Inputs = (Handle<Recording>, RawFile, Handle<AerialImage>);

@@ -8,6 +8,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod aerial_intersection;
+pub mod atan2_poly;
 pub mod closest_approach;
 pub mod distortion;
 pub mod frame;

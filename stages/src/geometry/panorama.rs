@@ -6,6 +6,7 @@
 //! `d_pano = (cos E sin A, cos E cos A, sin E)` (east, north, up); the world direction is
 //! `d_world = R·d_pano` with `R = Rz(−yaw)·Rx(pitch)·Ry(roll)` ([`panorama_rotation`]).
 
+use super::atan2_poly::atan2_poly;
 use super::ray::Ray;
 use super::rotation::panorama_rotation;
 use crate::campaign::Recording;
@@ -98,6 +99,24 @@ impl PanoramaCamera {
             u_px = 0.0;
         }
         let v_px = h * (FRAC_PI_2 - elevation_rad) / PI;
+        (u_px, v_px)
+    }
+
+    /// [`Self::ray_pano_to_pixel`] with [`atan2_poly`] instead of libm (≤ 1e-9 px apart for finite, non-zero
+    /// directions): for dense sampling maps such as the ortho-projection's, never for measurements.
+    #[inline]
+    pub fn ray_pano_to_pixel_fast(&self, dir_pano: &Vector3<f64>) -> (f64, f64) {
+        let w = f64::from(self.width_px);
+        let h = f64::from(self.height_px);
+        let azimuth_rad = atan2_poly(dir_pano.x, dir_pano.y);
+        let horizontal = (dir_pano.x * dir_pano.x + dir_pano.y * dir_pano.y).sqrt();
+        let elevation_rad = atan2_poly(dir_pano.z, horizontal);
+        // azimuth + π ∈ [0, 2π]: only exactly 2π needs wrapping. Multiplications by the pixel scale, not divisions.
+        let mut u_px = (azimuth_rad + PI) * (w / TAU);
+        if u_px >= w {
+            u_px -= w;
+        }
+        let v_px = (FRAC_PI_2 - elevation_rad) * (h / PI);
         (u_px, v_px)
     }
 

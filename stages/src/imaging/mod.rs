@@ -7,6 +7,7 @@ pub mod huge_pages;
 pub mod image;
 pub mod io;
 
+pub mod bilinear_many;
 pub mod border;
 pub mod convolve;
 pub mod gaussian;

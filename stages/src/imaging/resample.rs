@@ -7,6 +7,7 @@
 
 use rayon::prelude::*;
 
+use super::bilinear_many::{sample_bilinear_many, BilinearScratch};
 use super::border::Border;
 use super::image::GrayImage;
 use super::sample::{sample_bicubic, sample_bilinear};
@@ -62,6 +63,29 @@ where
     if out_width == 0 {
         return out;
     }
+    if interp == Interpolation::Bilinear {
+        // The row's positions first (NaN where the map has none), then the two-pass sampler.
+        out.data.par_chunks_mut(out_width).enumerate().for_each_init(
+            || RowBuffers::new(out_width),
+            |b, (row, out_row)| {
+                let positions = b.us.iter_mut().zip(b.vs.iter_mut()).zip(b.mapped.iter_mut());
+                for (col, ((u, v), mapped)) in positions.enumerate() {
+                    let p = map(col, row);
+                    *mapped = p.is_some();
+                    (*u, *v) = p.unwrap_or((f64::NAN, f64::NAN));
+                }
+                let mapped = &b.mapped;
+                sample_bilinear_many(src, &b.us, &b.vs, out_row, &mut b.scratch, |i, u, v| {
+                    if mapped[i] {
+                        sample_bilinear(src, u, v, border)
+                    } else {
+                        fill_value
+                    }
+                });
+            },
+        );
+        return out;
+    }
     out.data
         .par_chunks_mut(out_width)
         .enumerate()
@@ -73,6 +97,26 @@ where
             }
         });
     out
+}
+
+/// One output row's source positions and the sampler's scratch (one per rayon task, reused across rows).
+struct RowBuffers {
+    us: Vec<f64>,
+    vs: Vec<f64>,
+    /// Whether the map gave a position (else the fill value).
+    mapped: Vec<bool>,
+    scratch: BilinearScratch,
+}
+
+impl RowBuffers {
+    fn new(width: usize) -> Self {
+        Self {
+            us: vec![0.0; width],
+            vs: vec![0.0; width],
+            mapped: vec![false; width],
+            scratch: BilinearScratch::default(),
+        }
+    }
 }
 
 /// Resize `src` to `out_width × out_height` by pure scaling (pixel-area aligned: the image rectangles coincide).

@@ -47,7 +47,37 @@ pub fn floor_fast(x: f64) -> f64 {
 }
 
 /// Bilinear interpolation at (u_px, v_px).
+#[inline]
 pub fn sample_bilinear(img: &GrayImage, u_px: f64, v_px: f64, border: Border) -> f32 {
+    let x = u_px - 0.5;
+    let y = v_px - 0.5;
+    // Interior fast path (all four neighbours inside; false for NaN): no border logic, truncation is floor.
+    if x >= 0.0 && y >= 0.0 && x < (img.width as f64 - 1.0) && y < (img.height as f64 - 1.0) {
+        return bilinear_interior(&img.data, img.width, x, y);
+    }
+    sample_bilinear_border(img, u_px, v_px, border)
+}
+
+/// Bilinear interpolation at pixel-index coordinates (x, y) = (u − 0.5, v − 0.5) with
+/// 0 ≤ x < width − 1 and 0 ≤ y < height − 1 (the caller checks). `data` is row-major with `width` columns.
+#[inline(always)]
+pub fn bilinear_interior(data: &[f32], width: usize, x: f64, y: f64) -> f32 {
+    let (x0, y0) = (x as usize, y as usize);
+    let fx = (x - x0 as f64) as f32;
+    let fy = (y - y0 as f64) as f32;
+    let i = y0 * width + x0;
+    let quad = &data[i..i + width + 2];
+    let (p00, p10) = (quad[0], quad[1]);
+    let (p01, p11) = (quad[width], quad[width + 1]);
+    let top = p00 + (p10 - p00) * fx;
+    let bottom = p01 + (p11 - p01) * fx;
+    top + (bottom - top) * fy
+}
+
+/// [`sample_bilinear`] for positions near or beyond the border (and non-finite ones).
+#[cold]
+#[inline(never)]
+fn sample_bilinear_border(img: &GrayImage, u_px: f64, v_px: f64, border: Border) -> f32 {
     if img.width == 0 || img.height == 0 || !u_px.is_finite() || !v_px.is_finite() {
         return empty_value(border);
     }

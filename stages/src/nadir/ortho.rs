@@ -14,6 +14,7 @@
 use super::vehicle_mask::VehicleMask;
 use crate::campaign::Recording;
 use crate::geometry::PanoramaCamera;
+use crate::imaging::bilinear_many::{sample_bilinear_many, BilinearScratch};
 use crate::imaging::border::Border;
 use crate::imaging::sample::{floor_fast, sample_bilinear};
 use crate::imaging::GrayImage;
@@ -169,8 +170,10 @@ pub struct OrthoImage {
 
 /// Bilinear sample of an equirectangular panorama, continuous across the seam at azimuth ±180° (u = 0 / W):
 /// columns wrap around, rows clamp at the poles. Reads the panorama in place (no padded copy per call: the
-/// 3 cm ortho of a 4000 × 2000 panorama would otherwise copy 32 MB to fill 0.5 M pixels).
-#[inline]
+/// 3 cm ortho of a 4000 × 2000 panorama would otherwise copy 32 MB to fill 0.5 M pixels). The ortho-projection
+/// calls it only where [`sample_bilinear_many`] finds a neighbour outside the image.
+#[cold]
+#[inline(never)]
 fn sample_panorama(pano: &GrayImage, u_px: f64, v_px: f64) -> f32 {
     let (w, h) = (pano.width, pano.height);
     let x = u_px - 0.5;
@@ -194,144 +197,111 @@ fn sample_panorama(pano: &GrayImage, u_px: f64, v_px: f64) -> f32 {
     top + (bottom - top) * fy
 }
 
-/// Node spacing of the interpolated ortho → panorama map, ortho pixels.
-pub const MAP_CELL_PX: usize = 8;
-
-/// Largest admitted error of the interpolated map, panorama pixels: a cell whose interpolated centre is further
-/// than this from the exact projection is projected exactly, pixel by pixel.
-pub const MAP_TOLERANCE_PX: f64 = 0.01;
-
-/// The ortho pixel → panorama pixel map of one ortho image, computed exactly at nodes every [`MAP_CELL_PX`]
-/// pixels and interpolated bilinearly inside cells where that is accurate to [`MAP_TOLERANCE_PX`] (checked at
-/// each cell's centre); cells at the panorama seam, near the nadir (where the map bends fast) or with a node
-/// that does not project are computed exactly per pixel. The map is smooth elsewhere, so this replaces ~64
-/// trigonometric projections by one.
-struct PanoramaMap<'a> {
-    georef: &'a OrthoGeoref,
-    camera: &'a PanoramaCamera,
-    /// Node columns/rows (pixel indices), first 0, last `width − 1`/`height − 1`.
-    node_cols: Vec<usize>,
-    node_rows: Vec<usize>,
-    /// Exact map at the nodes, row-major over (node_rows × node_cols).
-    nodes: Vec<Option<(f64, f64)>>,
-    /// Per cell (row-major over (node_rows − 1) × (node_cols − 1)): interpolation is accurate.
-    smooth: Vec<bool>,
+/// The ortho pixel → panorama pixel sampling map along one ortho row. The world direction from the projection
+/// centre to column `col`'s ground point is `d(col) = d0 + d_step·col` (the plane is flat), formed from the
+/// camera-to-foot offset so that no national-grid coordinate enters (no cancellation near the nadir); rotated into
+/// the panorama frame once per row. Each pixel then costs two polynomial `atan2`
+/// ([`PanoramaCamera::ray_pano_to_pixel_fast`]) and no libm call; ≤ 1e-6 px from the exact inverse
+/// [`OrthoGeoref::ortho_to_panorama_pixel`] (test).
+struct RowMap {
+    /// World direction from the projection centre to column 0's ground point, and its per-column step.
+    d0_world: Vector3<f64>,
+    d_step_world: Vector3<f64>,
+    /// The same in the panorama frame.
+    d0_pano: Vector3<f64>,
+    d_step_pano: Vector3<f64>,
 }
 
-fn node_positions(n: usize) -> Vec<usize> {
-    let mut v: Vec<usize> = (0..n).step_by(MAP_CELL_PX).collect();
-    if *v.last().unwrap_or(&0) != n.saturating_sub(1) {
-        v.push(n - 1);
-    }
-    if v.len() == 1 {
-        v.push(v[0]);
-    }
-    v
-}
-
-impl<'a> PanoramaMap<'a> {
-    fn new(georef: &'a OrthoGeoref, camera: &'a PanoramaCamera) -> Self {
-        let node_cols = node_positions(georef.width_px);
-        let node_rows = node_positions(georef.height_px);
-        let exact = |col: usize, row: usize| {
-            georef.ortho_to_panorama_pixel(camera, col as f64 + 0.5, row as f64 + 0.5)
-        };
-        let nodes: Vec<Option<(f64, f64)>> = node_rows
-            .par_iter()
-            .flat_map_iter(|&r| node_cols.iter().map(move |&c| exact(c, r)))
-            .collect();
-        let (nc, nr) = (node_cols.len(), node_rows.len());
-        let half_width = f64::from(camera.width_px) / 2.0;
-        let smooth: Vec<bool> = (0..(nr - 1) * (nc - 1))
-            .into_par_iter()
-            .map(|cell| {
-                let (i, j) = (cell / (nc - 1), cell % (nc - 1));
-                let corners = [
-                    nodes[i * nc + j],
-                    nodes[i * nc + j + 1],
-                    nodes[(i + 1) * nc + j],
-                    nodes[(i + 1) * nc + j + 1],
-                ];
-                let Some(c) = corners.iter().copied().collect::<Option<Vec<_>>>() else {
-                    return false;
-                };
-                let (umin, umax) = c
-                    .iter()
-                    .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
-                if umax - umin > half_width {
-                    return false; // the cell straddles the seam
-                }
-                let (c0, c1) = (node_cols[j], node_cols[j + 1]);
-                let (r0, r1) = (node_rows[i], node_rows[i + 1]);
-                let (cm, rm) = ((c0 + c1) / 2, (r0 + r1) / 2);
-                // The centre and the four edge midpoints must interpolate within the tolerance (the map bends
-                // fast near the nadir, where the azimuth turns quickly: a single probe can pass by symmetry).
-                [(cm, rm), (cm, r0), (cm, r1), (c0, rm), (c1, rm)]
-                    .iter()
-                    .all(|&(pc, pr)| {
-                        exact(pc, pr).is_some_and(|truth| {
-                            let interp = bilerp(&c, frac(pc, c0, c1), frac(pr, r0, r1));
-                            (interp.0 - truth.0).hypot(interp.1 - truth.1) <= MAP_TOLERANCE_PX
-                        })
-                    })
-            })
-            .collect();
+impl RowMap {
+    fn new(georef: &OrthoGeoref, camera: &PanoramaCamera, row: usize) -> Self {
+        let (right, up) = georef.axes();
+        let foot_offset = Vector3::from(georef.foot_world) - camera.center_world;
+        let a0_m = (0.5 - georef.width_px as f64 / 2.0) * georef.gsd_m;
+        let b_m = (georef.height_px as f64 / 2.0 - (row as f64 + 0.5)) * georef.gsd_m;
+        let right = Vector3::new(right[0], right[1], 0.0);
+        let up = Vector3::new(up[0], up[1], 0.0);
+        let d0_world = foot_offset + right * a0_m + up * b_m;
+        let d_step_world = right * georef.gsd_m;
+        let world_to_pano = camera.rotation_pano_to_world.transpose();
         Self {
-            georef,
-            camera,
-            node_cols,
-            node_rows,
-            nodes,
-            smooth,
+            d0_world,
+            d_step_world,
+            d0_pano: world_to_pano * d0_world,
+            d_step_pano: world_to_pano * d_step_world,
         }
     }
 
-    /// The panorama pixel of ortho pixel (col, row) (its centre), `None` if it does not project.
+    /// World direction from the projection centre to column `col`'s ground point.
     #[inline]
-    fn at(&self, col: usize, row: usize, cell_i: usize, cell_j: usize) -> Option<(f64, f64)> {
-        let nc = self.node_cols.len();
-        if self.smooth[cell_i * (nc - 1) + cell_j] {
-            let (c0, c1) = (self.node_cols[cell_j], self.node_cols[cell_j + 1]);
-            let (r0, r1) = (self.node_rows[cell_i], self.node_rows[cell_i + 1]);
-            let corner = |a: usize, b: usize| self.nodes[a * nc + b].unwrap_or((0.0, 0.0));
-            let c = [
-                corner(cell_i, cell_j),
-                corner(cell_i, cell_j + 1),
-                corner(cell_i + 1, cell_j),
-                corner(cell_i + 1, cell_j + 1),
-            ];
-            Some(bilerp(&c, frac(col, c0, c1), frac(row, r0, r1)))
-        } else {
-            self.georef
-                .ortho_to_panorama_pixel(self.camera, col as f64 + 0.5, row as f64 + 0.5)
+    fn direction_world(&self, col: usize) -> Vector3<f64> {
+        self.d0_world + self.d_step_world * col as f64
+    }
+
+    /// The panorama pixel (`us`, `vs`) of every column's ground point and `valid` = 1, or NaN and 0 where the
+    /// vehicle hides the point (or it is the projection centre itself). Branch-free, so it vectorises (with AVX2
+    /// where the CPU has it; no FMA, so the values are the same either way).
+    fn fill(
+        &self,
+        camera: &PanoramaCamera,
+        vehicle: &VehicleMask,
+        heading: (f64, f64),
+        us: &mut [f64],
+        vs: &mut [f64],
+        valid: &mut [u8],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above).
+            return unsafe { self.fill_avx2(camera, vehicle, heading, us, vs, valid) };
+        }
+        self.fill_impl(camera, vehicle, heading, us, vs, valid)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn fill_avx2(
+        &self,
+        camera: &PanoramaCamera,
+        vehicle: &VehicleMask,
+        heading: (f64, f64),
+        us: &mut [f64],
+        vs: &mut [f64],
+        valid: &mut [u8],
+    ) {
+        self.fill_impl(camera, vehicle, heading, us, vs, valid)
+    }
+
+    #[inline(always)]
+    fn fill_impl(
+        &self,
+        camera: &PanoramaCamera,
+        vehicle: &VehicleMask,
+        heading: (f64, f64),
+        us: &mut [f64],
+        vs: &mut [f64],
+        valid: &mut [u8],
+    ) {
+        let cols = us.iter_mut().zip(vs.iter_mut()).zip(valid.iter_mut());
+        for (col, ((u, v), valid)) in cols.enumerate() {
+            let hidden = vehicle.hides_direction(heading, &self.direction_world(col));
+            let d = self.d0_pano + self.d_step_pano * col as f64;
+            let norm_sq = d.norm_squared();
+            let ok = (norm_sq > 0.0) & norm_sq.is_finite() & !hidden;
+            let (pu, pv) = camera.ray_pano_to_pixel_fast(&d);
+            *u = if ok { pu } else { f64::NAN };
+            *v = if ok { pv } else { f64::NAN };
+            *valid = u8::from(ok);
         }
     }
-}
 
-#[inline]
-fn frac(x: usize, a: usize, b: usize) -> f64 {
-    if b > a {
-        (x - a) as f64 / (b - a) as f64
-    } else {
-        0.0
+    /// Panorama pixel of column `col`'s ground point; `None` where the point is the projection centre itself.
+    #[cfg(test)]
+    #[inline]
+    fn panorama_pixel(&self, camera: &PanoramaCamera, col: usize) -> Option<(f64, f64)> {
+        let d = self.d0_pano + self.d_step_pano * col as f64;
+        let norm_sq = d.norm_squared();
+        (norm_sq > 0.0 && norm_sq.is_finite()).then(|| camera.ray_pano_to_pixel_fast(&d))
     }
-}
-
-/// Bilinear interpolation of corner values [top-left, top-right, bottom-left, bottom-right].
-#[inline]
-fn bilerp(c: &[(f64, f64)], tx: f64, ty: f64) -> (f64, f64) {
-    let top = (
-        c[0].0 + (c[1].0 - c[0].0) * tx,
-        c[0].1 + (c[1].1 - c[0].1) * tx,
-    );
-    let bottom = (
-        c[2].0 + (c[3].0 - c[2].0) * tx,
-        c[2].1 + (c[3].1 - c[2].1) * tx,
-    );
-    (
-        top.0 + (bottom.0 - top.0) * ty,
-        top.1 + (bottom.1 - top.1) * ty,
-    )
 }
 
 /// Ortho-project `panorama` (grey, W = 2H) of `recording` with `params`. Thesis 3.4.3.
@@ -348,7 +318,6 @@ pub fn ortho_project(
         recording.z - recording.camera_height_m,
     ];
     let georef = OrthoGeoref::new(foot, params);
-    let map = PanoramaMap::new(&georef, &camera);
     let heading = recording.heading_deg.to_radians().sin_cos();
     let (w, h) = (georef.width_px, georef.height_px);
     let mut image = GrayImage::filled(w, h, 0.0);
@@ -358,26 +327,22 @@ pub fn ortho_project(
         .par_chunks_mut(w)
         .zip(valid.par_chunks_mut(w))
         .enumerate()
-        .for_each(|(row, (out, ok))| {
-            let cell_i = (row / MAP_CELL_PX).min(map.node_rows.len() - 2);
-            // Ground points of this row: p(col) = first + col · step (no trigonometry per pixel).
-            let first = georef.pixel_to_world(0.5, row as f64 + 0.5);
-            let step = georef.pixel_to_world(1.5, row as f64 + 0.5) - first;
-            for col in 0..w {
-                let p = first + step * col as f64;
-                if params
-                    .vehicle
-                    .hides_with_heading(&camera.center_world, heading, &p)
-                {
-                    continue;
-                }
-                let cell_j = (col / MAP_CELL_PX).min(map.node_cols.len() - 2);
-                if let Some((u, v)) = map.at(col, row, cell_i, cell_j) {
-                    out[col] = sample_panorama(panorama, u, v);
-                    ok[col] = 1;
-                }
-            }
-        });
+        .for_each_init(
+            || (vec![0.0; w], vec![0.0; w], BilinearScratch::default()),
+            |(us, vs, scratch), (row, (out, ok))| {
+                // Pass 1: the panorama pixel of every ortho pixel (NaN where the vehicle hides the ground).
+                RowMap::new(&georef, &camera, row).fill(&camera, &params.vehicle, heading, us, vs, ok);
+                // Pass 2: bilinear sampling; the seam columns and pole rows wrap/clamp.
+                sample_bilinear_many(panorama, us, vs, out, scratch, |_, u, v| {
+                    if u.is_nan() {
+                        0.0
+                    } else {
+                        sample_panorama(panorama, u, v)
+                    }
+                });
+            },
+        );
+    debug_assert_eq!(h * w, image.data.len());
     OrthoImage {
         image,
         valid,
@@ -404,7 +369,7 @@ mod tests {
     }
 
     #[test]
-    fn the_interpolated_map_matches_the_exact_projection() {
+    fn the_row_map_matches_the_exact_inverse_within_1e6_px() {
         for (gsd_m, rotation_deg, heading_deg) in
             [(0.03, 0.0, 67.0), (0.1, 123.0, 200.0), (0.05, 0.0, 0.0)]
         {
@@ -431,29 +396,77 @@ mod tests {
                 ..OrthoParams::default()
             };
             let georef = OrthoGeoref::new([rec.x, rec.y, rec.z - rec.camera_height_m], &params);
-            let map = PanoramaMap::new(&georef, &camera);
             let mut worst = 0.0f64;
             for row in 0..georef.height_px {
+                let map = RowMap::new(&georef, &camera, row);
                 for col in 0..georef.width_px {
-                    let ci = (row / MAP_CELL_PX).min(map.node_rows.len() - 2);
-                    let cj = (col / MAP_CELL_PX).min(map.node_cols.len() - 2);
                     let exact =
                         georef.ortho_to_panorama_pixel(&camera, col as f64 + 0.5, row as f64 + 0.5);
-                    let got = map.at(col, row, ci, cj);
-                    match (exact, got) {
+                    match (exact, map.panorama_pixel(&camera, col)) {
                         (Some(a), Some(b)) => {
                             let du = (a.0 - b.0).abs();
                             let du = du.min(4000.0 - du); // the same direction across the seam
-                            let e = du.hypot(a.1 - b.1);
-                            worst = worst.max(e);
+                            worst = worst.max(du.hypot(a.1 - b.1));
                         }
                         (None, None) => {}
                         _ => panic!("projection differs in existence at ({col}, {row})"),
                     }
+                    let ground = camera.center_world + map.direction_world(col);
+                    let truth = georef.pixel_to_world(col as f64 + 0.5, row as f64 + 0.5);
+                    assert!((ground - truth).norm() < 1e-9, "ground point of ({col}, {row})");
                 }
             }
-            // The tolerance is checked at cell centres; elsewhere in a smooth cell the error is of the same order.
-            assert!(worst < 0.03, "gsd {gsd_m}: worst map error {worst} px");
+            assert!(worst < 1e-6, "gsd {gsd_m}: worst map error {worst:e} px");
         }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn the_avx2_row_map_is_bit_identical_to_the_scalar_one() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            eprintln!("no AVX2 on this CPU: nothing to compare");
+            return;
+        }
+        let rec = Recording {
+            image_id: "r".into(),
+            file: "r.jpg".into(),
+            time: "2020-01-01T00:00:00Z".into(),
+            time_s: 0.0,
+            x: 92_007.83,
+            y: 437_001.05,
+            z: 3.43,
+            heading_deg: 141.0,
+            camera_height_m: 2.2,
+            sigma_xy_m: None,
+            sigma_z_m: None,
+            yaw_deg: 0.24,
+            pitch_deg: -0.49,
+            roll_deg: -0.19,
+        };
+        let camera = PanoramaCamera::from_recording(&rec, 4000, 2000);
+        let params = OrthoParams {
+            gsd_m: 0.05,
+            rotation_deg: 33.0,
+            ..OrthoParams::default()
+        };
+        let georef = OrthoGeoref::new([rec.x, rec.y, rec.z - rec.camera_height_m], &params);
+        let heading = rec.heading_deg.to_radians().sin_cos();
+        let n = georef.width_px;
+        let mut hidden = 0;
+        for row in 0..georef.height_px {
+            let map = RowMap::new(&georef, &camera, row);
+            let mut a = (vec![0.0; n], vec![0.0; n], vec![0u8; n]);
+            let mut b = a.clone();
+            map.fill_impl(&camera, &params.vehicle, heading, &mut a.0, &mut a.1, &mut a.2);
+            // SAFETY: AVX2 was detected above.
+            unsafe { map.fill_avx2(&camera, &params.vehicle, heading, &mut b.0, &mut b.1, &mut b.2) };
+            assert_eq!(a.2, b.2, "row {row}: validity");
+            for col in 0..n {
+                assert_eq!(a.0[col].to_bits(), b.0[col].to_bits(), "u of ({col}, {row})");
+                assert_eq!(a.1[col].to_bits(), b.1[col].to_bits(), "v of ({col}, {row})");
+            }
+            hidden += a.2.iter().filter(|&&ok| ok == 0).count();
+        }
+        assert!(hidden > 100, "the vehicle mask hid only {hidden} pixels");
     }
 }

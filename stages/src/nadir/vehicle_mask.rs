@@ -80,18 +80,23 @@ impl VehicleMask {
         (sin_h, cos_h): (f64, f64),
         point_world: &Vector3<f64>,
     ) -> bool {
-        if !self.enabled {
-            return false;
-        }
-        let d = point_world - camera_world;
-        if d.z >= -self.roof_drop_m {
-            return false; // never reaches the roof plane
-        }
-        let t = self.roof_drop_m / -d.z;
-        let (east, north) = (d.x * t, d.y * t);
-        let forward = east * sin_h + north * cos_h;
-        let left = -east * cos_h + north * sin_h;
-        forward <= self.front_m && forward >= -self.rear_m && left.abs() <= self.half_width_m
+        self.hides_direction((sin_h, cos_h), &(point_world - camera_world))
+    }
+
+    /// [`Self::hides_with_heading`] for the offset `d` (world, metres) from the camera to the point.
+    #[inline]
+    pub fn hides_direction(&self, (sin_h, cos_h): (f64, f64), d: &Vector3<f64>) -> bool {
+        // A point above the roof plane (depth ≤ roof_drop) is never hidden. Below it, where the ray meets the roof
+        // plane it is scaled by roof_drop / depth (> 0): compare scaled offsets with the body's extent multiplied by
+        // depth instead (no division per point). Non-short-circuit `&` keeps it branch-free (vectorisable).
+        let depth_m = -d.z;
+        let forward = (d.x * sin_h + d.y * cos_h) * self.roof_drop_m;
+        let left = (-d.x * cos_h + d.y * sin_h) * self.roof_drop_m;
+        self.enabled
+            & (depth_m > self.roof_drop_m)
+            & (forward <= self.front_m * depth_m)
+            & (forward >= -self.rear_m * depth_m)
+            & (left.abs() <= self.half_width_m * depth_m)
     }
 }
 

@@ -230,3 +230,23 @@ fn from_recording_uses_pose_and_rotation() {
     );
     assert!((cam.pixel_angle_rad() - 0.075f64.to_radians()).abs() < 1e-15);
 }
+
+#[test]
+fn fast_projection_matches_the_exact_one_within_1e9_px() {
+    let cam = PanoramaCamera::new(W, H, rd_centre(), 0.7, -0.4, 0.3);
+    let mut worst = 0.0f64;
+    for i in 0..200 {
+        for j in 0..100 {
+            // Directions of all azimuths and elevations except the poles, at several lengths.
+            let az = -std::f64::consts::PI + (i as f64 + 0.5) * std::f64::consts::TAU / 200.0;
+            let el = -1.55 + (j as f64 + 0.5) * 3.1 / 100.0;
+            let len = [0.01, 1.0, 3e4][(i + j) % 3];
+            let d = Vector3::new(el.cos() * az.sin(), el.cos() * az.cos(), el.sin()) * len;
+            let (ue, ve) = cam.ray_pano_to_pixel(&d);
+            let (uf, vf) = cam.ray_pano_to_pixel_fast(&d);
+            assert!((0.0..f64::from(W)).contains(&uf), "u {uf} outside [0, W)");
+            worst = worst.max(wrapped_du(ue, uf).max((ve - vf).abs()));
+        }
+    }
+    assert!(worst < 1e-9, "worst difference {worst:e} px");
+}
