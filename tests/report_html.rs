@@ -99,7 +99,6 @@ fn report_of_a_tiny_run() {
     let html = std::fs::read_to_string(&index).unwrap();
     for id in [
         "summary-run",
-        "summary-stages",
         "table-3-1",
         "thesis-table-3-1",
         "accuracy",
@@ -119,8 +118,14 @@ fn report_of_a_tiny_run() {
             );
         }
     }
+    // The run's own log (times, nodes executed / cached) is kept apart from the result tables.
+    for id in ["summary-engine", "summary-stages"] {
+        assert!(html.contains(&format!("id=\"table-{id}\"")), "table {id} missing");
+        assert!(html.contains(&format!("href=\"run-log/{id}.csv\"")), "{id} not linked from run-log/");
+        assert!(!report.join("tables").join(format!("{id}.csv")).exists());
+    }
     assert!(html.contains("thesis (Rotterdam data)") && html.contains("skytie (this campaign)"));
-    let md = std::fs::read_to_string(report.join("tables/summary-stages.md")).unwrap();
+    let md = std::fs::read_to_string(report.join("run-log/summary-stages.md")).unwrap();
     assert!(
         md.contains("| stage | executed | cached | failed | skipped | seconds |"),
         "{md}"
@@ -148,6 +153,33 @@ fn report_of_a_tiny_run() {
             "no nadir registration view although correspondences.csv has nadir rows: {names:?}"
         );
     }
+
+    // Re-running the workflow (warm cache: nothing executes) reproduces every result table byte-identically;
+    // only the run log (times, nodes executed / cached) differs.
+    let rerun = tmp.path().join("out-rerun");
+    run_ok(
+        skytie()
+            .arg("run")
+            .arg(&wf)
+            .arg("--cache")
+            .arg(&cache)
+            .arg("--out")
+            .arg(&rerun)
+            .arg("--quiet"),
+    );
+    let (tables, tables_rerun) = (
+        snapshot(&report.join("tables")),
+        snapshot(&rerun.join("report/tables")),
+    );
+    assert!(tables.len() > 10, "{} tables", tables.len());
+    let differing: Vec<&String> = tables
+        .keys()
+        .chain(tables_rerun.keys())
+        .filter(|k| tables.get(*k) != tables_rerun.get(*k))
+        .collect();
+    assert!(differing.is_empty(), "a rerun changed the tables {differing:?}");
+    let engine = std::fs::read_to_string(rerun.join("report/run-log/summary-engine.csv")).unwrap();
+    assert!(engine.contains("nodes executed,0"), "{engine}");
 
     // Headless Chromium: every image loads with a non-zero natural size; screenshot.
     let Some(chromium) = find_chromium() else {

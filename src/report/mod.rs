@@ -5,7 +5,10 @@
 //! Writes `OUT/report/index.html` (summary, and for a plain run the result sections; for a sweep the sweep
 //! tables and charts plus one page `variant-<name>.html` per variant), figures as SVG / PNG files in
 //! `OUT/report/figures/`, and every table also as CSV and Markdown in `OUT/report/tables/`. The same OUT
-//! gives byte-identical files (no timestamps except those read from OUT).
+//! gives byte-identical files (no timestamps except those read from OUT). The tables that describe the run
+//! itself rather than its results — wall and node times, nodes executed / served from the cache, when it
+//! finished — go to `OUT/report/run-log/` instead, so that re-running a workflow reproduces `tables/`
+//! byte-identically (a warm rerun executes nothing and takes less time, which is all that changes).
 
 pub mod html;
 pub mod image_cache;
@@ -55,6 +58,8 @@ pub struct ReportSummary {
     pub pages: Vec<PathBuf>,
     /// Table ids (each written as `tables/<id>.csv` and `.md`).
     pub tables: Vec<String>,
+    /// Ids of the run-log tables (`run-log/<id>.csv` and `.md`).
+    pub run_log_tables: Vec<String>,
     /// Figure files written.
     pub figures: Vec<PathBuf>,
     /// Sections left out or degraded, one line each (e.g. "no campaign folder: no true positions").
@@ -67,6 +72,8 @@ pub struct Builder {
     pub campaign: Option<PathBuf>,
     pub options: ReportOptions,
     tables: Vec<Table>,
+    /// Tables about the run itself (times, cache use), written to [`RUN_LOG_DIR`].
+    run_log: Vec<Table>,
     table_ids: BTreeSet<String>,
     pub figures: Vec<PathBuf>,
     pub notes: Vec<String>,
@@ -78,6 +85,7 @@ pub struct Builder {
 
 /// Folder names inside `OUT/report/`.
 pub const TABLES_DIR: &str = "tables";
+pub const RUN_LOG_DIR: &str = "run-log";
 pub const FIGURES_DIR: &str = "figures";
 
 impl Builder {
@@ -91,6 +99,19 @@ impl Builder {
         page.raw(&t.to_html(TABLES_DIR));
         self.table_ids.insert(t.id.clone());
         self.tables.push(t);
+    }
+
+    /// Like [`Builder::table`] for a table about the run itself (times, nodes executed / cached), which
+    /// differs between runs of the same workflow: its files go to `run-log/`, not `tables/`.
+    pub fn run_log_table(&mut self, page: &mut Page, t: Table) {
+        debug_assert!(
+            !self.table_ids.contains(&t.id),
+            "duplicate table id {}",
+            t.id
+        );
+        page.raw(&t.to_html(RUN_LOG_DIR));
+        self.table_ids.insert(t.id.clone());
+        self.run_log.push(t);
     }
 
     /// The absolute path and the page-relative href of a figure file named `name`.
@@ -113,6 +134,7 @@ impl Builder {
             campaign: self.campaign.clone(),
             options: self.options.clone(),
             tables: Vec::new(),
+            run_log: Vec::new(),
             table_ids: BTreeSet::new(),
             figures: Vec::new(),
             notes: Vec::new(),
@@ -123,14 +145,23 @@ impl Builder {
 
     /// Takes over what a [`Builder::child`] collected (called in variant order: deterministic output).
     fn absorb(&mut self, child: Builder) {
-        for t in child.tables {
+        for (t, run_log) in child
+            .tables
+            .into_iter()
+            .map(|t| (t, false))
+            .chain(child.run_log.into_iter().map(|t| (t, true)))
+        {
             debug_assert!(
                 !self.table_ids.contains(&t.id),
                 "duplicate table id {}",
                 t.id
             );
             self.table_ids.insert(t.id.clone());
-            self.tables.push(t);
+            if run_log {
+                self.run_log.push(t);
+            } else {
+                self.tables.push(t);
+            }
         }
         self.figures.extend(child.figures);
         self.notes.extend(child.notes);
@@ -161,7 +192,7 @@ pub fn slug(s: &str) -> String {
 pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSummary, String> {
     let run = RunOutputs::read(out_dir)?;
     let report_dir = out_dir.join("report");
-    for d in [report_dir.join(TABLES_DIR), report_dir.join(FIGURES_DIR)] {
+    for d in [TABLES_DIR, RUN_LOG_DIR, FIGURES_DIR].map(|d| report_dir.join(d)) {
         std::fs::create_dir_all(&d)
             .map_err(|e| format!("{}: cannot create the folder: {e}", d.display()))?;
     }
@@ -175,6 +206,7 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
         campaign,
         options: options.clone(),
         tables: Vec::new(),
+        run_log: Vec::new(),
         table_ids: BTreeSet::new(),
         figures: Vec::new(),
         notes: Vec::new(),
@@ -242,8 +274,13 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
     }
     let index_path = report_dir.join("index.html");
     pages.insert(0, (index_path.clone(), index.render()));
-    for t in &b.tables {
-        let base = report_dir.join(TABLES_DIR).join(&t.id);
+    let table_files = b
+        .tables
+        .iter()
+        .map(|t| (t, TABLES_DIR))
+        .chain(b.run_log.iter().map(|t| (t, RUN_LOG_DIR)));
+    for (t, dir) in table_files.clone() {
+        let base = report_dir.join(dir).join(&t.id);
         for (ext, text) in [("csv", t.to_csv()), ("md", t.to_markdown())] {
             let p = base.with_extension(ext);
             atomic_write(&p, text.as_bytes())
@@ -256,12 +293,12 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
     }
     // Files of an earlier build that this one did not write (renamed views, removed variants) would be stale.
     let mut current: BTreeSet<PathBuf> = b.figures.iter().cloned().collect();
-    for t in &b.tables {
-        let base = report_dir.join(TABLES_DIR).join(&t.id);
+    for (t, dir) in table_files {
+        let base = report_dir.join(dir).join(&t.id);
         current.insert(base.with_extension("csv"));
         current.insert(base.with_extension("md"));
     }
-    for dir in [TABLES_DIR, FIGURES_DIR] {
+    for dir in [TABLES_DIR, RUN_LOG_DIR, FIGURES_DIR] {
         let Ok(entries) = std::fs::read_dir(report_dir.join(dir)) else {
             continue;
         };
@@ -276,6 +313,7 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
         index: index_path,
         pages: pages.into_iter().map(|(p, _)| p).collect(),
         tables: b.tables.iter().map(|t| t.id.clone()).collect(),
+        run_log_tables: b.run_log.iter().map(|t| t.id.clone()).collect(),
         figures: b.figures,
         notes: b.notes,
     })

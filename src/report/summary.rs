@@ -66,11 +66,22 @@ pub fn summary_section(b: &mut Builder, page: &mut Page, run: &RunOutputs) {
     {
         kv("skytie version", v.to_string());
     }
-    if let Some(s) = prov.and_then(|p| num_at(p, "timings.finished_unix_s")) {
-        kv("finished (unix time, s)", fmt_count(Some(s)));
-    }
     if run.is_sweep {
         kv("variants", fmt_count(Some(run.sets.len() as f64)));
+    }
+    b.table(page, t);
+
+    // What this particular run did: differs between runs of one workflow (a warm rerun executes nothing).
+    let mut t = Table::new(
+        "summary-engine",
+        "This run: nodes executed / served from the cache, time",
+        Origin::Skytie,
+        &["item", "value"],
+    )
+    .with_note("run log: written to run-log/, not tables/ (it differs between runs of the same workflow)");
+    let mut kv = |k: &str, v: String| t.push(vec![k.to_string(), v]);
+    if let Some(s) = prov.and_then(|p| num_at(p, "timings.finished_unix_s")) {
+        kv("finished (unix time, s)", fmt_count(Some(s)));
     }
     for (label, key, decimals) in [
         ("nodes total", "engine.nodes_total", None),
@@ -95,7 +106,7 @@ pub fn summary_section(b: &mut Builder, page: &mut Page, run: &RunOutputs) {
             );
         }
     }
-    b.table(page, t);
+    b.run_log_table(page, t);
 
     if let Some(stages) = obj_at(m, "stages") {
         let mut t = Table::new(
@@ -104,7 +115,10 @@ pub fn summary_section(b: &mut Builder, page: &mut Page, run: &RunOutputs) {
             Origin::Skytie,
             &["stage", "executed", "cached", "failed", "skipped", "seconds"],
         )
-        .with_note("seconds = summed node time (nodes run in parallel, so the sum can exceed the wall time).");
+        .with_note(
+            "seconds = summed node time (nodes run in parallel, so the sum can exceed the wall time); run log: \
+             written to run-log/, not tables/",
+        );
         for (name, s) in stages {
             let c = |k: &str| fmt_count(num_at(s, k));
             t.push(vec![
@@ -116,7 +130,7 @@ pub fn summary_section(b: &mut Builder, page: &mut Page, run: &RunOutputs) {
                 fmt_num(num_at(s, "seconds"), 2),
             ]);
         }
-        b.table(page, t);
+        b.run_log_table(page, t);
     }
     problems(b, page, run);
 }
