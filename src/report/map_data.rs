@@ -164,9 +164,110 @@ pub fn read_map_data(dir: &Path, campaign: Option<&Path>) -> Result<Option<MapDa
     }))
 }
 
+/// Recordings and check points further apart than this (m) from every other one of a group belong to separate
+/// areas, each drawn as its own map (a campaign of several areas kilometres apart would otherwise shrink every
+/// street to a few pixels). Consecutive recordings are ~5 m apart, so one street of any length stays one area.
+pub const AREA_GAP_M: f64 = 250.0;
+
+impl MapData {
+    /// Splits the map into areas: groups of recordings and check points linked by distances ≤ `gap_m`
+    /// (single linkage, by recorded position). Areas are ordered by their first recording (in `ids` order);
+    /// one area is the whole map. An area of check points without recordings follows the others.
+    pub fn areas(self, gap_m: f64) -> Vec<MapData> {
+        let n_rec = self.recordings.len();
+        let points: Vec<[f64; 2]> = self
+            .recordings
+            .iter()
+            .map(|r| r.recorded)
+            .chain(self.checkpoints.iter().map(|c| c.position))
+            .collect();
+        let mut parent: Vec<usize> = (0..points.len()).collect();
+        fn root(parent: &mut [usize], mut i: usize) -> usize {
+            while parent[i] != i {
+                parent[i] = parent[parent[i]];
+                i = parent[i];
+            }
+            i
+        }
+        let gap_sq = gap_m * gap_m;
+        for i in 0..points.len() {
+            for j in i + 1..points.len() {
+                let (dx, dy) = (points[i][0] - points[j][0], points[i][1] - points[j][1]);
+                if dx * dx + dy * dy <= gap_sq {
+                    let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+                    if a != b {
+                        parent[a.max(b)] = a.min(b);
+                    }
+                }
+            }
+        }
+        // Area index by root, in order of first appearance (recordings first).
+        let mut area_of_root: BTreeMap<usize, usize> = BTreeMap::new();
+        let mut area: Vec<usize> = Vec::with_capacity(points.len());
+        for i in 0..points.len() {
+            let r = root(&mut parent, i);
+            let next = area_of_root.len();
+            area.push(*area_of_root.entry(r).or_insert(next));
+        }
+        let mut out: Vec<MapData> = (0..area_of_root.len())
+            .map(|_| MapData {
+                ids: Vec::new(),
+                recordings: Vec::new(),
+                checkpoints: Vec::new(),
+                has_truth: self.has_truth,
+            })
+            .collect();
+        for (k, (id, rec)) in self.ids.into_iter().zip(self.recordings).enumerate() {
+            out[area[k]].ids.push(id);
+            out[area[k]].recordings.push(rec);
+        }
+        for (k, c) in self.checkpoints.into_iter().enumerate() {
+            out[area[n_rec + k]].checkpoints.push(c);
+        }
+        out
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn areas_are_groups_further_apart_than_the_gap() {
+        let rec = |x: f64, y: f64| MapRecording {
+            recorded: [x, y],
+            adjusted: None,
+            truth: None,
+            kind: CorrespondenceKind::None,
+        };
+        // A 1 km street of 5-m steps (one area), a second street 3 km east, a check point near the second.
+        let mut ids = Vec::new();
+        let mut recordings = Vec::new();
+        for i in 0..200 {
+            ids.push(format!("a{i:03}"));
+            recordings.push(rec(92_000.0 + 5.0 * i as f64, 437_000.0));
+        }
+        for i in 0..10 {
+            ids.push(format!("b{i:03}"));
+            recordings.push(rec(95_000.0, 437_000.0 + 5.0 * i as f64));
+        }
+        let checkpoints = vec![MapCheckPoint {
+            position: [95_010.0, 437_020.0],
+            error_before: None,
+            error_after: None,
+        }];
+        let data = MapData {
+            ids,
+            recordings,
+            checkpoints,
+            has_truth: false,
+        };
+        let areas = data.areas(AREA_GAP_M);
+        assert_eq!(areas.len(), 2);
+        assert_eq!((areas[0].recordings.len(), areas[0].checkpoints.len()), (200, 0));
+        assert_eq!((areas[1].recordings.len(), areas[1].checkpoints.len()), (10, 1));
+        assert_eq!(areas[1].ids[0], "b000");
+    }
 
     #[test]
     fn correspondence_kinds_per_recording() {

@@ -5,7 +5,7 @@
 
 use super::html::Page;
 use super::inputs::{num_at, obj_at, read_csv_opt, ResultSet, RunOutputs};
-use super::map_data::read_map_data;
+use super::map_data::{read_map_data, AREA_GAP_M};
 use super::plots::histogram::{histogram, HistSeries};
 use super::plots::trajectory::{trajectory_map, trim};
 use super::plots::{GREY, VERMILLION};
@@ -57,32 +57,51 @@ fn map_section(
         );
         return Ok(());
     };
-    let (path, href) = b.figure_path(&format!("{prefix}trajectory.svg"));
-    let scales = trajectory_map(
-        &path,
-        &format!("Recordings and check points{title_suffix}"),
-        &data.recordings,
-        &data.checkpoints,
-    )?;
-    b.wrote_figure(path);
-    let truth = if data.has_truth {
-        "true positions from the campaign's truth/ folder (evaluation only)"
-    } else {
-        "no true positions (no truth/ folder)"
-    };
-    page.figure(
-        &href,
-        "trajectory map",
-        &format!(
-            "{} recordings: recorded (hollow), adjusted (filled, coloured by aerial correspondences), {truth}. \
-             {} check points with horizontal error vectors (estimated − true) before (grey) and after (red) \
-             the adjustment, drawn {}× longer than they are; scale bar {} m.",
-            data.recordings.len(),
-            data.checkpoints.len(),
-            trim(scales.exaggeration),
-            trim(scales.scale_bar_m)
-        ),
-    );
+    let areas = data.areas(AREA_GAP_M);
+    let n_areas = areas.len();
+    if n_areas > 1 {
+        page.raw(&format!(
+            "<p>{n_areas} areas more than {} m apart: one map each.</p>\n",
+            trim(AREA_GAP_M)
+        ));
+    }
+    for (k, area) in areas.iter().enumerate() {
+        let (file, which) = if n_areas > 1 {
+            (
+                format!("{prefix}trajectory-area{}.svg", k + 1),
+                format!(", area {} of {n_areas}", k + 1),
+            )
+        } else {
+            (format!("{prefix}trajectory.svg"), String::new())
+        };
+        let (path, href) = b.figure_path(&file);
+        let scales = trajectory_map(
+            &path,
+            &format!("Recordings and check points{title_suffix}{which}"),
+            &area.recordings,
+            &area.checkpoints,
+        )?;
+        b.wrote_figure(path);
+        let truth = if area.has_truth {
+            "true positions from the campaign's truth/ folder (evaluation only)"
+        } else {
+            "no true positions (no truth/ folder)"
+        };
+        page.figure(
+            &href,
+            "trajectory map",
+            &format!(
+                "{}{} recordings: recorded (hollow), adjusted (filled, coloured by aerial correspondences), {truth}. \
+                 {} check points with horizontal error vectors (estimated − true) before (grey) and after (red) \
+                 the adjustment, drawn {}× longer than they are; scale bar {} m.",
+                if n_areas > 1 { format!("Area {} of {n_areas}: ", k + 1) } else { String::new() },
+                area.recordings.len(),
+                area.checkpoints.len(),
+                trim(scales.exaggeration),
+                trim(scales.scale_bar_m)
+            ),
+        );
+    }
     Ok(())
 }
 

@@ -142,7 +142,17 @@ pub fn trajectory_map(
     let exaggeration = exaggeration_for(extent, max_err);
     let scale_bar_m = nice_floor((lx1 - lx0) / 5.0);
     let vector_bar_m = nice_floor(if max_err > 0.0 { max_err } else { 0.1 });
-    let legend_rows = 8u32;
+    // Legend rows: recorded, true (if any), one per correspondence kind, check point + its two vectors.
+    let n_kinds = {
+        let mut k: Vec<CorrespondenceKind> = recordings.iter().map(|r| r.kind).collect();
+        k.sort();
+        k.dedup();
+        k.len() as u32
+    };
+    let legend_rows = 1
+        + u32::from(recordings.iter().any(|r| r.truth.is_some()))
+        + n_kinds
+        + if checkpoints.is_empty() { 0 } else { 3 };
     let (width, height) = (
         plot_w as u32 + 90 + 30,
         plot_h as u32 + 60 + 70 + 22 * legend_rows,
