@@ -10,7 +10,8 @@
 //! Written to `$SKYTIE_PEER_DIR/ortho/` (default `<temp>/skytie_peers/ortho/`): `panorama.png`, and per GSD
 //! `map_{gsd}cm_u.npy`, `map_{gsd}cm_v.npy` (float32, campaign pixel convention: pixel centres at +0.5, NaN
 //! where the vehicle hides the ground), `ortho_{gsd}cm.npy` (skytie's float32 output, for the agreement check)
-//! and `skytie_{gsd}cm.csv` (timings). Run: `cargo bench -p skytie-stages --bench ortho`.
+//! `skytie_{gsd}cm.csv` (timings) and `geometry_{gsd}cm.json` (ground grid and panorama rotation, for a peer that
+//! computes the map itself). Run: `cargo bench -p skytie-stages --bench ortho`.
 
 #[path = "peer_support/mod.rs"]
 mod peer_support;
@@ -190,6 +191,33 @@ fn bench_gsd(panorama: &GrayImage, gsd_cm: u32, dir: &Path) {
     }
     println!("  remap vs ortho_project, max |difference| on valid pixels: {max_diff:.2e}");
     std::fs::write(dir.join(format!("skytie_{gsd_cm}cm.csv")), csv).expect("write timing CSV");
+
+    // The geometry, so that the peer script can also compute the map itself (NumPy) before `cv2.remap`, the
+    // whole job `ortho_project` does: d_world(col, row) = foot − centre + a·right + b·up with
+    // a = (col + 0.5 − W/2)·gsd, b = (H/2 − row − 0.5)·gsd; d_pano = Rᵀ·d_world (R row-major, pano → world).
+    let r = params.rotation_deg.to_radians();
+    let foot_offset = [
+        ortho.georef.foot_world[0] - camera.center_world.x,
+        ortho.georef.foot_world[1] - camera.center_world.y,
+        ortho.georef.foot_world[2] - camera.center_world.z,
+    ];
+    let rot = camera.rotation_pano_to_world;
+    let rot_rows: Vec<f64> = (0..3).flat_map(|i| (0..3).map(move |j| rot[(i, j)])).collect();
+    let json = format!(
+        "{{\"width_px\": {w}, \"height_px\": {h}, \"gsd_m\": {}, \"foot_offset_m\": {:?}, \
+         \"right\": [{}, {}], \"up\": [{}, {}], \"rotation_pano_to_world\": {:?}, \
+         \"panorama_width_px\": {}, \"panorama_height_px\": {}}}\n",
+        params.gsd_m,
+        foot_offset,
+        r.cos(),
+        -r.sin(),
+        r.sin(),
+        r.cos(),
+        rot_rows,
+        panorama.width,
+        panorama.height
+    );
+    std::fs::write(dir.join(format!("geometry_{gsd_cm}cm.json")), json).expect("write geometry");
 }
 
 fn main() {
