@@ -27,6 +27,20 @@ fn run_ok(cmd: &mut Command) -> String {
     text
 }
 
+/// `skytie run WORKFLOW --cache CACHE --out OUT --quiet`, which must succeed.
+fn run_workflow(wf: &Path, cache: &Path, out: &Path) {
+    run_ok(
+        skytie()
+            .arg("run")
+            .arg(wf)
+            .arg("--cache")
+            .arg(cache)
+            .arg("--out")
+            .arg(out)
+            .arg("--quiet"),
+    );
+}
+
 /// Every referenced image / table file of `page` exists and is non-empty; returns the image paths.
 fn check_references(page: &Path) -> Vec<PathBuf> {
     let (imgs, links) = referenced_files(page);
@@ -51,16 +65,7 @@ fn report_of_a_tiny_run() {
     let tmp = tempfile::tempdir().unwrap();
     let (cache, out) = (tmp.path().join("cache"), tmp.path().join("out"));
     let wf = Path::new(env!("CARGO_MANIFEST_DIR")).join("workflows/tiny.toml");
-    run_ok(
-        skytie()
-            .arg("run")
-            .arg(&wf)
-            .arg("--cache")
-            .arg(&cache)
-            .arg("--out")
-            .arg(&out)
-            .arg("--quiet"),
-    );
+    run_workflow(&wf, &cache, &out);
     let report = out.join("report");
     let index = report.join("index.html");
     assert!(
@@ -157,16 +162,7 @@ fn report_of_a_tiny_run() {
     // Re-running the workflow (warm cache: nothing executes) reproduces every result table byte-identically;
     // only the run log (times, nodes executed / cached) differs.
     let rerun = tmp.path().join("out-rerun");
-    run_ok(
-        skytie()
-            .arg("run")
-            .arg(&wf)
-            .arg("--cache")
-            .arg(&cache)
-            .arg("--out")
-            .arg(&rerun)
-            .arg("--quiet"),
-    );
+    run_workflow(&wf, &cache, &rerun);
     let (tables, tables_rerun) = (
         snapshot(&report.join("tables")),
         snapshot(&rerun.join("report/tables")),

@@ -91,27 +91,26 @@ pub const FIGURES_DIR: &str = "figures";
 impl Builder {
     /// Adds a table to `page` and queues its CSV/Markdown files. Ids must be unique in the report.
     pub fn table(&mut self, page: &mut Page, t: Table) {
-        debug_assert!(
-            !self.table_ids.contains(&t.id),
-            "duplicate table id {}",
-            t.id
-        );
-        page.raw(&t.to_html(TABLES_DIR));
-        self.table_ids.insert(t.id.clone());
+        self.show(page, &t, TABLES_DIR);
         self.tables.push(t);
     }
 
     /// Like [`Builder::table`] for a table about the run itself (times, nodes executed / cached), which
     /// differs between runs of the same workflow: its files go to `run-log/`, not `tables/`.
     pub fn run_log_table(&mut self, page: &mut Page, t: Table) {
+        self.show(page, &t, RUN_LOG_DIR);
+        self.run_log.push(t);
+    }
+
+    /// Puts `t` on `page`, its CSV/Markdown links pointing into `dir`, and reserves its id.
+    fn show(&mut self, page: &mut Page, t: &Table, dir: &str) {
         debug_assert!(
             !self.table_ids.contains(&t.id),
             "duplicate table id {}",
             t.id
         );
-        page.raw(&t.to_html(RUN_LOG_DIR));
+        page.raw(&t.to_html(dir));
         self.table_ids.insert(t.id.clone());
-        self.run_log.push(t);
     }
 
     /// The absolute path and the page-relative href of a figure file named `name`.

@@ -354,6 +354,39 @@ pub fn ortho_project(
 mod tests {
     use super::*;
 
+    /// A recording in national-grid coordinates (4000 × 2000 panorama, small residual rotation) and its ortho
+    /// grid for the given GSD, image rotation and heading.
+    fn setup(
+        gsd_m: f64,
+        rotation_deg: f64,
+        heading_deg: f64,
+    ) -> (Recording, PanoramaCamera, OrthoParams, OrthoGeoref) {
+        let rec = Recording {
+            image_id: "r".into(),
+            file: "r.jpg".into(),
+            time: "2020-01-01T00:00:00Z".into(),
+            time_s: 0.0,
+            x: 92_007.83,
+            y: 437_001.05,
+            z: 3.43,
+            heading_deg,
+            camera_height_m: 2.2,
+            sigma_xy_m: None,
+            sigma_z_m: None,
+            yaw_deg: 0.24,
+            pitch_deg: -0.49,
+            roll_deg: -0.19,
+        };
+        let camera = PanoramaCamera::from_recording(&rec, 4000, 2000);
+        let params = OrthoParams {
+            gsd_m,
+            rotation_deg,
+            ..OrthoParams::default()
+        };
+        let georef = OrthoGeoref::new([rec.x, rec.y, rec.z - rec.camera_height_m], &params);
+        (rec, camera, params, georef)
+    }
+
     #[test]
     fn panorama_sampling_wraps_across_the_seam() {
         // 4 × 2 panorama; columns 0 and 3 are the seam neighbours.
@@ -373,29 +406,7 @@ mod tests {
         for (gsd_m, rotation_deg, heading_deg) in
             [(0.03, 0.0, 67.0), (0.1, 123.0, 200.0), (0.05, 0.0, 0.0)]
         {
-            let rec = Recording {
-                image_id: "r".into(),
-                file: "r.jpg".into(),
-                time: "2020-01-01T00:00:00Z".into(),
-                time_s: 0.0,
-                x: 92_007.83,
-                y: 437_001.05,
-                z: 3.43,
-                heading_deg,
-                camera_height_m: 2.2,
-                sigma_xy_m: None,
-                sigma_z_m: None,
-                yaw_deg: 0.24,
-                pitch_deg: -0.49,
-                roll_deg: -0.19,
-            };
-            let camera = PanoramaCamera::from_recording(&rec, 4000, 2000);
-            let params = OrthoParams {
-                gsd_m,
-                rotation_deg,
-                ..OrthoParams::default()
-            };
-            let georef = OrthoGeoref::new([rec.x, rec.y, rec.z - rec.camera_height_m], &params);
+            let (_, camera, _, georef) = setup(gsd_m, rotation_deg, heading_deg);
             let mut worst = 0.0f64;
             for row in 0..georef.height_px {
                 let map = RowMap::new(&georef, &camera, row);
@@ -427,29 +438,7 @@ mod tests {
             eprintln!("no AVX2 on this CPU: nothing to compare");
             return;
         }
-        let rec = Recording {
-            image_id: "r".into(),
-            file: "r.jpg".into(),
-            time: "2020-01-01T00:00:00Z".into(),
-            time_s: 0.0,
-            x: 92_007.83,
-            y: 437_001.05,
-            z: 3.43,
-            heading_deg: 141.0,
-            camera_height_m: 2.2,
-            sigma_xy_m: None,
-            sigma_z_m: None,
-            yaw_deg: 0.24,
-            pitch_deg: -0.49,
-            roll_deg: -0.19,
-        };
-        let camera = PanoramaCamera::from_recording(&rec, 4000, 2000);
-        let params = OrthoParams {
-            gsd_m: 0.05,
-            rotation_deg: 33.0,
-            ..OrthoParams::default()
-        };
-        let georef = OrthoGeoref::new([rec.x, rec.y, rec.z - rec.camera_height_m], &params);
+        let (rec, camera, params, georef) = setup(0.05, 33.0, 141.0);
         let heading = rec.heading_deg.to_radians().sin_cos();
         let n = georef.width_px;
         let mut hidden = 0;
