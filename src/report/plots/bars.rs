@@ -3,6 +3,7 @@
 //! category names are drawn left of the plot in a label column sized to the longest name, so long variant
 //! names never overlap.
 
+use super::trajectory::trim;
 use super::{plot_err, write_svg, CAPTION_PX, DARK, FONT, LABEL_PX, TICK_PX};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -59,6 +60,7 @@ pub fn grouped_bars(
             .disable_y_mesh()
             .y_labels(0)
             .x_desc(x_desc)
+            .x_label_formatter(&|v| trim(*v))
             .axis_desc_style((FONT, LABEL_PX))
             .label_style((FONT, TICK_PX))
             .draw()

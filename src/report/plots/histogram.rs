@@ -1,6 +1,7 @@
 //! Residual histograms: the distribution of one quantity (e.g. check-point 2D error, metres) for up to a
 //! few series (before / after the adjustment) on shared bins, bars of a bin side by side.
 
+use super::trajectory::trim;
 use super::{nice_floor, plot_err, write_svg, CAPTION_PX, FONT, LABEL_PX, TICK_PX};
 use plotters::prelude::*;
 use std::path::Path;
@@ -69,6 +70,7 @@ pub fn histogram(
         chart
             .configure_mesh()
             .x_desc(x_desc)
+            .x_label_formatter(&|v| trim(*v))
             .y_desc("count")
             .y_label_formatter(&|v| if (v - v.round()).abs() < 1e-9 { format!("{v:.0}") } else { String::new() })
             .axis_desc_style((FONT, LABEL_PX))

@@ -175,6 +175,8 @@ pub fn trajectory_map(
             .configure_mesh()
             .x_desc(format!("easting − {:.0} [m]", origin[0]))
             .y_desc(format!("northing − {:.0} [m]", origin[1]))
+            .x_label_formatter(&|v| trim(*v))
+            .y_label_formatter(&|v| trim(*v))
             .axis_desc_style((FONT, LABEL_PX))
             .label_style((FONT, TICK_PX))
             .light_line_style(WHITE.mix(0.0))
