@@ -13,14 +13,14 @@ const TAN_PI_8: f64 = 0.414_213_562_373_095_03;
 
 /// atan(r) = r · P(r²) on |r| ≤ tan(π/8); coefficients of P in increasing powers of r².
 const ATAN_COEFFS: [f64; 8] = [
-    9.999_999_999_940_336_61e-1,
-    -3.333_333_316_420_296_62e-1,
-    1.999_998_600_162_583_02e-1,
-    -1.428_519_178_616_034_50e-1,
-    1.110_069_302_835_935_13e-1,
-    -8.971_534_242_626_426_35e-2,
-    6.892_754_580_481_244_56e-2,
-    -3.639_229_298_264_679_70e-2,
+    0.9999999999940337,
+    -0.33333333164202966,
+    0.1999998600162583,
+    -0.14285191786160345,
+    0.11100693028359351,
+    -0.08971534242626426,
+    0.06892754580481245,
+    -0.0363922929826468,
 ];
 
 /// `y.atan2(x)` for finite arguments (same quadrant and sign conventions, including ±0 and ±π), max error
@@ -65,7 +65,7 @@ mod tests {
         for i in 0..n {
             // Directions all around the circle at varied radii, plus axis-aligned and near-octant-boundary ones.
             let phi = -PI + 2.0 * PI * (i as f64 + 0.37) / n as f64;
-            let radius = 10f64.powi((i % 7) as i32 - 3);
+            let radius = 10f64.powi(i % 7 - 3);
             let (y, x) = (radius * phi.sin(), radius * phi.cos());
             worst = worst.max((atan2_poly(y, x) - y.atan2(x)).abs());
         }
