@@ -15,8 +15,8 @@ pub struct SummarizeNadir;
 
 impl Stage for SummarizeNadir {
     const NAME: &'static str = "nadir";
-    // 2: counts `parallax_rejected`. 3: counts `unconfirmed`.
-    const VERSION: &'static str = "3";
+    // 2: counts `parallax_rejected`. 3: counts `unconfirmed`. 4: counts `shift_inconsistent`.
+    const VERSION: &'static str = "4";
     type Params = SummaryParams;
     type Output = NadirSummary;
     type Inputs = (

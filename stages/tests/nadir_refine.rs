@@ -502,6 +502,7 @@ fn refinement_of(row: &AerialImage, obs: &[(String, (f64, f64))]) -> AerialRefin
         aerial_id: row.image_id.clone(),
         tried: obs.len(),
         parallax_rejected: 0,
+        shift_inconsistent: 0,
         unconfirmed: 0,
         matches: obs
             .iter()

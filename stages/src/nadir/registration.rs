@@ -117,6 +117,10 @@ pub struct AerialRefinement {
     /// Of `tried`: not located because a neighbouring recording shows the template differently (parallax
     /// check, `nadir::parallax_check`).
     pub parallax_rejected: usize,
+    /// Of `tried`: located, but dropped because their correction disagrees with the image's other tie points
+    /// (`RefineParams::max_shift_spread_px`).
+    #[serde(default)]
+    pub shift_inconsistent: usize,
     /// Of `tried`: located, but dropped because fewer than `RefineParams::min_located` tie points were located
     /// in this image (a lone located template has no other to confirm the pair's registration).
     pub unconfirmed: usize,
@@ -131,6 +135,7 @@ impl AerialRefinement {
             aerial_id: aerial_id.to_string(),
             tried: 0,
             parallax_rejected: 0,
+            shift_inconsistent: 0,
             unconfirmed: 0,
             matches: Vec::new(),
         }

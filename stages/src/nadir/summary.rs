@@ -29,6 +29,9 @@ pub struct NadirSummary {
     /// Tie points × aerial images not located because a neighbouring recording shows the template differently
     /// (`nadir::parallax_check`).
     pub parallax_rejected: usize,
+    /// Tie points × aerial images located but dropped: their correction disagrees with the other tie points of
+    /// the recording in that image (`RefineParams::max_shift_spread_px`).
+    pub shift_inconsistent: usize,
     /// Tie points × aerial images located but dropped: too few located in that image (`RefineParams::min_located`).
     pub unconfirmed: usize,
     /// Recordings with at least one MM–aerial correspondence.
@@ -107,6 +110,7 @@ impl NadirSummary {
         for r in refinements {
             s.tie_points += r.matches.len();
             s.parallax_rejected += r.parallax_rejected;
+            s.shift_inconsistent += r.shift_inconsistent;
             s.unconfirmed += r.unconfirmed;
             if !r.matches.is_empty() {
                 images_per_recording
@@ -148,6 +152,7 @@ impl NadirSummary {
             "recordings_with_aerial_fraction": frac,
             "tie_points": self.tie_points,
             "parallax_rejected": self.parallax_rejected,
+            "shift_inconsistent": self.shift_inconsistent,
             "unconfirmed": self.unconfirmed,
             "mean_aerial_images_per_recording": self.mean_aerial_images_per_recording,
             "control_points": self.control_points,
