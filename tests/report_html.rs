@@ -125,8 +125,14 @@ fn report_of_a_tiny_run() {
     }
     // The run's own log (times, nodes executed / cached) is kept apart from the result tables.
     for id in ["summary-engine", "summary-stages"] {
-        assert!(html.contains(&format!("id=\"table-{id}\"")), "table {id} missing");
-        assert!(html.contains(&format!("href=\"run-log/{id}.csv\"")), "{id} not linked from run-log/");
+        assert!(
+            html.contains(&format!("id=\"table-{id}\"")),
+            "table {id} missing"
+        );
+        assert!(
+            html.contains(&format!("href=\"run-log/{id}.csv\"")),
+            "{id} not linked from run-log/"
+        );
         assert!(!report.join("tables").join(format!("{id}.csv")).exists());
     }
     assert!(html.contains("thesis (Rotterdam data)") && html.contains("skytie (this campaign)"));
@@ -173,7 +179,10 @@ fn report_of_a_tiny_run() {
         .chain(tables_rerun.keys())
         .filter(|k| tables.get(*k) != tables_rerun.get(*k))
         .collect();
-    assert!(differing.is_empty(), "a rerun changed the tables {differing:?}");
+    assert!(
+        differing.is_empty(),
+        "a rerun changed the tables {differing:?}"
+    );
     let engine = std::fs::read_to_string(rerun.join("report/run-log/summary-engine.csv")).unwrap();
     assert!(engine.contains("nodes executed,0"), "{engine}");
 

@@ -23,8 +23,9 @@ impl Stage for RefineStage {
     const NAME: &'static str = "refine";
     // 2: phase correlation refines on the 3×3 direct-DFT surface and cuts near-zero bins relative to the RMS.
     // 3: the parallax check against the window's neighbouring recordings (their orthos are inputs).
-    // 4: `min_located`. 5: the shift-consistency check (`max_shift_spread_px`).
-    const VERSION: &'static str = "5";
+    // 4: `min_located`. 5: the shift-consistency check (`max_shift_spread_px`). 6: its consensus by
+    // `estimators::median_consensus` (Euclidean deviation; non-finite corrections never inliers).
+    const VERSION: &'static str = "6";
     type Params = RefineParams;
     type Output = AerialRefinement;
     type Inputs = (

@@ -264,8 +264,14 @@ mod tests {
         };
         let areas = data.areas(AREA_GAP_M);
         assert_eq!(areas.len(), 2);
-        assert_eq!((areas[0].recordings.len(), areas[0].checkpoints.len()), (200, 0));
-        assert_eq!((areas[1].recordings.len(), areas[1].checkpoints.len()), (10, 1));
+        assert_eq!(
+            (areas[0].recordings.len(), areas[0].checkpoints.len()),
+            (200, 0)
+        );
+        assert_eq!(
+            (areas[1].recordings.len(), areas[1].checkpoints.len()),
+            (10, 1)
+        );
         assert_eq!(areas[1].ids[0], "b000");
     }
 

@@ -78,7 +78,9 @@ pub fn summary_section(b: &mut Builder, page: &mut Page, run: &RunOutputs) {
         Origin::Skytie,
         &["item", "value"],
     )
-    .with_note("run log: written to run-log/, not tables/ (it differs between runs of the same workflow)");
+    .with_note(
+        "run log: written to run-log/, not tables/ (it differs between runs of the same workflow)",
+    );
     let mut kv = |k: &str, v: String| t.push(vec![k.to_string(), v]);
     if let Some(s) = prov.and_then(|p| num_at(p, "timings.finished_unix_s")) {
         kv("finished (unix time, s)", fmt_count(Some(s)));

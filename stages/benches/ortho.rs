@@ -202,7 +202,9 @@ fn bench_gsd(panorama: &GrayImage, gsd_cm: u32, dir: &Path) {
         ortho.georef.foot_world[2] - camera.center_world.z,
     ];
     let rot = camera.rotation_pano_to_world;
-    let rot_rows: Vec<f64> = (0..3).flat_map(|i| (0..3).map(move |j| rot[(i, j)])).collect();
+    let rot_rows: Vec<f64> = (0..3)
+        .flat_map(|i| (0..3).map(move |j| rot[(i, j)]))
+        .collect();
     let json = format!(
         "{{\"width_px\": {w}, \"height_px\": {h}, \"gsd_m\": {}, \"foot_offset_m\": {:?}, \
          \"right\": [{}, {}], \"up\": [{}, {}], \"rotation_pano_to_world\": {:?}, \

@@ -72,7 +72,13 @@ pub fn histogram(
             .x_desc(x_desc)
             .x_label_formatter(&|v| trim(*v))
             .y_desc("count")
-            .y_label_formatter(&|v| if (v - v.round()).abs() < 1e-9 { format!("{v:.0}") } else { String::new() })
+            .y_label_formatter(&|v| {
+                if (v - v.round()).abs() < 1e-9 {
+                    format!("{v:.0}")
+                } else {
+                    String::new()
+                }
+            })
             .axis_desc_style((FONT, LABEL_PX))
             .label_style((FONT, TICK_PX))
             .disable_x_mesh()

@@ -30,7 +30,10 @@ pub fn sample_bilinear_many(
     mut edge: impl FnMut(usize, f64, f64) -> f32,
 ) {
     let n = out.len();
-    assert!(us.len() == n && vs.len() == n, "sample_bilinear_many: lengths differ");
+    assert!(
+        us.len() == n && vs.len() == n,
+        "sample_bilinear_many: lengths differ"
+    );
     let (w, h) = (img.width, img.height);
     if w < 2 || h < 2 || img.data.len() >= i32::MAX as usize {
         for (i, ((o, &u), &v)) in out.iter_mut().zip(us).zip(vs).enumerate() {
@@ -72,8 +75,13 @@ pub fn sample_bilinear_many(
 fn split(img: &GrayImage, us: &[f64], vs: &[f64], s: &mut BilinearScratch) {
     let (x_max, y_max) = ((img.width - 1) as f64, (img.height - 1) as f64);
     let w = img.width as i32;
-    let cols = s.top_left.iter_mut().zip(s.fx.iter_mut()).zip(s.fy.iter_mut());
-    for (((k, fx), fy), (inside, (&u, &v))) in cols.zip(s.inside.iter_mut().zip(us.iter().zip(vs))) {
+    let cols = s
+        .top_left
+        .iter_mut()
+        .zip(s.fx.iter_mut())
+        .zip(s.fy.iter_mut());
+    for (((k, fx), fy), (inside, (&u, &v))) in cols.zip(s.inside.iter_mut().zip(us.iter().zip(vs)))
+    {
         let (x, y) = (u - 0.5, v - 0.5);
         let ok = x >= 0.0 && y >= 0.0 && x < x_max && y < y_max;
         let (x, y) = if ok { (x, y) } else { (0.0, 0.0) };
@@ -100,7 +108,13 @@ fn blend(data: &[f32], w: usize, top_left: &[i32], fx: &[f32], fy: &[f32], out: 
 }
 
 #[inline(always)]
-fn split_and_blend(img: &GrayImage, us: &[f64], vs: &[f64], s: &mut BilinearScratch, out: &mut [f32]) {
+fn split_and_blend(
+    img: &GrayImage,
+    us: &[f64],
+    vs: &[f64],
+    s: &mut BilinearScratch,
+    out: &mut [f32],
+) {
     split(img, us, vs, s);
     blend(&img.data, img.width, &s.top_left, &s.fx, &s.fy, out);
 }
@@ -159,7 +173,9 @@ mod tests {
     #[test]
     fn equals_sample_bilinear_inside_and_defers_to_the_edge_rule_outside() {
         let (w, h) = (37, 23);
-        let data: Vec<f32> = (0..w * h).map(|i| ((i * 7919) % 1000) as f32 / 1000.0).collect();
+        let data: Vec<f32> = (0..w * h)
+            .map(|i| ((i * 7919) % 1000) as f32 / 1000.0)
+            .collect();
         let img = GrayImage::from_vec(w, h, data).unwrap();
         // Positions everywhere, including exact pixel centres, the last interior fractions, outside and NaN.
         let mut us = Vec::new();
@@ -172,10 +188,17 @@ mod tests {
         vs.extend([0.5, 3.5, h as f64 - 0.5001, 2.0, f64::NAN]);
         let mut out = vec![0.0f32; us.len()];
         let mut edges = 0;
-        sample_bilinear_many(&img, &us, &vs, &mut out, &mut BilinearScratch::default(), |_, u, v| {
-            edges += 1;
-            sample_bilinear(&img, u, v, Border::Constant(-7.0))
-        });
+        sample_bilinear_many(
+            &img,
+            &us,
+            &vs,
+            &mut out,
+            &mut BilinearScratch::default(),
+            |_, u, v| {
+                edges += 1;
+                sample_bilinear(&img, u, v, Border::Constant(-7.0))
+            },
+        );
         for i in 0..us.len() {
             let want = sample_bilinear(&img, us[i], vs[i], Border::Constant(-7.0));
             assert!(
@@ -186,7 +209,10 @@ mod tests {
                 out[i]
             );
         }
-        assert!(edges > 50 && edges < us.len() - 100, "{edges} positions took the edge rule");
+        assert!(
+            edges > 50 && edges < us.len() - 100,
+            "{edges} positions took the edge rule"
+        );
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -197,11 +223,17 @@ mod tests {
             return;
         }
         let (w, h) = (61, 29);
-        let data: Vec<f32> = (0..w * h).map(|i| ((i * 104_729) % 997) as f32 / 997.0).collect();
+        let data: Vec<f32> = (0..w * h)
+            .map(|i| ((i * 104_729) % 997) as f32 / 997.0)
+            .collect();
         let img = GrayImage::from_vec(w, h, data).unwrap();
         let n = 1003; // not a multiple of 8: the scalar tail runs too
-        let us: Vec<f64> = (0..n).map(|i| -1.0 + (i * 37 % n) as f64 * 0.0637).collect();
-        let vs: Vec<f64> = (0..n).map(|i| -0.7 + (i * 91 % n) as f64 * 0.0311).collect();
+        let us: Vec<f64> = (0..n)
+            .map(|i| -1.0 + (i * 37 % n) as f64 * 0.0637)
+            .collect();
+        let vs: Vec<f64> = (0..n)
+            .map(|i| -0.7 + (i * 91 % n) as f64 * 0.0311)
+            .collect();
         let run = |avx2: bool| {
             let mut s = BilinearScratch {
                 top_left: vec![0; n],

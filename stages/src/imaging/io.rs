@@ -94,12 +94,10 @@ fn grey_values(img: image::DynamicImage) -> Vec<f32> {
         ),
         image::DynamicImage::ImageRgb8(b) => collect_f32(
             n,
-            b.as_raw()
-                .chunks_exact(3)
-                .map(|p| {
-                    let c = |k: usize| unit_rgb[p[k] as usize];
-                    luminance(c(0), c(1), c(2))
-                }),
+            b.as_raw().chunks_exact(3).map(|p| {
+                let c = |k: usize| unit_rgb[p[k] as usize];
+                luminance(c(0), c(1), c(2))
+            }),
         ),
         other => {
             let rgb = other.to_rgb32f().into_raw();
@@ -190,11 +188,17 @@ mod tests {
     fn grey_from_bytes_equals_the_image_crate_float_conversion() {
         // Every byte value in every channel position, for RGB and grey 8-bit images.
         let (w, h) = (256, 3);
-        let rgb: Vec<u8> = (0..w * h * 3).map(|i| ((i * 7 + i / 3) % 256) as u8).collect();
+        let rgb: Vec<u8> = (0..w * h * 3)
+            .map(|i| ((i * 7 + i / 3) % 256) as u8)
+            .collect();
         let grey: Vec<u8> = (0..w * h).map(|i| (i % 256) as u8).collect();
         let images = [
-            image::DynamicImage::ImageRgb8(image::RgbImage::from_raw(w as u32, h as u32, rgb).unwrap()),
-            image::DynamicImage::ImageLuma8(image::GrayImage::from_raw(w as u32, h as u32, grey).unwrap()),
+            image::DynamicImage::ImageRgb8(
+                image::RgbImage::from_raw(w as u32, h as u32, rgb).unwrap(),
+            ),
+            image::DynamicImage::ImageLuma8(
+                image::GrayImage::from_raw(w as u32, h as u32, grey).unwrap(),
+            ),
         ];
         for img in images {
             let reference: Vec<f32> = img

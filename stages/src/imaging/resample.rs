@@ -65,25 +65,31 @@ where
     }
     if interp == Interpolation::Bilinear {
         // The row's positions first (NaN where the map has none), then the two-pass sampler.
-        out.data.par_chunks_mut(out_width).enumerate().for_each_init(
-            || RowBuffers::new(out_width),
-            |b, (row, out_row)| {
-                let positions = b.us.iter_mut().zip(b.vs.iter_mut()).zip(b.mapped.iter_mut());
-                for (col, ((u, v), mapped)) in positions.enumerate() {
-                    let p = map(col, row);
-                    *mapped = p.is_some();
-                    (*u, *v) = p.unwrap_or((f64::NAN, f64::NAN));
-                }
-                let mapped = &b.mapped;
-                sample_bilinear_many(src, &b.us, &b.vs, out_row, &mut b.scratch, |i, u, v| {
-                    if mapped[i] {
-                        sample_bilinear(src, u, v, border)
-                    } else {
-                        fill_value
+        out.data
+            .par_chunks_mut(out_width)
+            .enumerate()
+            .for_each_init(
+                || RowBuffers::new(out_width),
+                |b, (row, out_row)| {
+                    let positions =
+                        b.us.iter_mut()
+                            .zip(b.vs.iter_mut())
+                            .zip(b.mapped.iter_mut());
+                    for (col, ((u, v), mapped)) in positions.enumerate() {
+                        let p = map(col, row);
+                        *mapped = p.is_some();
+                        (*u, *v) = p.unwrap_or((f64::NAN, f64::NAN));
                     }
-                });
-            },
-        );
+                    let mapped = &b.mapped;
+                    sample_bilinear_many(src, &b.us, &b.vs, out_row, &mut b.scratch, |i, u, v| {
+                        if mapped[i] {
+                            sample_bilinear(src, u, v, border)
+                        } else {
+                            fill_value
+                        }
+                    });
+                },
+            );
         return out;
     }
     out.data

@@ -10,6 +10,7 @@
 
 use crate::campaign::{AerialImage, Recording};
 use crate::correspondence::{AerialControlPoint, MmTiePoint, PanoObservation};
+use crate::estimators::median_consensus::median_in_place;
 use crate::geometry::{triangulate_rays, FrameCamera, PanoramaCamera, Ray};
 use crate::nadir::registration::AerialRefinement;
 use nalgebra::Vector3;
@@ -50,23 +51,11 @@ impl ErrorStats {
         let (rh, rv) = (rms(&h), rms(&v));
         Self {
             count: errors.len(),
-            median_horizontal_m: median(&mut h),
+            median_horizontal_m: median_in_place(&mut h).unwrap_or(0.0),
             rms_horizontal_m: rh,
-            median_vertical_m: median(&mut v),
+            median_vertical_m: median_in_place(&mut v).unwrap_or(0.0),
             rms_vertical_m: rv,
         }
-    }
-}
-
-fn median(x: &mut [f64]) -> f64 {
-    x.sort_by(f64::total_cmp);
-    let n = x.len();
-    if n == 0 {
-        0.0
-    } else if n % 2 == 1 {
-        x[n / 2]
-    } else {
-        0.5 * (x[n / 2 - 1] + x[n / 2])
     }
 }
 
@@ -222,7 +211,7 @@ pub fn grade_nadir(
             .then_with(|| a.aerial_id.cmp(&b.aerial_id))
     });
     if !errors_px.is_empty() {
-        let mid = median(&mut errors_px); // sorts
+        let mid = median_in_place(&mut errors_px).unwrap_or(0.0); // sorts
         let at = |q: f64| errors_px[((errors_px.len() - 1) as f64 * q).round() as usize];
         g.correspondence_error_px = [mid, at(0.9), at(1.0)];
     }

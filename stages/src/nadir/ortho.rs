@@ -331,7 +331,14 @@ pub fn ortho_project(
             || (vec![0.0; w], vec![0.0; w], BilinearScratch::default()),
             |(us, vs, scratch), (row, (out, ok))| {
                 // Pass 1: the panorama pixel of every ortho pixel (NaN where the vehicle hides the ground).
-                RowMap::new(&georef, &camera, row).fill(&camera, &params.vehicle, heading, us, vs, ok);
+                RowMap::new(&georef, &camera, row).fill(
+                    &camera,
+                    &params.vehicle,
+                    heading,
+                    us,
+                    vs,
+                    ok,
+                );
                 // Pass 2: bilinear sampling; the seam columns and pole rows wrap/clamp.
                 sample_bilinear_many(panorama, us, vs, out, scratch, |_, u, v| {
                     if u.is_nan() {
@@ -424,7 +431,10 @@ mod tests {
                     }
                     let ground = camera.center_world + map.direction_world(col);
                     let truth = georef.pixel_to_world(col as f64 + 0.5, row as f64 + 0.5);
-                    assert!((ground - truth).norm() < 1e-9, "ground point of ({col}, {row})");
+                    assert!(
+                        (ground - truth).norm() < 1e-9,
+                        "ground point of ({col}, {row})"
+                    );
                 }
             }
             assert!(worst < 1e-6, "gsd {gsd_m}: worst map error {worst:e} px");
@@ -446,13 +456,37 @@ mod tests {
             let map = RowMap::new(&georef, &camera, row);
             let mut a = (vec![0.0; n], vec![0.0; n], vec![0u8; n]);
             let mut b = a.clone();
-            map.fill_impl(&camera, &params.vehicle, heading, &mut a.0, &mut a.1, &mut a.2);
+            map.fill_impl(
+                &camera,
+                &params.vehicle,
+                heading,
+                &mut a.0,
+                &mut a.1,
+                &mut a.2,
+            );
             // SAFETY: AVX2 was detected above.
-            unsafe { map.fill_avx2(&camera, &params.vehicle, heading, &mut b.0, &mut b.1, &mut b.2) };
+            unsafe {
+                map.fill_avx2(
+                    &camera,
+                    &params.vehicle,
+                    heading,
+                    &mut b.0,
+                    &mut b.1,
+                    &mut b.2,
+                )
+            };
             assert_eq!(a.2, b.2, "row {row}: validity");
             for col in 0..n {
-                assert_eq!(a.0[col].to_bits(), b.0[col].to_bits(), "u of ({col}, {row})");
-                assert_eq!(a.1[col].to_bits(), b.1[col].to_bits(), "v of ({col}, {row})");
+                assert_eq!(
+                    a.0[col].to_bits(),
+                    b.0[col].to_bits(),
+                    "u of ({col}, {row})"
+                );
+                assert_eq!(
+                    a.1[col].to_bits(),
+                    b.1[col].to_bits(),
+                    "v of ({col}, {row})"
+                );
             }
             hidden += a.2.iter().filter(|&&ok| ok == 0).count();
         }

@@ -32,6 +32,7 @@ use super::parallax_check::{parallax_share, ParallaxScratch};
 use super::registration::{AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch};
 use crate::campaign::{AerialImage, AerialKind};
 use crate::correspondence::AerialObservation;
+use crate::estimators::median_consensus::median_consensus;
 use crate::geometry::Similarity2;
 use crate::imaging::border::Border;
 use crate::imaging::sample::sample_bicubic;
@@ -511,7 +512,8 @@ pub fn refine_in_aerial(
     }
     if p.max_shift_spread_px > 0.0 {
         let before = result.matches.len();
-        result.matches = consistent_shifts(std::mem::take(&mut result.matches), p.max_shift_spread_px);
+        result.matches =
+            consistent_shifts(std::mem::take(&mut result.matches), p.max_shift_spread_px);
         result.shift_inconsistent = before - result.matches.len();
     }
     if result.matches.len() < p.min_located {
@@ -538,22 +540,20 @@ fn consistent_shifts(matches: Vec<AerialMatch>, spread_px: f64) -> Vec<AerialMat
             .all(|m| matches.iter().all(|o| !far(shift(m), shift(o))));
         return if agree { matches } else { Vec::new() };
     }
-    let median = |mut v: Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        let n = v.len();
-        if n % 2 == 1 {
-            v[n / 2]
-        } else {
-            0.5 * (v[n / 2 - 1] + v[n / 2])
-        }
+    let shifts: Vec<[f64; 2]> = matches
+        .iter()
+        .map(|m| {
+            let (du, dv) = shift(m);
+            [du, dv]
+        })
+        .collect();
+    let Some(consensus) = median_consensus(&shifts, spread_px) else {
+        return Vec::new(); // no finite correction at all
     };
-    let centre = (
-        median(matches.iter().map(|m| shift(m).0).collect()),
-        median(matches.iter().map(|m| shift(m).1).collect()),
-    );
     matches
         .into_iter()
-        .filter(|m| !far(shift(m), centre))
+        .zip(consensus.inliers)
+        .filter_map(|(m, inlier)| inlier.then_some(m))
         .collect()
 }
 
@@ -598,6 +598,9 @@ mod tests {
         assert_eq!(ids(&consistent_shifts(agree, 5.0)), ["a", "b"]);
         let disagree = vec![located("a", (0.5, 0.5)), located("b", (10.5, 0.5))];
         assert!(consistent_shifts(disagree, 5.0).is_empty());
-        assert_eq!(ids(&consistent_shifts(vec![located("a", (9.0, 9.0))], 5.0)), ["a"]);
+        assert_eq!(
+            ids(&consistent_shifts(vec![located("a", (9.0, 9.0))], 5.0)),
+            ["a"]
+        );
     }
 }

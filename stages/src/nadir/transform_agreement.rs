@@ -13,6 +13,7 @@
 //! and the transform is kept.
 
 use super::registration::{InitialTransform, TransformOutcome};
+use crate::estimators::median_consensus::median_in_place;
 
 /// The transforms of one recording that agree with each other: `outcome` unchanged, or turned into a
 /// rejection when its implied offset lies farther than `max_disagreement_m` from the median of the offsets
@@ -49,13 +50,7 @@ pub fn check_agreement(
             .iter()
             .map(|t| t.centre_offset_world_m[axis])
             .collect();
-        v.sort_by(f64::total_cmp);
-        let n = v.len();
-        if n % 2 == 1 {
-            v[n / 2]
-        } else {
-            0.5 * (v[n / 2 - 1] + v[n / 2])
-        }
+        median_in_place(&mut v).unwrap_or(0.0)
     };
     let (mx, my) = (median(0), median(1));
     let d = (own.centre_offset_world_m[0] - mx).hypot(own.centre_offset_world_m[1] - my);

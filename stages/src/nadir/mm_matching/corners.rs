@@ -10,6 +10,7 @@ use super::params::MmMatchParams;
 use super::prepared::PreparedOrtho;
 use super::template::{match_corner, TemplateScratch};
 use super::OrthoView;
+use crate::estimators::median_consensus::median_in_place;
 use crate::features::forstner::{forstner_corners, Corner, ForstnerParams};
 use rayon::prelude::*;
 
@@ -123,19 +124,6 @@ fn locate(
     ))
 }
 
-/// Median of a small list (sorted in place; mean of the middle two for an even count).
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    if n == 0 {
-        0.0
-    } else if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        0.5 * (values[n / 2 - 1] + values[n / 2])
-    }
-}
-
 /// Locate every corner in the neighbour (thesis 3.4.4.4). One entry per corner: `Some` when the template
 /// match succeeded and passed the verification. Deterministic for any thread count (per-corner results,
 /// ordered collect, median of the sorted offsets).
@@ -162,7 +150,10 @@ pub fn match_corners(
         .collect();
     let mut du: Vec<f64> = located.iter().flatten().map(|(_, d)| d.0).collect();
     let mut dv: Vec<f64> = located.iter().flatten().map(|(_, d)| d.1).collect();
-    let (mu, mv) = (median(&mut du), median(&mut dv));
+    let (mu, mv) = (
+        median_in_place(&mut du).unwrap_or(0.0),
+        median_in_place(&mut dv).unwrap_or(0.0),
+    );
     located
         .into_iter()
         .map(|l| {
@@ -170,16 +161,4 @@ pub fn match_corners(
             ((d.0 - mu).hypot(d.1 - mv) <= p.corner_tolerance_px).then_some(c)
         })
         .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::median;
-
-    #[test]
-    fn median_of_odd_even_and_empty() {
-        assert_eq!(median(&mut [3.0, -1.0, 2.0]), 2.0);
-        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
-        assert_eq!(median(&mut []), 0.0);
-    }
 }
