@@ -3,24 +3,12 @@
 //! recording to a user campaign re-runs only that recording's nodes, and the shipped full chain
 //! (`workflows/tiny.toml`) runs through registration, adjustment, verification and the exports.
 
+#[path = "support/cli.rs"]
+mod cli;
+
+use cli::{run_ok, skytie};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn skytie() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_skytie"))
-}
-
-fn run_ok(cmd: &mut Command) -> String {
-    let out = cmd.output().expect("start skytie");
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(out.status.success(), "{cmd:?} failed: {text}");
-    text
-}
 
 fn files(root: &Path) -> BTreeMap<String, Vec<u8>> {
     fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<String, Vec<u8>>) {
@@ -53,16 +41,7 @@ fn stage(m: &serde_json::Value, stage: &str, what: &str) -> u64 {
 
 /// `skytie run WF --cache CACHE --out OUT --quiet`, then OUT's metrics.
 fn run_workflow(wf: &Path, cache: &Path, out: &Path) -> serde_json::Value {
-    run_ok(
-        skytie()
-            .arg("run")
-            .arg(wf)
-            .arg("--cache")
-            .arg(cache)
-            .arg("--out")
-            .arg(out)
-            .arg("--quiet"),
-    );
+    cli::run_workflow(wf, cache, out);
     metrics(out)
 }
 

@@ -4,42 +4,15 @@
 //! rendered headless, every image must load with a non-zero natural size, and a screenshot is written.
 //! A second test builds a sweep report from a hand-made OUT whose tables have known values.
 
+#[path = "support/cli.rs"]
+mod cli;
 #[path = "support/report_check.rs"]
 mod report_check;
 
+use cli::{run_ok, run_workflow, skytie};
 use report_check::*;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Instant;
-
-fn skytie() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_skytie"))
-}
-
-fn run_ok(cmd: &mut Command) -> String {
-    let out = cmd.output().expect("start skytie");
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(out.status.success(), "{cmd:?} failed: {text}");
-    text
-}
-
-/// `skytie run WORKFLOW --cache CACHE --out OUT --quiet`, which must succeed.
-fn run_workflow(wf: &Path, cache: &Path, out: &Path) {
-    run_ok(
-        skytie()
-            .arg("run")
-            .arg(wf)
-            .arg("--cache")
-            .arg(cache)
-            .arg("--out")
-            .arg(out)
-            .arg("--quiet"),
-    );
-}
 
 /// Every referenced image / table file of `page` exists and is non-empty; returns the image paths.
 fn check_references(page: &Path) -> Vec<PathBuf> {
