@@ -3,7 +3,6 @@
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use skytie_stages::campaign::Recording;
-use skytie_stages::imaging::io::load_gray;
 use skytie_stages::nadir::{ortho_project, OrthoImage, OrthoParams};
 use std::sync::Arc;
 
@@ -25,7 +24,8 @@ impl Stage for OrthoProject {
         (rec, pano): (Arc<Recording>, RawFileValue),
         _: &NodeCtx,
     ) -> Result<OrthoImage, StageError> {
-        let image = load_gray(&pano.path).map_err(|e| StageError::new(e.to_string()))?;
+        // Shared with the recording's other ortho nodes (one decode per panorama while it stays in memory).
+        let image = super::decoded_images::gray(&pano)?;
         if image.width != 2 * image.height {
             return Err(StageError::new(format!(
                 "{}: panorama is {}×{} px; an equirectangular panorama must be twice as wide as high",

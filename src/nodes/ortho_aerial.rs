@@ -5,7 +5,6 @@
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::geometry::FrameCamera;
-use skytie_stages::imaging::io::load_gray;
 use skytie_stages::nadir::aerial_overlap::foot_point_world;
 use skytie_stages::nadir::aerial_patch::ortho_params_for_aerial;
 use skytie_stages::nadir::{ortho_project, OrthoImage, OrthoParams};
@@ -28,7 +27,8 @@ impl Stage for OrthoForAerial {
         (rec, pano, aerial): (Arc<Recording>, RawFileValue, Arc<AerialImage>),
         _: &NodeCtx,
     ) -> Result<OrthoImage, StageError> {
-        let image = load_gray(&pano.path).map_err(|e| StageError::new(e.to_string()))?;
+        // Shared with the recording's other ortho nodes (one decode per panorama while it stays in memory).
+        let image = super::decoded_images::gray(&pano)?;
         let cam = FrameCamera::from_aerial(&aerial);
         let params = ortho_params_for_aerial(&cam, foot_point_world(&rec), base);
         if let Err(errs) = params.validate() {
