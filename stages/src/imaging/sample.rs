@@ -61,7 +61,7 @@ pub fn sample_bilinear(img: &GrayImage, u_px: f64, v_px: f64, border: Border) ->
 /// Bilinear interpolation at pixel-index coordinates (x, y) = (u − 0.5, v − 0.5) with
 /// 0 ≤ x < width − 1 and 0 ≤ y < height − 1 (the caller checks). `data` is row-major with `width` columns.
 #[inline(always)]
-pub fn bilinear_interior(data: &[f32], width: usize, x: f64, y: f64) -> f32 {
+fn bilinear_interior(data: &[f32], width: usize, x: f64, y: f64) -> f32 {
     let (x0, y0) = (x as usize, y as usize);
     let fx = (x - x0 as f64) as f32;
     let fy = (y - y0 as f64) as f32;

@@ -68,22 +68,11 @@ impl VehicleMask {
         point_world: &Vector3<f64>,
     ) -> bool {
         let h = heading_deg.to_radians();
-        self.hides_with_heading(camera_world, h.sin_cos(), point_world)
+        self.hides_direction(h.sin_cos(), &(point_world - camera_world))
     }
 
-    /// [`Self::hides`] with the heading given as (sin, cos) of its angle, for callers testing many points of
-    /// one recording (no trigonometry per point).
-    #[inline]
-    pub fn hides_with_heading(
-        &self,
-        camera_world: &Vector3<f64>,
-        (sin_h, cos_h): (f64, f64),
-        point_world: &Vector3<f64>,
-    ) -> bool {
-        self.hides_direction((sin_h, cos_h), &(point_world - camera_world))
-    }
-
-    /// [`Self::hides_with_heading`] for the offset `d` (world, metres) from the camera to the point.
+    /// [`Self::hides`] for the offset `d` (world, metres) from the camera to the point, with the heading given as
+    /// (sin, cos) of its angle (for callers testing many points of one recording: no trigonometry per point).
     #[inline]
     pub fn hides_direction(&self, (sin_h, cos_h): (f64, f64), d: &Vector3<f64>) -> bool {
         // A point above the roof plane (depth ≤ roof_drop) is never hidden. Below it, where the ray meets the roof
