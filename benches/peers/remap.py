@@ -3,22 +3,29 @@
 
 Setup (never part of the test path; see benches/README.md):
     python3 -m venv /tmp/peers && /tmp/peers/bin/pip install opencv-contrib-python-headless numpy
-    cargo bench -p skytie-stages --bench ortho              # writes <temp>/skytie_peers/ortho/
-    /tmp/peers/bin/python benches/peers/remap.py [<temp>/skytie_peers/ortho]
+    /tmp/peers/bin/python benches/peers/remap.py [--rounds N] [<temp>/skytie_peers/ortho]
+
+Each of the N rounds (default 5) first runs the Rust bench (`cargo bench -p skytie-stages --bench ortho` from
+this repository; `--rounds 0` skips it and uses the files already there, one round) and then times OpenCV right
+after it, so every ratio compares two measurements taken seconds apart; the summary gives the median ratio over
+the rounds and its range (the machines are shared and noisy: absolute times swing by ±50 %, paired ratios less).
 
 The Rust bench writes `panorama.png` (8-bit), per GSD the float32 maps `map_{gsd}cm_{u,v}.npy` (campaign pixel
 convention, pixel centres at +0.5; NaN where the vehicle hides the ground), skytie's output `ortho_{gsd}cm.npy`
-and its timings `skytie_{gsd}cm.csv`. Here the panorama gets one wrapped column on each side (as skytie does for
-the ±180° seam), the map is converted to OpenCV's convention (x = u − 0.5 + 1 for the padding, y = v − 0.5),
-masked pixels are sent outside the image, and `cv2.remap(INTER_LINEAR, BORDER_REPLICATE)` is timed (median wall
-time, 1 thread and the default thread count). Prints the max difference to skytie's output on valid pixels and
-the ratios skytie / OpenCV for the full `ortho_project` (which also computes the map) and for skytie's `remap`
-given the same map; and, for the whole job, `ortho_project` against the map computed with NumPy from
+and its timings `skytie_{gsd}cm.csv`. Here the panorama gets one wrapped column on each side (as the Rust bench
+does for skytie's `remap_with_map`), the map is converted to OpenCV's convention (x = u − 0.5 + 1 for the
+padding, y = v − 0.5), masked pixels are sent outside the image, and `cv2.remap(INTER_LINEAR, BORDER_REPLICATE)`
+is timed: median over repetitions, thread CPU time with 1 thread (`time.thread_time_ns`, the clock the Rust side
+uses), wall time with the default thread count. Prints the max difference to skytie's output on valid pixels and
+the ratios skytie / OpenCV for skytie's `remap_with_map` given the same map and for the full `ortho_project`
+(which also computes the map); and, for the whole job, `ortho_project` against the map computed with NumPy from
 `geometry_{gsd}cm.json` followed by `cv2.remap`.
 """
+import argparse
 import csv
 import glob
 import os
+import subprocess
 import sys
 import tempfile
 import time
@@ -28,13 +35,23 @@ import json
 import numpy as np
 
 
-def median_ms(fn, reps):
+def median_ms(fn, reps, cpu_time=False):
+    """Median time of `fn` in ms: thread CPU time (single-threaded peers) or wall time."""
+    clock = time.thread_time if cpu_time else time.perf_counter
     t = []
     for _ in range(reps):
-        t0 = time.perf_counter()
+        t0 = clock()
         fn()
-        t.append((time.perf_counter() - t0) * 1e3)
+        t.append((clock() - t0) * 1e3)
     return float(np.median(t))
+
+
+def run_rust_bench(folder):
+    """One run of the Rust bench, writing its inputs and timings into `folder` (= $SKYTIE_PEER_DIR/ortho)."""
+    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    env = dict(os.environ, SKYTIE_PEER_DIR=os.path.dirname(os.path.abspath(folder)))
+    subprocess.run(["cargo", "bench", "-q", "-p", "skytie-stages", "--bench", "ortho"], cwd=repo, env=env,
+                   check=True, stdout=subprocess.DEVNULL)
 
 
 def numpy_map(g):
@@ -57,15 +74,14 @@ def numpy_map(g):
     return (np.mod(u, pw) - 0.5 + 1.0).astype(np.float32), (v - 0.5).astype(np.float32)
 
 
-def main(folder):
+def one_round(folder, rows, whole_job):
+    """Time cv2.remap (and, in the first round, the whole NumPy + OpenCV job) against the Rust timings now in
+    `folder`; append (tag, threads, cv2 ms, skytie remap ms, skytie ortho ms) to `rows`."""
     pano8 = cv2.imread(os.path.join(folder, "panorama.png"), cv2.IMREAD_GRAYSCALE)
     if pano8 is None:
         sys.exit(f"no panorama.png in {folder}: run the Rust bench first (see the docstring)")
     pano = pano8.astype(np.float32) / 255.0
     padded = np.ascontiguousarray(np.hstack([pano[:, -1:], pano, pano[:, :1]]))
-    print(f"{'GSD':>5} | {'ortho px':>9} | {'threads':>7} | {'cv2.remap ms':>12} | {'skytie remap ms':>15} | "
-          f"{'ortho_project ms':>16} | {'remap/cv2':>9} | {'ortho/cv2':>9}")
-    print("-" * 104)
     for u_path in sorted(glob.glob(os.path.join(folder, "map_*cm_u.npy"))):
         tag = os.path.basename(u_path)[len("map_"):-len("_u.npy")]
         mu = np.load(u_path)
@@ -75,34 +91,65 @@ def main(folder):
         w = pano.shape[1]
         map_x = np.where(valid, np.mod(mu, w) - 0.5 + 1.0, -10.0).astype(np.float32)
         map_y = np.where(valid, mv - 0.5, -10.0).astype(np.float32)
-        out = cv2.remap(padded, map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
-        diff = float(np.abs(out[valid] - ours[valid]).max()) if valid.any() else 0.0
         sky = {}
         for r in csv.DictReader(open(os.path.join(folder, f"skytie_{tag}.csv"))):
             sky[(r["method"], int(r["threads"]))] = float(r["ms"])
         reps = 30 if mu.size > 100_000 else 200
+        for threads in sorted({t for _, t in sky}):
+            cv2.setNumThreads(threads)
+            remap = lambda: cv2.remap(padded, map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+            ms = median_ms(remap, reps, cpu_time=threads == 1)
+            rows.append((tag, threads, ms, sky[("skytie remap (same map)", threads)],
+                         sky[("skytie ortho_project", threads)]))
+        if tag in whole_job:
+            continue
+        out = cv2.remap(padded, map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+        diff = float(np.abs(out[valid] - ours[valid]).max()) if valid.any() else 0.0
         geometry = json.load(open(os.path.join(folder, f"geometry_{tag}.json")))
-        nx, ny = numpy_map(geometry)
+        nx, _ = numpy_map(geometry)
         map_err = float(np.abs(nx[valid] - map_x[valid]).max()) if valid.any() else 0.0
         full = {}
         for threads in sorted({t for _, t in sky}):
             cv2.setNumThreads(threads)
-            ms = median_ms(lambda: cv2.remap(padded, map_x, map_y, cv2.INTER_LINEAR,
-                                             borderMode=cv2.BORDER_REPLICATE), reps)
-            full[threads] = median_ms(lambda: cv2.remap(padded, *numpy_map(geometry), cv2.INTER_LINEAR,
-                                                        borderMode=cv2.BORDER_REPLICATE), max(reps // 4, 8))
-            s_remap = sky[("skytie remap (same map)", threads)]
-            s_ortho = sky[("skytie ortho_project", threads)]
-            print(f"{tag:>5} | {mu.shape[1]:>4}x{mu.shape[0]:<4} | {threads:>7} | {ms:>12.3f} | {s_remap:>15.3f} | "
-                  f"{s_ortho:>16.3f} | {s_remap / ms:>8.2f}x | {s_ortho / ms:>8.2f}x")
-        print(f"{tag:>5} | max |cv2.remap − skytie ortho| on {int(valid.sum())} valid px: {diff:.2e}")
-        for threads, ms in full.items():
-            s_ortho = sky[("skytie ortho_project", threads)]
-            print(f"{tag:>5} | whole job, {threads} thread(s): NumPy map + cv2.remap {ms:.3f} ms (NumPy single-threaded), "
-                  f"skytie ortho_project {s_ortho:.3f} ms: {s_ortho / ms:.2f}x (NumPy map vs skytie's: max "
-                  f"{map_err:.1e} px)")
+            full[threads] = (median_ms(lambda: cv2.remap(padded, *numpy_map(geometry), cv2.INTER_LINEAR,
+                                                         borderMode=cv2.BORDER_REPLICATE), max(reps // 4, 8)),
+                             sky[("skytie ortho_project", threads)])
+        whole_job[tag] = (mu.shape, int(valid.sum()), diff, map_err, full)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
+    parser.add_argument("--rounds", type=int, default=5,
+                        help="Rust bench + OpenCV rounds (0: use the files already in FOLDER, one round)")
+    parser.add_argument("folder", nargs="?", default=os.path.join(tempfile.gettempdir(), "skytie_peers", "ortho"))
+    args = parser.parse_args()
+    rows, whole_job = [], {}
+    for k in range(max(args.rounds, 1)):
+        if args.rounds > 0:
+            run_rust_bench(args.folder)
+        one_round(args.folder, rows, whole_job)
+    print(f"{'round':>5} | {'GSD':>5} | {'threads':>7} | {'cv2.remap ms':>12} | {'skytie remap ms':>15} | "
+          f"{'ortho_project ms':>16} | {'remap/cv2':>9} | {'ortho/cv2':>9}")
+    print("-" * 104)
+    per_key = {}
+    n_keys = len({(t, th) for t, th, *_ in rows})
+    for i, (tag, threads, ms, s_remap, s_ortho) in enumerate(rows):
+        print(f"{i // n_keys + 1:>5} | {tag:>5} | {threads:>7} | {ms:>12.3f} | {s_remap:>15.3f} | {s_ortho:>16.3f} | "
+              f"{s_remap / ms:>8.2f}x | {s_ortho / ms:>8.2f}x")
+        per_key.setdefault((tag, threads), []).append((s_remap / ms, s_ortho / ms))
+    print(f"\nmedian (min–max) over {max(args.rounds, 1)} round(s), 1 thread in thread CPU time, more in wall time:")
+    for (tag, threads), ratios in sorted(per_key.items()):
+        r = np.array(ratios)
+        print(f"{tag:>5} | {threads} thread(s) | remap_with_map / cv2.remap {np.median(r[:, 0]):.2f}x "
+              f"({r[:, 0].min():.2f}–{r[:, 0].max():.2f}) | ortho_project / cv2.remap {np.median(r[:, 1]):.2f}x "
+              f"({r[:, 1].min():.2f}–{r[:, 1].max():.2f})")
+    for tag, (shape, n_valid, diff, map_err, full) in sorted(whole_job.items()):
+        print(f"{tag:>5} | {shape[1]}x{shape[0]} px | max |cv2.remap − skytie ortho| on {n_valid} valid px: {diff:.2e}")
+        for threads, (ms, s_ortho) in full.items():
+            print(f"{tag:>5} | whole job (first round), {threads} thread(s): NumPy map + cv2.remap {ms:.3f} ms "
+                  f"(NumPy single-threaded), skytie ortho_project {s_ortho:.3f} ms: {s_ortho / ms:.2f}x "
+                  f"(NumPy map vs skytie's: max {map_err:.1e} px)")
 
 
 if __name__ == "__main__":
-    default = os.path.join(tempfile.gettempdir(), "skytie_peers", "ortho")
-    main(sys.argv[1] if len(sys.argv) > 1 else default)
+    main()

@@ -3,9 +3,10 @@
 //!
 //! A 4000×2000 band-limited texture panorama (8-bit, written as PNG and re-loaded, so both sides see identical
 //! pixels) is ortho-projected at 3 cm (707×707 px) and 10 cm (212×212 px) on a 30 m diagonal. Timed, per GSD,
-//! with 1 thread and the default rayon pool:
+//! with 1 thread (thread CPU time) and the default rayon pool (wall time):
 //! - `ortho_project` (projection of every ortho pixel + vehicle mask + bilinear sampling: the real stage);
-//! - `remap` with the precomputed map (bilinear sampling only — the like-for-like peer of `cv2.remap`).
+//! - `remap_with_map` with the precomputed map on the seam-padded panorama (bilinear sampling only — the
+//!   like-for-like peer of `cv2.remap`).
 //!
 //! Written to `$SKYTIE_PEER_DIR/ortho/` (default `<temp>/skytie_peers/ortho/`): `panorama.png`, and per GSD
 //! `map_{gsd}cm_u.npy`, `map_{gsd}cm_v.npy` (float32, campaign pixel convention: pixel centres at +0.5, NaN
@@ -16,7 +17,7 @@
 #[path = "peer_support/mod.rs"]
 mod peer_support;
 
-use peer_support::{peer_dir, write_npy_f32};
+use peer_support::{median_round_ms, peer_dir, write_npy_f32};
 use std::path::Path;
 use std::time::Instant;
 
@@ -24,8 +25,9 @@ use skytie_stages::campaign::Recording;
 use skytie_stages::geometry::PanoramaCamera;
 use skytie_stages::imaging::border::Border;
 use skytie_stages::imaging::gaussian::gaussian_blur;
+use skytie_stages::imaging::huge_pages::collect_f32;
 use skytie_stages::imaging::io::{load_gray, save_gray};
-use skytie_stages::imaging::resample::{remap, Interpolation};
+use skytie_stages::imaging::resample::{remap_with_map, Interpolation, SourceMap};
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::{ortho_project, OrthoGeoref, OrthoParams};
 
@@ -50,6 +52,20 @@ fn textured(w: usize, h: usize, seed: u64) -> GrayImage {
     img
 }
 
+/// `img` with one wrapped column on each side (column −1 = the last, column w = the first), in memory advised to
+/// use huge pages like the loaded panorama's.
+fn pad_seam(img: &GrayImage) -> GrayImage {
+    let w = img.width;
+    let rows = img.data.chunks_exact(w);
+    let padded = rows.flat_map(|row| {
+        std::iter::once(row[w - 1])
+            .chain(row.iter().copied())
+            .chain(std::iter::once(row[0]))
+    });
+    GrayImage::from_vec(w + 2, img.height, collect_f32((w + 2) * img.height, padded))
+        .expect("padded size")
+}
+
 fn recording() -> Recording {
     Recording {
         image_id: "bench".into(),
@@ -69,13 +85,18 @@ fn recording() -> Recording {
     }
 }
 
-/// Median wall time (ms) of `reps` runs of `f` inside a rayon pool of `threads`.
+/// Median time (ms) of `reps` runs of `f` inside a rayon pool of `threads`: with 1 thread the CPU time of the
+/// pool's thread (robust against other processes sharing the cores, the clock the peer script uses for
+/// `cv2.remap` with 1 thread), else wall time.
 fn median_ms(threads: usize, reps: usize, mut f: impl FnMut() + Send) -> f64 {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .unwrap();
     pool.install(|| {
+        if threads == 1 {
+            return median_round_ms(reps, f);
+        }
         let mut t: Vec<f64> = (0..reps)
             .map(|_| {
                 let s = Instant::now();
@@ -126,31 +147,28 @@ fn bench_gsd(panorama: &GrayImage, gsd_cm: u32, dir: &Path) {
         &ortho.image.data,
     );
 
-    // skytie's generic remap with the same (f32) map; the seam column is wrapped like ortho_project does.
-    let wrap_u = |u: f32| {
-        let (u, pw) = (u as f64, panorama.width as f64);
-        if u < 0.0 {
-            u + pw
-        } else if u >= pw {
-            u - pw
-        } else {
-            u
-        }
+    // skytie's remap with the same (f32) map, on the panorama padded with one wrapped column on each side, as
+    // the peer script does for cv2.remap (the seam then needs no wrap rule; padding is not timed on either side).
+    let padded = pad_seam(panorama);
+    let source_map = SourceMap {
+        width: w,
+        height: h,
+        u_px: map_u
+            .iter()
+            .map(|&u| u.rem_euclid(panorama.width as f32) + 1.0)
+            .collect(),
+        v_px: map_v.clone(),
     };
-    let map = |col: usize, row: usize| {
-        let i = row * w + col;
-        let (u, v) = (map_u[i], map_v[i]);
-        (!u.is_nan()).then(|| (wrap_u(u), v as f64))
+    let remap_same_map = || {
+        remap_with_map(
+            &padded,
+            &source_map,
+            Interpolation::Bilinear,
+            Border::Clamp,
+            0.0,
+        )
     };
-    let remapped = remap(
-        panorama,
-        w,
-        h,
-        Interpolation::Bilinear,
-        Border::Clamp,
-        0.0,
-        map,
-    );
+    let remapped = remap_same_map();
     let max_diff = remapped
         .data
         .iter()
@@ -172,15 +190,7 @@ fn bench_gsd(panorama: &GrayImage, gsd_cm: u32, dir: &Path) {
             std::hint::black_box(ortho_project(panorama, &rec, &params));
         });
         let sampling = median_ms(t, reps, || {
-            std::hint::black_box(remap(
-                panorama,
-                w,
-                h,
-                Interpolation::Bilinear,
-                Border::Clamp,
-                0.0,
-                map,
-            ));
+            std::hint::black_box(remap_same_map());
         });
         println!(
             "  {t} thread(s): ortho_project {full:.3} ms, remap with the map {sampling:.3} ms"

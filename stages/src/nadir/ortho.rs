@@ -14,7 +14,7 @@
 use super::vehicle_mask::VehicleMask;
 use crate::campaign::Recording;
 use crate::geometry::PanoramaCamera;
-use crate::imaging::bilinear_many::{sample_bilinear_many, BilinearScratch};
+use crate::imaging::bilinear_many::sample_bilinear_many;
 use crate::imaging::border::Border;
 use crate::imaging::sample::{floor_fast, sample_bilinear};
 use crate::imaging::GrayImage;
@@ -328,8 +328,8 @@ pub fn ortho_project(
         .zip(valid.par_chunks_mut(w))
         .enumerate()
         .for_each_init(
-            || (vec![0.0; w], vec![0.0; w], BilinearScratch::default()),
-            |(us, vs, scratch), (row, (out, ok))| {
+            || (vec![0.0; w], vec![0.0; w]),
+            |(us, vs), (row, (out, ok))| {
                 // Pass 1: the panorama pixel of every ortho pixel (NaN where the vehicle hides the ground).
                 RowMap::new(&georef, &camera, row).fill(
                     &camera,
@@ -340,12 +340,8 @@ pub fn ortho_project(
                     ok,
                 );
                 // Pass 2: bilinear sampling; the seam columns and pole rows wrap/clamp.
-                sample_bilinear_many(panorama, us, vs, out, scratch, |_, u, v| {
-                    if u.is_nan() {
-                        0.0
-                    } else {
-                        sample_panorama(panorama, u, v)
-                    }
+                sample_bilinear_many(panorama, us, vs, out, 0.0, |_, u, v| {
+                    sample_panorama(panorama, u, v)
                 });
             },
         );
