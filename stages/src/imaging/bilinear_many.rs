@@ -7,15 +7,65 @@
 
 use super::image::GrayImage;
 
+/// A coordinate type [`sample_bilinear_many`] reads: `f64` (positions computed on the fly) or `f32` (stored maps,
+/// the form `cv2.remap` takes). f32 values are widened to f64 exactly, so both give the same samples.
+pub trait Coordinate: Copy + sealed::Sealed {
+    fn to_f64(self) -> f64;
+
+    /// Four consecutive coordinates from `p`, widened to f64 lanes.
+    ///
+    /// # Safety
+    /// The CPU supports AVX2 and `p .. p + 4` is readable.
+    #[cfg(target_arch = "x86_64")]
+    unsafe fn load4_avx2(p: *const Self) -> std::arch::x86_64::__m256d;
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for f64 {}
+    impl Sealed for f32 {}
+}
+
+impl Coordinate for f64 {
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn load4_avx2(p: *const Self) -> std::arch::x86_64::__m256d {
+        // SAFETY: the caller guarantees four readable values.
+        unsafe { std::arch::x86_64::_mm256_loadu_pd(p) }
+    }
+}
+
+impl Coordinate for f32 {
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        f64::from(self)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn load4_avx2(p: *const Self) -> std::arch::x86_64::__m256d {
+        use std::arch::x86_64::*;
+        // SAFETY: the caller guarantees four readable values.
+        unsafe { _mm256_cvtps_pd(_mm_loadu_ps(p)) }
+    }
+}
+
 /// `out[i]` = `img` sampled bilinearly at `(us[i], vs[i])` (campaign pixel convention: pixel centres at +0.5)
 /// where the four neighbours lie inside the image; `nan_value` where `us[i]` is NaN ("no position": masked
 /// pixels); elsewhere `out[i] = edge(i, us[i], vs[i])`. Images of 2³¹ pixels or more, or less than 2 × 2, send
 /// every position but the NaN ones to `edge`, which must therefore be a complete sampler. `us`, `vs` and `out`
 /// must have the same length.
-pub fn sample_bilinear_many(
+pub fn sample_bilinear_many<C: Coordinate>(
     img: &GrayImage,
-    us: &[f64],
-    vs: &[f64],
+    us: &[C],
+    vs: &[C],
     out: &mut [f32],
     nan_value: f32,
     mut edge: impl FnMut(usize, f64, f64) -> f32,
@@ -28,6 +78,7 @@ pub fn sample_bilinear_many(
     let (w, h) = (img.width, img.height);
     if w < 2 || h < 2 || img.data.len() >= i32::MAX as usize {
         for (i, ((o, &u), &v)) in out.iter_mut().zip(us).zip(vs).enumerate() {
+            let (u, v) = (u.to_f64(), v.to_f64());
             *o = if u.is_nan() { nan_value } else { edge(i, u, v) };
         }
         return;
@@ -43,10 +94,10 @@ pub fn sample_bilinear_many(
 /// The scalar loop (the same operations, in the same order, as [`super::sample::sample_bilinear`]); `first` is
 /// the index of `out[0]` in the caller's row (for `edge`). The caller guarantees w, h ≥ 2.
 #[inline(always)]
-fn sample_scalar(
+fn sample_scalar<C: Coordinate>(
     img: &GrayImage,
-    us: &[f64],
-    vs: &[f64],
+    us: &[C],
+    vs: &[C],
     out: &mut [f32],
     first: usize,
     nan_value: f32,
@@ -55,6 +106,7 @@ fn sample_scalar(
     let (data, w) = (&img.data[..], img.width);
     let (x_max, y_max) = ((img.width - 1) as f64, (img.height - 1) as f64);
     for (i, ((o, &u), &v)) in out.iter_mut().zip(us).zip(vs).enumerate() {
+        let (u, v) = (u.to_f64(), v.to_f64());
         let (x, y) = (u - 0.5, v - 0.5);
         if x >= 0.0 && y >= 0.0 && x < x_max && y < y_max {
             // Truncation is floor for non-negative values.
@@ -80,10 +132,10 @@ fn sample_scalar(
 /// `edge`. The caller guarantees w, h ≥ 2, w·h < 2³¹ and AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn sample_avx2(
+unsafe fn sample_avx2<C: Coordinate>(
     img: &GrayImage,
-    us: &[f64],
-    vs: &[f64],
+    us: &[C],
+    vs: &[C],
     out: &mut [f32],
     nan_value: f32,
     edge: &mut impl FnMut(usize, f64, f64) -> f32,
@@ -106,8 +158,8 @@ unsafe fn sample_avx2(
         // SAFETY: at + 4 ≤ lanes ≤ n = us.len() = vs.len().
         let (u, v) = unsafe {
             (
-                _mm256_loadu_pd(us.as_ptr().add(at)),
-                _mm256_loadu_pd(vs.as_ptr().add(at)),
+                C::load4_avx2(us.as_ptr().add(at)),
+                C::load4_avx2(vs.as_ptr().add(at)),
             )
         };
         let (x, y) = (_mm256_sub_pd(u, half), _mm256_sub_pd(v, half));
@@ -187,7 +239,7 @@ unsafe fn sample_avx2(
         let done = in_lo | (in_hi << 4) | nan_lanes;
         if done != 0xff {
             for j in (0..8).filter(|j| done & (1 << j) == 0) {
-                out[i + j] = edge(i + j, us[i + j], vs[i + j]);
+                out[i + j] = edge(i + j, us[i + j].to_f64(), vs[i + j].to_f64());
             }
         }
     }
@@ -298,6 +350,41 @@ mod tests {
         assert_eq!(scalar[7], -8.0);
         for i in 0..n {
             assert_eq!(scalar[i].to_bits(), wide[i].to_bits(), "position {i}");
+        }
+        // f32 coordinates (a stored map): the same samples as their f64 widening, on both paths.
+        let (us32, vs32): (Vec<f32>, Vec<f32>) = (
+            us.iter().map(|&u| u as f32).collect(),
+            vs.iter().map(|&v| v as f32).collect(),
+        );
+        let widened = |c: &[f32]| c.iter().map(|&x| f64::from(x)).collect::<Vec<f64>>();
+        let mut want = vec![0.0f32; n];
+        sample_scalar(
+            &img,
+            &widened(&us32),
+            &widened(&vs32),
+            &mut want,
+            0,
+            -0.5,
+            &mut { edge_value },
+        );
+        let mut scalar32 = vec![0.0f32; n];
+        sample_scalar(&img, &us32, &vs32, &mut scalar32, 0, -0.5, &mut {
+            edge_value
+        });
+        let mut wide32 = vec![0.0f32; n];
+        // SAFETY: as above.
+        unsafe { sample_avx2(&img, &us32, &vs32, &mut wide32, -0.5, &mut { edge_value }) };
+        for i in 0..n {
+            assert_eq!(
+                want[i].to_bits(),
+                scalar32[i].to_bits(),
+                "f32 scalar, position {i}"
+            );
+            assert_eq!(
+                want[i].to_bits(),
+                wide32[i].to_bits(),
+                "f32 AVX2, position {i}"
+            );
         }
     }
 }

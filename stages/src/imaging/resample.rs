@@ -125,16 +125,14 @@ pub fn remap_with_map(
         });
     }
     let mut out = GrayImage::filled(w, h, fill_value);
-    remap_rows_bilinear(src, &mut out, border, fill_value, |row, us, vs| {
-        let (u_row, v_row) = (&map.u_px[row * w..][..w], &map.v_px[row * w..][..w]);
-        for ((u, v), (&mu, &mv)) in us
-            .iter_mut()
-            .zip(vs.iter_mut())
-            .zip(u_row.iter().zip(v_row))
-        {
-            (*u, *v) = (f64::from(mu), f64::from(mv));
-        }
-    });
+    out.data
+        .par_chunks_mut(w)
+        .zip(map.u_px.par_chunks(w).zip(map.v_px.par_chunks(w)))
+        .for_each(|(out_row, (us, vs))| {
+            sample_bilinear_many(src, us, vs, out_row, fill_value, |_, u, v| {
+                sample_bilinear(src, u, v, border)
+            });
+        });
     out
 }
 
