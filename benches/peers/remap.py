@@ -10,7 +10,8 @@ this repository; `--rounds 0` skips it and uses the files already there, one rou
 after it, so every ratio compares two measurements taken seconds apart; the summary gives the median ratio over
 the rounds and its range (the machines are shared and noisy: absolute times swing by ±50 %, paired ratios less).
 
-The Rust bench writes `panorama.png` (8-bit), per GSD the float32 maps `map_{gsd}cm_{u,v}.npy` (campaign pixel
+The Rust bench writes `panorama.png` (8-bit) and the float32 values it decoded from it (`panorama.npy`, used
+here so that both sides sample identical floats), per GSD the float32 maps `map_{gsd}cm_{u,v}.npy` (campaign pixel
 convention, pixel centres at +0.5; NaN where the vehicle hides the ground), skytie's output `ortho_{gsd}cm.npy`
 and its timings `skytie_{gsd}cm.csv`. Here the panorama gets one wrapped column on each side (as the Rust bench
 does for skytie's `remap_with_map`), the map is converted to OpenCV's convention (x = u − 0.5 + 1 for the
@@ -19,7 +20,8 @@ is timed: median over repetitions, thread CPU time with 1 thread (`time.thread_t
 uses), wall time with the default thread count. Prints the max difference to skytie's output on valid pixels and
 the ratios skytie / OpenCV for skytie's `remap_with_map` given the same map and for the full `ortho_project`
 (which also computes the map); and, for the whole job, `ortho_project` against the map computed with NumPy from
-`geometry_{gsd}cm.json` followed by `cv2.remap`.
+`geometry_{gsd}cm.json` followed by `cv2.remap`. Accuracy: both `cv2.remap` and skytie's `remap_with_map`
+(`remap_{gsd}cm.npy`) against float64 bilinear interpolation on the same map.
 """
 import argparse
 import csv
@@ -44,6 +46,17 @@ def median_ms(fn, reps, cpu_time=False):
         fn()
         t.append((clock() - t0) * 1e3)
     return float(np.median(t))
+
+
+def bilinear_reference(img, x, y):
+    """Bilinear interpolation in float64 at OpenCV-convention positions (x, y) (pixel centres at integers), all
+    inside: the exact value both samplers approximate (OpenCV rounds the fractions to 1/32 px, INTER_BITS = 5)."""
+    img = img.astype(np.float64)
+    x0, y0 = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
+    fx, fy = x - x0, y - y0
+    top = img[y0, x0] + (img[y0, x0 + 1] - img[y0, x0]) * fx
+    bottom = img[y0 + 1, x0] + (img[y0 + 1, x0 + 1] - img[y0 + 1, x0]) * fx
+    return top + (bottom - top) * fy
 
 
 def run_rust_bench(folder):
@@ -77,10 +90,10 @@ def numpy_map(g):
 def one_round(folder, rows, whole_job):
     """Time cv2.remap (and, in the first round, the whole NumPy + OpenCV job) against the Rust timings now in
     `folder`; append (tag, threads, cv2 ms, skytie remap ms, skytie ortho ms) to `rows`."""
-    pano8 = cv2.imread(os.path.join(folder, "panorama.png"), cv2.IMREAD_GRAYSCALE)
-    if pano8 is None:
-        sys.exit(f"no panorama.png in {folder}: run the Rust bench first (see the docstring)")
-    pano = pano8.astype(np.float32) / 255.0
+    npy = os.path.join(folder, "panorama.npy")
+    if not os.path.exists(npy):
+        sys.exit(f"no panorama.npy in {folder}: run the Rust bench first (see the docstring)")
+    pano = np.load(npy)  # the float32 grey values skytie decoded from panorama.png
     padded = np.ascontiguousarray(np.hstack([pano[:, -1:], pano, pano[:, :1]]))
     for u_path in sorted(glob.glob(os.path.join(folder, "map_*cm_u.npy"))):
         tag = os.path.basename(u_path)[len("map_"):-len("_u.npy")]
@@ -89,7 +102,8 @@ def one_round(folder, rows, whole_job):
         ours = np.load(os.path.join(folder, f"ortho_{tag}.npy"))
         valid = ~np.isnan(mu)
         w = pano.shape[1]
-        map_x = np.where(valid, np.mod(mu, w) - 0.5 + 1.0, -10.0).astype(np.float32)
+        # (u mod w + 1) − 0.5 in float32, the operations and rounding of the Rust bench's map (+1: the padding).
+        map_x = np.where(valid, (np.mod(mu, w) + np.float32(1.0)) - np.float32(0.5), -10.0).astype(np.float32)
         map_y = np.where(valid, mv - 0.5, -10.0).astype(np.float32)
         sky = {}
         for r in csv.DictReader(open(os.path.join(folder, f"skytie_{tag}.csv"))):
@@ -105,6 +119,12 @@ def one_round(folder, rows, whole_job):
             continue
         out = cv2.remap(padded, map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
         diff = float(np.abs(out[valid] - ours[valid]).max()) if valid.any() else 0.0
+        # Accuracy on the same f32 map against float64 bilinear interpolation, where all four neighbours are inside.
+        inner = valid & (map_y >= 0) & (map_y < padded.shape[0] - 1)
+        ref = bilinear_reference(padded, map_x[inner].astype(np.float64), map_y[inner].astype(np.float64))
+        sky_remap = np.load(os.path.join(folder, f"remap_{tag}.npy"))
+        accuracy = {name: (float(np.abs(v[inner] - ref).max()), float(np.sqrt(np.mean((v[inner] - ref) ** 2))))
+                    for name, v in (("cv2.remap", out), ("skytie remap_with_map", sky_remap))}
         geometry = json.load(open(os.path.join(folder, f"geometry_{tag}.json")))
         nx, _ = numpy_map(geometry)
         map_err = float(np.abs(nx[valid] - map_x[valid]).max()) if valid.any() else 0.0
@@ -114,7 +134,7 @@ def one_round(folder, rows, whole_job):
             full[threads] = (median_ms(lambda: cv2.remap(padded, *numpy_map(geometry), cv2.INTER_LINEAR,
                                                          borderMode=cv2.BORDER_REPLICATE), max(reps // 4, 8)),
                              sky[("skytie ortho_project", threads)])
-        whole_job[tag] = (mu.shape, int(valid.sum()), diff, map_err, full)
+        whole_job[tag] = (mu.shape, int(valid.sum()), diff, map_err, full, accuracy)
 
 
 def main():
@@ -143,8 +163,11 @@ def main():
         print(f"{tag:>5} | {threads} thread(s) | remap_with_map / cv2.remap {np.median(r[:, 0]):.2f}x "
               f"({r[:, 0].min():.2f}–{r[:, 0].max():.2f}) | ortho_project / cv2.remap {np.median(r[:, 1]):.2f}x "
               f"({r[:, 1].min():.2f}–{r[:, 1].max():.2f})")
-    for tag, (shape, n_valid, diff, map_err, full) in sorted(whole_job.items()):
+    for tag, (shape, n_valid, diff, map_err, full, accuracy) in sorted(whole_job.items()):
         print(f"{tag:>5} | {shape[1]}x{shape[0]} px | max |cv2.remap − skytie ortho| on {n_valid} valid px: {diff:.2e}")
+        for name, (worst, rms) in accuracy.items():
+            print(f"{tag:>5} | {name} vs float64 bilinear on the same map (image range 0..1): max {worst:.2e}, "
+                  f"RMS {rms:.2e}")
         for threads, (ms, s_ortho) in full.items():
             print(f"{tag:>5} | whole job (first round), {threads} thread(s): NumPy map + cv2.remap {ms:.3f} ms "
                   f"(NumPy single-threaded), skytie ortho_project {s_ortho:.3f} ms: {s_ortho / ms:.2f}x "

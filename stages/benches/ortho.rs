@@ -8,9 +8,11 @@
 //! - `remap_with_map` with the precomputed map on the seam-padded panorama (bilinear sampling only — the
 //!   like-for-like peer of `cv2.remap`).
 //!
-//! Written to `$SKYTIE_PEER_DIR/ortho/` (default `<temp>/skytie_peers/ortho/`): `panorama.png`, and per GSD
+//! Written to `$SKYTIE_PEER_DIR/ortho/` (default `<temp>/skytie_peers/ortho/`): `panorama.png` and its decoded
+//! float32 values `panorama.npy`, and per GSD
 //! `map_{gsd}cm_u.npy`, `map_{gsd}cm_v.npy` (float32, campaign pixel convention: pixel centres at +0.5, NaN
-//! where the vehicle hides the ground), `ortho_{gsd}cm.npy` (skytie's float32 output, for the agreement check)
+//! where the vehicle hides the ground), `ortho_{gsd}cm.npy` and `remap_{gsd}cm.npy` (skytie's float32 outputs of
+//! `ortho_project` and `remap_with_map`, for the agreement and accuracy checks),
 //! `skytie_{gsd}cm.csv` (timings) and `geometry_{gsd}cm.json` (ground grid and panorama rotation, for a peer that
 //! computes the map itself). Run: `cargo bench -p skytie-stages --bench ortho`.
 
@@ -169,6 +171,12 @@ fn bench_gsd(panorama: &GrayImage, gsd_cm: u32, dir: &Path) {
         )
     };
     let remapped = remap_same_map();
+    write_npy_f32(
+        &dir.join(format!("remap_{gsd_cm}cm.npy")),
+        h,
+        w,
+        &remapped.data,
+    );
     let max_diff = remapped
         .data
         .iter()
@@ -238,6 +246,14 @@ fn main() {
     let png = dir.join("panorama.png");
     save_gray(&png, &textured(4000, 2000, 7)).expect("write the panorama PNG");
     let panorama = load_gray(&png).expect("re-load the panorama PNG");
+    // The grey values exactly as skytie decoded them (an 8-bit → float conversion may differ from NumPy's
+    // `/ 255.0` in the last bit), so that the peer samples the very same floats.
+    write_npy_f32(
+        &dir.join("panorama.npy"),
+        panorama.height,
+        panorama.width,
+        &panorama.data,
+    );
     for gsd_cm in [3, 10] {
         bench_gsd(&panorama, gsd_cm, &dir);
     }
