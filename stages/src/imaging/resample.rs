@@ -65,12 +65,21 @@ where
         return out;
     }
     if interp == Interpolation::Bilinear {
-        // The row's positions first, then the row sampler.
-        remap_rows_bilinear(src, &mut out, border, fill_value, |row, us, vs| {
-            for (col, (u, v)) in us.iter_mut().zip(vs.iter_mut()).enumerate() {
-                (*u, *v) = map(col, row).unwrap_or((f64::NAN, f64::NAN));
-            }
-        });
+        // The row's positions first (NaN: no source), then the row sampler.
+        out.data
+            .par_chunks_mut(out_width)
+            .enumerate()
+            .for_each_init(
+                || (vec![0.0; out_width], vec![0.0; out_width]),
+                |(us, vs), (row, out_row)| {
+                    for (col, (u, v)) in us.iter_mut().zip(vs.iter_mut()).enumerate() {
+                        (*u, *v) = map(col, row).unwrap_or((f64::NAN, f64::NAN));
+                    }
+                    sample_bilinear_many(src, us, vs, out_row, fill_value, |_, u, v| {
+                        sample_bilinear(src, u, v, border)
+                    });
+                },
+            );
         return out;
     }
     out.data
@@ -134,27 +143,6 @@ pub fn remap_with_map(
             });
         });
     out
-}
-
-/// Bilinear remap, rows in parallel: `positions(row, us, vs)` fills the row's source positions (NaN u: no
-/// source, `fill_value`), then [`sample_bilinear_many`] samples them (`border` near the edge).
-fn remap_rows_bilinear(
-    src: &GrayImage,
-    out: &mut GrayImage,
-    border: Border,
-    fill_value: f32,
-    positions: impl Fn(usize, &mut [f64], &mut [f64]) + Sync,
-) {
-    let width = out.width;
-    out.data.par_chunks_mut(width).enumerate().for_each_init(
-        || (vec![0.0; width], vec![0.0; width]),
-        |(us, vs), (row, out_row)| {
-            positions(row, us, vs);
-            sample_bilinear_many(src, us, vs, out_row, fill_value, |_, u, v| {
-                sample_bilinear(src, u, v, border)
-            });
-        },
-    );
 }
 
 /// Resize `src` to `out_width × out_height` by pure scaling (pixel-area aligned: the image rectangles coincide).
