@@ -185,6 +185,15 @@ pub fn phasecorr(a: &PairArgs) -> Result<(), String> {
 pub fn ncc(a: &NccArgs) -> Result<(), String> {
     let t = load_gray(&a.template).map_err(|e| e.to_string())?;
     let i = load_gray(&a.image).map_err(|e| e.to_string())?;
+    // A constant template has no normalised correlation anywhere (every score would be 0 at an arbitrary place).
+    if t.data.windows(2).all(|p| p[0] == p[1]) {
+        return Err(format!(
+            "{}: the template is constant (every pixel {}), so its normalised cross-correlation is undefined; \
+             crop a part with texture",
+            a.template.display(),
+            t.data.first().copied().unwrap_or(0.0)
+        ));
+    }
     let m = match_template(&i, &t).map_err(|e| e.to_string())?;
     println!("{} {} {}", m.u_px, m.v_px, m.score);
     Ok(())

@@ -1,0 +1,92 @@
+//! Shared helpers of the tests that drive `skytie tool …` (tools_nadir, tools_oblique): the command and its
+//! output, CSV rows, a band-limited test texture and a one-recording stripe campaign.
+#![allow(dead_code)]
+
+use skytie_stages::imaging::gaussian_blur;
+use skytie_stages::imaging::io::save_rgb;
+use skytie_stages::imaging::{GrayImage, RgbImage};
+use std::path::Path;
+use std::process::Command;
+
+/// Exit code, stdout, stderr of `skytie tool ARGS…`.
+pub fn tool(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_skytie"))
+        .arg("tool")
+        .args(args)
+        .output()
+        .expect("start skytie");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+pub fn tool_ok(args: &[&str]) -> String {
+    let (code, stdout, stderr) = tool(args);
+    assert_eq!(code, 0, "skytie tool {args:?} failed: {stdout}{stderr}");
+    stdout
+}
+
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Data rows of a CSV (header checked against `header_prefix`), split into fields.
+pub fn csv_rows(path: &Path, header_prefix: &str) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().expect("a header row");
+    assert!(
+        header.starts_with(header_prefix),
+        "header {header:?} of {}",
+        path.display()
+    );
+    lines
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect()
+}
+
+/// Band-limited noise in [0.1, 0.9]: uniform noise blurred with σ = `sigma_px`, stretched.
+pub fn texture(w: usize, h: usize, sigma_px: f32, seed: u64) -> GrayImage {
+    let mut state = seed;
+    let noise: Vec<f32> = (0..w * h)
+        .map(|_| {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+        })
+        .collect();
+    let mut img = gaussian_blur(&GrayImage::from_vec(w, h, noise).unwrap(), sigma_px);
+    let (lo, hi) = img
+        .data
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+    img.data
+        .iter_mut()
+        .for_each(|v| *v = 0.1 + 0.8 * (*v - lo) / (hi - lo));
+    img
+}
+
+/// A one-recording campaign whose 360×180 panorama is dark blue except for a red stripe at azimuth 90° ± 4°
+/// (east; equirectangular columns u = W·(A + 180°)/360°).
+pub fn stripe_campaign(root: &Path, heading_deg: f64) {
+    std::fs::create_dir_all(root.join("mm/panoramas")).unwrap();
+    std::fs::write(
+        root.join("mm/recordings.csv"),
+        format!(
+            "image_id,file,time,x,y,z,heading,camera_height\n\
+             r1,r1.png,2019-06-14T10:31:07Z,500000.0,5400000.0,102.5,{heading_deg},2.5\n"
+        ),
+    )
+    .unwrap();
+    let mut pano = RgbImage::filled(360, 180, [0.0, 0.0, 0.4]);
+    for r in 0..180 {
+        for c in 266..274 {
+            pano.set(c, r, [1.0, 0.0, 0.0]);
+        }
+    }
+    save_rgb(&root.join("mm/panoramas/r1.png"), &pano, 95).unwrap();
+}
