@@ -17,9 +17,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use skytie_stages::features::kaze::{detect_and_describe, Features, KazeParams, Scheme};
-use skytie_stages::imaging::gaussian::gaussian_blur;
 use skytie_stages::imaging::io::{load_gray, save_gray};
 use skytie_stages::imaging::GrayImage;
+use skytie_stages::synth::test_texture::band_limited_noise;
 
 const SIZE: usize = 1000;
 const SHIFT_X: usize = 17;
@@ -47,24 +47,10 @@ fn process_cpu_s() -> Option<f64> {
 
 /// Band-limited noise: uniform noise blurred with σ = 2.5 px, stretched to [0, 1] and 8-bit quantised.
 fn textured(w: usize, h: usize, seed: u64) -> GrayImage {
-    let mut state = seed;
-    let noise: Vec<f32> = (0..w * h)
-        .map(|_| {
-            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-        })
-        .collect();
-    let mut img = gaussian_blur(&GrayImage::from_vec(w, h, noise).unwrap(), 2.5);
-    let (lo, hi) = img
-        .data
-        .iter()
-        .fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+    let mut img = band_limited_noise(w, h, 2.5, seed);
     img.data
         .iter_mut()
-        .for_each(|v| *v = ((*v - lo) / (hi - lo) * 255.0).round() / 255.0);
+        .for_each(|v| *v = (*v * 255.0).round() / 255.0);
     img
 }
 

@@ -26,33 +26,12 @@ use std::time::Instant;
 use skytie_stages::campaign::Recording;
 use skytie_stages::geometry::PanoramaCamera;
 use skytie_stages::imaging::border::Border;
-use skytie_stages::imaging::gaussian::gaussian_blur;
 use skytie_stages::imaging::huge_pages::collect_f32;
 use skytie_stages::imaging::io::{load_gray, save_gray};
 use skytie_stages::imaging::resample::{remap_with_map, Interpolation, SourceMap};
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::{ortho_project, OrthoGeoref, OrthoParams};
-
-/// Band-limited noise (uniform noise blurred with σ = 2 px, stretched to [0, 1]).
-fn textured(w: usize, h: usize, seed: u64) -> GrayImage {
-    let mut state = seed;
-    let noise: Vec<f32> = (0..w * h)
-        .map(|_| {
-            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-        })
-        .collect();
-    let mut img = gaussian_blur(&GrayImage::from_vec(w, h, noise).unwrap(), 2.0);
-    let (lo, hi) = img
-        .data
-        .iter()
-        .fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
-    img.data.iter_mut().for_each(|v| *v = (*v - lo) / (hi - lo));
-    img
-}
+use skytie_stages::synth::test_texture::band_limited_noise;
 
 /// `img` with one wrapped column on each side (column −1 = the last, column w = the first), in memory advised to
 /// use huge pages like the loaded panorama's.
@@ -244,7 +223,7 @@ fn main() {
     let dir = peer_dir("ortho");
     std::fs::create_dir_all(&dir).expect("create the peer directory");
     let png = dir.join("panorama.png");
-    save_gray(&png, &textured(4000, 2000, 7)).expect("write the panorama PNG");
+    save_gray(&png, &band_limited_noise(4000, 2000, 2.0, 7)).expect("write the panorama PNG");
     let panorama = load_gray(&png).expect("re-load the panorama PNG");
     // The grey values exactly as skytie decoded them (an 8-bit → float conversion may differ from NumPy's
     // `/ 255.0` in the last bit), so that the peer samples the very same floats.

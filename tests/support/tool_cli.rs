@@ -2,9 +2,9 @@
 //! output, CSV rows, a band-limited test texture and a one-recording stripe campaign.
 #![allow(dead_code)]
 
-use skytie_stages::imaging::gaussian_blur;
 use skytie_stages::imaging::io::save_rgb;
 use skytie_stages::imaging::{GrayImage, RgbImage};
+use skytie_stages::synth::test_texture::band_limited_noise;
 use std::path::Path;
 use std::process::Command;
 
@@ -49,24 +49,8 @@ pub fn csv_rows(path: &Path, header_prefix: &str) -> Vec<Vec<String>> {
 
 /// Band-limited noise in [0.1, 0.9]: uniform noise blurred with σ = `sigma_px`, stretched.
 pub fn texture(w: usize, h: usize, sigma_px: f32, seed: u64) -> GrayImage {
-    let mut state = seed;
-    let noise: Vec<f32> = (0..w * h)
-        .map(|_| {
-            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-        })
-        .collect();
-    let mut img = gaussian_blur(&GrayImage::from_vec(w, h, noise).unwrap(), sigma_px);
-    let (lo, hi) = img
-        .data
-        .iter()
-        .fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
-    img.data
-        .iter_mut()
-        .for_each(|v| *v = 0.1 + 0.8 * (*v - lo) / (hi - lo));
+    let mut img = band_limited_noise(w, h, sigma_px, seed);
+    img.data.iter_mut().for_each(|v| *v = 0.1 + 0.8 * *v);
     img
 }
 

@@ -21,6 +21,7 @@ pub mod render;
 pub mod render_store;
 pub mod rng;
 pub mod scene_truth;
+pub mod test_texture;
 pub mod trajectory;
 pub mod vehicle;
 
