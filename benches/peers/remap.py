@@ -27,7 +27,6 @@ import argparse
 import csv
 import glob
 import os
-import subprocess
 import sys
 import tempfile
 import time
@@ -35,6 +34,7 @@ import time
 import cv2
 import json
 import numpy as np
+from rust_bench import run_rust_bench
 
 
 def median_ms(fn, reps, cpu_time=False):
@@ -57,14 +57,6 @@ def bilinear_reference(img, x, y):
     top = img[y0, x0] + (img[y0, x0 + 1] - img[y0, x0]) * fx
     bottom = img[y0 + 1, x0] + (img[y0 + 1, x0 + 1] - img[y0 + 1, x0]) * fx
     return top + (bottom - top) * fy
-
-
-def run_rust_bench(folder):
-    """One run of the Rust bench, writing its inputs and timings into `folder` (= $SKYTIE_PEER_DIR/ortho)."""
-    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    env = dict(os.environ, SKYTIE_PEER_DIR=os.path.dirname(os.path.abspath(folder)))
-    subprocess.run(["cargo", "bench", "-q", "-p", "skytie-stages", "--bench", "ortho"], cwd=repo, env=env,
-                   check=True, stdout=subprocess.DEVNULL)
 
 
 def numpy_map(g):
@@ -146,7 +138,7 @@ def main():
     rows, whole_job = [], {}
     for k in range(max(args.rounds, 1)):
         if args.rounds > 0:
-            run_rust_bench(args.folder)
+            run_rust_bench("ortho", args.folder)
         one_round(args.folder, rows, whole_job)
     print(f"{'round':>5} | {'GSD':>5} | {'threads':>7} | {'cv2.remap ms':>12} | {'skytie remap ms':>15} | "
           f"{'ortho_project ms':>16} | {'remap/cv2':>9} | {'ortho/cv2':>9}")
