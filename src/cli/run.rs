@@ -13,10 +13,10 @@
 //! not load, unknown pipeline, cache cannot be opened) or when the output files cannot be written.
 
 use crate::cli::common::{load_workflow, CacheOpt, ThreadsOpt, DEFAULT_WORKFLOW};
+use crate::dag::progress::{Progress, ProgressMode};
 use crate::dag::{Mode, NodeStatus, PipelineError, Session};
 use crate::hashing::StatCache;
 use crate::metrics::{add_sections, sweep_csv, write_json, Summary};
-use crate::progress::{Progress, ProgressMode};
 use crate::workflow::Workflow;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -217,10 +217,7 @@ pub fn write_outputs(
             );
             rows.push((v.clone(), row));
         }
-        skytie_stages::fsutil::atomic_write(
-            &out_dir.join("sweep.csv"),
-            sweep_csv(&rows).as_bytes(),
-        )?;
+        skytie_util::fsutil::atomic_write(&out_dir.join("sweep.csv"), sweep_csv(&rows).as_bytes())?;
     } else {
         add_sections(
             &mut doc,
@@ -231,15 +228,4 @@ pub fn write_outputs(
     let prov = crate::provenance::provenance(wf, session, started_unix_s, wall_seconds);
     write_json(&out_dir.join("provenance.json"), &prov)?;
     Ok(())
-}
-
-/// Turn a pipeline error of a plan into "planning stopped here" (not an error) or a real error.
-pub fn plan_stop(
-    result: Result<(), PipelineError>,
-) -> Result<Option<PipelineError>, PipelineError> {
-    match result {
-        Ok(()) => Ok(None),
-        Err(e @ PipelineError::NotYetAvailable(_)) => Ok(Some(e)),
-        Err(e) => Err(e),
-    }
 }

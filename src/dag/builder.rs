@@ -170,7 +170,7 @@ impl DagBuilder {
     ) -> BuildError {
         let first = &self.nodes[other];
         let mut differences = Vec::new();
-        crate::dag::record::diff_json("", &first.params_json, params_json, &mut differences);
+        crate::dag::json_diff::diff_json("", &first.params_json, params_json, &mut differences);
         let what = if differences.is_empty() {
             "same params but different inputs or stage version".to_string()
         } else {

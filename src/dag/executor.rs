@@ -19,10 +19,11 @@ use crate::dag::builder::Dag;
 use crate::dag::inputs::{InputRef, InputValue, NodeId, RawFileValue};
 use crate::dag::key::node_key;
 use crate::dag::node::{AnyValue, Node};
+use crate::dag::progress::Progress;
 use crate::dag::record::{self, NodeRecord, RecordedInput};
 use crate::dag::stage::{dirs_root, tmp_dir_for, NodeCtx};
+pub use crate::dag::status::NodeStatus;
 use crate::hashing::{ContentHash, NodeKey, StatCache};
-use crate::progress::Progress;
 use crate::store::{EntryMeta, Loaded, Store};
 use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -35,27 +36,6 @@ use std::time::{Instant, SystemTime, UNIX_EPOCH};
 pub enum Mode {
     Run,
     Plan,
-}
-
-/// What happened to a node.
-#[derive(Clone, Debug, PartialEq)]
-pub enum NodeStatus {
-    /// The stage ran (or was recomputed because its cached artifact was corrupt or missing).
-    Executed,
-    /// The output came from the cache.
-    Cached,
-    /// The stage returned an error or panicked; nothing was stored.
-    Failed(String),
-    /// Not run because an upstream node failed (identity of that node).
-    Skipped { upstream: String },
-    /// Plan mode: the node will run, with the reasons.
-    WillRun { reasons: Vec<String> },
-}
-
-impl NodeStatus {
-    pub fn is_ok(&self) -> bool {
-        matches!(self, NodeStatus::Executed | NodeStatus::Cached)
-    }
 }
 
 /// The outcome of one node.

@@ -9,7 +9,7 @@
 //! b.add(ToyScale, "x", Default::default(), folder).unwrap(); // ToyScale reads a Handle<f64>
 //! ```
 
-use crate::dag::stage::StageError;
+use crate::dag::error::StageError;
 use crate::hashing::ContentHash;
 use std::any::Any;
 use std::marker::PhantomData;

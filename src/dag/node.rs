@@ -1,8 +1,9 @@
 //! A node of the DAG with its stage type erased, so nodes of many stage types live in one graph.
 
 use crate::codec::{Artifact, CodecError};
+use crate::dag::error::StageError;
 use crate::dag::inputs::{InputRef, InputSet, InputValue};
-use crate::dag::stage::{NodeCtx, Stage, StageError};
+use crate::dag::stage::{NodeCtx, Stage};
 use std::any::Any;
 use std::io::{self, Read, Write};
 use std::sync::Arc;

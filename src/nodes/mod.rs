@@ -11,6 +11,7 @@ pub mod consensus;
 pub mod control;
 pub mod decoded_images;
 pub mod facades;
+pub mod image_artifact;
 pub mod mm_match;
 pub mod nadir_grade;
 pub mod nadir_options;

@@ -1,12 +1,13 @@
-//! Pipelines built from the real stages (`pipeline = "skytie"`, the default). The `toy` pipeline used by the
-//! engine's own tests lives in `crate::testing`.
+//! Pipelines built from the real stages (`pipeline = "skytie"`, the default), and the registry of every
+//! pipeline the command line can run (the `toy` pipeline used by the engine's own tests lives in
+//! `crate::testing`).
 
 pub mod adjust;
 pub mod nadir;
 pub mod oblique;
 pub mod skytie;
 
-use crate::dag::PipelineError;
+use crate::dag::{Pipeline, PipelineError};
 use crate::workflow::Workflow;
 use skytie_stages::campaign::Recording;
 
@@ -35,4 +36,21 @@ pub(crate) fn missing_upstream(
         wf.path.display(),
         missing.join(", "),
     ))
+}
+
+/// The pipeline a workflow asks for.
+pub fn pipeline_by_name(name: &str) -> Result<&'static dyn Pipeline, String> {
+    match name {
+        "skytie" => Ok(&skytie::SkytiePipeline),
+        "toy" => Ok(&crate::testing::toy_pipeline::ToyPipeline),
+        other => Err(format!(
+            "unknown pipeline '{other}': this skytie knows: {} (set `pipeline = ...` in the workflow)",
+            known_pipelines().join(", ")
+        )),
+    }
+}
+
+/// Names of the registered pipelines.
+pub fn known_pipelines() -> Vec<&'static str> {
+    vec!["skytie", "toy"]
 }

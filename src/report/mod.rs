@@ -25,7 +25,7 @@ pub mod thesis_values;
 use html::Page;
 use inputs::RunOutputs;
 use rayon::prelude::*;
-use skytie_stages::fsutil::atomic_write;
+use skytie_util::fsutil::atomic_write;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use tables::Table;

@@ -11,10 +11,12 @@ pub mod correspondence;
 pub mod estimators;
 pub mod export;
 pub mod features;
-pub mod fsutil;
 pub mod geometry;
 pub mod imaging;
 pub mod matching;
 pub mod nadir;
 pub mod oblique;
 pub mod synth;
+
+/// Atomic file replacement (from `skytie-util`, shared with the engine).
+pub use skytie_util::fsutil;

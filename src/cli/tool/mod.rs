@@ -10,7 +10,7 @@ use clap::Subcommand;
 use nadir::*;
 use oblique::*;
 use skytie_stages::campaign::{read_campaign, Recording};
-use skytie_stages::fsutil::atomic_write;
+use skytie_util::fsutil::atomic_write;
 use std::path::{Path, PathBuf};
 
 /// The tools.

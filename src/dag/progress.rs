@@ -2,7 +2,7 @@
 //! lines when stderr is not a terminal, nothing but errors with `--quiet`. Warnings (e.g. a corrupt cache
 //! entry) are printed once each, above the bars.
 
-use crate::dag::NodeStatus;
+use crate::dag::status::NodeStatus;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
 use std::io::IsTerminal;
