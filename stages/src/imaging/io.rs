@@ -1,9 +1,11 @@
-//! Reading and writing image files (JPEG, PNG, TIFF via the `image` crate) as [`GrayImage`]/[`RgbImage`].
-//!
-//! 8-bit files map to 0..1 (value / 255); 16-bit files to 0..1 (value / 65535). Writing clamps to 0..1 and
-//! rounds to 8 bits. Writes are atomic (see [`crate::fsutil`]).
+//! Reading whole image files as [`GrayImage`] (through [`super::decode`], the decoders of the pipeline's
+//! pyramids: JPEG luma, 8-bit files / 255, 16-bit files / their white level) or [`RgbImage`] (the `image`
+//! crate, for the tools), and writing them. Writing clamps to 0..1 and rounds to 8 bits. Writes are atomic
+//! (see [`crate::fsutil`]). Reading a whole image reserves its buffer from the memory budget
+//! ([`super::budget`]); the pipeline reads windows of pyramids instead ([`super::pyramid`]).
 
-use super::huge_pages::collect_f32;
+use super::decode::collect::GreyCollector;
+use super::decode::limits::{check_claimed_size, reserve};
 use super::{GrayImage, RgbImage};
 use std::path::Path;
 
@@ -15,15 +17,42 @@ pub struct ImageIoError {
     pub message: String,
 }
 
-fn err(path: &Path, message: impl Into<String>) -> ImageIoError {
-    ImageIoError {
-        path: path.display().to_string(),
-        message: message.into(),
+impl ImageIoError {
+    pub fn new(path: &Path, message: impl Into<String>) -> Self {
+        ImageIoError {
+            path: path.display().to_string(),
+            message: message.into(),
+        }
     }
 }
 
+fn err(path: &Path, message: impl Into<String>) -> ImageIoError {
+    ImageIoError::new(path, message)
+}
+
+/// Decodes `path` with the `image` crate, its allocation limit replaced by the memory budget (the crate's
+/// default of 512 MiB refuses valid large frames).
 fn open(path: &Path) -> Result<image::DynamicImage, ImageIoError> {
-    let reader = image::ImageReader::open(path)
+    let (w, h) = dimensions(path)?;
+    let file_len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    let format = super::decode::detect_format(path)?;
+    let max_px_per_byte = match format {
+        super::decode::FileFormat::Jpeg => super::decode::limits::px_per_byte::JPEG,
+        super::decode::FileFormat::Png => super::decode::limits::px_per_byte::PNG,
+        _ => super::decode::limits::px_per_byte::TIFF,
+    };
+    let (w, h) = (w as usize, h as usize);
+    check_claimed_size(path, format.name(), w, h, file_len, max_px_per_byte)?;
+    // The decoded RGB(A) image at up to 16 bits, and its 32-bit float RGB copy.
+    let _reservation = reserve(
+        path,
+        format.name(),
+        w,
+        h,
+        w * h * (8 + 12),
+        "its decoded colour image",
+    )?;
+    let mut reader = image::ImageReader::open(path)
         .map_err(|e| {
             err(
                 path,
@@ -32,6 +61,7 @@ fn open(path: &Path) -> Result<image::DynamicImage, ImageIoError> {
         })?
         .with_guessed_format()
         .map_err(|e| err(path, format!("cannot read ({e})")))?;
+    reader.no_limits();
     reader.decode().map_err(|e| {
         err(
             path,
@@ -40,70 +70,12 @@ fn open(path: &Path) -> Result<image::DynamicImage, ImageIoError> {
     })
 }
 
-/// Load any supported image as a single-channel image (luminance for colour files).
+/// Load any supported image as a single-channel image: the grey of [`super::decode`] (JPEG/JFIF luma for
+/// colour files), 8-bit samples / 255, 16-bit samples / the image's white level.
 pub fn load_gray(path: &Path) -> Result<GrayImage, ImageIoError> {
-    let img = open(path)?;
-    let (w, h) = (img.width() as usize, img.height() as usize);
-    Ok(GrayImage {
-        width: w,
-        height: h,
-        data: grey_values(img),
-    })
-}
-
-/// The image crate's u8 → f32 channel conversion (`to_rgb32f`) of every byte value, for 8-bit RGB and grey
-/// images, read off the crate itself so that a table lookup gives exactly its values.
-fn unit_tables() -> &'static ([f32; 256], [f32; 256]) {
-    static TABLES: std::sync::OnceLock<([f32; 256], [f32; 256])> = std::sync::OnceLock::new();
-    TABLES.get_or_init(|| {
-        let bytes: Vec<u8> = (0..=255u8).collect();
-        let rgb: Vec<u8> = bytes.iter().flat_map(|&v| [v, v, v]).collect();
-        let first_channel = |img: image::DynamicImage| -> [f32; 256] {
-            let f = img.to_rgb32f().into_raw();
-            std::array::from_fn(|v| f[3 * v])
-        };
-        (
-            first_channel(image::DynamicImage::ImageRgb8(
-                image::RgbImage::from_raw(256, 1, rgb).expect("256 × 1 RGB"),
-            )),
-            first_channel(image::DynamicImage::ImageLuma8(
-                image::GrayImage::from_raw(256, 1, bytes).expect("256 × 1 grey"),
-            )),
-        )
-    })
-}
-
-/// Luminance `0.2126 R + 0.7152 G + 0.0722 B` of 0..1 channels (16-bit grey: value / 65535). 8-bit grey and RGB
-/// are converted straight from their bytes by [`unit_tables`], so the values are exactly those of
-/// `to_rgb32f()`, without its 3 × 4-byte-per-pixel intermediate (a 4800 × 2400 panorama: 138 MB and 0.1 s of
-/// the 0.2 s `load_gray` took).
-fn grey_values(img: image::DynamicImage) -> Vec<f32> {
-    let n = img.width() as usize * img.height() as usize;
-    let (unit_rgb, unit_grey) = unit_tables();
-    let luminance = |r: f32, g: f32, b: f32| 0.2126 * r + 0.7152 * g + 0.0722 * b;
-    match img {
-        image::DynamicImage::ImageLuma16(b) => {
-            collect_f32(n, b.into_raw().into_iter().map(|v| v as f32 / 65535.0))
-        }
-        image::DynamicImage::ImageLuma8(b) => collect_f32(
-            n,
-            b.as_raw().iter().map(|&v| {
-                let x = unit_grey[v as usize];
-                luminance(x, x, x)
-            }),
-        ),
-        image::DynamicImage::ImageRgb8(b) => collect_f32(
-            n,
-            b.as_raw().chunks_exact(3).map(|p| {
-                let c = |k: usize| unit_rgb[p[k] as usize];
-                luminance(c(0), c(1), c(2))
-            }),
-        ),
-        other => {
-            let rgb = other.to_rgb32f().into_raw();
-            collect_f32(n, rgb.chunks_exact(3).map(|p| luminance(p[0], p[1], p[2])))
-        }
-    }
+    let mut collector = GreyCollector::new(path);
+    super::decode::decode_grey(path, &mut collector)?;
+    Ok(collector.finish())
 }
 
 /// Load any supported image as RGB.
@@ -183,37 +155,6 @@ pub fn save_gray(path: &Path, img: &GrayImage) -> Result<(), ImageIoError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn grey_from_bytes_equals_the_image_crate_float_conversion() {
-        // Every byte value in every channel position, for RGB and grey 8-bit images.
-        let (w, h) = (256, 3);
-        let rgb: Vec<u8> = (0..w * h * 3)
-            .map(|i| ((i * 7 + i / 3) % 256) as u8)
-            .collect();
-        let grey: Vec<u8> = (0..w * h).map(|i| (i % 256) as u8).collect();
-        let images = [
-            image::DynamicImage::ImageRgb8(
-                image::RgbImage::from_raw(w as u32, h as u32, rgb).unwrap(),
-            ),
-            image::DynamicImage::ImageLuma8(
-                image::GrayImage::from_raw(w as u32, h as u32, grey).unwrap(),
-            ),
-        ];
-        for img in images {
-            let reference: Vec<f32> = img
-                .to_rgb32f()
-                .into_raw()
-                .chunks_exact(3)
-                .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
-                .collect();
-            let got = grey_values(img);
-            assert_eq!(got.len(), reference.len());
-            for (a, b) in got.iter().zip(&reference) {
-                assert_eq!(a.to_bits(), b.to_bits());
-            }
-        }
-    }
 
     #[test]
     fn png_round_trip_is_exact_at_8_bits() {

@@ -5,8 +5,13 @@
 
 /// Huge-page advice for large image buffers (from `skytie-util`, shared with the engine).
 pub use skytie_util::huge_pages;
+pub mod budget;
+pub mod decode;
 pub mod image;
+pub mod ingest;
 pub mod io;
+pub mod pyramid;
+pub mod tiff_write;
 
 pub mod bilinear_many;
 pub mod border;

@@ -1,0 +1,407 @@
+//! TIFF and BigTIFF files through the `tiff` crate, one row of strips or tiles at a time: 8- or 16-bit grey,
+//! RGB(A) or YCbCr (JPEG-compressed TIFFs keep their Y plane), chunky or planar, with any compression the
+//! crate reads (none, LZW, Deflate, PackBits, JPEG) and predictors. Only the first image of the file is read
+//! (overviews of a pyramidal TIFF are not needed: skytie builds its own).
+
+use super::geotiff::GeoTiffTags;
+use super::grey::{grey_row16, grey_row8, Channels};
+use super::limits::{check_claimed_size, px_per_byte, reserve};
+use super::tiff_lzw::{read_lzw_chunk, ChunkCoding};
+use super::{sink_error, FileFormat, GreyInfo, GreyRowSink};
+use crate::imaging::io::ImageIoError;
+use crate::imaging::pyramid::SampleDepth;
+use std::io::BufReader;
+use std::path::Path;
+use tiff::decoder::{ChunkType, Decoder, DecodingResult, Limits};
+use tiff::tags::{ByteOrder, CompressionMethod, PlanarConfiguration, Predictor, Tag};
+use tiff::ColorType;
+
+type TiffDecoder = Decoder<BufReader<std::fs::File>>;
+
+fn tiff_error(path: &Path, e: tiff::TiffError) -> ImageIoError {
+    ImageIoError::new(
+        path,
+        format!("does not decode as a TIFF ({e}); is it truncated or corrupt?"),
+    )
+}
+
+/// How the first image's pixels are stored.
+struct Structure {
+    width: usize,
+    height: usize,
+    channels: Channels,
+    depth: SampleDepth,
+    planar: bool,
+    /// Chunk (strip or tile) size, pixels.
+    chunk_w: usize,
+    chunk_h: usize,
+    /// LZW chunks are decompressed by [`read_lzw_chunk`]: their offsets, byte counts and coding.
+    lzw: Option<LzwChunks>,
+}
+
+struct LzwChunks {
+    /// Tiles hold `chunk_h` rows even at the bottom edge; the last strip holds only the rows left.
+    tiled: bool,
+    offsets: Vec<u64>,
+    counts: Vec<u64>,
+    coding: ChunkCoding,
+}
+
+impl Structure {
+    fn chunks_across(&self) -> usize {
+        self.width.div_ceil(self.chunk_w)
+    }
+
+    fn chunks_down(&self) -> usize {
+        self.height.div_ceil(self.chunk_h)
+    }
+}
+
+fn structure(path: &Path, dec: &mut TiffDecoder) -> Result<Structure, ImageIoError> {
+    let (w, h) = dec.dimensions().map_err(|e| tiff_error(path, e))?;
+    let colour = dec.colortype().map_err(|e| tiff_error(path, e))?;
+    let unsupported = |what: String| {
+        ImageIoError::new(
+            path,
+            format!("{what}; skytie reads 8- or 16-bit grey, RGB(A) or YCbCr TIFFs — convert it (e.g. gdal_translate -ot Byte)"),
+        )
+    };
+    let (channels, bits) = match colour {
+        ColorType::Gray(b) => (Channels::Grey { extra: 0 }, b),
+        ColorType::GrayA(b) => (Channels::Grey { extra: 1 }, b),
+        ColorType::RGB(b) => (Channels::Rgb { extra: 0 }, b),
+        ColorType::RGBA(b) => (Channels::Rgb { extra: 1 }, b),
+        ColorType::YCbCr(b) => (Channels::YCbCr, b),
+        ColorType::Multiband {
+            bit_depth,
+            num_samples,
+        } if num_samples >= 1 => (
+            Channels::Grey {
+                extra: usize::from(num_samples) - 1,
+            },
+            bit_depth,
+        ),
+        other => {
+            return Err(unsupported(format!(
+                "its colour type {other:?} is not supported"
+            )))
+        }
+    };
+    let depth = match bits {
+        8 => SampleDepth::U8,
+        16 => SampleDepth::U16,
+        b => return Err(unsupported(format!("it has {b}-bit samples"))),
+    };
+    let planar = dec
+        .find_tag_unsigned::<u16>(Tag::PlanarConfiguration)
+        .ok()
+        .flatten()
+        == Some(PlanarConfiguration::Planar.to_u16())
+        && channels.samples() > 1;
+    let (cw, ch) = dec.chunk_dimensions();
+    let (chunk_w, chunk_h) = match dec.get_chunk_type() {
+        ChunkType::Tile => (cw as usize, ch as usize),
+        ChunkType::Strip => (w as usize, (ch as usize).min(h as usize)),
+    };
+    if chunk_w == 0 || chunk_h == 0 {
+        return Err(ImageIoError::new(
+            path,
+            "declares empty strips or tiles: the file is corrupt",
+        ));
+    }
+    let compression = dec
+        .find_tag_unsigned::<u16>(Tag::Compression)
+        .ok()
+        .flatten();
+    let lzw = if compression == Some(CompressionMethod::LZW.to_u16()) {
+        let tiled = matches!(dec.get_chunk_type(), ChunkType::Tile);
+        let (offsets_tag, counts_tag) = if tiled {
+            (Tag::TileOffsets, Tag::TileByteCounts)
+        } else {
+            (Tag::StripOffsets, Tag::StripByteCounts)
+        };
+        let offsets = dec
+            .get_tag_u64_vec(offsets_tag)
+            .map_err(|e| tiff_error(path, e))?;
+        let counts = dec
+            .get_tag_u64_vec(counts_tag)
+            .map_err(|e| tiff_error(path, e))?;
+        let predictor = dec
+            .find_tag_unsigned::<u16>(Tag::Predictor)
+            .ok()
+            .flatten()
+            .unwrap_or(1);
+        if predictor != 1 && predictor != Predictor::Horizontal.to_u16() {
+            return Err(unsupported(format!(
+                "its LZW predictor {predictor} is not supported"
+            )));
+        }
+        Some(LzwChunks {
+            tiled,
+            offsets,
+            counts,
+            coding: ChunkCoding {
+                row_px: chunk_w,
+                samples: if planar { 1 } else { channels.samples() },
+                bytes_per_sample: depth.bytes(),
+                horizontal_predictor: predictor == Predictor::Horizontal.to_u16(),
+                big_endian: dec.byte_order() == ByteOrder::BigEndian,
+            },
+        })
+    } else {
+        None
+    };
+    Ok(Structure {
+        width: w as usize,
+        height: h as usize,
+        channels,
+        depth,
+        planar,
+        chunk_w,
+        chunk_h,
+        lzw,
+    })
+}
+
+/// Samples of one decoded chunk (or plane of a chunk) as u16 or u8; `Err` for other sample types.
+enum Samples {
+    U8(Vec<u8>),
+    U16(Vec<u16>),
+}
+
+fn samples(path: &Path, r: DecodingResult) -> Result<Samples, ImageIoError> {
+    match r {
+        DecodingResult::U8(v) => Ok(Samples::U8(v)),
+        DecodingResult::U16(v) => Ok(Samples::U16(v)),
+        _ => Err(ImageIoError::new(
+            path,
+            "has floating-point or signed samples; skytie reads unsigned 8- or 16-bit images — convert it",
+        )),
+    }
+}
+
+/// One row of chunks decoded into full-width grey rows (`band8` or `band16`, `width × band_h`).
+struct Band {
+    band8: Vec<u8>,
+    band16: Vec<u16>,
+    pixel8: Vec<u8>,
+    pixel16: Vec<u16>,
+    grey8: Vec<u8>,
+    grey16: Vec<u16>,
+}
+
+/// The decoded samples of chunk `index` (as the `tiff` crate returns them: `dw` pixels per row) or, for LZW,
+/// as [`read_lzw_chunk`] does (the chunk's full stored width per row); returns them and that row width.
+fn read_chunk(
+    path: &Path,
+    dec: &mut TiffDecoder,
+    raw: &std::fs::File,
+    s: &Structure,
+    index: usize,
+    (dw, dh): (usize, usize),
+) -> Result<(Samples, usize), ImageIoError> {
+    let Some(lzw) = &s.lzw else {
+        let r = dec
+            .read_chunk(index as u32)
+            .map_err(|e| tiff_error(path, e))?;
+        return Ok((samples(path, r)?, dw));
+    };
+    let (Some(&offset), Some(&count)) = (lzw.offsets.get(index), lzw.counts.get(index)) else {
+        return Err(ImageIoError::new(
+            path,
+            format!("has no offset for strip or tile {index}: the file is corrupt"),
+        ));
+    };
+    let rows = if lzw.tiled { s.chunk_h } else { dh };
+    let c = &lzw.coding;
+    let expected = c.row_px * rows * c.samples * c.bytes_per_sample;
+    let bytes = read_lzw_chunk(path, raw, offset, count, expected, c)?;
+    let samples = match s.depth {
+        SampleDepth::U8 => Samples::U8(bytes),
+        SampleDepth::U16 => Samples::U16(
+            bytes
+                .chunks_exact(2)
+                .map(|b| u16::from_le_bytes([b[0], b[1]]))
+                .collect(),
+        ),
+    };
+    Ok((samples, c.row_px))
+}
+
+impl Band {
+    /// Reads chunk row `row` of `s` into the band; returns its height.
+    fn read(
+        &mut self,
+        path: &Path,
+        dec: &mut TiffDecoder,
+        raw: &std::fs::File,
+        s: &Structure,
+        row: usize,
+    ) -> Result<usize, ImageIoError> {
+        let band_h = s.chunk_h.min(s.height - row * s.chunk_h);
+        let per_plane = s.chunks_across() * s.chunks_down();
+        for c in 0..s.chunks_across() {
+            let index = row * s.chunks_across() + c;
+            let (dw, dh) = dec.chunk_data_dimensions(index as u32);
+            let (dw, dh) = (dw as usize, (dh as usize).min(band_h));
+            let planes = if s.planar { s.channels.samples() } else { 1 };
+            let mut decoded = Vec::with_capacity(planes);
+            let mut row_px = dw;
+            for p in 0..planes {
+                let (samples, px) = read_chunk(path, dec, raw, s, p * per_plane + index, (dw, dh))?;
+                decoded.push(samples);
+                row_px = px;
+            }
+            self.place(path, s, &decoded, c * s.chunk_w, (dw, dh), row_px)?;
+        }
+        Ok(band_h)
+    }
+
+    /// Converts the decoded chunk (`dw × dh` pixels in rows of `row_px` pixels; one sample vector, or one per
+    /// plane) to grey and copies it into the band at column `x0`.
+    fn place(
+        &mut self,
+        path: &Path,
+        s: &Structure,
+        decoded: &[Samples],
+        x0: usize,
+        (dw, dh): (usize, usize),
+        row_px: usize,
+    ) -> Result<(), ImageIoError> {
+        let n = s.channels.samples();
+        let stride = if s.planar { row_px } else { row_px * n };
+        let short = || {
+            ImageIoError::new(
+                path,
+                "a strip or tile holds fewer samples than its size needs: the file is corrupt",
+            )
+        };
+        for r in 0..dh {
+            match (s.depth, decoded) {
+                (SampleDepth::U8, [Samples::U8(v)]) => {
+                    let src = v.get(r * stride..r * stride + dw * n).ok_or_else(short)?;
+                    grey_row8(src, s.channels, &mut self.grey8);
+                }
+                (SampleDepth::U8, planes) => {
+                    self.pixel8.clear();
+                    for i in 0..dw {
+                        for p in planes {
+                            let Samples::U8(v) = p else {
+                                return Err(short());
+                            };
+                            self.pixel8.push(*v.get(r * stride + i).ok_or_else(short)?);
+                        }
+                    }
+                    grey_row8(&self.pixel8, s.channels, &mut self.grey8);
+                }
+                (SampleDepth::U16, [Samples::U16(v)]) => {
+                    let src = v.get(r * stride..r * stride + dw * n).ok_or_else(short)?;
+                    grey_row16(src, s.channels, &mut self.grey16);
+                }
+                (SampleDepth::U16, planes) => {
+                    self.pixel16.clear();
+                    for i in 0..dw {
+                        for p in planes {
+                            let Samples::U16(v) = p else {
+                                return Err(short());
+                            };
+                            self.pixel16.push(*v.get(r * stride + i).ok_or_else(short)?);
+                        }
+                    }
+                    grey_row16(&self.pixel16, s.channels, &mut self.grey16);
+                }
+            }
+            let dst = r * s.width + x0;
+            let w = dw.min(s.width - x0);
+            match s.depth {
+                SampleDepth::U8 => self.band8[dst..dst + w].copy_from_slice(&self.grey8[..w]),
+                SampleDepth::U16 => self.band16[dst..dst + w].copy_from_slice(&self.grey16[..w]),
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Decodes the TIFF or BigTIFF `path` into `sink` as grey, one row of strips or tiles at a time.
+pub fn decode(path: &Path, sink: &mut dyn GreyRowSink) -> Result<GreyInfo, ImageIoError> {
+    let file = std::fs::File::open(path)
+        .map_err(|e| ImageIoError::new(path, format!("cannot open ({e})")))?;
+    let file_len = file
+        .metadata()
+        .map_err(|e| ImageIoError::new(path, format!("cannot read ({e})")))?
+        .len();
+    let raw = file
+        .try_clone()
+        .map_err(|e| ImageIoError::new(path, format!("cannot read ({e})")))?;
+    let mut dec = Decoder::new(BufReader::new(file)).map_err(|e| tiff_error(path, e))?;
+    let s = structure(path, &mut dec)?;
+    check_claimed_size(path, "TIFF", s.width, s.height, file_len, px_per_byte::TIFF)?;
+    let bytes = s.depth.bytes();
+    let chunk_bytes = s.chunk_w * s.chunk_h * s.channels.samples() * bytes;
+    let band_bytes = s.width * s.chunk_h * bytes;
+    // A decoded chunk, its compressed bytes (at most its decoded size for the formats read) and the band.
+    let _reservation = reserve(
+        path,
+        "TIFF",
+        s.width,
+        s.height,
+        2 * chunk_bytes + band_bytes,
+        "one row of its strips or tiles",
+    )?;
+    dec = dec.with_limits({
+        let mut l = Limits::default();
+        l.decoding_buffer_size = chunk_bytes + (1 << 20);
+        l.intermediate_buffer_size = 2 * chunk_bytes + (1 << 20);
+        l.ifd_value_size = l.ifd_value_size.max(64 << 20);
+        l
+    });
+    let info = GreyInfo {
+        width: s.width,
+        height: s.height,
+        depth: s.depth,
+        format: if file_is_bigtiff(path) {
+            FileFormat::BigTiff
+        } else {
+            FileFormat::Tiff
+        },
+        geotiff: GeoTiffTags::read(&mut dec),
+    };
+    sink.begin(&info).map_err(|e| sink_error(path, e))?;
+    let mut band = Band {
+        band8: vec![
+            0;
+            if s.depth == SampleDepth::U8 {
+                s.width * s.chunk_h
+            } else {
+                0
+            }
+        ],
+        band16: vec![
+            0;
+            if s.depth == SampleDepth::U16 {
+                s.width * s.chunk_h
+            } else {
+                0
+            }
+        ],
+        pixel8: Vec::new(),
+        pixel16: Vec::new(),
+        grey8: Vec::new(),
+        grey16: Vec::new(),
+    };
+    for row in 0..s.chunks_down() {
+        let band_h = band.read(path, &mut dec, &raw, &s, row)?;
+        for r in 0..band_h {
+            let result = match s.depth {
+                SampleDepth::U8 => sink.row_u8(&band.band8[r * s.width..(r + 1) * s.width]),
+                SampleDepth::U16 => sink.row_u16(&band.band16[r * s.width..(r + 1) * s.width]),
+            };
+            result.map_err(|e| sink_error(path, e))?;
+        }
+    }
+    Ok(info)
+}
+
+fn file_is_bigtiff(path: &Path) -> bool {
+    matches!(super::detect_format(path), Ok(FileFormat::BigTiff))
+}
