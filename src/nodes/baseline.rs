@@ -2,7 +2,8 @@
 //! NCC template matching, `skytie_stages::nadir::baseline`) in place of the phase-correlation `refine` node when
 //! `[nadir] matcher = "baseline"` — so thesis Table 2-10's comparison can be regenerated as a sweep.
 
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::nodes::ingest::IngestedImage;
 use crate::nodes::refine::locate_with_accepted;
 use skytie_stages::campaign::AerialImage;
 use skytie_stages::nadir::baseline::{baseline_matches, BaselineParams};
@@ -14,12 +15,13 @@ pub struct BaselineStage;
 
 impl Stage for BaselineStage {
     const NAME: &'static str = "baseline";
-    const VERSION: &'static str = "3";
+    // 4: the aerial image is read as a window of its pyramid at the working level.
+    const VERSION: &'static str = "4";
     type Params = BaselineParams;
     type Output = AerialRefinement;
     type Inputs = (
         Handle<OrthoImage>,
-        RawFile,
+        Handle<IngestedImage>,
         Handle<AerialImage>,
         Handle<TransformOutcome>,
         Handle<MmWindowMatch>,
@@ -30,7 +32,7 @@ impl Stage for BaselineStage {
         p: &BaselineParams,
         (ortho, aerial_file, aerial, outcome, window): (
             Arc<OrthoImage>,
-            RawFileValue,
+            Arc<IngestedImage>,
             Arc<AerialImage>,
             Arc<TransformOutcome>,
             Arc<MmWindowMatch>,

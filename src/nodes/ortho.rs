@@ -1,39 +1,56 @@
 //! `ortho`: per recording, the panorama ortho-projected onto the ground plane — thesis 3.4.3
-//! (`skytie_stages::nadir::ortho_project`). Inputs: the recording's row and its panorama file (hashed by content).
+//! (`skytie_stages::nadir::ortho_project`). Inputs: the recording's row and its ingested panorama, of which only
+//! the bands of rows and pyramid levels the projection samples are read.
 
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::nodes::image_tiles;
+use crate::nodes::ingest::IngestedImage;
 use skytie_stages::campaign::Recording;
+use skytie_stages::imaging::equirect::PanoramaLevels;
+use skytie_stages::imaging::pyramid::TileSource;
+use skytie_stages::nadir::ortho::panorama_bands;
 use skytie_stages::nadir::{ortho_project, OrthoImage, OrthoParams};
 use std::sync::Arc;
 
 crate::serde_artifact!(OrthoImage);
+
+/// The bands of `pano` that the ortho-projection of `rec` with `p` samples; an error when the panorama is not
+/// equirectangular (W = 2H).
+pub fn panorama_for_ortho(
+    pano: &IngestedImage,
+    rec: &Recording,
+    p: &OrthoParams,
+) -> Result<PanoramaLevels, StageError> {
+    if pano.width != 2 * pano.height {
+        return Err(StageError::new(format!(
+            "{}: panorama is {}×{} px; an equirectangular panorama must be twice as wide as high",
+            pano.source, pano.width, pano.height
+        )));
+    }
+    let pyramid = image_tiles::open(pano)?;
+    let size = (pano.width as usize, pano.height as usize);
+    let bands = panorama_bands(rec, p, size, pyramid.layout().levels() - 1);
+    PanoramaLevels::read_bands(&pyramid, &bands).map_err(|e| StageError::new(e.to_string()))
+}
 
 /// The ortho-projection node.
 pub struct OrthoProject;
 
 impl Stage for OrthoProject {
     const NAME: &'static str = "ortho";
-    const VERSION: &'static str = "3";
+    // 4: the panorama is read from its pyramid, each ortho pixel at the level of its ground footprint.
+    const VERSION: &'static str = "4";
     type Params = OrthoParams;
     type Output = OrthoImage;
-    type Inputs = (Handle<Recording>, RawFile);
+    type Inputs = (Handle<Recording>, Handle<IngestedImage>);
 
     fn run(
         &self,
         p: &OrthoParams,
-        (rec, pano): (Arc<Recording>, RawFileValue),
+        (rec, pano): (Arc<Recording>, Arc<IngestedImage>),
         _: &NodeCtx,
     ) -> Result<OrthoImage, StageError> {
-        // Shared with the recording's other ortho nodes (one decode per panorama while it stays in memory).
-        let image = super::decoded_images::gray(&pano)?;
-        if image.width != 2 * image.height {
-            return Err(StageError::new(format!(
-                "{}: panorama is {}×{} px; an equirectangular panorama must be twice as wide as high",
-                pano.path.display(),
-                image.width,
-                image.height
-            )));
-        }
-        Ok(ortho_project(&image, &rec, p))
+        let panorama = panorama_for_ortho(&pano, &rec, p)?;
+        Ok(ortho_project(&panorama, &rec, p))
     }
 }

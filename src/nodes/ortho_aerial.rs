@@ -2,7 +2,9 @@
 //! sampling distance and rotated to its orientation (thesis 3.4.3 and 3.4.5.2: "the MM are ortho-projected again
 //! for this step, but with a resolution of 10 cm"), so that MM and aerial patches differ by about a translation.
 
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::nodes::ingest::IngestedImage;
+use crate::nodes::ortho::panorama_for_ortho;
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::geometry::FrameCamera;
 use skytie_stages::nadir::aerial_overlap::foot_point_world;
@@ -11,24 +13,29 @@ use skytie_stages::nadir::{ortho_project, OrthoImage, OrthoParams};
 use std::sync::Arc;
 
 /// The aerial-oriented ortho-projection node. Its params are the workflow's `[ortho]` table (diagonal,
-/// vehicle mask); `gsd_m` and `rotation_deg` are replaced by the aerial image's.
+/// vehicle mask, `registration_gsd_m`); `gsd_m` and `rotation_deg` are replaced by the aerial image's (at its
+/// working level, `skytie_stages::nadir::aerial_patch::working_level`).
 pub struct OrthoForAerial;
 
 impl Stage for OrthoForAerial {
     const NAME: &'static str = "ortho_aerial";
-    const VERSION: &'static str = "3";
+    // 4: the panorama is read from its pyramid at each pixel's footprint level; the GSD is the aerial
+    // image's at its working level (`registration_gsd_m`).
+    const VERSION: &'static str = "4";
     type Params = OrthoParams;
     type Output = OrthoImage;
-    type Inputs = (Handle<Recording>, RawFile, Handle<AerialImage>);
+    type Inputs = (
+        Handle<Recording>,
+        Handle<IngestedImage>,
+        Handle<AerialImage>,
+    );
 
     fn run(
         &self,
         base: &OrthoParams,
-        (rec, pano, aerial): (Arc<Recording>, RawFileValue, Arc<AerialImage>),
+        (rec, pano, aerial): (Arc<Recording>, Arc<IngestedImage>, Arc<AerialImage>),
         _: &NodeCtx,
     ) -> Result<OrthoImage, StageError> {
-        // Shared with the recording's other ortho nodes (one decode per panorama while it stays in memory).
-        let image = super::decoded_images::gray(&pano)?;
         let cam = FrameCamera::from_aerial(&aerial);
         let params = ortho_params_for_aerial(&cam, foot_point_world(&rec), base);
         if let Err(errs) = params.validate() {
@@ -41,6 +48,7 @@ impl Stage for OrthoForAerial {
                     .join("; ")
             )));
         }
-        Ok(ortho_project(&image, &rec, &params))
+        let panorama = panorama_for_ortho(&pano, &rec, &params)?;
+        Ok(ortho_project(&panorama, &rec, &params))
     }
 }

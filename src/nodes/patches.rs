@@ -3,9 +3,10 @@
 //! image that the visibility hypothesis did not accept for any plane gives an empty set. The sparse clouds
 //! are the same list as the `facades` node's (the triplet's own first, then its neighbours).
 
-use super::decoded_images;
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use super::image_tiles;
+use crate::dag::{Handle, NodeCtx, Stage, StageError};
 use crate::nodes::facades::neighbourhood_cloud;
+use crate::nodes::ingest::IngestedImage;
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::oblique::patch_registration::{register_patches, PatchParams};
 use skytie_stages::oblique::{PatchRegistrationSet, PatchStats, SparseCloud, TripletFacades};
@@ -19,14 +20,15 @@ pub struct PatchesStage;
 impl Stage for PatchesStage {
     const NAME: &'static str = "patches";
     // 4: Mattes MI weights the bilinear samples with per-evaluation weights (scores differ in the last bits).
-    const VERSION: &'static str = "6";
+    // 7: both images are read from their pyramids (the oblique at `registration_resolution_m`).
+    const VERSION: &'static str = "7";
     type Params = PatchParams;
     type Output = PatchRegistrationSet;
     type Inputs = (
         Handle<Recording>,
-        RawFile,
+        Handle<IngestedImage>,
         Handle<AerialImage>,
-        RawFile,
+        Handle<IngestedImage>,
         Vec<Handle<SparseCloud>>,
         Handle<TripletFacades>,
     );
@@ -36,9 +38,9 @@ impl Stage for PatchesStage {
         p: &PatchParams,
         (rec, pano, oblique, oblique_file, clouds, facades): (
             Arc<Recording>,
-            RawFileValue,
+            Arc<IngestedImage>,
             Arc<AerialImage>,
-            RawFileValue,
+            Arc<IngestedImage>,
             Vec<Arc<SparseCloud>>,
             Arc<TripletFacades>,
         ),
@@ -57,16 +59,17 @@ impl Stage for PatchesStage {
             });
         }
         let cloud = neighbourhood_cloud(&clouds)?;
-        let pano_img = decoded_images::gray(&pano)?;
-        let oblique_img = decoded_images::gray(&oblique_file)?;
-        Ok(register_patches(
-            &rec,
-            &pano_img,
-            &oblique,
-            &oblique_img,
-            &cloud,
-            &facades,
-            p,
-        ))
+        if (oblique_file.width, oblique_file.height)
+            != (u64::from(oblique.width_px), u64::from(oblique.height_px))
+        {
+            return Err(StageError::new(format!(
+                "{}: oblique image is {}×{} px but aerial/oblique/cameras.csv says {}×{}; fix the width/height columns",
+                oblique_file.source, oblique_file.width, oblique_file.height, oblique.width_px, oblique.height_px
+            )));
+        }
+        let pano_img = image_tiles::open(&pano)?;
+        let oblique_img = image_tiles::open(&oblique_file)?;
+        register_patches(&rec, &pano_img, &oblique, &oblique_img, &cloud, &facades, p)
+            .map_err(|e| StageError::new(e.to_string()))
     }
 }

@@ -4,10 +4,11 @@
 //! views (their orthos for the same aerial image, `skytie_stages::nadir::parallax_check`). A rejected transform
 //! gives an empty refinement.
 
-use super::decoded_images;
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use super::image_tiles::{self, CachedPyramid};
+use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::nodes::ingest::IngestedImage;
 use skytie_stages::campaign::AerialImage;
-use skytie_stages::imaging::GrayImage;
+use skytie_stages::imaging::pyramid::PyramidError;
 use skytie_stages::nadir::refine::{refine_in_aerial, NeighbourOrtho, RefineParams};
 use skytie_stages::nadir::{
     AerialRefinement, InitialTransform, MmWindowMatch, OrthoImage, TransformOutcome,
@@ -24,13 +25,14 @@ impl Stage for RefineStage {
     // 2: phase correlation refines on the 3×3 direct-DFT surface and cuts near-zero bins relative to the RMS.
     // 3: the parallax check against the window's neighbouring recordings (their orthos are inputs).
     // 4: `min_located`. 5: the shift-consistency check (`max_shift_spread_px`). 6: its consensus by
-    // `estimators::median_consensus` (Euclidean deviation; non-finite corrections never inliers).
-    const VERSION: &'static str = "6";
+    // `estimators::median_consensus` (Euclidean deviation; non-finite corrections never inliers). 7: the aerial
+    // image is read as a window of its pyramid at the working level; `max_shift_spread_px` in working pixels.
+    const VERSION: &'static str = "7";
     type Params = RefineParams;
     type Output = AerialRefinement;
     type Inputs = (
         Handle<OrthoImage>,
-        RawFile,
+        Handle<IngestedImage>,
         Handle<AerialImage>,
         Handle<TransformOutcome>,
         Handle<MmWindowMatch>,
@@ -42,7 +44,7 @@ impl Stage for RefineStage {
         p: &RefineParams,
         (ortho, aerial_file, aerial, outcome, window, neighbour_orthos): (
             Arc<OrthoImage>,
-            RawFileValue,
+            Arc<IngestedImage>,
             Arc<AerialImage>,
             Arc<TransformOutcome>,
             Arc<MmWindowMatch>,
@@ -67,13 +69,13 @@ impl Stage for RefineStage {
 }
 
 /// Shared by `refine` and `baseline`: an empty refinement when the transform was rejected, else `locate` on
-/// the decoded aerial image.
+/// the ingested aerial image.
 pub fn locate_with_accepted(
     outcome: &TransformOutcome,
     window: &MmWindowMatch,
     aerial: &AerialImage,
-    aerial_file: &RawFileValue,
-    locate: impl FnOnce(&InitialTransform, &GrayImage) -> AerialRefinement,
+    aerial_image: &IngestedImage,
+    locate: impl FnOnce(&InitialTransform, &CachedPyramid) -> Result<AerialRefinement, PyramidError>,
 ) -> Result<AerialRefinement, StageError> {
     let TransformOutcome::Accepted(t) = outcome else {
         return Ok(AerialRefinement::empty(
@@ -81,6 +83,6 @@ pub fn locate_with_accepted(
             &aerial.image_id,
         ));
     };
-    let image = decoded_images::gray(aerial_file)?;
-    Ok(locate(t, &image))
+    let pyramid = image_tiles::open(aerial_image)?;
+    locate(t, &pyramid).map_err(|e| StageError::new(e.to_string()))
 }

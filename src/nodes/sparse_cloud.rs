@@ -3,10 +3,13 @@
 //! outlier removal, triangulation in the original equirectangular geometry. Inputs: the three recording rows
 //! and panorama files (hashed by content).
 
-use super::decoded_images;
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use super::image_tiles;
+use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::nodes::ingest::IngestedImage;
 use skytie_stages::campaign::Recording;
-use skytie_stages::oblique::sparse_cloud::{sparse_cloud, SparseCloudParams};
+use skytie_stages::imaging::equirect::PanoramaLevels;
+use skytie_stages::imaging::pyramid::TileSource;
+use skytie_stages::oblique::sparse_cloud::{panorama_bands, sparse_cloud, SparseCloudParams};
 use skytie_stages::oblique::SparseCloud;
 use std::sync::Arc;
 
@@ -17,15 +20,16 @@ pub struct SparseCloudStage;
 
 impl Stage for SparseCloudStage {
     const NAME: &'static str = "sparse_cloud";
-    const VERSION: &'static str = "1";
+    // 2: the views sample the panoramas' pyramids at the level of their pixel.
+    const VERSION: &'static str = "2";
     type Params = SparseCloudParams;
     type Output = SparseCloud;
-    type Inputs = (Vec<Handle<Recording>>, Vec<RawFile>);
+    type Inputs = (Vec<Handle<Recording>>, Vec<Handle<IngestedImage>>);
 
     fn run(
         &self,
         p: &SparseCloudParams,
-        (recs, panos): (Vec<Arc<Recording>>, Vec<RawFileValue>),
+        (recs, panos): (Vec<Arc<Recording>>, Vec<Arc<IngestedImage>>),
         _: &NodeCtx,
     ) -> Result<SparseCloud, StageError> {
         if recs.len() != 3 || panos.len() != 3 {
@@ -33,9 +37,16 @@ impl Stage for SparseCloudStage {
                 "internal: sparse_cloud needs exactly three recordings and panoramas",
             ));
         }
-        let images = panos
+        let images = recs
             .iter()
-            .map(decoded_images::gray)
+            .zip(&panos)
+            .map(|(rec, pano)| {
+                let pyramid = image_tiles::open(pano)?;
+                let size = (pano.width as usize, pano.height as usize);
+                let bands = panorama_bands(rec, p, size, pyramid.layout().levels() - 1);
+                PanoramaLevels::read_bands(&pyramid, &bands)
+                    .map_err(|e| StageError::new(e.to_string()))
+            })
             .collect::<Result<Vec<_>, _>>()?;
         Ok(sparse_cloud(
             [&recs[0], &recs[1], &recs[2]],

@@ -2,8 +2,9 @@
 //! oriented ortho image and the aerial image (thesis 3.4.5.2, `skytie_stages::nadir::initial_transform`).
 //! A rejected transform is a normal output (with its reason), not a failure.
 
-use super::decoded_images;
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use super::image_tiles;
+use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::nodes::ingest::IngestedImage;
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::nadir::initial_transform::{initial_transform, TransformParams};
 use skytie_stages::nadir::{OrthoImage, TransformOutcome};
@@ -16,14 +17,15 @@ pub struct InitialTransformStage;
 
 impl Stage for InitialTransformStage {
     const NAME: &'static str = "transform";
-    // 3: accepted transforms carry the implied offset as a vector (`centre_offset_world_m`).
-    const VERSION: &'static str = "3";
+    // 3: accepted transforms carry the implied offset as a vector (`centre_offset_world_m`). 4: the aerial patch
+    // is read from the image's pyramid at the working level; the RANSAC threshold is in working pixels.
+    const VERSION: &'static str = "4";
     type Params = TransformParams;
     type Output = TransformOutcome;
     type Inputs = (
         Handle<Recording>,
         Handle<OrthoImage>,
-        RawFile,
+        Handle<IngestedImage>,
         Handle<AerialImage>,
     );
 
@@ -33,12 +35,13 @@ impl Stage for InitialTransformStage {
         (rec, ortho, aerial_file, aerial): (
             Arc<Recording>,
             Arc<OrthoImage>,
-            RawFileValue,
+            Arc<IngestedImage>,
             Arc<AerialImage>,
         ),
         _: &NodeCtx,
     ) -> Result<TransformOutcome, StageError> {
-        let image = decoded_images::gray(&aerial_file)?;
-        Ok(initial_transform(&rec, &ortho, &image, &aerial, p))
+        let pyramid = image_tiles::open(&aerial_file)?;
+        initial_transform(&rec, &ortho, &pyramid, &aerial, p)
+            .map_err(|e| StageError::new(e.to_string()))
     }
 }

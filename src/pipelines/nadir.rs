@@ -10,6 +10,7 @@ use crate::nodes::aerial::{SelectAerial, SelectAerialParams};
 use crate::nodes::baseline::BaselineStage;
 use crate::nodes::campaign::CampaignSnapshot;
 use crate::nodes::control::ControlStage;
+use crate::nodes::ingest::{ingest_file, IngestedImage};
 use crate::nodes::mm_match::MmMatch;
 use crate::nodes::nadir_grade::{grade_metrics, GradeNadir, TRUTH_AERIAL_NADIR, TRUTH_RECORDINGS};
 use crate::nodes::nadir_options::{Matcher, NadirOptions};
@@ -52,7 +53,10 @@ pub struct RecordingItem<'a> {
     pub row: Handle<Recording>,
     /// The 3 cm ortho image (thesis 3.4.3); `None` when the workflow does not enable `ortho`.
     pub ortho: Option<Handle<OrthoImage>>,
+    /// The panorama file (stages that only read its header or hash).
     pub pano: RawFile,
+    /// The panorama ingested into its pyramid (stages that read its pixels).
+    pub pano_image: Handle<IngestedImage>,
 }
 
 /// What the nadir chain hands to later stages (the adjustment).
@@ -181,12 +185,16 @@ pub fn add_nadir(
                 }
             };
             let pair = pair_label(&item.recording.image_id, &row.image_id);
-            let aerial_file = RawFile(nadir_dir.join(&row.file));
+            let aerial_file = ingest_file(
+                b,
+                &format!("nadir {}", row.image_id),
+                nadir_dir.join(&row.file),
+            )?;
             let ortho = b.add(
                 OrthoForAerial,
                 &pair,
                 ortho_base.clone(),
-                (item.row, item.pano.clone(), aerial),
+                (item.row, item.pano_image, aerial),
             )?;
             if !on("transform") {
                 continue;
@@ -195,7 +203,7 @@ pub fn add_nadir(
                 InitialTransformStage,
                 &pair,
                 transform_params.clone(),
-                (item.row, ortho, aerial_file.clone(), aerial),
+                (item.row, ortho, aerial_file, aerial),
             )?;
             pairs.push((
                 aerial,
@@ -231,7 +239,7 @@ pub fn add_nadir(
                                 OrthoForAerial,
                                 &pair_label(&n.recording.image_id, &aerial_id),
                                 ortho_base.clone(),
-                                (n.row, n.pano.clone(), aerial),
+                                (n.row, n.pano_image, aerial),
                             )
                         })
                         .collect::<Result<Vec<_>, _>>()?;

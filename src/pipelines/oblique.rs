@@ -14,6 +14,7 @@ use crate::nodes::aerial::{SelectAerial, SelectAerialParams};
 use crate::nodes::campaign::CampaignSnapshot;
 use crate::nodes::consensus::{ConsensusStage, ObliqueOutput};
 use crate::nodes::facades::FacadesStage;
+use crate::nodes::ingest::ingest_file;
 use crate::nodes::oblique_grade::{
     GradeOblique, SCENE_TRUTH_FILE, TRUTH_AERIAL_OBLIQUE, TRUTH_RECORDINGS,
 };
@@ -111,7 +112,7 @@ pub fn add_oblique(
             cloud_params.clone(),
             (
                 w.iter().map(|m| m.row).collect::<Vec<_>>(),
-                w.iter().map(|m| m.pano.clone()).collect::<Vec<_>>(),
+                w.iter().map(|m| m.pano_image).collect::<Vec<_>>(),
             ),
         )?;
         triplets.push((i + 1, cloud));
@@ -188,15 +189,20 @@ pub fn add_oblique(
         for (a, aerial) in aerials {
             let row = &oblique_rows[a];
             let pair = format!("rec {} × {}", centre.recording.image_id, row.image_id);
+            let oblique_image = ingest_file(
+                b,
+                &format!("oblique {}", row.image_id),
+                oblique_dir.join(&row.file),
+            )?;
             sets.push(b.add(
                 PatchesStage,
                 &pair,
                 patch_params.clone(),
                 (
                     centre.row,
-                    centre.pano.clone(),
+                    centre.pano_image,
                     aerial,
-                    RawFile(oblique_dir.join(&row.file)),
+                    oblique_image,
                     neighbourhood.clone(),
                     facades,
                 ),

@@ -14,6 +14,7 @@ use super::{adjust, nadir, oblique, wf_err};
 use crate::dag::{DagBuilder, Pipeline, PipelineError, RawFile, Session};
 use crate::exports::{verification_table, write_exports, ExportInputs};
 use crate::nodes::campaign::{listing_hash, metadata_inputs};
+use crate::nodes::ingest::ingest_file;
 use crate::nodes::{
     CampaignSummary, LoadCampaign, LoadCampaignParams, OrthoProject, SelectRecording,
     SelectRecordingParams, SummarizeCampaign, SummaryParams, SynthCampaign, SynthParams,
@@ -140,8 +141,9 @@ impl Pipeline for SkytiePipeline {
                     snap,
                 )?;
                 let pano = RawFile(root.join("mm/panoramas").join(&rec.file));
+                let pano_image = ingest_file(&mut b, &label, pano.0.clone())?;
                 let ortho = if ortho_on {
-                    let o = b.add(OrthoProject, &label, ortho.clone(), (row, pano.clone()))?;
+                    let o = b.add(OrthoProject, &label, ortho.clone(), (row, pano_image))?;
                     orthos.push(o);
                     Some(o)
                 } else {
@@ -152,6 +154,7 @@ impl Pipeline for SkytiePipeline {
                     row,
                     ortho,
                     pano,
+                    pano_image,
                 });
             }
             let nadir_handles = if nadir_on {

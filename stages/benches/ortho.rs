@@ -30,7 +30,7 @@ use skytie_stages::imaging::huge_pages::collect_f32;
 use skytie_stages::imaging::io::{load_gray, save_gray};
 use skytie_stages::imaging::resample::{remap_with_map, Interpolation, SourceMap};
 use skytie_stages::imaging::GrayImage;
-use skytie_stages::nadir::{ortho_project, OrthoGeoref, OrthoParams};
+use skytie_stages::nadir::{ortho_project_whole, OrthoGeoref, OrthoParams};
 use skytie_stages::synth::test_texture::band_limited_noise;
 
 /// `img` with one wrapped column on each side (column −1 = the last, column w = the first), in memory advised to
@@ -96,7 +96,7 @@ fn bench_gsd(panorama: &GrayImage, gsd_cm: u32, dir: &Path) {
         gsd_m: gsd_cm as f64 / 100.0,
         ..OrthoParams::default()
     };
-    let ortho = ortho_project(panorama, &rec, &params);
+    let ortho = ortho_project_whole(panorama, &rec, &params);
     let (w, h) = (ortho.georef.width_px, ortho.georef.height_px);
 
     // The map ortho_project samples with: panorama pixel of each ortho pixel centre, NaN where masked.
@@ -174,7 +174,7 @@ fn bench_gsd(panorama: &GrayImage, gsd_cm: u32, dir: &Path) {
     );
     for t in [1, threads] {
         let full = median_ms(t, reps, || {
-            std::hint::black_box(ortho_project(panorama, &rec, &params));
+            std::hint::black_box(ortho_project_whole(panorama, &rec, &params));
         });
         let sampling = median_ms(t, reps, || {
             std::hint::black_box(remap_same_map());
@@ -183,10 +183,10 @@ fn bench_gsd(panorama: &GrayImage, gsd_cm: u32, dir: &Path) {
             "  {t} thread(s): ortho_project {full:.3} ms, remap with the map {sampling:.3} ms"
         );
         csv.push_str(&format!(
-            "skytie ortho_project,{t},{full:.6}\nskytie remap (same map),{t},{sampling:.6}\n"
+            "skytie ortho_project_whole,{t},{full:.6}\nskytie remap (same map),{t},{sampling:.6}\n"
         ));
     }
-    println!("  remap vs ortho_project, max |difference| on valid pixels: {max_diff:.2e}");
+    println!("  remap vs ortho_project_whole, max |difference| on valid pixels: {max_diff:.2e}");
     std::fs::write(dir.join(format!("skytie_{gsd_cm}cm.csv")), csv).expect("write timing CSV");
 
     // The geometry, so that the peer script can also compute the map itself (NumPy) before `cv2.remap`, the

@@ -6,7 +6,9 @@ use nalgebra::{Vector2, Vector3};
 use skytie_stages::campaign::AerialImage;
 use skytie_stages::correspondence::{MmTiePoint, PanoObservation};
 use skytie_stages::geometry::Similarity2;
+use skytie_stages::imaging::pyramid::MemoryPyramid;
 use skytie_stages::imaging::GrayImage;
+use skytie_stages::nadir::aerial_patch::AerialWindow;
 use skytie_stages::nadir::baseline::{
     baseline_matches, isolated_aerial_keypoints, BaselineParams, KdTree2,
 };
@@ -203,7 +205,15 @@ fn true_aerial_px(s: &Scene, i: usize) -> Vector2<f64> {
 fn kd_tree_isolation_keeps_corners_of_isolated_markings_only() {
     let s = scene();
     let p = BaselineParams::default();
-    let kps = isolated_aerial_keypoints(&s.ortho, &s.aerial, &transform(s.truth), 0.1, &p);
+    // The window `baseline_matches` reads: the footprint grown by half the isolation box.
+    let tf = transform(s.truth).ortho_to_aerial;
+    let size = (s.ortho.image.width, s.ortho.image.height);
+    let margin = p.isolation_box_m / 2.0 / 0.1 / tf.scale;
+    let pyramid = MemoryPyramid::from_gray(&s.aerial);
+    let window = AerialWindow::read(&pyramid, size, &tf, margin)
+        .unwrap()
+        .unwrap();
+    let kps = isolated_aerial_keypoints(&window, 0.1, &p);
     // Every kept keypoint is near a corner of an isolated square, and every such corner has a keypoint.
     let near = |k: &[f64; 2], i: usize| {
         let t = true_aerial_px(&s, i);
@@ -253,12 +263,13 @@ fn baseline_locates_isolated_corners_by_ncc_and_snaps_to_the_keypoints() {
     };
     let r = baseline_matches(
         &s.ortho,
-        &s.aerial,
+        &MemoryPyramid::from_gray(&s.aerial),
         &s.row,
         &transform(off.compose(&s.truth)),
         &s.window,
         &p,
-    );
+    )
+    .unwrap();
     println!("tried {} matched {}", r.tried, r.matches.len());
     assert_eq!(r.tried, s.window.tie_points.len());
     let mut located = vec![false; s.window.tie_points.len()];
@@ -287,12 +298,13 @@ fn baseline_locates_isolated_corners_by_ncc_and_snaps_to_the_keypoints() {
     // Deterministic.
     let again = baseline_matches(
         &s.ortho,
-        &s.aerial,
+        &MemoryPyramid::from_gray(&s.aerial),
         &s.row,
         &transform(off.compose(&s.truth)),
         &s.window,
         &p,
-    );
+    )
+    .unwrap();
     assert_eq!(r, again);
 }
 

@@ -18,13 +18,16 @@ use skytie_stages::campaign::{
 use skytie_stages::estimators::SplitMix64;
 use skytie_stages::geometry::{intersect_ray_plane, FrameCamera, Plane, PointPair, Similarity2};
 use skytie_stages::imaging::io::load_gray;
+use skytie_stages::imaging::pyramid::MemoryPyramid;
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::aerial_overlap::{foot_point_world, overlapping_nadir};
 use skytie_stages::nadir::aerial_patch::ortho_params_for_aerial;
 use skytie_stages::nadir::initial_transform::{
     centre_offset_world, initial_transform, reuse_neighbour, TransformParams,
 };
-use skytie_stages::nadir::{ortho_project, OrthoGeoref, OrthoImage, OrthoParams, TransformOutcome};
+use skytie_stages::nadir::{
+    ortho_project_whole, OrthoGeoref, OrthoImage, OrthoParams, TransformOutcome,
+};
 use skytie_stages::synth::{generate, Preset, SynthOptions};
 use std::collections::HashMap;
 use std::path::Path;
@@ -206,7 +209,10 @@ fn ortho_params_align_ortho_and_aerial_axes_for_kappa_30() {
     let ortho = render_ortho(&georef, &georef, &pattern);
     let rec = recording_at("pattern", foot, 2.2);
     let p = TransformParams::default();
-    let t = accepted(&initial_transform(&rec, &ortho, &aerial, &row, &p)).clone();
+    let t = accepted(
+        &initial_transform(&rec, &ortho, &MemoryPyramid::from_gray(&aerial), &row, &p).unwrap(),
+    )
+    .clone();
     assert!(
         rotation_error_deg(&t.ortho_to_aerial) < 0.1,
         "image rotation {} deg",
@@ -245,7 +251,10 @@ fn recovers_a_known_position_error_and_rejects_implausible_offsets() {
         let georef = OrthoGeoref::new(recorded, &params);
         let ortho = render_ortho(&georef, &true_georef, &pattern);
         let rec = recording_at("r", recorded, 2.2);
-        (initial_transform(&rec, &ortho, &aerial, &row, &p), georef)
+        (
+            initial_transform(&rec, &ortho, &MemoryPyramid::from_gray(&aerial), &row, &p).unwrap(),
+            georef,
+        )
     };
 
     // 0.8 m error: accepted, and the centre offset is the correction (true − recorded).
@@ -319,7 +328,7 @@ fn blank_or_mismatched_aerial_is_rejected_with_a_reason() {
     let rec = recording_at("r", foot, 2.2);
     let p = TransformParams::default();
     let blank = GrayImage::filled(512, 384, 0.4);
-    match initial_transform(&rec, &ortho, &blank, &row, &p) {
+    match initial_transform(&rec, &ortho, &MemoryPyramid::from_gray(&blank), &row, &p).unwrap() {
         TransformOutcome::Rejected { reason, .. } => assert!(
             reason.contains("no KAZE keypoints in the aerial patch"),
             "{reason}"
@@ -327,7 +336,15 @@ fn blank_or_mismatched_aerial_is_rejected_with_a_reason() {
         other => panic!("{other:?}"),
     }
     let wrong_size = GrayImage::filled(100, 50, 0.4);
-    match initial_transform(&rec, &ortho, &wrong_size, &row, &p) {
+    match initial_transform(
+        &rec,
+        &ortho,
+        &MemoryPyramid::from_gray(&wrong_size),
+        &row,
+        &p,
+    )
+    .unwrap()
+    {
         TransformOutcome::Rejected { reason, .. } => assert!(reason.contains("100×50"), "{reason}"),
         other => panic!("{other:?}"),
     }
@@ -339,10 +356,12 @@ fn blank_or_mismatched_aerial_is_rejected_with_a_reason() {
     match initial_transform(
         &far,
         &far_ortho,
-        &render_aerial(&cam, &pattern, 0.0),
+        &MemoryPyramid::from_gray(&render_aerial(&cam, &pattern, 0.0)),
         &row,
         &p,
-    ) {
+    )
+    .unwrap()
+    {
         TransformOutcome::Rejected { reason, .. } => {
             assert!(reason.contains("does not overlap"), "{reason}")
         }
@@ -423,9 +442,11 @@ fn evaluate_campaign(root: &Path, p: &TransformParams) -> CampaignStats {
             let row = &campaign.nadir[i];
             let cam = FrameCamera::from_aerial(row);
             let params = ortho_params_for_aerial(&cam, foot, &OrthoParams::default());
-            let ortho = ortho_project(&pano, rec, &params);
+            let ortho = ortho_project_whole(&pano, rec, &params);
             let start = Instant::now();
-            let outcome = initial_transform(rec, &ortho, &aerials[i], row, p);
+            let outcome =
+                initial_transform(rec, &ortho, &MemoryPyramid::from_gray(&aerials[i]), row, p)
+                    .unwrap();
             stats.seconds_per_pair.push(start.elapsed().as_secs_f64());
             stats.pairs += 1;
             let t = match outcome {

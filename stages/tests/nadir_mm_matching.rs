@@ -16,7 +16,9 @@ use skytie_stages::geometry::{triangulate_rays, PanoramaCamera, Ray};
 use skytie_stages::imaging::io::load_gray;
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::mm_matching::{match_window, MmMatchParams, OrthoView};
-use skytie_stages::nadir::{ortho_project, MmWindowMatch, OrthoImage, OrthoParams, PairMethod};
+use skytie_stages::nadir::{
+    ortho_project_whole, MmWindowMatch, OrthoImage, OrthoParams, PairMethod,
+};
 use skytie_stages::synth::generate::plan_campaign;
 use skytie_stages::synth::scene::{Epoch, Scene};
 use skytie_stages::synth::{generate, Preset, SynthOptions};
@@ -90,7 +92,7 @@ fn orthos(poses: &[Recording], panoramas: &[GrayImage]) -> Vec<OrthoImage> {
     poses
         .iter()
         .zip(panoramas)
-        .map(|(r, pano)| ortho_project(pano, r, &OrthoParams::default()))
+        .map(|(r, pano)| ortho_project_whole(pano, r, &OrthoParams::default()))
         .collect()
 }
 

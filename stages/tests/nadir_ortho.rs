@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 use skytie_stages::campaign::Recording;
 use skytie_stages::geometry::PanoramaCamera;
 use skytie_stages::imaging::GrayImage;
-use skytie_stages::nadir::{ortho_project, OrthoParams, VehicleMask};
+use skytie_stages::nadir::{ortho_project_whole, OrthoParams, VehicleMask};
 
 const DISC_RADIUS_M: f64 = 0.15;
 
@@ -93,7 +93,7 @@ fn check(rec: Recording, rotation_deg: f64) {
         vehicle,
         ..OrthoParams::default()
     };
-    let ortho = ortho_project(&pano, &rec, &params);
+    let ortho = ortho_project_whole(&pano, &rec, &params);
     assert_eq!(
         ortho.image.width,
         (30.0 / 2f64.sqrt() / 0.03f64).round() as usize
@@ -148,7 +148,7 @@ fn discs_land_within_half_an_ortho_pixel_rotated_and_with_residual_attitude() {
 fn vehicle_is_masked_around_the_foot_point() {
     let rec = recording(0.0, 0.0, 0.0, 45.0);
     let pano = GrayImage::filled(512, 256, 0.5);
-    let ortho = ortho_project(&pano, &rec, &OrthoParams::default());
+    let ortho = ortho_project_whole(&pano, &rec, &OrthoParams::default());
     let n = ortho.image.width;
     // The foot point (image centre) is under the car; a corner of the plane is visible.
     assert_eq!(ortho.valid[(n / 2) * n + n / 2], 0);

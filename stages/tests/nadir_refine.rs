@@ -7,6 +7,7 @@ use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::correspondence::{AerialObservation, MmTiePoint, PanoObservation};
 use skytie_stages::estimators::rng::SplitMix64;
 use skytie_stages::geometry::{FrameCamera, PanoramaCamera, PointPair, Similarity2};
+use skytie_stages::imaging::pyramid::MemoryPyramid;
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::control_points::{aerial_control_points, ControlParams};
 use skytie_stages::nadir::refine::{refine_in_aerial, RefineParams};
@@ -242,13 +243,14 @@ fn refinement_recovers_a_subpixel_offset_under_radiometric_change_and_noise() {
     p.validate().unwrap();
     let r = refine_in_aerial(
         &pair.ortho,
-        &pair.aerial,
+        &MemoryPyramid::from_gray(&pair.aerial),
         &row,
         &transform(initial),
         &pair.window,
         &[],
         &p,
-    );
+    )
+    .unwrap();
     let (rms_before, _) = {
         let mut s = 0.0;
         for m in &r.matches {
@@ -286,13 +288,14 @@ fn refinement_recovers_a_subpixel_offset_under_radiometric_change_and_noise() {
     // Deterministic, in tie-point order.
     let again = refine_in_aerial(
         &pair.ortho,
-        &pair.aerial,
+        &MemoryPyramid::from_gray(&pair.aerial),
         &row,
         &transform(initial),
         &pair.window,
         &[],
         &p,
-    );
+    )
+    .unwrap();
     assert_eq!(r, again);
     let ids: Vec<usize> = r
         .matches
@@ -316,13 +319,14 @@ fn refinement_handles_larger_offsets_within_the_margin() {
     let row = aerial_row("aer", 400, 360);
     let r = refine_in_aerial(
         &pair.ortho,
-        &pair.aerial,
+        &MemoryPyramid::from_gray(&pair.aerial),
         &row,
         &transform(off.compose(&pair.truth)),
         &pair.window,
         &[],
         &params_at_peak_05(),
-    );
+    )
+    .unwrap();
     let (rms, _) = errors_px(&pair, &r);
     assert!(r.matches.len() >= 70, "{}", r.matches.len());
     assert!(rms < 0.1, "rms {rms}");
@@ -335,13 +339,14 @@ fn unrelated_aerial_content_gives_weak_peaks_that_are_rejected() {
     let row = aerial_row("aer", 400, 360);
     let r = refine_in_aerial(
         &pair.ortho,
-        &other.aerial,
+        &MemoryPyramid::from_gray(&other.aerial),
         &row,
         &transform(pair.truth),
         &pair.window,
         &[],
         &params_at_peak_05(),
-    );
+    )
+    .unwrap();
     println!("unrelated: {} of {} accepted", r.matches.len(), r.tried);
     assert!(r.tried > 70);
     assert!(
@@ -362,13 +367,14 @@ fn tie_points_outside_the_aerial_image_are_not_tried_and_bad_transforms_give_not
     let p = params_at_peak_05();
     let r = refine_in_aerial(
         &pair.ortho,
-        &pair.aerial,
+        &MemoryPyramid::from_gray(&pair.aerial),
         &row,
         &transform(far),
         &pair.window,
         &[],
         &p,
-    );
+    )
+    .unwrap();
     assert_eq!((r.tried, r.matches.len()), (0, 0));
     let nan = Similarity2 {
         scale: f64::NAN,
@@ -376,13 +382,14 @@ fn tie_points_outside_the_aerial_image_are_not_tried_and_bad_transforms_give_not
     };
     let r = refine_in_aerial(
         &pair.ortho,
-        &pair.aerial,
+        &MemoryPyramid::from_gray(&pair.aerial),
         &row,
         &transform(nan),
         &pair.window,
         &[],
         &p,
-    );
+    )
+    .unwrap();
     assert_eq!((r.tried, r.matches.len()), (0, 0));
 }
 
@@ -393,13 +400,14 @@ fn a_tie_point_located_alone_in_an_image_is_not_kept_unless_min_located_is_1() {
     let p = params_at_peak_05();
     let all = refine_in_aerial(
         &pair.ortho,
-        &pair.aerial,
+        &MemoryPyramid::from_gray(&pair.aerial),
         &row,
         &transform(pair.truth),
         &pair.window,
         &[],
         &p,
-    );
+    )
+    .unwrap();
     assert_eq!(all.unconfirmed, 0);
     // Keep only the window's first two locatable tie points.
     let keep: Vec<usize> = all
@@ -425,13 +433,14 @@ fn a_tie_point_located_alone_in_an_image_is_not_kept_unless_min_located_is_1() {
         };
         refine_in_aerial(
             &pair.ortho,
-            &pair.aerial,
+            &MemoryPyramid::from_gray(&pair.aerial),
             &row,
             &transform(pair.truth),
             &window_of_ids(ids),
             &[],
             &q,
         )
+        .unwrap()
     };
     let two = run(&keep, 2);
     assert_eq!((two.tried, two.matches.len(), two.unconfirmed), (2, 2, 0));
@@ -695,7 +704,7 @@ mod e2e {
     use skytie_stages::campaign::read::read_campaign;
     use skytie_stages::features::forstner::{forstner_corners, ForstnerParams};
     use skytie_stages::imaging::io::load_gray;
-    use skytie_stages::nadir::ortho_project;
+    use skytie_stages::nadir::ortho_project_whole;
     use skytie_stages::synth::generate::plan_campaign;
     use skytie_stages::synth::scene::Epoch;
     use skytie_stages::synth::SynthOptions;
@@ -783,7 +792,7 @@ mod e2e {
                 let (pw, ph) = (pano.width as u32, pano.height as u32);
                 // Tie points: Förstner corners of the 3 cm ortho image (the MM-matching detector), their pano
                 // pixels by the exact inverse, their truth by casting the TRUE ray into the scene.
-                let fine = ortho_project(&pano, rec, &OrthoParams::default());
+                let fine = ortho_project_whole(&pano, rec, &OrthoParams::default());
                 let corners = forstner_corners(
                     &fine.image,
                     &ForstnerParams {
@@ -851,7 +860,7 @@ mod e2e {
                         continue;
                     }
                     let aerial = load_gray(&dir.join("aerial/nadir").join(&row.file)).unwrap();
-                    let ortho = ortho_project(
+                    let ortho = ortho_project_whole(
                         &pano,
                         rec,
                         &OrthoParams {
@@ -870,7 +879,16 @@ mod e2e {
                         centre_offset_world_m: [0.0, 0.0],
                         reused_from: None,
                     };
-                    let r = refine_in_aerial(&ortho, &aerial, row, &t, &window, &[], params);
+                    let r = refine_in_aerial(
+                        &ortho,
+                        &MemoryPyramid::from_gray(&aerial),
+                        row,
+                        &t,
+                        &window,
+                        &[],
+                        params,
+                    )
+                    .unwrap();
                     stats.pairs += 1;
                     stats.tried += r.tried;
                     stats.located += r.matches.len();

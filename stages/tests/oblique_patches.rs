@@ -8,6 +8,8 @@ use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::correspondence::{MmTiePoint, PanoObservation};
 use skytie_stages::geometry::frame::FrameCamera;
 use skytie_stages::geometry::panorama::PanoramaCamera;
+use skytie_stages::imaging::equirect::PanoramaLevels;
+use skytie_stages::imaging::pyramid::{MemoryPyramid, ScaledWindow};
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::oblique::patch::{
     fill_from_frame, fill_from_panorama, real_resolution_ratio, PatchGrid,
@@ -257,6 +259,8 @@ fn patches_of_a_textured_facade_from_two_cameras_agree_and_resolution_ratio_foll
         0.1,
     )
     .unwrap();
+    let pano = PanoramaLevels::from_image(&pano, 3);
+    let obl_img = ScaledWindow::whole(obl_img);
     let mm = fill_from_panorama(&grid, &pano_cam, &pano);
     let ob = fill_from_frame(&grid, &cam_o, &obl_img);
     assert_eq!(ob.valid_pixels, grid.size_px * grid.size_px);
@@ -285,7 +289,7 @@ fn patches_of_a_textured_facade_from_two_cameras_agree_and_resolution_ratio_foll
         0.2,
     )
     .unwrap();
-    let (r_coarse, inside) = real_resolution_ratio(&coarse, &cam_o, 1000, 1000);
+    let (r_coarse, inside) = real_resolution_ratio(&coarse, &cam_o, &obl_img);
     assert_eq!(r_coarse, 1.0);
     assert_eq!(inside, 1.0);
     let fine = PatchGrid::new(
@@ -296,7 +300,7 @@ fn patches_of_a_textured_facade_from_two_cameras_agree_and_resolution_ratio_foll
         0.02,
     )
     .unwrap();
-    let (r_fine, _) = real_resolution_ratio(&fine, &cam_o, 1000, 1000);
+    let (r_fine, _) = real_resolution_ratio(&fine, &cam_o, &obl_img);
     let expected = 0.02 * 0.02 / (0.0586 * 0.0829);
     assert!((r_fine - expected).abs() < 0.03, "{r_fine} vs {expected}");
     // The sampling-free ratio equals the one counted while filling.
@@ -323,6 +327,7 @@ fn run(
 ) -> skytie_stages::oblique::types::PatchRegistrationSet {
     // The scene is rendered once per test binary (the panorama always from the true pose).
     static IMAGES: OnceLock<(GrayImage, GrayImage)> = OnceLock::new();
+    static PYRAMIDS: OnceLock<(MemoryPyramid, MemoryPyramid)> = OnceLock::new();
     let (pano, obl_img) = IMAGES.get_or_init(|| {
         (
             render_panorama(&true_recording()),
@@ -334,7 +339,22 @@ fn run(
     let mut recorded = rec_true.clone();
     recorded.x += shift_x_m;
     let (cloud, facades) = cloud_and_facades(&recorded, points, shift_x_m, resolution_m);
-    register_patches(&recorded, pano, &obl, obl_img, &cloud, &facades, params)
+    let pyramids = PYRAMIDS.get_or_init(|| {
+        (
+            MemoryPyramid::from_gray(pano),
+            MemoryPyramid::from_gray(obl_img),
+        )
+    });
+    register_patches(
+        &recorded,
+        &pyramids.0,
+        &obl,
+        &pyramids.1,
+        &cloud,
+        &facades,
+        params,
+    )
+    .unwrap()
 }
 
 #[test]

@@ -8,6 +8,7 @@
 
 use skytie_stages::campaign::{read_recordings_csv, Recording};
 use skytie_stages::geometry::{triangulate_rays, PanoramaCamera, Ray};
+use skytie_stages::imaging::equirect::PanoramaLevels;
 use skytie_stages::imaging::io::load_gray;
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::oblique::sparse_cloud::{sparse_cloud, SparseCloudParams};
@@ -74,8 +75,10 @@ fn clouds(c: &Campaign, p: &SparseCloudParams) -> Vec<SparseCloud> {
     (1..c.recorded.len().saturating_sub(1))
         .map(|i| {
             let recs = [&c.recorded[i - 1], &c.recorded[i], &c.recorded[i + 1]];
-            let panos = [&c.panoramas[i - 1], &c.panoramas[i], &c.panoramas[i + 1]];
-            sparse_cloud(recs, panos, p)
+            let levels: Vec<PanoramaLevels> = (i - 1..=i + 1)
+                .map(|k| PanoramaLevels::from_image(&c.panoramas[k], 3))
+                .collect();
+            sparse_cloud(recs, [&levels[0], &levels[1], &levels[2]], p)
         })
         .collect()
 }
@@ -219,7 +222,10 @@ fn sparse_cloud_is_deterministic() {
     let c = &fixture().campaign;
     let p = SparseCloudParams::default();
     let recs = [&c.recorded[0], &c.recorded[1], &c.recorded[2]];
-    let panos = [&c.panoramas[0], &c.panoramas[1], &c.panoramas[2]];
+    let levels: Vec<PanoramaLevels> = (0..3)
+        .map(|k| PanoramaLevels::from_image(&c.panoramas[k], 3))
+        .collect();
+    let panos = [&levels[0], &levels[1], &levels[2]];
     let a = sparse_cloud(recs, panos, &p);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)

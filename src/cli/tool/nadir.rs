@@ -9,7 +9,7 @@ use skytie_stages::imaging::io::{load_gray, save_gray};
 use skytie_stages::imaging::wallis::{wallis_filter, WallisParams};
 use skytie_stages::matching::ncc::match_template;
 use skytie_stages::matching::phase_correlation::{phase_correlate, PhaseCorrelationParams};
-use skytie_stages::nadir::{ortho_project, OrthoParams};
+use skytie_stages::nadir::{ortho_project_whole, OrthoParams};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -94,7 +94,7 @@ pub fn ortho(a: &OrthoArgs) -> Result<(), String> {
     params.validate().map_err(|errs| {
         option_errors(&errs, &[("gsd_m", "gsd"), ("rotation_deg", "rotate-deg")])
     })?;
-    let ortho = ortho_project(&pano, &rec, &params);
+    let ortho = ortho_project_whole(&pano, &rec, &params);
     save_gray(&a.out, &ortho.image).map_err(|e| e.to_string())?;
     let g = &ortho.georef;
     println!(

@@ -28,7 +28,7 @@ use skytie_stages::correspondence::PanoObservation;
 use skytie_stages::geometry::{FrameCamera, PanoramaCamera};
 use skytie_stages::imaging::image::RgbImage;
 use skytie_stages::imaging::io::{dimensions, save_rgb};
-use skytie_stages::nadir::{ortho_project, OrthoParams};
+use skytie_stages::nadir::{ortho_project_whole, OrthoParams};
 use skytie_stages::oblique::grading::Truth as StageTruth;
 use skytie_stages::synth::scene_truth::{SceneOracle, SceneTruth, SCENE_TRUTH_FILE};
 use std::collections::{BTreeMap, HashMap};
@@ -442,7 +442,7 @@ fn nadir_view(
     let pano = ctx
         .images
         .gray(&ctx.campaign.root.join("mm/panoramas").join(&rec.file))?;
-    let ortho = ortho_project(&pano, rec, &OrthoParams::default());
+    let ortho = ortho_project_whole(&pano, rec, &OrthoParams::default());
     let g = &ortho.georef;
     let left = crop_scaled(
         &ortho.image,

@@ -20,6 +20,7 @@
 use super::local_frame::LocalOrigin;
 use super::panorama::PanoramaCamera;
 use super::rotation::{rot_x, rot_y, rot_z};
+use crate::imaging::equirect::PanoramaLevels;
 use crate::imaging::{GrayImage, RgbImage};
 use nalgebra::{Matrix3, Matrix3x4, Vector3};
 use rayon::prelude::*;
@@ -175,22 +176,42 @@ impl PerspectiveView {
         }
     }
 
-    /// Render the view from a grey panorama (bilinear; columns wrap around the panorama's seam, rows clamp
-    /// at the poles). `cam` is the panorama's camera (its size must be the image's).
-    pub fn render(&self, pano: &GrayImage, cam: &PanoramaCamera) -> GrayImage {
+    /// Angle subtended by the view's centre pixel, radians.
+    pub fn centre_pixel_angle_rad(&self) -> f64 {
+        (1.0 / self.focal_px).atan()
+    }
+
+    /// The range of panorama rows (full resolution, `cam`'s pixels) the view's pixels sample.
+    pub fn panorama_rows(&self, cam: &PanoramaCamera) -> (f64, f64) {
+        let w = f64::from(self.width_px);
+        let n = 64;
+        let mut lo = f64::INFINITY;
+        let mut hi = f64::NEG_INFINITY;
+        for k in 0..=n {
+            let t = w * k as f64 / n as f64;
+            for (u, v) in [(t, 0.0), (t, w), (0.0, t), (w, t), (w / 2.0, t)] {
+                let (_, pv) = self.pixel_to_panorama(cam, u, v);
+                lo = lo.min(pv);
+                hi = hi.max(pv);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Render the view: every pixel centre's panorama pixel sampled by `sample`.
+    fn render_with(
+        &self,
+        cam: &PanoramaCamera,
+        sample: impl Fn(f64, f64) -> f32 + Sync,
+    ) -> GrayImage {
         let w = self.width_px as usize;
         let mut data = vec![0f32; w * w];
-        let view = ChannelView {
-            width: pano.width,
-            height: pano.height,
-            data: &pano.data,
-        };
         data.par_chunks_mut(w.max(1)).enumerate().for_each_init(
             || vec![(0.0, 0.0); w],
             |lut, (row, out)| {
                 self.panorama_lookup_row(cam, row, lut);
                 for (o, &(u, v)) in out.iter_mut().zip(lut.iter()) {
-                    *o = view.sample::<1>(u, v)[0];
+                    *o = sample(u, v);
                 }
             },
         );
@@ -199,6 +220,28 @@ impl PerspectiveView {
             height: w,
             data,
         }
+    }
+
+    /// Render the view from a grey panorama (bilinear; columns wrap around the panorama's seam, rows clamp
+    /// at the poles). `cam` is the panorama's camera (its size must be the image's).
+    pub fn render(&self, pano: &GrayImage, cam: &PanoramaCamera) -> GrayImage {
+        let view = ChannelView {
+            width: pano.width,
+            height: pano.height,
+            data: &pano.data,
+        };
+        self.render_with(cam, |u, v| view.sample::<1>(u, v)[0])
+    }
+
+    /// Render the view from the bands of a panorama (`cam`'s size is its full resolution), sampling
+    /// `level` of its pyramid.
+    pub fn render_levels(
+        &self,
+        pano: &PanoramaLevels,
+        cam: &PanoramaCamera,
+        level: usize,
+    ) -> GrayImage {
+        self.render_with(cam, |u, v| pano.sample(level, u, v))
     }
 
     /// Render the view from an RGB panorama (as [`Self::render`]).

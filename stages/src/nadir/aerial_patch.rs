@@ -7,11 +7,18 @@
 //! gives the GSD (`1/√|det J|`, metres per pixel) and the rotation of the nearest similarity gives the azimuth of
 //! the aerial image's "up" direction, which becomes the ortho image's `rotation_deg` (see `ortho.rs`: the ortho's
 //! "up" points at azimuth `rotation_deg`). Ortho pixels then map to aerial pixels by (nearly) a pure translation.
+//!
+//! Working resolution: an aerial image finer than `OrthoParams::registration_gsd_m` is registered at a level of
+//! its pyramid — the coarsest whose GSD does not exceed that ([`working_level`]) — and the ortho is made at that
+//! level's GSD, so a 2.5 cm frame is matched exactly like the same frame taken at 10 cm. The aerial side is read
+//! as a window of that level ([`extract_patch`], [`AerialWindow`]); measurements are returned in full-resolution
+//! aerial pixels.
 
 use super::ortho::{OrthoGeoref, OrthoParams};
-use crate::geometry::FrameCamera;
+use crate::geometry::{FrameCamera, Similarity2};
+use crate::imaging::pyramid::{footprint_level, PyramidError, ScaledWindow, TileSource};
 use crate::imaging::GrayImage;
-use nalgebra::Vector3;
+use nalgebra::{Vector2, Vector3};
 
 /// Step of the finite differences of the projection Jacobian, metres on the ground.
 const JACOBIAN_STEP_M: f64 = 1.0;
@@ -53,60 +60,108 @@ pub fn aerial_ground_similarity(cam: &FrameCamera, point_world: [f64; 3]) -> Opt
     (gsd_m.is_finite() && gsd_m > 0.0).then_some((gsd_m, azimuth_deg))
 }
 
-/// `base` with the GSD set to the aerial GSD at `foot_world` and the rotation set so that the ortho image's axes
-/// are aligned with the aerial image's axes (thesis 3.4.5.2: "the resolution of the projected MM images is set to
-/// match the aerial images' resolution"). If the foot point does not project into the camera, `base` is returned
-/// unchanged (such an image does not overlap the recording; see `aerial_overlap`).
+/// Levels a pyramid of a `width × height` image has at least (its coarsest level fits 32 px).
+fn level_count(width: u32, height: u32) -> usize {
+    let mut side = width.max(height).max(1);
+    let mut n = 1;
+    while side > 32 {
+        side = side.div_ceil(2);
+        n += 1;
+    }
+    n
+}
+
+/// The pyramid level of an aerial image of `aerial_gsd_m` (size `width × height`) that the registration works
+/// at: the coarsest whose GSD `aerial_gsd_m · 2^l` does not exceed `registration_gsd_m` (level 0 for images
+/// at or coarser than it).
+pub fn working_level(
+    aerial_gsd_m: f64,
+    registration_gsd_m: f64,
+    (width, height): (u32, u32),
+) -> usize {
+    footprint_level(aerial_gsd_m, registration_gsd_m, level_count(width, height))
+}
+
+/// The pyramid level at which an ortho made by [`ortho_params_for_aerial`] meets the aerial image, from the
+/// scale of a transform ortho px → full aerial px (≈ 2^level).
+pub fn level_of_scale(ortho_to_aerial_scale: f64) -> usize {
+    if !(ortho_to_aerial_scale.is_finite() && ortho_to_aerial_scale > 1.0) {
+        return 0;
+    }
+    ortho_to_aerial_scale.log2().round().max(0.0) as usize
+}
+
+/// `base` with the GSD set to the aerial GSD at `foot_world` (at the working level, [`working_level`]) and the
+/// rotation set so that the ortho image's axes are aligned with the aerial image's axes (thesis 3.4.5.2: "the
+/// resolution of the projected MM images is set to match the aerial images' resolution"). If the foot point
+/// does not project into the camera, `base` is returned unchanged (such an image does not overlap the
+/// recording; see `aerial_overlap`).
 pub fn ortho_params_for_aerial(
     cam: &FrameCamera,
     foot_world: [f64; 3],
     base: &OrthoParams,
 ) -> OrthoParams {
     match aerial_ground_similarity(cam, foot_world) {
-        Some((gsd_m, rotation_deg)) => OrthoParams {
-            gsd_m,
-            rotation_deg,
-            ..base.clone()
-        },
+        Some((gsd_m, rotation_deg)) => {
+            let level = working_level(
+                gsd_m,
+                base.registration_gsd_m,
+                (cam.width_px, cam.height_px),
+            );
+            OrthoParams {
+                gsd_m: gsd_m * (1u64 << level) as f64,
+                rotation_deg,
+                ..base.clone()
+            }
+        }
         None => base.clone(),
     }
 }
 
-/// A rectangular crop of an aerial image.
+/// A rectangular crop of an aerial image at one pyramid level.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AerialPatch {
     pub image: GrayImage,
-    /// Full-image continuous pixel coordinates of the patch's (0, 0) corner (integers): a patch pixel (u, v)
-    /// is the full-image pixel (u + origin_u_px, v + origin_v_px).
+    /// Full-image continuous pixel coordinates of the patch's (0, 0) corner: a patch pixel (u, v) is the
+    /// full-image pixel (u·scale + origin_u_px, v·scale + origin_v_px).
     pub origin_u_px: f64,
     pub origin_v_px: f64,
+    /// Full-image pixels per patch pixel (2^level).
+    pub scale: f64,
 }
 
 impl AerialPatch {
     /// Full-image pixel of a patch pixel.
     pub fn to_full(&self, u_px: f64, v_px: f64) -> (f64, f64) {
-        (u_px + self.origin_u_px, v_px + self.origin_v_px)
+        (
+            u_px * self.scale + self.origin_u_px,
+            v_px * self.scale + self.origin_v_px,
+        )
     }
 
     /// Patch pixel of a full-image pixel.
     pub fn to_patch(&self, u_px: f64, v_px: f64) -> (f64, f64) {
-        (u_px - self.origin_u_px, v_px - self.origin_v_px)
+        (
+            (u_px - self.origin_u_px) / self.scale,
+            (v_px - self.origin_v_px) / self.scale,
+        )
     }
 }
 
 /// The region of `aerial` (camera `cam`) covering the ortho footprint of `georef` enlarged by `margin_m` on every
 /// side (thesis 3.4.5.1: the patch "overlaps the MM image to the extent of the expected localisation error"),
-/// clipped to the image. The footprint's corners and edge midpoints are projected through the camera and their
-/// bounding box taken (whole pixels). `None` if a footprint point lies behind the camera or the clipped patch is
-/// smaller than [`MIN_PATCH_SIDE_PX`] on a side.
+/// clipped to the image, read at pyramid `level`. The footprint's corners and edge midpoints are projected
+/// through the camera and their bounding box taken (whole pixels). `Ok(None)` if a footprint point lies behind
+/// the camera or the clipped patch is smaller than [`MIN_PATCH_SIDE_PX`] on a side.
 pub fn extract_patch(
-    aerial: &GrayImage,
+    aerial: &dyn TileSource,
     cam: &FrameCamera,
     georef: &OrthoGeoref,
     margin_m: f64,
-) -> Option<AerialPatch> {
+    level: usize,
+) -> Result<Option<AerialPatch>, PyramidError> {
     if !(margin_m.is_finite() && georef.gsd_m > 0.0) {
-        return None;
+        return Ok(None);
     }
     let grow_px = margin_m.max(0.0) / georef.gsd_m;
     let (w, h) = (georef.width_px as f64, georef.height_px as f64);
@@ -119,7 +174,9 @@ pub fn extract_patch(
             if i == 1 && j == 1 {
                 continue;
             }
-            let (u, v) = cam.project_world(&georef.pixel_to_world(x, y))?;
+            let Some((u, v)) = cam.project_world(&georef.pixel_to_world(x, y)) else {
+                return Ok(None);
+            };
             u_min = u_min.min(u);
             u_max = u_max.max(u);
             v_min = v_min.min(v);
@@ -127,25 +184,76 @@ pub fn extract_patch(
         }
     }
     if !(u_min.is_finite() && u_max.is_finite() && v_min.is_finite() && v_max.is_finite()) {
-        return None;
+        return Ok(None);
     }
-    let col0 = u_min.floor().max(0.0);
-    let row0 = v_min.floor().max(0.0);
-    let col1 = u_max.ceil().min(aerial.width as f64);
-    let row1 = v_max.ceil().min(aerial.height as f64);
-    if !(col1 - col0 >= MIN_PATCH_SIDE_PX as f64 && row1 - row0 >= MIN_PATCH_SIDE_PX as f64) {
-        return None;
+    let Some(win) = ScaledWindow::read(aerial, level, [u_min, v_min, u_max, v_max])? else {
+        return Ok(None);
+    };
+    if !(win.image.width >= MIN_PATCH_SIDE_PX && win.image.height >= MIN_PATCH_SIDE_PX) {
+        return Ok(None);
     }
-    let (c0, r0, c1, r1) = (col0 as usize, row0 as usize, col1 as usize, row1 as usize);
-    let mut data = Vec::with_capacity((c1 - c0) * (r1 - r0));
-    for row in r0..r1 {
-        data.extend_from_slice(&aerial.row(row)[c0..c1]);
+    let (origin_u_px, origin_v_px) = win.to_full(0.0, 0.0);
+    Ok(Some(AerialPatch {
+        scale: win.scale(),
+        image: win.image,
+        origin_u_px,
+        origin_v_px,
+    }))
+}
+
+/// The aerial image around an ortho image's footprint, read at the level where the ortho meets it, and the
+/// transform ortho px → full aerial px re-expressed into the window's pixels.
+pub struct AerialWindow {
+    pub window: ScaledWindow,
+    /// Ortho px → window px.
+    pub ortho_to_window: Similarity2,
+}
+
+impl AerialWindow {
+    /// The window of `aerial` covering the ortho (`width × height` px) mapped by `ortho_to_aerial`, grown by
+    /// `margin_ortho_px` ortho pixels on every side, clipped to the image, at level
+    /// [`level_of_scale`]`(ortho_to_aerial.scale)`. `Ok(None)` when it misses the image.
+    pub fn read(
+        aerial: &dyn TileSource,
+        (width, height): (usize, usize),
+        ortho_to_aerial: &Similarity2,
+        margin_ortho_px: f64,
+    ) -> Result<Option<Self>, PyramidError> {
+        let m = margin_ortho_px;
+        let (w, h) = (width as f64, height as f64);
+        let corners = [(-m, -m), (w + m, -m), (-m, h + m), (w + m, h + m)]
+            .map(|(x, y)| ortho_to_aerial.apply(&Vector2::new(x, y)));
+        let lo = |f: fn(&Vector2<f64>) -> f64| corners.iter().map(f).fold(f64::INFINITY, f64::min);
+        let hi =
+            |f: fn(&Vector2<f64>) -> f64| corners.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
+        let level = level_of_scale(ortho_to_aerial.scale);
+        let Some(window) = ScaledWindow::read(
+            aerial,
+            level,
+            [lo(|c| c.x), lo(|c| c.y), hi(|c| c.x), hi(|c| c.y)],
+        )?
+        else {
+            return Ok(None);
+        };
+        let s = window.scale();
+        let t = ortho_to_aerial;
+        let ortho_to_window = Similarity2 {
+            scale: t.scale / s,
+            rotation_rad: t.rotation_rad,
+            tx: t.tx / s - window.rect.x0 as f64,
+            ty: t.ty / s - window.rect.y0 as f64,
+        };
+        Ok(Some(Self {
+            window,
+            ortho_to_window,
+        }))
     }
-    Some(AerialPatch {
-        image: GrayImage::from_vec(c1 - c0, r1 - r0, data)?,
-        origin_u_px: col0,
-        origin_v_px: row0,
-    })
+
+    /// Whether the full-resolution aerial pixel (u, v) lies inside the whole image.
+    pub fn image_contains(&self, u_px: f64, v_px: f64) -> bool {
+        let (w, h) = self.window.full_size;
+        u_px >= 0.0 && v_px >= 0.0 && u_px < w as f64 && v_px < h as f64
+    }
 }
 
 #[cfg(test)]
@@ -196,28 +304,74 @@ mod tests {
             (0..512 * 384).map(|i| (i % 512) as f32 / 512.0).collect(),
         )
         .unwrap();
-        let patch = extract_patch(&img, &cam, &georef, 1.5).unwrap();
+        let pyramid = crate::imaging::pyramid::MemoryPyramid::from_gray(&img);
+        let patch = extract_patch(&pyramid, &cam, &georef, 1.5, 0)
+            .unwrap()
+            .unwrap();
         // 212 px footprint + 2 × 15 px margin, centred on the principal point.
         let expected = georef.width_px as f64 + 30.0;
         assert!((patch.image.width as f64 - expected).abs() <= 2.0);
         assert!((patch.image.height as f64 - expected).abs() <= 2.0);
         assert!((patch.origin_u_px + patch.image.width as f64 / 2.0 - 256.0).abs() <= 1.0);
-        assert_eq!(
-            patch.image.get(3, 5),
-            img.get(
-                3 + patch.origin_u_px as usize,
-                5 + patch.origin_v_px as usize
-            )
+        let expected = img.get(
+            3 + patch.origin_u_px as usize,
+            5 + patch.origin_v_px as usize,
         );
+        assert!((patch.image.get(3, 5) - expected).abs() < 1e-5);
+        // At level 1 the patch covers the same region with half the pixels.
+        let half = extract_patch(&pyramid, &cam, &georef, 1.5, 1)
+            .unwrap()
+            .unwrap();
+        assert_eq!(half.scale, 2.0);
+        assert!((half.image.width as f64 - patch.image.width as f64 / 2.0).abs() <= 1.0);
+        let (u, v) = half.to_full(1.5, 2.5);
+        assert_eq!(half.to_patch(u, v), (1.5, 2.5));
         // Near the image edge the patch is clipped to the image.
         let edge_foot = [1000.0, 2000.0 + 16.0, 2.2];
         let georef = OrthoGeoref::new(edge_foot, &params);
-        let clipped = extract_patch(&img, &cam, &georef, 1.5).unwrap();
+        let clipped = extract_patch(&pyramid, &cam, &georef, 1.5, 0)
+            .unwrap()
+            .unwrap();
         assert!(clipped.origin_u_px >= 0.0 && clipped.origin_v_px >= 0.0);
         assert!(clipped.origin_u_px as usize + clipped.image.width <= 512);
         assert!(clipped.origin_v_px as usize + clipped.image.height <= 384);
         // Far outside: no patch.
         let georef = OrthoGeoref::new([1000.0, 2100.0, 2.2], &params);
-        assert!(extract_patch(&img, &cam, &georef, 1.5).is_none());
+        assert!(extract_patch(&pyramid, &cam, &georef, 1.5, 0)
+            .unwrap()
+            .is_none());
+    }
+
+    #[test]
+    fn working_levels_keep_the_gsd_at_or_below_the_registration_gsd() {
+        assert_eq!(working_level(0.10, 0.12, (1600, 1200)), 0);
+        assert_eq!(working_level(0.025, 0.12, (6400, 4800)), 2);
+        assert_eq!(working_level(0.00605, 0.12, (26460, 17004)), 4);
+        assert_eq!(working_level(0.06, 0.12, (1000, 1000)), 1);
+        assert_eq!(working_level(0.001, 0.12, (64, 64)), 1);
+        assert_eq!(level_of_scale(4.0003), 2);
+        assert_eq!(level_of_scale(0.98), 0);
+        // A frame 4× finer gives an ortho at the same GSD.
+        let coarse = camera(0.0);
+        let fine = FrameCamera::from_opk(
+            Vector3::new(1000.0, 2000.0, 4472.2),
+            0.0,
+            0.0,
+            0.0,
+            4.0 * 44_700.0,
+            4.0 * 256.0,
+            4.0 * 192.0,
+            4 * 512,
+            4 * 384,
+            BrownDistortion::default(),
+        );
+        let base = OrthoParams {
+            registration_gsd_m: 0.12,
+            ..OrthoParams::default()
+        };
+        let foot = [1003.0, 1995.0, 2.2];
+        let a = ortho_params_for_aerial(&coarse, foot, &base);
+        let b = ortho_params_for_aerial(&fine, foot, &base);
+        assert_eq!(a.gsd_m, b.gsd_m);
     }
 }

@@ -26,6 +26,7 @@ pub use kdtree::KdTree2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::aerial_patch::AerialWindow;
 use super::ortho::OrthoImage;
 use super::refine::{cut_ortho_template, grey_std, sample_aerial_on_ortho_grid};
 use super::registration::{AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch};
@@ -34,6 +35,7 @@ use crate::correspondence::AerialObservation;
 use crate::features::forstner::{forstner_corners, ForstnerParams};
 use crate::geometry::FrameCamera;
 use crate::imaging::gaussian::gaussian_blur;
+use crate::imaging::pyramid::{PyramidError, TileSource};
 use crate::imaging::GrayImage;
 use crate::matching::ncc::match_template;
 use nalgebra::{Vector2, Vector3};
@@ -181,47 +183,26 @@ impl BaselineParams {
     }
 }
 
-/// Isolated Förstner keypoints (full aerial pixels) in the part of `aerial` that `mm_ortho` covers through
-/// `ortho_to_aerial`; `gsd_m` is the aerial GSD on the ground, m/px (thesis 2.2.3.2).
+/// Isolated Förstner keypoints (full aerial pixels) in `aerial`, the window of the aerial image around the
+/// part `mm_ortho` covers (grown by half the isolation box so that keypoints near its edge see all their
+/// neighbours, [`AerialWindow`]); `gsd_m` is the aerial GSD on the ground at full resolution, m/px (thesis
+/// 2.2.3.2). The detector runs on the window's level.
 pub fn isolated_aerial_keypoints(
-    mm_ortho: &OrthoImage,
-    aerial: &GrayImage,
-    t: &InitialTransform,
+    aerial: &AerialWindow,
     gsd_m: f64,
     p: &BaselineParams,
 ) -> Vec<[f64; 2]> {
-    // Bounding box of the ortho footprint in the aerial image, enlarged by half the isolation box so that
-    // keypoints near its edge see all their neighbours.
-    let (w, h) = (
-        mm_ortho.georef.width_px as f64,
-        mm_ortho.georef.height_px as f64,
-    );
     let half_box_px = p.isolation_box_m / 2.0 / gsd_m;
-    let corners = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)]
-        .map(|(x, y)| t.ortho_to_aerial.apply(&Vector2::new(x, y)));
-    let lo = |f: fn(&Vector2<f64>) -> f64| corners.iter().map(f).fold(f64::INFINITY, f64::min);
-    let hi = |f: fn(&Vector2<f64>) -> f64| corners.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
-    let x0 = (lo(|c| c.x) - half_box_px).floor().max(0.0);
-    let y0 = (lo(|c| c.y) - half_box_px).floor().max(0.0);
-    let x1 = (hi(|c| c.x) + half_box_px).ceil().min(aerial.width as f64);
-    let y1 = (hi(|c| c.y) + half_box_px).ceil().min(aerial.height as f64);
-    if !(x1 - x0 >= 8.0 && y1 - y0 >= 8.0) {
+    let patch = &aerial.window.image;
+    if !(patch.width >= 8 && patch.height >= 8) {
         return Vec::new();
     }
-    let (x0, y0, pw, ph) = (
-        x0 as usize,
-        y0 as usize,
-        (x1 - x0) as usize,
-        (y1 - y0) as usize,
-    );
-    let mut patch = GrayImage::filled(pw, ph, 0.0);
-    for row in 0..ph {
-        let src = &aerial.row(y0 + row)[x0..x0 + pw];
-        patch.data[row * pw..(row + 1) * pw].copy_from_slice(src);
-    }
-    let points: Vec<[f64; 2]> = forstner_corners(&patch, &p.forstner())
+    let points: Vec<[f64; 2]> = forstner_corners(patch, &p.forstner())
         .into_iter()
-        .map(|c| [c.u_px + x0 as f64, c.v_px + y0 as f64])
+        .map(|c| {
+            let (u, v) = aerial.window.to_full(c.u_px, c.v_px);
+            [u, v]
+        })
         .collect();
     let tree = KdTree2::build(&points);
     points
@@ -236,12 +217,12 @@ pub fn isolated_aerial_keypoints(
 /// peak. Invalid parameters or transform yield an empty refinement.
 pub fn baseline_matches(
     mm_ortho: &OrthoImage,
-    aerial: &GrayImage,
+    aerial: &dyn TileSource,
     aerial_row: &AerialImage,
     t: &InitialTransform,
     window: &MmWindowMatch,
     p: &BaselineParams,
-) -> AerialRefinement {
+) -> Result<AerialRefinement, PyramidError> {
     let mut result = AerialRefinement::empty(&t.recording_id, &aerial_row.image_id);
     let tf = t.ortho_to_aerial;
     let transform_ok = [tf.scale, tf.rotation_rad, tf.tx, tf.ty]
@@ -249,14 +230,23 @@ pub fn baseline_matches(
         .all(|v| v.is_finite())
         && tf.scale > 1e-6;
     if !transform_ok || p.validate().is_err() {
-        return result;
+        return Ok(result);
     }
     let foot = Vector3::from(mm_ortho.georef.foot_world);
     let gsd_m = FrameCamera::from_aerial(aerial_row).gsd_at(&foot);
     if !(gsd_m.is_finite() && gsd_m > 0.0) {
-        return result;
+        return Ok(result);
     }
-    let keypoints = isolated_aerial_keypoints(mm_ortho, aerial, t, gsd_m, p);
+    // The window must hold the isolation boxes of keypoints at the footprint's edge and every search window.
+    let margin_ortho_px = (p.isolation_box_m / 2.0 / gsd_m) / tf.scale + p.search_px as f64 + 4.0;
+    let size = (mm_ortho.image.width, mm_ortho.image.height);
+    let Some(aerial_window) = AerialWindow::read(aerial, size, &tf, margin_ortho_px)? else {
+        return Ok(result);
+    };
+    let keypoints = isolated_aerial_keypoints(&aerial_window, gsd_m, p);
+    let tf_window = aerial_window.ortho_to_window;
+    // Snapping distance in full-resolution pixels (the parameter is in working pixels).
+    let snap_px = p.snap_px * aerial_window.window.scale();
     let keypoint_tree = KdTree2::build(&keypoints);
     let blurred = OrthoImage {
         image: if p.mm_blur_sigma_px > 0.0 {
@@ -278,15 +268,11 @@ pub fn baseline_matches(
                     .georef
                     .world_to_pixel(&Vector3::new(g[0], g[1], g[2]));
                 let predicted = tf.apply(&Vector2::new(u_o, v_o));
-                if !(predicted.x >= 0.0
-                    && predicted.y >= 0.0
-                    && predicted.x < aerial.width as f64
-                    && predicted.y < aerial.height as f64)
-                {
+                if !aerial_window.image_contains(predicted.x, predicted.y) {
                     return (false, None);
                 }
                 // No isolated keypoint anywhere near: nothing to measure (saves the NCC).
-                let reach = (p.search_px as f64 / 2.0 + p.snap_px) * tf.scale;
+                let reach = p.search_px as f64 / 2.0 * tf.scale + snap_px;
                 if keypoint_tree.count_in_box([predicted.x, predicted.y], [reach, reach]) == 0 {
                     return (true, None);
                 }
@@ -300,8 +286,8 @@ pub fn baseline_matches(
                 let margin = ((p.search_px - p.template_px) / 2) as f64;
                 let side = p.template_px + 2 * ((p.search_px - p.template_px) / 2);
                 if !sample_aerial_on_ortho_grid(
-                    aerial,
-                    &tf,
+                    &aerial_window.window.image,
+                    &tf_window,
                     x0 - margin,
                     y0 - margin,
                     side,
@@ -323,7 +309,7 @@ pub fn baseline_matches(
                 let mut best: Option<([f64; 2], f64)> = None;
                 for &k in &keypoints {
                     let d = (k[0] - peak.x).hypot(k[1] - peak.y);
-                    if d <= p.snap_px && best.is_none_or(|(_, bd)| d < bd) {
+                    if d <= snap_px && best.is_none_or(|(_, bd)| d < bd) {
                         best = Some((k, d));
                     }
                 }
@@ -353,5 +339,5 @@ pub fn baseline_matches(
         result.tried += usize::from(tried);
         result.matches.extend(m);
     }
-    result
+    Ok(result)
 }

@@ -20,7 +20,7 @@
 //! Option (thesis 3.4.5.2, last paragraph): [`reuse_neighbour`] adapts a neighbouring recording's transform to
 //! this recording through the recorded relative pose.
 
-use super::aerial_patch::{aerial_ground_similarity, extract_patch};
+use super::aerial_patch::{aerial_ground_similarity, extract_patch, level_of_scale};
 use super::ortho::{OrthoGeoref, OrthoImage};
 use super::registration::{InitialTransform, TransformOutcome};
 use super::translation_consensus::translation_consensus;
@@ -28,6 +28,7 @@ use crate::campaign::{AerialImage, Recording};
 use crate::estimators::{mix_seed, ransac_filtered, RansacParams};
 use crate::features::kaze::{detect_and_describe, Features, KazeParams};
 use crate::geometry::{intersect_ray_plane, FrameCamera, Plane, PointPair, Similarity2};
+use crate::imaging::pyramid::{PyramidError, TileSource};
 use crate::imaging::wallis::{wallis_filter, WallisParams};
 use crate::imaging::GrayImage;
 use crate::matching::descriptor_match::match_windowed;
@@ -68,7 +69,8 @@ pub struct TransformParams {
     pub match_ratio: f32,
     /// MM keypoints with a masked (vehicle) pixel within this radius, ortho pixels, are not used.
     pub mask_clearance_px: f64,
-    /// RANSAC inlier threshold, aerial pixels.
+    /// RANSAC inlier threshold, aerial pixels at the working level (the pixels the registration works in,
+    /// `OrthoParams::registration_gsd_m`).
     pub ransac_threshold_px: f64,
     /// RANSAC confidence in (0, 1).
     pub ransac_confidence: f64,
@@ -415,12 +417,45 @@ fn wallis_kaze(
 
 /// Thesis 3.4.5.2 for one (recording, aerial image): see the module documentation. `mm_ortho` is the recording's
 /// ortho image (ideally made with [`super::aerial_patch::ortho_params_for_aerial`] for this aerial image),
-/// `aerial` the grey aerial image (0..1) of the `cameras.csv` row `aerial_row`. Never panics on data: every
-/// failure is a `Rejected` with a reason.
+/// `aerial` the grey aerial image (0..1; its pyramid, read at the ortho's level) of the `cameras.csv` row
+/// `aerial_row`. Never panics on data: every failure is a `Rejected` with a reason; `Err` only when the image
+/// cannot be read.
 pub fn initial_transform(
     rec: &Recording,
     mm_ortho: &OrthoImage,
-    aerial: &GrayImage,
+    aerial: &dyn TileSource,
+    aerial_row: &AerialImage,
+    p: &TransformParams,
+) -> Result<TransformOutcome, PyramidError> {
+    // The only reading: the aerial patch, at the level the ortho was made for (its nominal scale ≈ 2^level).
+    let cam = FrameCamera::from_aerial(aerial_row);
+    let patch = match nominal_transform(&mm_ortho.georef, &cam) {
+        Some(nominal) => extract_patch(
+            aerial,
+            &cam,
+            &mm_ortho.georef,
+            p.max_localisation_error_m,
+            level_of_scale(nominal.scale),
+        )?,
+        None => None,
+    };
+    let size = (aerial.layout().width, aerial.layout().height);
+    Ok(transform_with_patch(
+        rec,
+        mm_ortho,
+        size,
+        patch.as_ref(),
+        aerial_row,
+        p,
+    ))
+}
+
+/// [`initial_transform`] once the aerial patch is read (`None`: the footprint misses the image).
+fn transform_with_patch(
+    rec: &Recording,
+    mm_ortho: &OrthoImage,
+    (aerial_w, aerial_h): (usize, usize),
+    patch: Option<&super::aerial_patch::AerialPatch>,
     aerial_row: &AerialImage,
     p: &TransformParams,
 ) -> TransformOutcome {
@@ -439,13 +474,11 @@ pub fn initial_transform(
             0,
         );
     }
-    if aerial.width != aerial_row.width_px as usize
-        || aerial.height != aerial_row.height_px as usize
-    {
+    if aerial_w != aerial_row.width_px as usize || aerial_h != aerial_row.height_px as usize {
         return reject(
             format!(
                 "aerial image {} is {}×{} px but aerial/nadir/cameras.csv says {}×{}; fix the width/height columns",
-                aerial_row.file, aerial.width, aerial.height, aerial_row.width_px, aerial_row.height_px
+                aerial_row.file, aerial_w, aerial_h, aerial_row.width_px, aerial_row.height_px
             ),
             0,
             0,
@@ -475,7 +508,7 @@ pub fn initial_transform(
             0,
         );
     };
-    let Some(patch) = extract_patch(aerial, &cam, georef, max_err_m) else {
+    let Some(patch) = patch else {
         return reject(
             "the ortho footprint (plus the localisation error) does not overlap the aerial image"
                 .into(),
@@ -493,7 +526,8 @@ pub fn initial_transform(
             0,
         );
     }
-    let window_px = max_err_m / aerial_gsd_m;
+    // The matching window in patch pixels (the patch is at the working level: `scale` full pixels each).
+    let window_px = max_err_m / (aerial_gsd_m * patch.scale);
 
     // Wallis + two KAZE detector instances, one descriptor configuration (thesis 3.4.5.2).
     let mm_features = match wallis_kaze(
@@ -594,6 +628,7 @@ pub fn initial_transform(
         // RANSAC similarity; only hypotheses close to the recorded-pose scale and rotation.
         let ransac = RansacParams {
             seed: pair_seed(p.seed, &rec.image_id, &aerial_row.image_id),
+            threshold: p.ransac_threshold_px * patch.scale,
             ..p.ransac()
         };
         let shape_ok = |m: &Similarity2| {
@@ -611,7 +646,8 @@ pub fn initial_transform(
         (fit.model, fit.inliers.len())
     } else {
         // Scale and rotation from the recorded pose, translation by exhaustive consensus.
-        let Some(c) = translation_consensus(&pairs, &nominal, p.ransac_threshold_px) else {
+        let Some(c) = translation_consensus(&pairs, &nominal, p.ransac_threshold_px * patch.scale)
+        else {
             return reject(
                 format!("{n_matches} matches, no translation consensus"),
                 n_matches,

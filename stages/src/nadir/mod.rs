@@ -17,7 +17,7 @@ pub mod transform_agreement;
 pub mod translation_consensus;
 pub mod vehicle_mask;
 
-pub use ortho::{ortho_project, OrthoGeoref, OrthoImage, OrthoParams};
+pub use ortho::{ortho_project, ortho_project_whole, OrthoGeoref, OrthoImage, OrthoParams};
 pub use registration::{
     AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch, PairMethod, PairReport,
     RecordingControl, TransformOutcome, ViewGround,

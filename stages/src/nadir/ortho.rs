@@ -6,6 +6,10 @@
 //! azimuth `rotation_deg` (0 = grid north; the aerial image's κ direction to align with it). Every ortho pixel is
 //! filled by back-projection: its ground point is projected into the panorama and the grey value interpolated
 //! bilinearly — so there are no gaps. Ground points hidden by the recording vehicle are masked (`valid = 0`).
+//! Where the panorama resolves the ground more finely than the ortho's pixel (near the vehicle), the sample
+//! comes from the panorama's pyramid level that matches the pixel's footprint ([`pixel_level`]), so the ortho
+//! averages the panorama there instead of aliasing it; the result depends on the ground, not on how many
+//! pixels the panorama has.
 //!
 //! Ortho images are for matching only: [`OrthoGeoref::ortho_to_panorama_pixel`] is the exact inverse that turns an
 //! ortho-image measurement back into the panorama's spherical geometry, where all measuring happens (3.4.3, last
@@ -14,9 +18,7 @@
 use super::vehicle_mask::VehicleMask;
 use crate::campaign::Recording;
 use crate::geometry::PanoramaCamera;
-use crate::imaging::bilinear_many::sample_bilinear_many;
-use crate::imaging::border::Border;
-use crate::imaging::sample::{floor_fast, sample_bilinear};
+use crate::imaging::equirect::PanoramaLevels;
 use crate::imaging::GrayImage;
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -34,6 +36,12 @@ pub struct OrthoParams {
     pub rotation_deg: f64,
     /// The recording vehicle's body, masked out.
     pub vehicle: VehicleMask,
+    /// `ortho_aerial` only: the coarsest GSD the MM↔aerial registration works at, m. An aerial image finer
+    /// than this is registered at the coarsest level of its pyramid whose GSD does not exceed it (a 2.5 cm
+    /// frame at 10 cm), and the ortho is made at that GSD; coarser images at their own GSD (thesis 3.4.5.2
+    /// works at the aerial images' 10 cm). Default 0.12 m: 10 cm frames and their GSD's variation across the
+    /// frame stay at full resolution.
+    pub registration_gsd_m: f64,
 }
 
 impl Default for OrthoParams {
@@ -43,6 +51,7 @@ impl Default for OrthoParams {
             diagonal_m: 30.0,
             rotation_deg: 0.0,
             vehicle: VehicleMask::default(),
+            registration_gsd_m: 0.12,
         }
     }
 }
@@ -61,6 +70,13 @@ impl OrthoParams {
             errs.push((
                 "diagonal_m".into(),
                 format!("must be in [1, 200] m, got {}", self.diagonal_m),
+            ));
+        }
+        let r = self.registration_gsd_m;
+        if !(r.is_finite() && (0.001..=10.0).contains(&r)) {
+            errs.push((
+                "registration_gsd_m".into(),
+                format!("must be in [0.001, 10] m, got {r}"),
             ));
         }
         if !self.rotation_deg.is_finite() {
@@ -166,35 +182,6 @@ pub struct OrthoImage {
     /// Row-major, one byte per pixel: 1 where the pixel holds ground seen by the panorama, 0 where masked.
     pub valid: Vec<u8>,
     pub georef: OrthoGeoref,
-}
-
-/// Bilinear sample of an equirectangular panorama, continuous across the seam at azimuth ±180° (u = 0 / W):
-/// columns wrap around, rows clamp at the poles. Reads the panorama in place (no padded copy per call: the
-/// 3 cm ortho of a 4000 × 2000 panorama would otherwise copy 32 MB to fill 0.5 M pixels). The ortho-projection
-/// calls it only where [`sample_bilinear_many`] finds a neighbour outside the image.
-#[cold]
-#[inline(never)]
-fn sample_panorama(pano: &GrayImage, u_px: f64, v_px: f64) -> f32 {
-    let (w, h) = (pano.width, pano.height);
-    let x = u_px - 0.5;
-    let x0f = floor_fast(x);
-    let x0 = x0f as isize;
-    if x0 >= 0 && (x0 as usize) + 1 < w {
-        return sample_bilinear(pano, u_px, v_px, Border::Clamp);
-    }
-    if w == 0 || h == 0 || !u_px.is_finite() || !v_px.is_finite() {
-        return 0.0;
-    }
-    let wrap = |c: isize| c.rem_euclid(w as isize) as usize;
-    let (c0, c1) = (wrap(x0), wrap(x0 + 1));
-    let y = (v_px - 0.5).clamp(0.0, (h - 1) as f64);
-    let y0 = (floor_fast(y) as usize).min(h - 1);
-    let y1 = (y0 + 1).min(h - 1);
-    let (fx, fy) = ((x - x0f) as f32, (y - y0 as f64) as f32);
-    let at = |c: usize, r: usize| pano.data[r * w + c];
-    let top = at(c0, y0) + (at(c1, y0) - at(c0, y0)) * fx;
-    let bottom = at(c0, y1) + (at(c1, y1) - at(c0, y1)) * fx;
-    top + (bottom - top) * fy
 }
 
 /// The ortho pixel → panorama pixel sampling map along one ortho row. The world direction from the projection
@@ -304,14 +291,110 @@ impl RowMap {
     }
 }
 
-/// Ortho-project `panorama` (grey, W = 2H) of `recording` with `params`. Thesis 3.4.3.
-pub fn ortho_project(
+/// The pyramid level for an ortho pixel of `gsd_m` whose ground point lies at `dir_world` from the projection
+/// centre, in a panorama of `pixel_angle_rad` per pixel: the finest level whose pixel covers at least the ortho
+/// pixel's area on the ground. A panorama pixel at horizontal distance d and height h spans `Δ·(d² + h²)/h`
+/// radially and `Δ·d` across, so the level is `⌊½·log2(g²·h / (Δ²·d·(d² + h²)))⌋`, clamped to
+/// `[0, max_level]`.
+#[inline]
+pub fn pixel_level(
+    dir_world: &Vector3<f64>,
+    gsd_m: f64,
+    pixel_angle_rad: f64,
+    max_level: usize,
+) -> usize {
+    let h = -dir_world.z;
+    let d2 = dir_world.x * dir_world.x + dir_world.y * dir_world.y;
+    let area = pixel_angle_rad * pixel_angle_rad * d2.sqrt() * (d2 + h * h) / h.abs().max(1e-9);
+    let ratio = gsd_m * gsd_m / area;
+    if !(ratio >= 4.0) {
+        return 0;
+    }
+    ((0.5 * ratio.log2()).floor() as usize).min(max_level)
+}
+
+/// Which rows of which pyramid levels [`ortho_project`] reads for `recording` with `params` from a panorama of
+/// `width × height` px with levels `0..=max_level`: (level, (v0, v1)) in full-resolution panorama rows, each
+/// level only over the ground distances where [`pixel_level`] picks it (with a margin for the recorded
+/// attitude).
+pub fn panorama_bands(
+    recording: &Recording,
+    params: &OrthoParams,
+    (width, height): (usize, usize),
+    max_level: usize,
+) -> Vec<(usize, (f64, f64))> {
+    let delta = std::f64::consts::TAU / width.max(1) as f64;
+    let h = recording.camera_height_m.max(0.05);
+    let g = params.gsd_m;
+    // Ground distances where level l applies: t(d) = g²h/(Δ²d(d² + h²)) in [4^l, 4^(l+1)), t falling in d.
+    let distance_where = |t: f64| {
+        // Solve d(d² + h²) = g²h/(Δ²t) by bisection on [0, 1e4].
+        let target = g * g * h / (delta * delta * t);
+        let (mut lo, mut hi) = (0.0f64, 1e4f64);
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            if mid * (mid * mid + h * h) < target {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        hi
+    };
+    let d_max = params.diagonal_m / 2.0 + 1.0;
+    let tilt = recording.pitch_deg.abs() + recording.roll_deg.abs() + 1.0;
+    let row_of = |d: f64, sign: f64| {
+        let elevation_deg = -(h / d.max(1e-3)).atan().to_degrees() + sign * tilt;
+        ((90.0 - elevation_deg) / 180.0 * height as f64).clamp(0.0, height as f64)
+    };
+    (0..=max_level)
+        .filter_map(|l| {
+            let d_far = if l == 0 {
+                d_max
+            } else {
+                distance_where(4f64.powi(l as i32)).min(d_max)
+            };
+            let d_near = if l == max_level {
+                0.0
+            } else {
+                distance_where(4f64.powi(l as i32 + 1))
+            };
+            (d_near < d_far).then(|| (l, (row_of(d_far, 1.0), row_of(d_near, -1.0))))
+        })
+        .collect()
+}
+
+/// [`ortho_project`] of a whole in-memory panorama (tools, tests): its coarser levels are computed here.
+pub fn ortho_project_whole(
     panorama: &GrayImage,
     recording: &Recording,
     params: &OrthoParams,
 ) -> OrthoImage {
-    let camera =
-        PanoramaCamera::from_recording(recording, panorama.width as u32, panorama.height as u32);
+    let size = (panorama.width, panorama.height);
+    let max_level = panorama_bands(recording, params, size, 12)
+        .iter()
+        .map(|(l, _)| *l)
+        .max()
+        .unwrap_or(0);
+    ortho_project(
+        &PanoramaLevels::from_image(panorama, max_level),
+        recording,
+        params,
+    )
+}
+
+/// Ortho-project `panorama` (grey, W = 2H; the bands of [`panorama_bands`]) of `recording` with `params`.
+/// Thesis 3.4.3.
+pub fn ortho_project(
+    panorama: &PanoramaLevels,
+    recording: &Recording,
+    params: &OrthoParams,
+) -> OrthoImage {
+    let camera = PanoramaCamera::from_recording(
+        recording,
+        panorama.width_px as u32,
+        panorama.height_px as u32,
+    );
     let foot = [
         recording.x,
         recording.y,
@@ -319,6 +402,8 @@ pub fn ortho_project(
     ];
     let georef = OrthoGeoref::new(foot, params);
     let heading = recording.heading_deg.to_radians().sin_cos();
+    let delta = camera.pixel_angle_rad();
+    let max_level = panorama.max_level();
     let (w, h) = (georef.width_px, georef.height_px);
     let mut image = GrayImage::filled(w, h, 0.0);
     let mut valid = vec![0u8; w * h];
@@ -328,21 +413,33 @@ pub fn ortho_project(
         .zip(valid.par_chunks_mut(w))
         .enumerate()
         .for_each_init(
-            || (vec![0.0; w], vec![0.0; w]),
-            |(us, vs), (row, (out, ok))| {
+            || (vec![0.0; w], vec![0.0; w], (Vec::new(), Vec::new())),
+            |(us, vs, scratch), (row, (out, ok))| {
                 // Pass 1: the panorama pixel of every ortho pixel (NaN where the vehicle hides the ground).
-                RowMap::new(&georef, &camera, row).fill(
-                    &camera,
-                    &params.vehicle,
-                    heading,
-                    us,
-                    vs,
-                    ok,
-                );
-                // Pass 2: bilinear sampling; the seam columns and pole rows wrap/clamp.
-                sample_bilinear_many(panorama, us, vs, out, 0.0, |_, u, v| {
-                    sample_panorama(panorama, u, v)
-                });
+                let map = RowMap::new(&georef, &camera, row);
+                map.fill(&camera, &params.vehicle, heading, us, vs, ok);
+                // Pass 2: bilinear sampling, run by run of columns sharing a pyramid level; the seam columns and
+                // pole rows wrap/clamp.
+                let level_at = |col: usize| {
+                    pixel_level(&map.direction_world(col), georef.gsd_m, delta, max_level)
+                };
+                let mut start = 0;
+                while start < w {
+                    let level = level_at(start);
+                    let mut end = start + 1;
+                    while end < w && level_at(end) == level {
+                        end += 1;
+                    }
+                    panorama.sample_many(
+                        level,
+                        &us[start..end],
+                        &vs[start..end],
+                        &mut out[start..end],
+                        0.0,
+                        scratch,
+                    );
+                    start = end;
+                }
             },
         );
     debug_assert_eq!(h * w, image.data.len());
@@ -393,15 +490,16 @@ mod tests {
     #[test]
     fn panorama_sampling_wraps_across_the_seam() {
         // 4 × 2 panorama; columns 0 and 3 are the seam neighbours.
-        let pano = GrayImage::from_vec(4, 2, vec![1.0, 2.0, 3.0, 5.0, 1.0, 2.0, 3.0, 5.0]).unwrap();
+        let img = GrayImage::from_vec(4, 2, vec![1.0, 2.0, 3.0, 5.0, 1.0, 2.0, 3.0, 5.0]).unwrap();
+        let pano = PanoramaLevels::from_image(&img, 0);
         // u = 0 lies halfway between the centres of column 3 (u = 3.5, wrapped to −0.5) and column 0 (0.5).
-        assert!((sample_panorama(&pano, 0.0, 1.0) - 3.0).abs() < 1e-6);
-        assert!((sample_panorama(&pano, 4.0, 1.0) - 3.0).abs() < 1e-6);
+        assert!((pano.sample(0, 0.0, 1.0) - 3.0).abs() < 1e-6);
+        assert!((pano.sample(0, 4.0, 1.0) - 3.0).abs() < 1e-6);
         // Interior samples are plain bilinear; pixel centres return the pixel.
-        assert!((sample_panorama(&pano, 1.5, 0.5) - 2.0).abs() < 1e-6);
-        assert!((sample_panorama(&pano, 2.0, 1.5) - 2.5).abs() < 1e-6);
+        assert!((pano.sample(0, 1.5, 0.5) - 2.0).abs() < 1e-6);
+        assert!((pano.sample(0, 2.0, 1.5) - 2.5).abs() < 1e-6);
         // Rows clamp at the poles.
-        assert!((sample_panorama(&pano, 3.5, 0.0) - 5.0).abs() < 1e-6);
+        assert!((pano.sample(0, 3.5, 0.0) - 5.0).abs() < 1e-6);
     }
 
     #[test]
@@ -434,6 +532,52 @@ mod tests {
                 }
             }
             assert!(worst < 1e-6, "gsd {gsd_m}: worst map error {worst:e} px");
+        }
+    }
+
+    #[test]
+    fn levels_follow_the_ground_footprint_and_the_bands_cover_them() {
+        let (rec, camera, _, georef) = setup(0.10, 0.0, 30.0);
+        let delta = camera.pixel_angle_rad();
+        // 4000-px panorama (Δ = 1.57 mrad), camera 2.2 m up, 10 cm pixels: t = g²h/(Δ²d(d² + h²)).
+        let at = |d: f64| pixel_level(&Vector3::new(d, 0.0, -2.2), 0.10, delta, 6);
+        assert_eq!(at(20.0), 0);
+        let t = |d: f64| 0.01 * 2.2 / (delta * delta * d * (d * d + 4.84));
+        for d in [0.5, 1.0, 3.0, 6.0, 10.0] {
+            assert_eq!(
+                at(d),
+                ((0.5 * t(d).log2()).floor().max(0.0) as usize).min(6),
+                "d = {d}"
+            );
+        }
+        assert!(at(3.0) >= 2 && at(10.0) >= 1);
+        // A panorama 4× as wide picks levels two higher at the same place.
+        let fine = |d: f64| pixel_level(&Vector3::new(d, 0.0, -2.2), 0.10, delta / 4.0, 9);
+        for d in [1.0, 3.0, 6.0, 10.0, 20.0] {
+            assert_eq!(fine(d), at(d) + 2, "d = {d}");
+        }
+        // Every pixel's level has a band that holds the panorama row of its ground point.
+        let params = OrthoParams {
+            gsd_m: 0.10,
+            ..OrthoParams::default()
+        };
+        let bands = panorama_bands(&rec, &params, (4000, 2000), 6);
+        for row in (0..georef.height_px).step_by(7) {
+            let map = RowMap::new(&georef, &camera, row);
+            for col in (0..georef.width_px).step_by(5) {
+                let Some((_, v)) = map.panorama_pixel(&camera, col) else {
+                    continue;
+                };
+                let level = pixel_level(&map.direction_world(col), 0.10, delta, 6);
+                let (_, (v0, v1)) = bands
+                    .iter()
+                    .find(|(l, _)| *l == level)
+                    .expect("band of the level");
+                assert!(
+                    *v0 <= v && v <= *v1,
+                    "({col}, {row}) level {level}: row {v} not in [{v0}, {v1}]"
+                );
+            }
         }
     }
 

@@ -27,6 +27,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::aerial_patch::AerialWindow;
 use super::ortho::OrthoImage;
 use super::parallax_check::{parallax_share, ParallaxScratch};
 use super::registration::{AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch};
@@ -35,6 +36,7 @@ use crate::correspondence::AerialObservation;
 use crate::estimators::median_consensus::median_consensus;
 use crate::geometry::Similarity2;
 use crate::imaging::border::Border;
+use crate::imaging::pyramid::{PyramidError, TileSource};
 use crate::imaging::sample::sample_bicubic;
 use crate::imaging::window::WindowKind;
 use crate::imaging::GrayImage;
@@ -408,9 +410,11 @@ pub struct NeighbourOrtho<'a> {
 /// Locate every tie point of `window` in one aerial nadir image by phase correlation (thesis 3.4.5.3).
 ///
 /// `mm_ortho` must be the ortho image of the window's detecting recording (`window.recording_id`) at about the
-/// aerial GSD; `t.ortho_to_aerial` maps its pixels to full `aerial` pixels. Matches keep the order of
-/// `window.tie_points`; the result is identical for any thread count. An invalid transform (non-finite or
-/// zero scale) yields an empty refinement.
+/// aerial GSD (at the working level, `aerial_patch::working_level`); `t.ortho_to_aerial` maps its pixels to
+/// full `aerial` pixels. The aerial image is read once, as the window of that level around the ortho's
+/// footprint ([`AerialWindow`]). Matches keep the order of `window.tie_points`; the result is identical for
+/// any thread count. An invalid transform (non-finite or zero scale) yields an empty refinement; `Err` only
+/// when the image cannot be read.
 ///
 /// **Parallax check** (`max_parallax_share` < 1, `nadir::parallax_check`): before a tie point is located, its
 /// template is compared with each neighbouring recording in `neighbours` that saw the corner
@@ -419,13 +423,13 @@ pub struct NeighbourOrtho<'a> {
 /// Neighbours without an ortho image here, or whose view of the template is mostly masked, give no verdict.
 pub fn refine_in_aerial(
     mm_ortho: &OrthoImage,
-    aerial: &GrayImage,
+    aerial: &dyn TileSource,
     aerial_row: &AerialImage,
     t: &InitialTransform,
     window: &MmWindowMatch,
     neighbours: &[NeighbourOrtho],
     p: &RefineParams,
-) -> AerialRefinement {
+) -> Result<AerialRefinement, PyramidError> {
     let mut result = AerialRefinement::empty(&t.recording_id, &aerial_row.image_id);
     let tf = t.ortho_to_aerial;
     let transform_ok = [tf.scale, tf.rotation_rad, tf.tx, tf.ty]
@@ -433,8 +437,17 @@ pub fn refine_in_aerial(
         .all(|v| v.is_finite())
         && tf.scale > 1e-6;
     if !transform_ok || p.validate().is_err() {
-        return result;
+        return Ok(result);
     }
+    // Search windows reach the template ± the margin, re-centred once by up to the margin (`search_template`),
+    // plus the bicubic kernel's reach.
+    let margin = 2.0 * p.search_margin_px as f64 + 4.0;
+    let size = (mm_ortho.image.width, mm_ortho.image.height);
+    let Some(aerial_window) = AerialWindow::read(aerial, size, &tf, margin)? else {
+        return Ok(result);
+    };
+    let aerial_img = &aerial_window.window.image;
+    let tf_window = aerial_window.ortho_to_window;
     let phase = p.phase_params();
     let n = window.tie_points.len().min(window.ground_world.len());
     let outcomes: Vec<Outcome> = (0..n)
@@ -445,11 +458,7 @@ pub fn refine_in_aerial(
                 .georef
                 .world_to_pixel(&Vector3::new(g[0], g[1], g[2]));
             let predicted = tf.apply(&Vector2::new(u_o, v_o));
-            if !(predicted.x >= 0.0
-                && predicted.y >= 0.0
-                && predicted.x < aerial.width as f64
-                && predicted.y < aerial.height as f64)
-            {
+            if !aerial_window.image_contains(predicted.x, predicted.y) {
                 return Outcome::Outside;
             }
             let Some(corner) = cut_template(mm_ortho, u_o, v_o, p, buf) else {
@@ -478,7 +487,9 @@ pub fn refine_in_aerial(
                     }
                 }
             }
-            let Some((dx, dy, peak)) = search_template(aerial, &tf, corner, p, &phase, buf) else {
+            let Some((dx, dy, peak)) =
+                search_template(aerial_img, &tf_window, corner, p, &phase, buf)
+            else {
                 return Outcome::Rejected;
             };
             let observed = tf.apply(&Vector2::new(u_o + dx, v_o + dy));
@@ -512,15 +523,16 @@ pub fn refine_in_aerial(
     }
     if p.max_shift_spread_px > 0.0 {
         let before = result.matches.len();
-        result.matches =
-            consistent_shifts(std::mem::take(&mut result.matches), p.max_shift_spread_px);
+        // The spread is in working pixels; corrections are in full-resolution pixels.
+        let spread_px = p.max_shift_spread_px * aerial_window.window.scale();
+        result.matches = consistent_shifts(std::mem::take(&mut result.matches), spread_px);
         result.shift_inconsistent = before - result.matches.len();
     }
     if result.matches.len() < p.min_located {
         result.unconfirmed = result.matches.len();
         result.matches.clear();
     }
-    result
+    Ok(result)
 }
 
 /// The matches whose correction (observed − predicted, aerial px) lies within `spread_px` of the component-wise

@@ -17,6 +17,8 @@
 
 use crate::geometry::frame::FrameCamera;
 use crate::geometry::panorama::PanoramaCamera;
+use crate::imaging::equirect::PanoramaLevels;
+use crate::imaging::pyramid::ScaledWindow;
 use crate::imaging::GrayImage;
 use nalgebra::Vector3;
 
@@ -96,28 +98,6 @@ impl PatchGrid {
     }
 }
 
-/// Bilinear sample of an equirectangular panorama at a continuous pixel, wrapping columns across the 0/360°
-/// seam and clamping rows; `None` for a non-finite coordinate or a row outside `[0, H)`.
-fn sample_panorama(pano: &GrayImage, u_px: f64, v_px: f64) -> Option<f32> {
-    let (w, h) = (pano.width, pano.height);
-    if w == 0 || h == 0 || !u_px.is_finite() || !(0.0..h as f64).contains(&v_px) {
-        return None;
-    }
-    let x = u_px - 0.5;
-    let y = (v_px - 0.5).clamp(0.0, (h - 1) as f64);
-    let x0f = x.floor();
-    let fx = x - x0f;
-    let y0 = (y.floor() as usize).min(h - 1);
-    let fy = y - y0 as f64;
-    let y1 = (y0 + 1).min(h - 1);
-    let x0 = (x0f as i64).rem_euclid(w as i64) as usize;
-    let x1 = (x0 + 1) % w;
-    let p = |c: usize, r: usize| f64::from(pano.data[r * w + c]);
-    let v = (1.0 - fy) * ((1.0 - fx) * p(x0, y0) + fx * p(x1, y0))
-        + fy * ((1.0 - fx) * p(x0, y1) + fx * p(x1, y1));
-    Some(v as f32)
-}
-
 /// Bilinear sample inside `[0, W) × [0, H)` (edge pixels replicated within the outer half pixel); `None`
 /// outside.
 fn sample_inside(img: &GrayImage, u_px: f64, v_px: f64) -> Option<f32> {
@@ -140,29 +120,49 @@ fn sample_inside(img: &GrayImage, u_px: f64, v_px: f64) -> Option<f32> {
 /// Most sub-samples per patch pixel and axis when a patch pixel covers several panorama pixels.
 pub const MAX_SUPERSAMPLING: usize = 4;
 
-/// Sub-samples per axis that make one patch pixel of `spacing_m` at `range_m` from the panorama centre average
-/// over the panorama pixels it covers (one panorama pixel spans `range · 2π / W` metres at right angles).
-fn supersampling(spacing_m: f64, range_m: f64, pano_width_px: u32) -> usize {
+/// The panorama level and sub-samples per axis that make one patch pixel of `spacing_m` at `range_m` from the
+/// panorama centre average over the panorama pixels it covers (one pixel of level l spans
+/// `range · 2π · 2^l / W` metres at right angles): the finest level, at most `max_level`, where at most
+/// [`MAX_SUPERSAMPLING`] sub-samples per axis do (a panorama several times finer than the patch is read from
+/// a coarser level instead of sampled more densely).
+pub fn panorama_sampling(
+    spacing_m: f64,
+    range_m: f64,
+    pano_width_px: u32,
+    max_level: usize,
+) -> (usize, usize) {
     let footprint_m = range_m * std::f64::consts::TAU / f64::from(pano_width_px.max(1));
     if !(footprint_m > 0.0) {
-        return 1;
+        return (0, 1);
     }
-    ((spacing_m / footprint_m).ceil() as usize).clamp(1, MAX_SUPERSAMPLING)
+    for level in 0..=max_level {
+        let k = (spacing_m / (footprint_m * (1u64 << level) as f64))
+            .ceil()
+            .max(1.0);
+        if k <= MAX_SUPERSAMPLING as f64 {
+            return (level, k as usize);
+        }
+    }
+    (max_level, MAX_SUPERSAMPLING)
 }
 
 /// The panorama patch: every grid pixel projected into the panorama (`cam`, whose `width_px` × `height_px`
-/// may differ from the image's size: coordinates are scaled) and sampled bilinearly; NaN where there is no
-/// data. The MM panorama resolves a façade 10 m away at ≈ 4 cm, finer than the oblique-resolution grid, so
-/// each patch pixel averages k × k bilinear samples spread over its cell (k from the panorama's pixel footprint
-/// at the patch centre, at most [`MAX_SUPERSAMPLING`]) instead of point-sampling — which would alias the
-/// façade texture and blur the MI optimum. A pixel whose sub-samples are partly missing averages the rest.
-pub fn fill_from_panorama(grid: &PatchGrid, cam: &PanoramaCamera, pano: &GrayImage) -> GrayImage {
+/// may differ from the panorama's full size: coordinates are scaled) and sampled bilinearly; NaN where there
+/// is no data. The MM panorama resolves a façade 10 m away at ≈ 4 cm, finer than the oblique-resolution grid,
+/// so each patch pixel averages k × k bilinear samples spread over its cell, from the level and with the k of
+/// [`panorama_sampling`] at the patch centre, instead of point-sampling — which would alias the façade texture
+/// and blur the MI optimum. A pixel whose sub-samples are partly missing averages the rest.
+pub fn fill_from_panorama(
+    grid: &PatchGrid,
+    cam: &PanoramaCamera,
+    pano: &PanoramaLevels,
+) -> GrayImage {
     let n = grid.size_px;
     let mut out = GrayImage::filled(n, n, f32::NAN);
-    let sx = pano.width as f64 / f64::from(cam.width_px);
-    let sy = pano.height as f64 / f64::from(cam.height_px);
+    let sx = pano.width_px as f64 / f64::from(cam.width_px);
+    let sy = pano.height_px as f64 / f64::from(cam.height_px);
     let range_m = (grid.centre_world - cam.center_world).norm();
-    let k = supersampling(grid.spacing_m, range_m, cam.width_px);
+    let (level, k) = panorama_sampling(grid.spacing_m, range_m, cam.width_px, pano.max_level());
     let offsets: Vec<f64> = (0..k).map(|j| (j as f64 + 0.5) / k as f64).collect();
     for row in 0..n {
         for col in 0..n {
@@ -172,7 +172,7 @@ pub fn fill_from_panorama(grid: &PatchGrid, cam: &PanoramaCamera, pano: &GrayIma
                     let p = grid.world_at(col as f64 + ox, row as f64 + oy);
                     if let Some(g) = cam
                         .project_world(&p)
-                        .and_then(|(u, v)| sample_panorama(pano, u * sx, v * sy))
+                        .and_then(|(u, v)| pano.sample_checked(level, u * sx, v * sy))
                     {
                         sum += f64::from(g);
                         count += 1;
@@ -216,21 +216,24 @@ impl FramePatch {
     }
 }
 
-/// Projects every grid pixel centre into a frame image: `(index, u, v)` in the image's own pixel size
-/// (camera coordinates scaled to the image) for the points inside it, in row-major order.
+/// Projects every grid pixel centre into a frame image read as `window` (a level of its pyramid): `(index, u,
+/// v)` in window pixels for the points inside the image and the window, in row-major order. The camera's
+/// pixels are the full-resolution image's.
 fn frame_projections(
     grid: &PatchGrid,
     cam: &FrameCamera,
-    img_width: usize,
-    img_height: usize,
+    window: &ScaledWindow,
     mut f: impl FnMut(usize, f64, f64),
 ) {
-    let sx = img_width as f64 / f64::from(cam.width_px);
-    let sy = img_height as f64 / f64::from(cam.height_px);
+    let (fw, fh) = (window.full_size.0 as f64, window.full_size.1 as f64);
+    let (ww, wh) = (window.image.width as f64, window.image.height as f64);
     grid.for_each_pixel(|i, p| {
         if let Some((u, v)) = cam.project_world(&p) {
-            let (u, v) = (u * sx, v * sy);
-            if (0.0..img_width as f64).contains(&u) && (0.0..img_height as f64).contains(&v) {
+            if !((0.0..fw).contains(&u) && (0.0..fh).contains(&v)) {
+                return;
+            }
+            let (u, v) = window.from_full(u, v);
+            if (0.0..ww).contains(&u) && (0.0..wh).contains(&v) {
                 f(i, u, v);
             }
         }
@@ -249,13 +252,15 @@ fn count_distinct(cells: &mut [u64]) -> usize {
     distinct
 }
 
-/// The oblique patch: every grid pixel centre projected with `cam` (scaled to the image's size) and sampled
-/// bilinearly, with the counts of the real-resolution ratio.
-pub fn fill_from_frame(grid: &PatchGrid, cam: &FrameCamera, img: &GrayImage) -> FramePatch {
+/// The oblique patch: every grid pixel centre projected with `cam` into `window` (the image at the level the
+/// patches are made at) and sampled bilinearly, with the counts of the real-resolution ratio (distinct pixels
+/// of that level).
+pub fn fill_from_frame(grid: &PatchGrid, cam: &FrameCamera, window: &ScaledWindow) -> FramePatch {
     let n = grid.size_px;
+    let img = &window.image;
     let mut out = GrayImage::filled(n, n, f32::NAN);
     let mut cells: Vec<u64> = Vec::with_capacity(n * n);
-    frame_projections(grid, cam, img.width, img.height, |i, u, v| {
+    frame_projections(grid, cam, window, |i, u, v| {
         if let Some(g) = sample_inside(img, u, v) {
             out.data[i] = g;
             cells.push((v.floor() as u64) * img.width as u64 + u.floor() as u64);
@@ -269,17 +274,17 @@ pub fn fill_from_frame(grid: &PatchGrid, cam: &FrameCamera, img: &GrayImage) -> 
     }
 }
 
-/// Real-resolution ratio of a grid in a frame image of `img_width × img_height` px, without sampling
+/// Real-resolution ratio of a grid in a frame image read as `window`, without sampling
 /// ([`FramePatch::real_resolution_ratio`]), and the fraction of the grid inside the image.
 pub fn real_resolution_ratio(
     grid: &PatchGrid,
     cam: &FrameCamera,
-    img_width: usize,
-    img_height: usize,
+    window: &ScaledWindow,
 ) -> (f64, f64) {
     let mut cells: Vec<u64> = Vec::with_capacity(grid.size_px * grid.size_px);
-    frame_projections(grid, cam, img_width, img_height, |_, u, v| {
-        cells.push((v.floor() as u64) * img_width as u64 + u.floor() as u64);
+    let width = window.image.width as u64;
+    frame_projections(grid, cam, window, |_, u, v| {
+        cells.push((v.floor() as u64) * width + u.floor() as u64);
     });
     let valid = cells.len();
     let fraction = valid as f64 / (grid.size_px * grid.size_px) as f64;
@@ -291,14 +296,18 @@ pub fn real_resolution_ratio(
 
 #[cfg(test)]
 mod supersampling_tests {
-    use super::supersampling;
+    use super::panorama_sampling;
 
     #[test]
-    fn sub_samples_follow_the_panorama_footprint() {
+    fn sub_samples_and_levels_follow_the_panorama_footprint() {
         // 1600-px panorama: a pixel spans 2π·10/1600 ≈ 3.9 cm at 10 m.
-        assert_eq!(supersampling(0.10, 10.0, 1600), 3);
-        assert_eq!(supersampling(0.03, 10.0, 1600), 1);
-        assert_eq!(supersampling(0.20, 10.0, 1600), 4); // capped
-        assert_eq!(supersampling(0.10, 0.0, 1600), 1);
+        assert_eq!(panorama_sampling(0.10, 10.0, 1600, 5), (0, 3));
+        assert_eq!(panorama_sampling(0.03, 10.0, 1600, 5), (0, 1));
+        // 0.20 m needs 6 sub-samples at level 0: level 1 with 3.
+        assert_eq!(panorama_sampling(0.20, 10.0, 1600, 5), (1, 3));
+        assert_eq!(panorama_sampling(0.20, 10.0, 1600, 0), (0, 4)); // capped
+        assert_eq!(panorama_sampling(0.10, 0.0, 1600, 5), (0, 1));
+        // The same panorama 4× as wide: two levels up, the same sub-samples.
+        assert_eq!(panorama_sampling(0.10, 10.0, 6400, 5), (2, 3));
     }
 }

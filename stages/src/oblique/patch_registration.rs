@@ -17,11 +17,13 @@
 //! oblique patch at x + (dx, dy); it converts to the plane shift (dx·s, −dy·s) along (`axis_u`, `axis_v`)
 //! (`patch` module doc), the `PatchMatch::shift_plane_m` convention.
 //!
-//! The panorama image must be the original panorama (its size defines the equirectangular camera, and the MM
-//! observations are in its pixels); the oblique image may be resampled (its coordinates are scaled to the
-//! camera's `width_px × height_px`). Deterministic: every registration seeds its ES and MI sampling from
-//! `seed`, the point id and the oblique image id; points run in parallel with an ordered collect.
+//! Both images are read through their pyramids ([`inputs`]): the oblique image as one window at the level
+//! whose resolution on the façade does not exceed `registration_resolution_m` (the theoretical resolution of
+//! the patches is that level's), the panorama as the bands its patches sample. Measurements are in the
+//! full-resolution images' pixels. Deterministic: every registration seeds its ES and MI sampling from `seed`,
+//! the point id and the oblique image id; points run in parallel with an ordered collect.
 
+pub mod inputs;
 mod params;
 pub mod search;
 
@@ -34,6 +36,8 @@ use crate::estimators::mix_seed;
 use crate::estimators::one_plus_one::OnePlusOneParams;
 use crate::geometry::frame::FrameCamera;
 use crate::geometry::panorama::PanoramaCamera;
+use crate::imaging::equirect::PanoramaLevels;
+use crate::imaging::pyramid::{PyramidError, ScaledWindow, TileSource};
 use crate::imaging::GrayImage;
 use crate::oblique::patch::{
     fill_from_frame, fill_from_panorama, real_resolution_ratio, PatchGrid,
@@ -81,9 +85,9 @@ enum FirstLevel {
 /// Everything the levels share.
 struct Context<'a> {
     pano_cam: PanoramaCamera,
-    pano: &'a GrayImage,
+    pano: &'a PanoramaLevels,
     frame_cam: FrameCamera,
-    oblique_img: &'a GrayImage,
+    oblique: &'a ScaledWindow,
     oblique_id: &'a str,
     p: &'a PatchParams,
 }
@@ -138,7 +142,7 @@ impl Context<'_> {
         let moving = fill_from_frame(
             &grid.shifted(oblique_offset_m),
             &self.frame_cam,
-            self.oblique_img,
+            self.oblique,
         );
         let fixed_valid =
             fixed.data.iter().filter(|v| v.is_finite()).count() as f64 / fixed.data.len() as f64;
@@ -192,7 +196,8 @@ impl Context<'_> {
         };
         let p = self.p;
         let centre = point.tie.point_world;
-        let s = c.view.resolution_m;
+        // The theoretical resolution at the level the oblique image is read at.
+        let s = c.view.resolution_m * self.oblique.scale();
         // thesis 4.4.5: the real-resolution ratio at the theoretical resolution, on the final level's extent.
         let ratio_extent = if p.hierarchical {
             p.fine_extent_m
@@ -202,12 +207,7 @@ impl Context<'_> {
         let Some(ratio_grid) = self.grid(c, centre, ratio_extent, s) else {
             return FirstLevel::Outside;
         };
-        let (ratio, inside) = real_resolution_ratio(
-            &ratio_grid,
-            &self.frame_cam,
-            self.oblique_img.width,
-            self.oblique_img.height,
-        );
+        let (ratio, inside) = real_resolution_ratio(&ratio_grid, &self.frame_cam, self.oblique);
         if inside < p.min_valid_fraction {
             return FirstLevel::Outside;
         }
@@ -253,7 +253,7 @@ impl Context<'_> {
             c,
             point.tie.point_world,
             p.fine_extent_m,
-            c.view.resolution_m,
+            c.view.resolution_m * self.oblique.scale(),
         )?;
         let (fixed, moving) = self.patches(&grid, coarse_m)?;
         let window_px = p.fine_window_m / grid.spacing_m;
@@ -307,33 +307,77 @@ impl Context<'_> {
 }
 
 /// Register every thinned façade point of `facades` whose plane sees `oblique` against the panorama `pano` of
-/// `recording` (the triplet centre). See the module doc for the levels; every candidate ends in exactly one of
-/// the `PatchStats` counters (`matches` includes `rejected_coarse`).
+/// `recording` (the triplet centre), both read through their pyramids ([`inputs`]). See the module doc for
+/// the levels; every candidate ends in exactly one of the `PatchStats` counters (`matches` includes
+/// `rejected_coarse`). `Err` only when an image cannot be read.
 pub fn register_patches(
     recording: &Recording,
-    pano: &GrayImage,
+    pano: &dyn TileSource,
     oblique: &AerialImage,
-    oblique_img: &GrayImage,
+    oblique_img: &dyn TileSource,
     cloud: &SparseCloud,
     facades: &TripletFacades,
     p: &PatchParams,
-) -> PatchRegistrationSet {
+) -> Result<PatchRegistrationSet, PyramidError> {
+    let candidates = candidates(facades, cloud, &oblique.image_id);
+    let frame_cam = FrameCamera::from_aerial(oblique);
+    let pano_layout = pano.layout();
+    let pano_cam = PanoramaCamera::from_recording(
+        recording,
+        pano_layout.width as u32,
+        pano_layout.height as u32,
+    );
+    let points: Vec<inputs::PointInPlane> = candidates
+        .iter()
+        .filter_map(|c| {
+            Some(inputs::PointInPlane {
+                plane: c.plane,
+                view: c.view,
+                point: c.point?,
+            })
+        })
+        .collect();
+    let level = inputs::oblique_level(&points, p, oblique_img.layout().levels());
+    let window = inputs::oblique_window(oblique_img, &frame_cam, &points, p, level)?;
+    let Some(window) = window else {
+        let mut stats = PatchStats {
+            candidates: candidates.len(),
+            ..PatchStats::default()
+        };
+        stats.rejected_outside = candidates.len();
+        return Ok(PatchRegistrationSet {
+            recording: recording.image_id.clone(),
+            oblique_image_id: oblique.image_id.clone(),
+            matches: Vec::new(),
+            stats,
+        });
+    };
+    let bands = inputs::panorama_bands(pano, &pano_cam, &points, p, window.scale())?;
     let ctx = Context {
-        pano_cam: PanoramaCamera::from_recording(recording, pano.width as u32, pano.height as u32),
-        pano,
-        frame_cam: FrameCamera::from_aerial(oblique),
-        oblique_img,
+        pano_cam,
+        pano: &bands,
+        frame_cam,
+        oblique: &window,
         oblique_id: &oblique.image_id,
         p,
     };
-    let candidates: Vec<Candidate> = facades
+    Ok(register_with(&ctx, recording, oblique, &candidates))
+}
+
+/// The thinned points of the planes that see oblique image `oblique_id`, plane by plane.
+fn candidates<'a>(
+    facades: &'a TripletFacades,
+    cloud: &'a SparseCloud,
+    oblique_id: &str,
+) -> Vec<Candidate<'a>> {
+    facades
         .planes
         .iter()
         .filter_map(|plane| {
             plane
                 .views
                 .iter()
-                .find(|v| v.image_id == oblique.image_id)
+                .find(|v| v.image_id == oblique_id)
                 .map(|view| (plane, view))
         })
         .flat_map(|(plane, view)| {
@@ -343,13 +387,22 @@ pub fn register_patches(
                 point: cloud.points.get(i),
             })
         })
-        .collect();
+        .collect()
+}
+
+/// The registration of `candidates` once the images are read.
+fn register_with(
+    ctx: &Context,
+    recording: &Recording,
+    oblique: &AerialImage,
+    candidates: &[Candidate],
+) -> PatchRegistrationSet {
+    let p = ctx.p;
     let mut stats = PatchStats {
         candidates: candidates.len(),
         ..PatchStats::default()
     };
-    let degenerate =
-        pano.width == 0 || pano.height == 0 || oblique_img.width == 0 || oblique_img.height == 0;
+    let degenerate = ctx.oblique.image.width == 0 || ctx.oblique.image.height == 0;
     let first: Vec<FirstLevel> = if degenerate {
         candidates.iter().map(|_| FirstLevel::Outside).collect()
     } else {

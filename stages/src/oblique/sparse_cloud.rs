@@ -22,7 +22,7 @@ use crate::features::daisy::DaisyExtractor;
 use crate::geometry::perspective::PerspectiveView;
 use crate::geometry::trifocal::TrifocalTensor;
 use crate::geometry::{LocalOrigin, PanoramaCamera};
-use crate::imaging::GrayImage;
+use crate::imaging::equirect::{level_for, PanoramaLevels};
 use crate::matching::descriptor_match::{
     match_ratio, match_restricted, DescriptorMatch, MatchError,
 };
@@ -40,15 +40,63 @@ struct ViewFeatures {
     corners: usize,
 }
 
+/// The pyramid level a view samples: the finest whose pixel is not smaller than the view's centre pixel.
+fn view_level(view: &PerspectiveView, cam: &PanoramaCamera, max_level: usize) -> usize {
+    level_for(
+        cam.pixel_angle_rad(),
+        view.centre_pixel_angle_rad(),
+        max_level,
+    )
+}
+
+/// The six views of the panorama of `rec` (three yaw deviations per side; a triplet member renders one per
+/// side, but which one depends on its place in the triplet).
+fn all_views(rec: &Recording, cam: &PanoramaCamera, p: &SparseCloudParams) -> Vec<PerspectiveView> {
+    StreetSide::BOTH
+        .iter()
+        .flat_map(|&side| p.yaw_deviations_deg(side))
+        .map(|d| {
+            PerspectiveView::of_panorama(
+                cam,
+                p.view_width_px,
+                p.vfov_deg,
+                rec.heading_deg + d,
+                p.pitch_deg,
+            )
+        })
+        .collect()
+}
+
+/// Which rows of which pyramid levels the views of the panorama of `rec` (`width × height` px, levels
+/// `0..=max_level`) sample: (level, (v0, v1)) in full-resolution rows.
+pub fn panorama_bands(
+    rec: &Recording,
+    p: &SparseCloudParams,
+    (width, height): (usize, usize),
+    max_level: usize,
+) -> Vec<(usize, (f64, f64))> {
+    let cam = PanoramaCamera::from_recording(rec, width as u32, height as u32);
+    let mut bands: Vec<(usize, (f64, f64))> = Vec::new();
+    for view in all_views(rec, &cam, p) {
+        let level = view_level(&view, &cam, max_level);
+        let (v0, v1) = view.panorama_rows(&cam);
+        match bands.iter_mut().find(|(l, _)| *l == level) {
+            Some((_, r)) => *r = (r.0.min(v0), r.1.max(v1)),
+            None => bands.push((level, (v0, v1))),
+        }
+    }
+    bands
+}
+
 /// Render view `view`, detect AGAST corners and describe them with DAISY (corners whose descriptor window
 /// leaves the view are dropped).
 fn view_features(
     view: PerspectiveView,
-    pano: &GrayImage,
+    pano: &PanoramaLevels,
     cam: &PanoramaCamera,
     p: &SparseCloudParams,
 ) -> ViewFeatures {
-    let img = view.render(pano, cam);
+    let img = view.render_levels(pano, cam, view_level(&view, cam, pano.max_level()));
     let corners = detect_agast(&img, &p.agast);
     let ex = DaisyExtractor::new(&img, &p.daisy);
     let len = ex.descriptor_len();
@@ -104,7 +152,7 @@ fn match_pair(
 fn side_cloud(
     side: StreetSide,
     recs: [&Recording; 3],
-    panos: [&GrayImage; 3],
+    panos: [&PanoramaLevels; 3],
     cams: &[PanoramaCamera; 3],
     p: &SparseCloudParams,
     stats: &mut SparseCloudStats,
@@ -207,15 +255,15 @@ fn side_cloud(
     points
 }
 
-/// The sparse cloud of the triplet `recs` (trajectory order; `panos[i]` is the panorama of `recs[i]`).
-/// Parameters are assumed valid ([`SparseCloudParams::validate`]).
+/// The sparse cloud of the triplet `recs` (trajectory order; `panos[i]` is the panorama of `recs[i]`, with
+/// the bands of [`panorama_bands`]). Parameters are assumed valid ([`SparseCloudParams::validate`]).
 pub fn sparse_cloud(
     recs: [&Recording; 3],
-    panos: [&GrayImage; 3],
+    panos: [&PanoramaLevels; 3],
     p: &SparseCloudParams,
 ) -> SparseCloud {
     let cams: [PanoramaCamera; 3] = std::array::from_fn(|i| {
-        PanoramaCamera::from_recording(recs[i], panos[i].width as u32, panos[i].height as u32)
+        PanoramaCamera::from_recording(recs[i], panos[i].width_px as u32, panos[i].height_px as u32)
     });
     let per_side: Vec<(Vec<SparsePoint>, SparseCloudStats)> = StreetSide::BOTH
         .par_iter()

@@ -64,6 +64,11 @@ pub struct PatchParams {
     /// Largest patch side, px: a finer theoretical resolution is coarsened to keep patches at most this size
     /// (default 256).
     pub max_patch_px: usize,
+    /// Coarsest resolution on the façade the patches are made at, metres: an oblique image finer than this
+    /// (at the finest of the node's façade points) is read from the coarsest level of its pyramid whose
+    /// resolution does not exceed it, and the theoretical resolution is that level's (default 0.12 m: the
+    /// thesis' 5–15 cm obliques are used at full resolution; a 150-megapixel frame at 1.5 cm is read at 12 cm).
+    pub registration_resolution_m: f64,
     /// Seed of the MI sampling and the ES; each registration derives its own from it, the point id and the
     /// oblique image id.
     pub seed: u64,
@@ -91,6 +96,7 @@ impl Default for PatchParams {
             es_epsilon_m: 1e-3,
             min_valid_fraction: 0.5,
             max_patch_px: 256,
+            registration_resolution_m: 0.12,
             seed: 0,
         }
     }
@@ -189,6 +195,15 @@ impl PatchParams {
             self.min_valid_fraction > 0.0 && self.min_valid_fraction <= 1.0,
             "min_valid_fraction",
             format!("must be in (0, 1], got {}", self.min_valid_fraction),
+        );
+        check(
+            self.registration_resolution_m.is_finite()
+                && (0.001..=10.0).contains(&self.registration_resolution_m),
+            "registration_resolution_m",
+            format!(
+                "must be in [0.001, 10] m, got {}",
+                self.registration_resolution_m
+            ),
         );
         check(
             (8..=4096).contains(&self.max_patch_px),

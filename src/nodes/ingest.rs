@@ -1,0 +1,123 @@
+//! `ingest`: one image file (panorama, nadir or oblique frame) decoded once into a tiled, multi-resolution grey
+//! pyramid in the node's cache folder (`skytie_stages::imaging::ingest`), which every later stage reads window
+//! by window at the resolution it works at. The output records where the pyramid lies and the hash that
+//! authenticates its index (and through it every tile); a pyramid file that went missing or changed size is
+//! rebuilt. A file that does not decode fails this node only, with the file and the decoder's reason; its
+//! dependents are skipped and counted.
+
+use crate::dag::{
+    BuildError, DagBuilder, Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError,
+};
+use crate::workflow::{ParamError, StageParams};
+use serde::{Deserialize, Serialize};
+use skytie_stages::imaging::decode::{FileFormat, GeoTiffTags};
+use skytie_stages::imaging::ingest::ingest_with_tiles;
+use skytie_stages::imaging::pyramid::{SampleDepth, DEFAULT_TILE_SIDE};
+
+/// File name of the pyramid in the node's folder.
+const PYRAMID_FILE: &str = "image.pyr";
+
+/// Parameters of ingestion.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct IngestParams {
+    /// Side of the square tiles, pixels (a multiple of 16 in [64, 2048]; default 256).
+    pub tile_side_px: usize,
+}
+
+impl Default for IngestParams {
+    fn default() -> Self {
+        Self {
+            tile_side_px: DEFAULT_TILE_SIDE,
+        }
+    }
+}
+
+impl StageParams for IngestParams {
+    fn validate(&self) -> Result<(), Vec<ParamError>> {
+        let t = self.tile_side_px;
+        if (64..=2048).contains(&t) && t % 16 == 0 {
+            Ok(())
+        } else {
+            Err(vec![ParamError::new(
+                "tile_side_px",
+                format!("must be a multiple of 16 in [64, 2048] px, got {t}"),
+            )])
+        }
+    }
+}
+
+/// An ingested image: its source, size and sample depth, and the pyramid file that holds it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IngestedImage {
+    /// The source file (for messages).
+    pub source: String,
+    pub format: FileFormat,
+    pub width: u64,
+    pub height: u64,
+    pub depth: SampleDepth,
+    /// The sample value that maps to grey 1.0.
+    pub white: u16,
+    pub levels: u32,
+    /// Absolute path of the pyramid file in the cache.
+    pub pyramid_path: String,
+    /// blake3 of the pyramid's header and tile hashes.
+    pub index_hash: [u8; 32],
+    pub file_len: u64,
+    /// GeoTIFF tags of the source, when it has them.
+    pub geotiff: Option<GeoTiffTags>,
+}
+crate::serde_artifact!(IngestedImage);
+
+/// The ingestion node.
+pub struct Ingest;
+
+impl Stage for Ingest {
+    const NAME: &'static str = "ingest";
+    const VERSION: &'static str = "1";
+    type Params = IngestParams;
+    type Output = IngestedImage;
+    type Inputs = RawFile;
+
+    fn run(
+        &self,
+        p: &IngestParams,
+        file: RawFileValue,
+        ctx: &NodeCtx,
+    ) -> Result<IngestedImage, StageError> {
+        let tmp = ctx.output_dir_tmp()?;
+        let done = ingest_with_tiles(&file.path, &tmp.join(PYRAMID_FILE), p.tile_side_px)
+            .map_err(|e| StageError::new(e.to_string()))?;
+        let layout = &done.pyramid.layout;
+        Ok(IngestedImage {
+            source: file.path.display().to_string(),
+            format: done.info.format,
+            width: layout.width as u64,
+            height: layout.height as u64,
+            depth: layout.depth,
+            white: done.pyramid.white,
+            levels: layout.levels() as u32,
+            pyramid_path: ctx
+                .output_dir()
+                .join(PYRAMID_FILE)
+                .to_string_lossy()
+                .into_owned(),
+            index_hash: done.pyramid.index_hash,
+            file_len: done.pyramid.file_len,
+            geotiff: done.info.geotiff,
+        })
+    }
+
+    fn cached_output_ok(&self, out: &IngestedImage, _ctx: &NodeCtx) -> bool {
+        std::fs::metadata(&out.pyramid_path).is_ok_and(|m| m.len() == out.file_len)
+    }
+}
+
+/// Adds the ingestion of `path` (item label `label`); equal files share one node.
+pub fn ingest_file(
+    b: &mut DagBuilder,
+    label: &str,
+    path: std::path::PathBuf,
+) -> Result<Handle<IngestedImage>, BuildError> {
+    b.add(Ingest, label, IngestParams::default(), RawFile(path))
+}
