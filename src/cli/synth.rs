@@ -1,13 +1,16 @@
 //! `skytie synth --preset P --seed N --out DIR`: write a synthetic campaign (campaign-format.md + `truth/`).
 
 use clap::Args;
+use skytie_stages::synth::generate::SizeOptions;
+use skytie_stages::synth::output::{aerial_format_from, parse_size_px};
 use skytie_stages::synth::{generate, Deterioration, Preset, SynthOptions};
 use std::path::PathBuf;
 
 /// Arguments of `skytie synth`.
 #[derive(Args, Debug)]
 pub struct SynthArgs {
-    /// Preset: tiny (CI smoke), demo (README default), paper (four areas, full resolution).
+    /// Preset: tiny (CI smoke), demo (README default), paper (four areas, full resolution), realsize (real
+    /// sensor sizes on a short street).
     #[arg(long, default_value = "demo")]
     pub preset: String,
     /// Seed of the scene, noise and deterioration (same seed ⇒ byte-identical folder).
@@ -22,6 +25,46 @@ pub struct SynthArgs {
     /// Rayon threads (default: all cores). The output does not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Nadir camera size WIDTHxHEIGHT, px (the footprint is kept: the GSD scales with the width).
+    #[arg(long, value_name = "WxH")]
+    pub nadir_size: Option<String>,
+    /// Oblique camera size WIDTHxHEIGHT, px (footprint and distortion coefficients kept).
+    #[arg(long, value_name = "WxH")]
+    pub oblique_size: Option<String>,
+    /// Panorama width, px (even; height = width / 2).
+    #[arg(long)]
+    pub panorama_width: Option<u32>,
+    /// Aerial frames as jpeg or tiff (tiled, 256-px tiles; BigTIFF when larger than 3 GiB).
+    #[arg(long)]
+    pub aerial_format: Option<String>,
+    /// Compression of tiled TIFF frames: jpeg, lzw, deflate or none.
+    #[arg(long, default_value = "jpeg")]
+    pub tiff_compression: String,
+    /// Bits per sample of tiled TIFF frames: 8 or 16 (16-bit frames hold 12-bit data).
+    #[arg(long, default_value_t = 8)]
+    pub bits: u8,
+    /// Render images at most this wide and upsample them to the camera's size (0: render at full size).
+    #[arg(long)]
+    pub render_max_width: Option<u32>,
+    /// Write the campaign at the size it is rendered at (a real-size preset's demo-size twin).
+    #[arg(long)]
+    pub at_render_size: bool,
+}
+
+/// The size options of the command line.
+fn size_options(a: &SynthArgs, preset: Preset) -> Result<SizeOptions, String> {
+    let mut s = SizeOptions {
+        nadir_px: a.nadir_size.as_deref().map(parse_size_px).transpose()?,
+        oblique_px: a.oblique_size.as_deref().map(parse_size_px).transpose()?,
+        render_max_width_px: a.render_max_width,
+        at_render_size: a.at_render_size,
+        ..SizeOptions::default()
+    };
+    if let Some(f) = &a.aerial_format {
+        let quality = preset.params().jpeg_quality;
+        s.aerial_format = Some(aerial_format_from(f, &a.tiff_compression, a.bits, quality)?);
+    }
+    Ok(s)
 }
 
 /// Run `skytie synth`; returns the exit code.
@@ -34,6 +77,14 @@ pub fn main(a: &SynthArgs) -> i32 {
         }
     };
     let mut options = SynthOptions::new(preset, a.seed);
+    options.panorama_width_px = a.panorama_width;
+    options.sizes = match size_options(a, preset) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
     options.deterioration = match a.deterioration.as_str() {
         "thesis" => Deterioration::Thesis,
         "none" => Deterioration::None,

@@ -9,6 +9,7 @@
 use crate::dag::{NodeCtx, Stage, StageError};
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
+use skytie_stages::synth::output::{aerial_format_from, parse_size_px};
 use skytie_stages::synth::{generate_resumable, Deterioration, Preset, SynthOptions, SynthSummary};
 use std::path::{Path, PathBuf};
 
@@ -16,7 +17,7 @@ use std::path::{Path, PathBuf};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SynthParams {
-    /// `tiny`, `demo` or `paper`.
+    /// `tiny`, `demo`, `paper` or `realsize`.
     pub preset: String,
     pub seed: u64,
     /// Recorded-position deterioration: `thesis` (0.80 m systematic + N(0, 0.10 m), thesis 3.5.1.2) or `none`.
@@ -25,6 +26,20 @@ pub struct SynthParams {
     pub panorama_width_px: u32,
     /// Override of the number of recordings per route (0 = the preset's).
     pub max_recordings_per_route: usize,
+    /// Override of the nadir camera size, "WIDTHxHEIGHT" px (empty = the preset's; the footprint is kept).
+    pub nadir_size_px: String,
+    /// Override of the oblique camera size, "WIDTHxHEIGHT" px (empty = the preset's; the footprint is kept).
+    pub oblique_size_px: String,
+    /// Aerial file format: "jpeg" or "tiff" (tiled; empty = the preset's).
+    pub aerial_format: String,
+    /// Compression of tiled TIFF aerial frames: "jpeg", "lzw", "deflate" or "none".
+    pub tiff_compression: String,
+    /// Bits per sample of tiled TIFF aerial frames: 8 or 16 (16-bit frames hold 12-bit data).
+    pub aerial_bits: u8,
+    /// Render images at most this wide and upsample them to the camera's size (0 = the preset's choice).
+    pub render_max_width_px: u32,
+    /// Write the campaign at its render size (the demo-size twin of a real-size preset).
+    pub at_render_size: bool,
 }
 
 impl Default for SynthParams {
@@ -35,6 +50,13 @@ impl Default for SynthParams {
             deterioration: "thesis".into(),
             panorama_width_px: 0,
             max_recordings_per_route: 0,
+            nadir_size_px: String::new(),
+            oblique_size_px: String::new(),
+            aerial_format: String::new(),
+            tiff_compression: "jpeg".into(),
+            aerial_bits: 8,
+            render_max_width_px: 0,
+            at_render_size: false,
         }
     }
 }
@@ -59,6 +81,25 @@ impl SynthParams {
         if self.max_recordings_per_route != 0 {
             o.max_recordings_per_route = Some(self.max_recordings_per_route);
         }
+        if !self.nadir_size_px.is_empty() {
+            o.sizes.nadir_px = Some(parse_size_px(&self.nadir_size_px)?);
+        }
+        if !self.oblique_size_px.is_empty() {
+            o.sizes.oblique_px = Some(parse_size_px(&self.oblique_size_px)?);
+        }
+        if !self.aerial_format.is_empty() {
+            let quality = preset.params().jpeg_quality;
+            o.sizes.aerial_format = Some(aerial_format_from(
+                &self.aerial_format,
+                &self.tiff_compression,
+                self.aerial_bits,
+                quality,
+            )?);
+        }
+        if self.render_max_width_px != 0 {
+            o.sizes.render_max_width_px = Some(self.render_max_width_px);
+        }
+        o.sizes.at_render_size = self.at_render_size;
         o.params().map_err(|e| e.to_string())?;
         Ok(o)
     }

@@ -60,15 +60,15 @@ pub fn aerial_ground_similarity(cam: &FrameCamera, point_world: [f64; 3]) -> Opt
     (gsd_m.is_finite() && gsd_m > 0.0).then_some((gsd_m, azimuth_deg))
 }
 
-/// Levels a pyramid of a `width × height` image has at least (its coarsest level fits 32 px).
+/// Levels the pyramid of a `width × height` image has.
 fn level_count(width: u32, height: u32) -> usize {
-    let mut side = width.max(height).max(1);
-    let mut n = 1;
-    while side > 32 {
-        side = side.div_ceil(2);
-        n += 1;
-    }
-    n
+    crate::imaging::pyramid::PyramidLayout::new(
+        width.max(1) as usize,
+        height.max(1) as usize,
+        crate::imaging::pyramid::SampleDepth::U8,
+        crate::imaging::pyramid::DEFAULT_TILE_SIDE,
+    )
+    .map_or(1, |l| l.levels())
 }
 
 /// The pyramid level of an aerial image of `aerial_gsd_m` (size `width × height`) that the registration works

@@ -9,6 +9,7 @@
 use super::aerial_plan::{plan_nadir, plan_oblique};
 use super::control::{plan_control, ControlParams, ControlSet};
 use super::deteriorate::{Deterioration, DeteriorationModel};
+use super::output::{render_factor, write_aerial_image, write_jpeg, AerialFormat};
 use super::postprocess::{apply_look, EpochLook};
 use super::preset::{Preset, PresetParams};
 use super::render::{primary_rays, render_frame, render_panorama_with_vehicle};
@@ -22,7 +23,6 @@ use super::SynthError;
 use crate::campaign::write as cw;
 use crate::campaign::{AerialImage, Recording};
 use crate::geometry::{FrameCamera, PanoramaCamera};
-use crate::imaging::io::save_rgb;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -43,6 +43,88 @@ pub struct SynthOptions {
     pub panorama_width_px: Option<u32>,
     /// Override the maximum number of panoramas per route.
     pub max_recordings_per_route: Option<usize>,
+    /// Sensor sizes and image files.
+    #[serde(default)]
+    pub sizes: SizeOptions,
+}
+
+/// Overrides of the preset's sensor sizes and image files.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SizeOptions {
+    /// Nadir camera width × height, px; the footprint is kept (the GSD scales with the width).
+    pub nadir_px: Option<(u32, u32)>,
+    /// Oblique camera width × height, px; the footprint and the distortion coefficients are kept.
+    pub oblique_px: Option<(u32, u32)>,
+    /// File format of the aerial frames.
+    pub aerial_format: Option<AerialFormat>,
+    /// Render at most this wide and upsample (`Some(0)`: render at the camera's size).
+    pub render_max_width_px: Option<u32>,
+    /// Write the campaign at the size it is rendered at (cameras divided by the render factors): the
+    /// demo-size twin of a real-size preset, with the same scene, trajectory, flight plans and content.
+    pub at_render_size: bool,
+}
+
+impl SizeOptions {
+    /// `p` with these overrides applied.
+    fn apply(&self, p: &mut PresetParams) -> Result<(), SynthError> {
+        let bad = |option: &str, message: String| SynthError::InvalidOption {
+            option: option.into(),
+            message,
+        };
+        let size_ok = |(w, h): (u32, u32)| w >= 16 && h >= 16 && w <= 1 << 20 && h <= 1 << 20;
+        if let Some((w, h)) = self.nadir_px {
+            if !size_ok((w, h)) {
+                return Err(bad(
+                    "nadir_px",
+                    format!("{w} × {h}; give sides in [16, 1048576]"),
+                ));
+            }
+            p.nadir.gsd_m *= f64::from(p.nadir.width_px) / f64::from(w);
+            (p.nadir.width_px, p.nadir.height_px) = (w, h);
+        }
+        if let Some((w, h)) = self.oblique_px {
+            if !size_ok((w, h)) {
+                return Err(bad(
+                    "oblique_px",
+                    format!("{w} × {h}; give sides in [16, 1048576]"),
+                ));
+            }
+            let f = f64::from(w) / f64::from(p.oblique.width_px);
+            p.oblique.gsd_center_m /= f;
+            p.oblique.corner_distortion_px *= f;
+            (p.oblique.width_px, p.oblique.height_px) = (w, h);
+        }
+        if let Some(format) = self.aerial_format {
+            format.check().map_err(|m| bad("aerial_format", m))?;
+            p.aerial_format = format;
+        }
+        if let Some(cap) = self.render_max_width_px {
+            p.render_max_width_px = (cap > 0).then_some(cap);
+        }
+        if self.at_render_size {
+            at_render_size(p);
+        }
+        Ok(())
+    }
+}
+
+/// The preset at the size its images are rendered at: every camera divided by its render factor, GSDs and
+/// pixel-sized noise and distortion scaled to match, nothing upsampled.
+fn at_render_size(p: &mut PresetParams) {
+    let cap = p.render_max_width_px;
+    let k = f64::from(render_factor(p.nadir.width_px, p.nadir.height_px, cap));
+    p.nadir.width_px = (f64::from(p.nadir.width_px) / k) as u32;
+    p.nadir.height_px = (f64::from(p.nadir.height_px) / k) as u32;
+    p.nadir.gsd_m *= k;
+    let k = f64::from(render_factor(p.oblique.width_px, p.oblique.height_px, cap));
+    p.oblique.width_px = (f64::from(p.oblique.width_px) / k) as u32;
+    p.oblique.height_px = (f64::from(p.oblique.height_px) / k) as u32;
+    p.oblique.gsd_center_m *= k;
+    p.oblique.corner_distortion_px /= k;
+    let k = render_factor(p.panorama_width_px, p.panorama_height_px(), cap);
+    p.panorama_width_px /= k;
+    p.observation_sigma_px /= f64::from(k);
+    p.render_max_width_px = None;
 }
 
 impl SynthOptions {
@@ -56,6 +138,7 @@ impl SynthOptions {
             oblique_altitude_m: None,
             panorama_width_px: None,
             max_recordings_per_route: None,
+            sizes: SizeOptions::default(),
         }
     }
 
@@ -108,6 +191,7 @@ impl SynthOptions {
             }
             p.max_recordings_per_route = n;
         }
+        self.sizes.apply(&mut p)?;
         Ok(p)
     }
 
@@ -243,6 +327,12 @@ pub fn plan_campaign(options: &SynthOptions) -> Result<CampaignPlan, SynthError>
             control,
         });
     }
+    let extension = params.aerial_format.extension();
+    for a in &mut areas {
+        for img in a.nadir.iter_mut().chain(a.oblique.iter_mut()) {
+            img.file = format!("{}.{extension}", img.image_id);
+        }
+    }
     let deterioration = options.deterioration.resolve(seed);
     let mut recorded = Vec::new();
     for a in &mut areas {
@@ -272,9 +362,15 @@ fn write_panorama(
     seed: u64,
     dir: &Path,
 ) -> Result<u64, SynthError> {
-    let camera = PanoramaCamera::new(
+    // Rendered at the camera's size / k, upsampled by k when written.
+    let k = render_factor(
         p.panorama_width_px,
         p.panorama_height_px(),
+        p.render_max_width_px,
+    );
+    let camera = PanoramaCamera::new(
+        p.panorama_width_px / k,
+        p.panorama_height_px() / k,
         Vector3::new(rec.x, rec.y, rec.z),
         rec.yaw_deg,
         rec.pitch_deg,
@@ -295,7 +391,7 @@ fn write_panorama(
         hash_str(&rec.image_id),
     );
     let path = dir.join(&rec.file);
-    save_rgb(&path, &img, p.jpeg_quality).map_err(|e| SynthError::io(&path, e))?;
+    write_jpeg(&img, k, &path, p.jpeg_quality)?;
     Ok(primary_rays(
         camera.width_px,
         camera.height_px,
@@ -311,12 +407,25 @@ fn write_aerial(
     seed: u64,
     dir: &Path,
 ) -> Result<u64, SynthError> {
-    let camera = FrameCamera::from_aerial(a);
+    // Rendered at the camera's size / k (the same camera with its interior orientation divided by k),
+    // upsampled by k when written.
+    let k = render_factor(a.width_px, a.height_px, p.render_max_width_px);
+    let mut camera = FrameCamera::from_aerial(a);
+    let kf = f64::from(k);
+    camera.focal_px /= kf;
+    camera.cx_px /= kf;
+    camera.cy_px /= kf;
+    camera.width_px /= k;
+    camera.height_px /= k;
     let linear = render_frame(scene, &camera, Epoch::Aerial, p.aerial_spp_axis);
     let img = apply_look(&linear, &EpochLook::aerial(), seed, hash_str(&a.image_id));
     let path = dir.join(&a.file);
-    save_rgb(&path, &img, p.jpeg_quality).map_err(|e| SynthError::io(&path, e))?;
-    Ok(primary_rays(a.width_px, a.height_px, p.aerial_spp_axis))
+    write_aerial_image(&img, k, &path, p.aerial_format, p.jpeg_quality)?;
+    Ok(primary_rays(
+        camera.width_px,
+        camera.height_px,
+        p.aerial_spp_axis,
+    ))
 }
 
 /// Write every file of the planned campaign into `root` (which must exist and be empty), taking the images an

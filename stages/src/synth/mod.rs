@@ -15,6 +15,7 @@ pub mod control;
 pub mod deteriorate;
 pub mod error;
 pub mod generate;
+pub mod output;
 pub mod postprocess;
 pub mod preset;
 pub mod render;

@@ -1,11 +1,13 @@
-//! The three synthetic campaign presets (`tiny`, `demo`, `paper`) and every knob they fix: scene areas,
-//! panorama size and supersampling, aerial flight plans, check-point density.
+//! The synthetic campaign presets (`tiny`, `demo`, `paper`, `realsize`) and every knob they fix: scene areas,
+//! panorama size and supersampling, aerial flight plans, check-point density, image sizes and files.
 //!
 //! Aerial geometry follows the thesis data: nadir at ≈ 4470 m above ground with ≈ 10 cm GSD and 60 % / 40 %
 //! overlap (thesis 3.5.1.1, 5.5), pentacam obliques tilted 45° at ≈ 450 m (thesis 4.5).
 
+use super::output::AerialFormat;
 use super::scene::{RouteSpec, SceneSpec};
 use super::SynthError;
+use crate::imaging::tiff_write::TiffCompression;
 use serde::{Deserialize, Serialize};
 
 /// A named preset of the synthetic campaign.
@@ -17,6 +19,10 @@ pub enum Preset {
     Demo,
     /// The thesis-sized campaign: four areas of ~100 panoramas each at full resolution (slow).
     Paper,
+    /// Real sensor sizes on a short street of the demo scene: a 26460 × 17004 nadir camera (UltraCam Eagle
+    /// Mark 3 class, tiled TIFF), 14192 × 10640 obliques, 8192 × 4096 panoramas; rendered at ≤ 2400 px wide
+    /// and upsampled to those sizes ([`super::output`]).
+    Realsize,
 }
 
 /// Distance between the origins of the four `paper` areas along world X, m.
@@ -26,7 +32,7 @@ pub const PAPER_AREA_SPACING_M: f64 = 2000.0;
 pub const PAPER_ROUTE_LENGTH_M: f64 = 495.0;
 
 /// Valid preset names, in the order shown in messages.
-pub const PRESET_NAMES: [&str; 3] = ["tiny", "demo", "paper"];
+pub const PRESET_NAMES: [&str; 4] = ["tiny", "demo", "paper", "realsize"];
 
 impl Preset {
     /// Parse a preset name (`tiny`, `demo`, `paper`, case-insensitive).
@@ -35,6 +41,7 @@ impl Preset {
             "tiny" => Ok(Preset::Tiny),
             "demo" => Ok(Preset::Demo),
             "paper" => Ok(Preset::Paper),
+            "realsize" => Ok(Preset::Realsize),
             _ => Err(SynthError::UnknownPreset {
                 name: name.to_string(),
                 valid: PRESET_NAMES.join(", "),
@@ -48,6 +55,7 @@ impl Preset {
             Preset::Tiny => "tiny",
             Preset::Demo => "demo",
             Preset::Paper => "paper",
+            Preset::Realsize => "realsize",
         }
     }
 
@@ -55,7 +63,7 @@ impl Preset {
     pub fn scene_specs(self) -> Vec<SceneSpec> {
         match self {
             Preset::Tiny => vec![SceneSpec::tiny()],
-            Preset::Demo => vec![SceneSpec::demo()],
+            Preset::Demo | Preset::Realsize => vec![SceneSpec::demo()],
             // The areas share one origin in their specs; they are placed side by side, far enough apart that
             // no aerial footprint of one area reaches another, and lengthened to ~100 panoramas each.
             Preset::Paper => (0..4)
@@ -129,6 +137,30 @@ impl Preset {
                 nadir: nadir(4000, 3000),
                 oblique: oblique(2000, 1500),
                 aerial_spp_axis: 2,
+                ..PresetParams::common()
+            },
+            // Rendered at 2205 × 1417 (nadir, ÷ 12), 887 × 665 (obliques, ÷ 16) and 2048 × 1024 (panoramas, ÷ 4),
+            // each at ≈ 10 cm on the ground like the demo; the footprints are the rendered images', so the GSD of
+            // the real-size files is 10 cm / 12 and / 16. Twelve recordings: a 55 m street.
+            Preset::Realsize => PresetParams {
+                panorama_width_px: 8192,
+                panorama_spp_axis: 2,
+                max_recordings_per_route: 12,
+                nadir: NadirPlan {
+                    gsd_m: 0.10 / 12.0,
+                    ..nadir(26460, 17004)
+                },
+                oblique: ObliquePlan {
+                    gsd_center_m: 0.10 / 16.0,
+                    corner_distortion_px: 2.0 * 16.0,
+                    ..oblique(14192, 10640)
+                },
+                aerial_spp_axis: 2,
+                render_max_width_px: Some(2400),
+                aerial_format: AerialFormat::TiledTiff {
+                    compression: TiffCompression::Jpeg(92),
+                    bits: 8,
+                },
                 ..PresetParams::common()
             },
         }
@@ -206,6 +238,11 @@ pub struct PresetParams {
     pub sigma_z_m: f64,
     /// JPEG quality of all images.
     pub jpeg_quality: u8,
+    /// Images are rendered at most this wide (at an exact integer fraction of the camera's size) and upsampled
+    /// to the camera's size; `None` renders at the camera's size ([`super::output::render_factor`]).
+    pub render_max_width_px: Option<u32>,
+    /// File format of the aerial frames (panoramas are always JPEG).
+    pub aerial_format: AerialFormat,
 }
 
 impl PresetParams {
@@ -246,6 +283,8 @@ impl PresetParams {
             sigma_xy_m: 1.0,
             sigma_z_m: 0.3,
             jpeg_quality: 92,
+            render_max_width_px: None,
+            aerial_format: AerialFormat::Jpeg,
         }
     }
 
@@ -261,12 +300,15 @@ mod tests {
 
     #[test]
     fn names_round_trip_and_unknown_names_list_the_valid_ones() {
-        for p in [Preset::Tiny, Preset::Demo, Preset::Paper] {
+        for p in [Preset::Tiny, Preset::Demo, Preset::Paper, Preset::Realsize] {
             assert_eq!(Preset::from_name(p.name()).unwrap(), p);
         }
         assert_eq!(Preset::from_name(" Demo ").unwrap(), Preset::Demo);
         let e = Preset::from_name("huge").unwrap_err().to_string();
-        assert!(e.contains("huge") && e.contains("tiny, demo, paper"), "{e}");
+        assert!(
+            e.contains("huge") && e.contains("tiny, demo, paper, realsize"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -301,6 +301,9 @@ impl PyramidBuilder {
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_else(|| "pyramid".into());
         let tmp = dest.with_file_name(format!(".{name}.{}.partial", std::process::id()));
+        if let Some(dir) = dest.parent().filter(|d| !d.as_os_str().is_empty()) {
+            fs::create_dir_all(dir)?;
+        }
         let file = OpenOptions::new()
             .read(true)
             .write(true)

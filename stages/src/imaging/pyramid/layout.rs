@@ -18,7 +18,10 @@ pub const TILE_HASH_LEN: usize = 32;
 pub const MAGIC: [u8; 8] = *b"SKYPYR\x00\x01";
 /// Default tile side, pixels.
 pub const DEFAULT_TILE_SIDE: usize = 256;
-/// Levels stop once both sides of a level fit in one tile, or at this many levels.
+/// Levels stop once the longer side of a level is at most this many pixels (so a stage can always reduce an
+/// image until a whole frame fits a few dozen pixels), or at [`MAX_LEVELS`].
+pub const TOP_LEVEL_SIDE: usize = 32;
+/// At most this many levels.
 pub const MAX_LEVELS: usize = 24;
 
 /// How a sample is stored.
@@ -85,7 +88,7 @@ impl PyramidLayout {
         let mut level_sizes = vec![(width, height)];
         while level_sizes.len() < MAX_LEVELS {
             let (w, h) = *level_sizes.last().expect("level 0 exists");
-            if w <= tile_side && h <= tile_side {
+            if w.max(h) <= TOP_LEVEL_SIDE {
                 break;
             }
             level_sizes.push((w.div_ceil(2), h.div_ceil(2)));
@@ -260,8 +263,8 @@ mod tests {
         assert_eq!(l.level_sizes[2], (6615, 4251));
         assert_eq!(l.level_sizes[3], (3308, 2126));
         let last = *l.level_sizes.last().unwrap();
-        assert!(last.0 <= 256 && last.1 <= 256);
-        assert_eq!(l.levels(), 8);
+        assert!(last.0 <= 32 && last.1 <= 32);
+        assert_eq!(l.levels(), 11);
         assert_eq!(l.tiles(0), (104, 67));
         // 1-px images have one level of one tile.
         let one = PyramidLayout::new(1, 1, SampleDepth::U16, 256).unwrap();
@@ -274,6 +277,7 @@ mod tests {
         let l = PyramidLayout::new(1000, 600, SampleDepth::U16, 128).unwrap();
         assert_eq!(l.tile_index(0, 0, 0), 0);
         assert_eq!(l.tile_index(1, 0, 0), 8 * 5);
+        assert_eq!(l.levels(), 6); // 1000 → 500 → 250 → 125 → 63 → 32
         assert_eq!(l.tile_offset(1) - l.tile_offset(0), 128 * 128 * 2);
         assert_eq!(
             l.file_len(),
