@@ -4,9 +4,9 @@
 //! COLMAP text model in `colmap/`. The encoders live in `skytie_stages::export`; every file is written atomically. A failed export is
 //! a warning naming the file; the run's other outputs are still written.
 
-use crate::nodes::adjust::AdjustReport;
-use crate::nodes::campaign::CampaignSnapshot;
-use crate::nodes::consensus::ObliqueOutput;
+use crate::nodes::adjust::adjustment::AdjustReport;
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::oblique::consensus::ObliqueOutput;
 use skytie_stages::adjustment::verify::{
     render_verification_table, write_verification_csv, Verification,
 };

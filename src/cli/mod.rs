@@ -5,6 +5,7 @@
 //! verify` found bad entries; 2 = usage or setup error (workflow does not load, unknown pipeline, cache or
 //! output folder not usable).
 
+pub mod builtin_workflows;
 pub mod cache;
 pub mod check;
 pub mod common;

@@ -32,8 +32,22 @@ macro_rules! forward_validate {
     )+};
 }
 
+/// `impl StageParams for T` for parameter structs declared with `skytie_stages::params!`.
+macro_rules! declared_params {
+    ($($t:ty),+ $(,)?) => {$(
+        impl StageParams for $t {
+            fn validate(&self) -> Result<(), Vec<ParamError>> {
+                skytie_stages::params::Params::validate(self).map_err(|v| {
+                    v.into_iter().map(|v| ParamError::new(v.field, v.message)).collect()
+                })
+            }
+        }
+    )+};
+}
+
+declared_params!(OrthoParams);
+
 forward_validate!(
-    OrthoParams,
     MmMatchParams,
     TransformParams,
     RefineParams,

@@ -10,17 +10,17 @@
 use super::nadir::RecordingItem;
 use super::{distance_m, missing_upstream, wf_err};
 use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
-use crate::nodes::aerial::{SelectAerial, SelectAerialParams};
-use crate::nodes::campaign::CampaignSnapshot;
-use crate::nodes::consensus::{ConsensusStage, ObliqueOutput};
-use crate::nodes::facades::FacadesStage;
-use crate::nodes::oblique_grade::{
+use crate::nodes::campaign::aerial::{SelectAerial, SelectAerialParams};
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::summary::SummaryParams;
+use crate::nodes::oblique::consensus::{ConsensusStage, ObliqueOutput};
+use crate::nodes::oblique::facades::FacadesStage;
+use crate::nodes::oblique::grade::{
     GradeOblique, SCENE_TRUTH_FILE, TRUTH_AERIAL_OBLIQUE, TRUTH_RECORDINGS,
 };
-use crate::nodes::oblique_options::ObliqueOptions;
-use crate::nodes::patches::PatchesStage;
-use crate::nodes::sparse_cloud::SparseCloudStage;
-use crate::nodes::summary::SummaryParams;
+use crate::nodes::oblique::options::ObliqueOptions;
+use crate::nodes::oblique::patches::PatchesStage;
+use crate::nodes::oblique::sparse_cloud::SparseCloudStage;
 use crate::workflow::Workflow;
 use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
 use skytie_stages::oblique::candidates::candidate_oblique;

@@ -13,7 +13,7 @@
 use super::{adjust, nadir, oblique, wf_err};
 use crate::dag::{DagBuilder, Pipeline, PipelineError, RawFile, Session};
 use crate::exports::{verification_table, write_exports, ExportInputs};
-use crate::nodes::campaign::{listing_hash, metadata_inputs};
+use crate::nodes::campaign::load::{listing_hash, metadata_inputs};
 use crate::nodes::{
     CampaignSummary, LoadCampaign, LoadCampaignParams, OrthoProject, SelectRecording,
     SelectRecordingParams, SummarizeCampaign, SummaryParams, SynthCampaign, SynthParams,

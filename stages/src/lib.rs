@@ -16,6 +16,8 @@ pub mod imaging;
 pub mod matching;
 pub mod nadir;
 pub mod oblique;
+pub mod params;
+pub mod rng;
 pub mod synth;
 
 /// Atomic file replacement (from `skytie-util`, shared with the engine).

@@ -5,7 +5,6 @@
 use nalgebra::{Matrix3, Vector2, Vector3};
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::correspondence::{AerialObservation, MmTiePoint, PanoObservation};
-use skytie_stages::estimators::rng::SplitMix64;
 use skytie_stages::geometry::{FrameCamera, PanoramaCamera, PointPair, Similarity2};
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::control_points::{aerial_control_points, ControlParams};
@@ -14,6 +13,7 @@ use skytie_stages::nadir::{
     AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch, OrthoGeoref, OrthoImage,
     OrthoParams,
 };
+use skytie_stages::rng::SplitMix64;
 
 // ---------------------------------------------------------------------------------------------------------
 // Helpers

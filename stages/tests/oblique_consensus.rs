@@ -4,7 +4,6 @@
 use nalgebra::{Matrix3, Vector3};
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::correspondence::{MmTiePoint, PanoObservation};
-use skytie_stages::estimators::rng::SplitMix64;
 use skytie_stages::geometry::{matrix_to_opk, FrameCamera};
 use skytie_stages::oblique::consensus::{
     consensus, consensus_with_diagnostics, ConsensusParams, SmallSetPolicy,
@@ -13,6 +12,7 @@ use skytie_stages::oblique::{
     PatchMatch, PatchRegistrationSet, PatchStats, SparseCloud, SparseCloudStats, SparsePoint,
     StreetSide,
 };
+use skytie_stages::rng::SplitMix64;
 
 const E0: f64 = 500_000.0;
 const N0: f64 = 5_400_000.0;

@@ -91,7 +91,8 @@ pub fn ortho(a: &OrthoArgs) -> Result<(), String> {
         ..OrthoParams::default()
     };
     params.vehicle.enabled = !a.no_mask;
-    params.validate().map_err(|errs| {
+    skytie_stages::params::Params::validate(&params).map_err(|errs| {
+        let errs: Vec<(String, String)> = errs.into_iter().map(|v| (v.field, v.message)).collect();
         option_errors(&errs, &[("gsd_m", "gsd"), ("rotation_deg", "rotate-deg")])
     })?;
     let ortho = ortho_project(&pano, &rec, &params);

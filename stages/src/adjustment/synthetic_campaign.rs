@@ -10,8 +10,8 @@ use crate::campaign::{AerialImage, AerialKind, CheckPoint, Observation, Recordin
 use crate::correspondence::{
     AerialControlPoint, AerialObservation, MmTiePoint, PanoObservation as CorrPanoObservation,
 };
-use crate::estimators::rng::SplitMix64;
 use crate::geometry::{matrix_to_opk, opk_to_matrix, triangulate_rays, FrameCamera};
+use crate::rng::SplitMix64;
 use nalgebra::Vector3;
 
 /// Parameters of the aerial part of a synthetic campaign.

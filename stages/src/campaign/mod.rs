@@ -1,5 +1,6 @@
 //! The campaign contract (shared/docs/campaign-format.md): model, reading with validation, writers.
 
+pub mod cameras;
 pub mod check;
 pub mod model;
 pub mod problem;

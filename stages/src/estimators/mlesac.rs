@@ -18,7 +18,7 @@
 //! world coordinates are ≈ 10⁵ m). Deterministic for a given `seed`.
 
 use super::ransac::required_iterations;
-use super::rng::SplitMix64;
+use crate::rng::SplitMix64;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use serde::{Deserialize, Serialize};
 

@@ -9,7 +9,7 @@
 //! child counts as a failure. The normal deviates come from a [`SplitMix64`] seeded by the params, so a run is
 //! reproducible bit for bit.
 
-use super::rng::SplitMix64;
+use crate::rng::SplitMix64;
 use serde::{Deserialize, Serialize};
 
 /// Settings of the (1+1)-ES (ITK class defaults).

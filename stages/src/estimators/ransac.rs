@@ -6,7 +6,7 @@
 //! Ties in the inlier count are broken by the smaller sum of squared inlier residuals (MSAC-like), so the
 //! result depends only on the data, the parameters and the seed.
 
-use super::rng::SplitMix64;
+use crate::rng::SplitMix64;
 
 /// A model RANSAC can estimate: fitted from `MIN_SAMPLES` data (minimal sample) or more (least squares).
 pub trait Model: Sized {

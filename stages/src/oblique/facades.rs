@@ -38,10 +38,10 @@ use self::thinning::box_grid_thin;
 use self::trajectory::{check_collinearity, reference_normal};
 use self::visibility::{check_visibility, horizontal_axes};
 use crate::campaign::{AerialImage, Recording};
-use crate::estimators::rng::mix_seed;
 use crate::geometry::local_frame::LocalOrigin;
 use crate::geometry::FrameCamera;
 use crate::oblique::types::{FacadePlane, FacadeStats, SparseCloud, StreetSide, TripletFacades};
+use crate::rng::mix_seed;
 use nalgebra::Vector3;
 
 /// FNV-1a hash of a string: a stable item id for seeding (independent of platform and run).

@@ -1,6 +1,5 @@
 //! Frame camera: ω-φ-κ cases computed by hand, distortion, round trips.
 
-use crate::campaign::AerialImage;
 use crate::geometry::{BrownDistortion, FrameCamera};
 use nalgebra::Vector3;
 
@@ -281,49 +280,6 @@ fn contains_is_half_open() {
     assert!(!cam.contains(10.0, 8_000.0));
     assert!(!cam.contains(-1e-9, 10.0));
     assert!(!cam.contains(f64::NAN, 10.0));
-}
-
-#[test]
-fn from_aerial_matches_from_opk() {
-    let img = AerialImage {
-        image_id: "n1".into(),
-        file: "n1.tif".into(),
-        x: 92_000.0,
-        y: 437_000.0,
-        z: 1_000.0,
-        omega_deg: 1.0,
-        phi_deg: -2.0,
-        kappa_deg: 93.0,
-        focal_px: F,
-        cx_px: CX + 3.5,
-        cy_px: CY - 2.25,
-        width_px: W,
-        height_px: H,
-        k1: -0.1,
-        k2: 0.02,
-        p1: 1e-3,
-        p2: -1e-3,
-        sigma_px: 0.5,
-    };
-    let cam = FrameCamera::from_aerial(&img);
-    let expected = FrameCamera::from_opk(
-        centre(),
-        1.0,
-        -2.0,
-        93.0,
-        F,
-        CX + 3.5,
-        CY - 2.25,
-        W,
-        H,
-        BrownDistortion {
-            k1: -0.1,
-            k2: 0.02,
-            p1: 1e-3,
-            p2: -1e-3,
-        },
-    );
-    assert_eq!(cam, expected);
 }
 
 #[test]

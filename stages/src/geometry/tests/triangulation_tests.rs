@@ -1,8 +1,8 @@
 //! Multi-view triangulation: exact rays, two-ray closed form, covariance behaviour, Monte Carlo check of the
 //! covariance, errors.
 
-use crate::estimators::SplitMix64;
 use crate::geometry::{triangulate_rays, Ray, TriangulationError};
+use crate::rng::SplitMix64;
 use nalgebra::{Matrix3, Vector3};
 
 fn rd_point() -> Vector3<f64> {

@@ -3,8 +3,8 @@
 //! Added only when `truth/recordings.csv` exists.
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
-use crate::nodes::adjust::AdjustReport;
-use crate::nodes::summary::SummaryParams;
+use crate::nodes::adjust::adjustment::AdjustReport;
+use crate::nodes::campaign::summary::SummaryParams;
 use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::read_recordings_csv;
 use std::collections::HashMap;

@@ -4,10 +4,10 @@
 //! when `truth/recordings.csv` exists; no processing stage reads `truth/`.
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
-use crate::nodes::campaign::CampaignSnapshot;
-use crate::nodes::consensus::ObliqueOutput;
-use crate::nodes::nadir_grade::load_truth;
-use crate::nodes::summary::SummaryParams;
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::summary::SummaryParams;
+use crate::nodes::nadir::grade::load_truth;
+use crate::nodes::oblique::consensus::ObliqueOutput;
 use skytie_stages::oblique::grading::{grade_oblique, ObliqueGrade};
 use skytie_stages::oblique::SparseCloud;
 use skytie_stages::synth::scene_truth::SceneTruth;
@@ -15,7 +15,7 @@ use std::sync::Arc;
 
 crate::serde_artifact!(ObliqueGrade);
 
-pub use crate::nodes::nadir_grade::TRUTH_RECORDINGS;
+pub use crate::nodes::nadir::grade::TRUTH_RECORDINGS;
 /// True oblique poses, when the campaign perturbed them (optional).
 pub const TRUTH_AERIAL_OBLIQUE: &str = "truth/aerial_oblique.csv";
 

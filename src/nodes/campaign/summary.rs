@@ -2,7 +2,7 @@
 //! problems and ortho coverage, contributed to `metrics.json` under `campaign` and `ortho`.
 
 use crate::dag::{Handle, NodeCtx, Stage, StageError};
-use crate::nodes::campaign::CampaignSnapshot;
+use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::Severity;

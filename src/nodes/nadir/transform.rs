@@ -2,8 +2,8 @@
 //! oriented ortho image and the aerial image (thesis 3.4.5.2, `skytie_stages::nadir::initial_transform`).
 //! A rejected transform is a normal output (with its reason), not a failure.
 
-use super::decoded_images;
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::nodes::campaign::decoded_images;
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::nadir::initial_transform::{initial_transform, TransformParams};
 use skytie_stages::nadir::{OrthoImage, TransformOutcome};

@@ -3,8 +3,8 @@
 //! `skytie_stages::adjustment::verify`), with a pass/fail flag against a tolerance.
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
-use crate::nodes::adjust::pano_sizes;
-use crate::nodes::campaign::CampaignSnapshot;
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::panorama_sizes::pano_sizes;
 use skytie_stages::adjustment::verify::{verify, Verification, VerifyConfig};
 use skytie_stages::correspondence::AerialControlPoint;
 use skytie_stages::nadir::RecordingControl;

@@ -59,7 +59,7 @@ pub fn metadata_inputs(root: &Path) -> Vec<RawFile> {
 
 /// blake3 (hex) of the sorted relative names of every file below `root` (not their contents).
 pub fn listing_hash(root: &Path) -> std::io::Result<String> {
-    let files = crate::nodes::synth::list_files(root)?;
+    let files = crate::nodes::campaign::synth::list_files(root)?;
     let mut h = blake3::Hasher::new();
     for (name, _) in &files {
         h.update(name.as_bytes());

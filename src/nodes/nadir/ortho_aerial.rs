@@ -28,15 +28,15 @@ impl Stage for OrthoForAerial {
         _: &NodeCtx,
     ) -> Result<OrthoImage, StageError> {
         // Shared with the recording's other ortho nodes (one decode per panorama while it stays in memory).
-        let image = super::decoded_images::gray(&pano)?;
+        let image = crate::nodes::campaign::decoded_images::gray(&pano)?;
         let cam = FrameCamera::from_aerial(&aerial);
         let params = ortho_params_for_aerial(&cam, foot_point_world(&rec), base);
-        if let Err(errs) = params.validate() {
+        if let Err(errs) = skytie_stages::params::Params::validate(&params) {
             return Err(StageError::new(format!(
                 "aerial image '{}': the ortho parameters derived from it are invalid ({})",
                 aerial.image_id,
                 errs.iter()
-                    .map(|(f, m)| format!("{f}: {m}"))
+                    .map(|v| format!("{}: {}", v.field, v.message))
                     .collect::<Vec<_>>()
                     .join("; ")
             )));

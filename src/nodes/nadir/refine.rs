@@ -4,8 +4,8 @@
 //! views (their orthos for the same aerial image, `skytie_stages::nadir::parallax_check`). A rejected transform
 //! gives an empty refinement.
 
-use super::decoded_images;
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::nodes::campaign::decoded_images;
 use skytie_stages::campaign::AerialImage;
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::refine::{refine_in_aerial, NeighbourOrtho, RefineParams};

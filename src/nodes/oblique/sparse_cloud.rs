@@ -3,8 +3,8 @@
 //! outlier removal, triangulation in the original equirectangular geometry. Inputs: the three recording rows
 //! and panorama files (hashed by content).
 
-use super::decoded_images;
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::nodes::campaign::decoded_images;
 use skytie_stages::campaign::Recording;
 use skytie_stages::oblique::sparse_cloud::{sparse_cloud, SparseCloudParams};
 use skytie_stages::oblique::SparseCloud;

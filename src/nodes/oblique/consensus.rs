@@ -3,8 +3,8 @@
 //! `skytie_stages::oblique::consensus`), with the pipeline's own counts (`oblique.*` metrics that need no truth).
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
-use crate::nodes::adjust::pano_sizes;
-use crate::nodes::campaign::CampaignSnapshot;
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::panorama_sizes::pano_sizes;
 use serde::{Deserialize, Serialize};
 use skytie_stages::oblique::consensus::{consensus, ConsensusParams};
 use skytie_stages::oblique::summary::ObliqueSummary;

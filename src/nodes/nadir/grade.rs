@@ -3,8 +3,8 @@
 //! README). Added by the pipeline only when `truth/recordings.csv` exists; no processing stage reads `truth/`.
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
-use crate::nodes::campaign::CampaignSnapshot;
-use crate::nodes::summary::SummaryParams;
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::summary::SummaryParams;
 use skytie_stages::campaign::{read_aerial_csv, read_recordings_csv, AerialImage};
 use skytie_stages::correspondence::{AerialControlPoint, MmTiePoint};
 use skytie_stages::imaging::io::dimensions;

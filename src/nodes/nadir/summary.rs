@@ -2,8 +2,8 @@
 //! correspondences and control points (`skytie_stages::nadir::summary`), contributed to metrics as `nadir`.
 
 use crate::dag::{Handle, NodeCtx, Stage, StageError};
-use crate::nodes::campaign::CampaignSnapshot;
-use crate::nodes::summary::SummaryParams;
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::summary::SummaryParams;
 use skytie_stages::nadir::summary::NadirSummary;
 use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, RecordingControl, TransformOutcome};
 use std::sync::Arc;

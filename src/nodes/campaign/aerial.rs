@@ -3,7 +3,7 @@
 //! dependents when other rows of the campaign change.
 
 use crate::dag::{Handle, NodeCtx, Stage, StageError};
-use crate::nodes::campaign::CampaignSnapshot;
+use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::{AerialImage, AerialKind};

@@ -25,7 +25,7 @@ impl Stage for OrthoProject {
         _: &NodeCtx,
     ) -> Result<OrthoImage, StageError> {
         // Shared with the recording's other ortho nodes (one decode per panorama while it stays in memory).
-        let image = super::decoded_images::gray(&pano)?;
+        let image = crate::nodes::campaign::decoded_images::gray(&pano)?;
         if image.width != 2 * image.height {
             return Err(StageError::new(format!(
                 "{}: panorama is {}×{} px; an equirectangular panorama must be twice as wide as high",

@@ -3,7 +3,7 @@
 //! `[nadir] matcher = "baseline"` — so thesis Table 2-10's comparison can be regenerated as a sweep.
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
-use crate::nodes::refine::locate_with_accepted;
+use crate::nodes::nadir::refine::locate_with_accepted;
 use skytie_stages::campaign::AerialImage;
 use skytie_stages::nadir::baseline::{baseline_matches, BaselineParams};
 use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, OrthoImage, TransformOutcome};

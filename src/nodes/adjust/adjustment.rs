@@ -5,8 +5,9 @@
 //! and the adjusted poses, two-view and multi-view). Check points are never used as control.
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
-use crate::nodes::campaign::CampaignSnapshot;
-use crate::nodes::consensus::ObliqueOutput;
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::panorama_sizes::pano_sizes;
+use crate::nodes::oblique::consensus::ObliqueOutput;
 use serde::{Deserialize, Serialize};
 use skytie_stages::adjustment::campaign_checkpoints::{compare_checkpoints, CheckPointComparison};
 use skytie_stages::adjustment::config::AdjustConfig;
@@ -15,7 +16,6 @@ use skytie_stages::adjustment::from_correspondences::{run, AdjustInputs, Adjustm
 use skytie_stages::adjustment::{RmseSummary, ViewSelection};
 use skytie_stages::correspondence::{AerialControlPoint, MmTiePoint};
 use skytie_stages::export::{checkpoint_rows, CheckPointRow};
-use skytie_stages::imaging::io::dimensions;
 use skytie_stages::nadir::{MmWindowMatch, RecordingControl};
 use skytie_stages::oblique::SparseCloud;
 use std::sync::Arc;
@@ -109,14 +109,6 @@ impl AdjustReport {
             "build": r.build,
         }})
     }
-}
-
-/// Panorama sizes from the panorama files (parallel to the campaign's recordings).
-pub fn pano_sizes(panos: &[RawFileValue]) -> Result<Vec<(u32, u32)>, StageError> {
-    panos
-        .iter()
-        .map(|p| dimensions(&p.path).map_err(|e| StageError::new(e.to_string())))
-        .collect()
 }
 
 /// The adjustment node. Inputs: snapshot, panorama files (snapshot order), the nadir windows' tie points and

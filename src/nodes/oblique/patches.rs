@@ -3,9 +3,9 @@
 //! image that the visibility hypothesis did not accept for any plane gives an empty set. The sparse clouds
 //! are the same list as the `facades` node's (the triplet's own first, then its neighbours).
 
-use super::decoded_images;
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
-use crate::nodes::facades::neighbourhood_cloud;
+use crate::nodes::campaign::decoded_images;
+use crate::nodes::oblique::facades::neighbourhood_cloud;
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::oblique::patch_registration::{register_patches, PatchParams};
 use skytie_stages::oblique::{PatchRegistrationSet, PatchStats, SparseCloud, TripletFacades};
