@@ -1,15 +1,13 @@
 //! Writing a run's user-facing files (issue 6 "Outputs") into `OUT/` (or `OUT/variants/<name>/` in a sweep)
 //! once the adjustment and verification nodes have produced their values: `trajectory_adjusted.csv`,
-//! `trajectory.geojson`, `tie_points.ply`, `checkpoints.csv`, `verification.csv`, `correspondences.csv` and a
+//! `trajectory.geojson`, `tie_points.ply`, `checkpoints.csv`, `verification.csv` (recorded trajectory), `verification_adjusted.csv`, `correspondences.csv` and a
 //! COLMAP text model in `colmap/`. The encoders live in `skytie_stages::export`; every file is written atomically. A failed export is
 //! a warning naming the file; the run's other outputs are still written.
 
-use crate::nodes::adjust::adjustment::AdjustReport;
+use crate::nodes::adjust::adjustment::{AdjustReport, Verdict};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::oblique::consensus::ObliqueOutput;
-use skytie_stages::adjustment::verify::{
-    render_verification_table, write_verification_csv, Verification,
-};
+use skytie_stages::adjustment::verify::{write_verification_csv, Verification};
 use skytie_stages::correspondence::AerialControlPoint;
 use skytie_stages::export::{
     write_adjusted_trajectory, write_checkpoint_errors_csv, write_colmap_model,
@@ -25,6 +23,8 @@ pub struct ExportInputs<'a> {
     pub snapshot: &'a CampaignSnapshot,
     pub report: Option<&'a AdjustReport>,
     pub verification: Option<&'a Verification>,
+    /// The adjusted trajectory's verification.
+    pub verification_adjusted: Option<&'a Verification>,
     /// The nadir chain's per-recording control points (trajectory order).
     pub nadir_control: &'a [Arc<RecordingControl>],
     /// The oblique chain's consensus output.
@@ -58,20 +58,38 @@ pub fn write_exports(dir: &Path, x: &ExportInputs<'_>) -> Vec<String> {
             ),
         );
     }
-    if let Some(v) = x.verification {
-        note(
-            "verification.csv",
-            write_verification_csv(&dir.join("verification.csv"), v),
-        );
+    for (file, v) in [
+        ("verification.csv", x.verification),
+        ("verification_adjusted.csv", x.verification_adjusted),
+    ] {
+        if let Some(v) = v {
+            note(file, write_verification_csv(&dir.join(file), v));
+        }
     }
     let Some(report) = x.report else {
         return problems;
     };
     let run = &report.run;
-    note(
-        "trajectory_adjusted.csv",
-        write_adjusted_trajectory(&dir.join("trajectory_adjusted.csv"), &c.recordings, run),
-    );
+    match report.verdict() {
+        Verdict::Corrected => note(
+            "trajectory_adjusted.csv",
+            write_adjusted_trajectory(&dir.join("trajectory_adjusted.csv"), &c.recordings, run),
+        ),
+        verdict => {
+            // Never present an uncorrected or worsened trajectory as the adjusted one; an older file goes too.
+            let stale = dir.join("trajectory_adjusted.csv");
+            if stale.exists() {
+                note("trajectory_adjusted.csv", std::fs::remove_file(&stale));
+            }
+            let why = match verdict {
+                Verdict::NothingCorrected => {
+                    "no recording observes aerial control, nothing was corrected"
+                }
+                _ => "the adjustment made the check points worse",
+            };
+            note("trajectory_adjusted.csv", Err(std::io::Error::other(why)));
+        }
+    }
     note(
         "checkpoints.csv",
         write_checkpoint_errors_csv(&dir.join("checkpoints.csv"), &report.multi_view.rows),
@@ -117,9 +135,4 @@ pub fn write_exports(dir: &Path, x: &ExportInputs<'_>) -> Vec<String> {
         )),
     }
     problems
-}
-
-/// The verification table for stdout.
-pub fn verification_table(v: &Verification) -> String {
-    render_verification_table(v)
 }

@@ -15,6 +15,7 @@ pub mod report;
 pub mod run;
 pub mod synth;
 pub mod tool;
+pub mod workflows;
 
 use clap::{Parser, Subcommand};
 
@@ -47,6 +48,8 @@ pub enum Command {
     Synth(synth::SynthArgs),
     /// Validate a campaign folder and list every problem.
     Check(check::CheckArgs),
+    /// List the built-in workflows, or print one (`show NAME`).
+    Workflows(workflows::WorkflowsArgs),
     /// Building blocks on plain files (ortho, kaze, forstner, wallis, phasecorr, ncc), CSV/plain output.
     #[command(subcommand)]
     Tool(tool::ToolCommand),
@@ -64,5 +67,6 @@ pub fn main() -> i32 {
         Command::Synth(a) => synth::main(a),
         Command::Check(a) => check::main(a),
         Command::Tool(t) => tool::main(t),
+        Command::Workflows(a) => workflows::main(a),
     }
 }

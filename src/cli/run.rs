@@ -16,6 +16,7 @@ use crate::cli::common::{load_workflow, CacheOpt, ThreadsOpt, DEFAULT_WORKFLOW};
 use crate::dag::progress::{Progress, ProgressMode};
 use crate::dag::{Mode, NodeStatus, PipelineError, Session};
 use crate::hashing::StatCache;
+use crate::headline::{headline, PARTIAL_EXIT_CODE};
 use crate::metrics::{add_sections, sweep_csv, write_json, Summary};
 use crate::workflow::Workflow;
 use clap::Args;
@@ -24,7 +25,7 @@ use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
 #[derive(Args, Debug, Clone)]
 pub struct RunArgs {
-    /// Workflow file.
+    /// Workflow: a built-in name (`skytie workflows` lists them) or a TOML file.
     #[arg(default_value = DEFAULT_WORKFLOW)]
     pub workflow: PathBuf,
     /// Use this campaign folder instead of the workflow's `campaign`.
@@ -40,6 +41,9 @@ pub struct RunArgs {
     /// Print only errors and the final summary.
     #[arg(long)]
     pub quiet: bool,
+    /// Also print the per-stage table (nodes executed / cached / failed / skipped, seconds).
+    #[arg(long)]
+    pub timings: bool,
 }
 
 /// What a finished run reports back (for the exit code and for tests).
@@ -96,30 +100,83 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
         progress.warn(&format!("could not save the stat cache: {e}"));
     }
     let summary = Summary::of(session.reports());
-    write_outputs(&wf, &session, &out_dir, started_unix_s, wall).map_err(|e| {
+    let metrics = write_outputs(&wf, &session, &out_dir, started_unix_s, wall).map_err(|e| {
         (
             2,
             format!("cannot write outputs to {}: {e}", out_dir.display()),
         )
     })?;
     // The HTML report (a failure is a warning: the run's outputs are already written).
-    match crate::report::build_report(
+    let report = crate::report::build_report(
         &out_dir,
         &crate::report::ReportOptions::standard(args.campaign.clone()),
-    ) {
-        Ok(r) if !args.quiet => println!("report: {}", r.index.display()),
-        Ok(_) => {}
-        Err(e) => progress.warn(&format!("the HTML report was not written: {e}")),
+    );
+    if let Err(e) = &report {
+        progress.warn(&format!("the HTML report was not written: {e}"));
     }
-    print!("{}", summary.table(wall));
+    if args.timings {
+        print!("{}", summary.table(wall));
+    }
     print_problems(&session);
     let useful = produced_something(&session);
     if let Err(e) = &result {
         eprintln!("error: {e}");
     }
-    let exit_code = if result.is_ok() && useful { 0 } else { 1 };
-    if !args.quiet {
-        println!("outputs in {}", out_dir.display());
+    let t = &summary.total;
+    let failed_items = t.failed + t.skipped;
+    println!(
+        "{} nodes: {} executed, {} cached, {} failed, {} skipped ({wall:.0} s{})",
+        summary.nodes_total,
+        t.executed,
+        t.cached,
+        t.failed,
+        t.skipped,
+        if args.timings {
+            ""
+        } else {
+            "; per-stage times with --timings"
+        }
+    );
+    let mut warning = false;
+    for (variant, doc) in &metrics {
+        let h = headline(doc);
+        warning |= h.status.is_warning();
+        if metrics.len() > 1 {
+            println!("[{variant}] {}", h.lines[0]);
+        } else {
+            println!();
+            print!("{}", h.render());
+        }
+    }
+    match &report {
+        Ok(r) => println!(
+            "outputs: {} (report: {})",
+            out_dir.display(),
+            r.index.display()
+        ),
+        Err(_) => println!("outputs: {}", out_dir.display()),
+    }
+    let exit_code = if result.is_err() || !useful {
+        1
+    } else if warning || failed_items > 0 {
+        PARTIAL_EXIT_CODE
+    } else {
+        0
+    };
+    if exit_code == PARTIAL_EXIT_CODE {
+        let mut why = Vec::new();
+        if failed_items > 0 {
+            why.push(format!(
+                "{failed_items} item(s) failed or were skipped (listed above)"
+            ));
+        }
+        if warning {
+            why.push("the result must not be used as it is (see the first line above)".to_string());
+        }
+        println!(
+            "finished with warnings: {} — exit code {PARTIAL_EXIT_CODE}",
+            why.join("; ")
+        );
     }
     Ok(RunResult {
         exit_code,
@@ -175,14 +232,16 @@ fn print_problems(session: &Session<'_>) {
     }
 }
 
-/// Write metrics.json, provenance.json and, for sweeps, per-variant metrics and sweep.csv.
+/// Write metrics.json, provenance.json and, for sweeps, per-variant metrics and sweep.csv. Returns the metrics
+/// of each variant (one, `default`, without a sweep).
 pub fn write_outputs(
     wf: &Workflow,
     session: &Session<'_>,
     out_dir: &Path,
     started_unix_s: u64,
     wall_seconds: f64,
-) -> std::io::Result<()> {
+) -> std::io::Result<Vec<(String, serde_json::Value)>> {
+    let mut per_variant = Vec::new();
     let warnings: usize = session.phases.iter().map(|p| p.warnings.len()).sum();
     let summary = Summary::of(session.reports());
     let mut doc = summary.to_json(wall_seconds, warnings);
@@ -206,6 +265,7 @@ pub fn write_outputs(
                 &out_dir.join("variants").join(v).join("metrics.json"),
                 &vdoc,
             )?;
+            per_variant.push((v.clone(), vdoc));
             // sweep.csv: the contributed sections.
             let mut row = serde_json::json!({});
             add_sections(
@@ -227,5 +287,8 @@ pub fn write_outputs(
     write_json(&out_dir.join("metrics.json"), &doc)?;
     let prov = crate::provenance::provenance(wf, session, started_unix_s, wall_seconds);
     write_json(&out_dir.join("provenance.json"), &prov)?;
-    Ok(())
+    if per_variant.is_empty() {
+        per_variant.push(("default".to_string(), doc));
+    }
+    Ok(per_variant)
 }

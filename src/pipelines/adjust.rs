@@ -20,7 +20,10 @@ use std::path::Path;
 /// Handles of the adjustment outputs (for the exports written after the run).
 pub struct AdjustHandles {
     pub report: Option<Handle<AdjustReport>>,
+    /// The recorded trajectory verified against aerial control (without adjusting).
     pub verification: Option<Handle<Verification>>,
+    /// The adjusted trajectory verified the same way (when both `adjust` and `verify` run).
+    pub verification_adjusted: Option<Handle<Verification>>,
 }
 
 /// Add `adjust`, `grade_adjust` and `verify` when the workflow enables them.
@@ -39,6 +42,7 @@ pub fn add_adjust(
     let mut out = AdjustHandles {
         report: None,
         verification: None,
+        verification_adjusted: None,
     };
     if !(on("adjust") || on("verify") || on("grade_adjust")) {
         return Ok(out);
@@ -117,12 +121,22 @@ pub fn add_adjust(
         };
         let v = b.add(
             VerifyStage,
-            "",
-            config,
-            (snap, panos, nadir.control.clone()),
+            "recorded",
+            config.clone(),
+            (snap, panos.clone(), nadir.control.clone(), Vec::new()),
         )?;
         b.metrics(v, "verify", verify_metrics);
         out.verification = Some(v);
+        if let Some(report) = out.report {
+            let v = b.add(
+                VerifyStage,
+                "adjusted",
+                config,
+                (snap, panos, nadir.control.clone(), vec![report]),
+            )?;
+            b.metrics(v, "verify_adjusted", verify_metrics);
+            out.verification_adjusted = Some(v);
+        }
     }
     Ok(out)
 }

@@ -12,7 +12,7 @@
 
 use super::{adjust, nadir, oblique, wf_err};
 use crate::dag::{DagBuilder, Pipeline, PipelineError, RawFile, Session};
-use crate::exports::{verification_table, write_exports, ExportInputs};
+use crate::exports::{write_exports, ExportInputs};
 use crate::nodes::campaign::load::{listing_hash, metadata_inputs};
 use crate::nodes::{
     CampaignSummary, LoadCampaign, LoadCampaignParams, OrthoProject, SelectRecording,
@@ -206,6 +206,7 @@ impl Pipeline for SkytiePipeline {
             for (variant, h, nadir_control, oblique_result) in &exports {
                 let report = h.report.and_then(|r| values.get(r));
                 let verification = h.verification.and_then(|v| values.get(v));
+                let verification_adjusted = h.verification_adjusted.and_then(|v| values.get(v));
                 let nadir_control: Vec<_> = nadir_control
                     .iter()
                     .filter_map(|c| values.get(*c))
@@ -227,14 +228,12 @@ impl Pipeline for SkytiePipeline {
                     snapshot: &snapshot,
                     report: report.as_deref(),
                     verification: verification.as_deref(),
+                    verification_adjusted: verification_adjusted.as_deref(),
                     nadir_control: &nadir_control,
                     oblique: oblique.as_deref(),
                 };
                 for problem in write_exports(&dir, &inputs) {
                     session.progress.warn(&problem);
-                }
-                if let (false, Some(v)) = (wf.is_sweep(), &verification) {
-                    session.progress.info(&verification_table(v));
                 }
             }
         }

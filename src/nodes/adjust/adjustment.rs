@@ -12,7 +12,9 @@ use serde::{Deserialize, Serialize};
 use skytie_stages::adjustment::campaign_checkpoints::{compare_checkpoints, CheckPointComparison};
 use skytie_stages::adjustment::config::AdjustConfig;
 use skytie_stages::adjustment::evaluate::MULTI_VIEW_RADIUS_M;
-use skytie_stages::adjustment::from_correspondences::{run, AdjustInputs, AdjustmentRun};
+use skytie_stages::adjustment::from_correspondences::{
+    run, AdjustInputs, AdjustmentRun, PointKind,
+};
 use skytie_stages::adjustment::{RmseSummary, ViewSelection};
 use skytie_stages::correspondence::{AerialControlPoint, MmTiePoint};
 use skytie_stages::export::{checkpoint_rows, CheckPointRow};
@@ -107,8 +109,97 @@ impl AdjustReport {
             "variance_factor": r.variance_factor,
             "redundancy": r.redundancy,
             "build": r.build,
+            "trajectory": recording_metrics(r),
+            "verdict": self.verdict().label(),
         }})
     }
+}
+
+/// How far the adjustment moved the recordings and how well it determined them: counts, horizontal shift
+/// (adjusted − recorded) and horizontal σ (√(σx² + σy²)) as median / 95th percentile / maximum, metres. A
+/// recording "with control" observes at least one aerial control point itself; the others are carried by tie
+/// points and relative constraints.
+fn recording_metrics(r: &AdjustmentRun) -> serde_json::Value {
+    let with_control = observes_control(r);
+    let moved: Vec<f64> = r
+        .recordings
+        .iter()
+        .map(|rec| {
+            (rec.adjusted_world[0] - rec.recorded_world[0])
+                .hypot(rec.adjusted_world[1] - rec.recorded_world[1])
+        })
+        .collect();
+    let sigma: Vec<f64> = r
+        .recordings
+        .iter()
+        .map(|rec| rec.sigma_m[0].hypot(rec.sigma_m[1]))
+        .collect();
+    serde_json::json!({
+        "count": r.recordings.len(),
+        "with_control": with_control.iter().filter(|&&c| c).count(),
+        "moved_2d_m": spread(moved),
+        "sigma_2d_m": spread(sigma),
+    })
+}
+
+/// Per recording of the run: whether it observes at least one aerial control point itself.
+pub fn observes_control(r: &AdjustmentRun) -> Vec<bool> {
+    let mut with_control = vec![false; r.recordings.len()];
+    for p in r.points.iter().filter(|p| p.point.kind != PointKind::Tie) {
+        for &(rec, _, _) in &p.point.pano {
+            if let Some(flag) = with_control.get_mut(rec) {
+                *flag = true;
+            }
+        }
+    }
+    with_control
+}
+
+/// Whether an adjustment corrected the trajectory, as far as the run can tell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    /// Some recordings observe aerial control, and the check points (if any) did not get worse.
+    Corrected,
+    /// No recording observes aerial control: the adjustment only smoothed the recorded trajectory.
+    NothingCorrected,
+    /// The check points are farther off after the adjustment than before (by more than 1 mm RMSE 2D).
+    CheckpointsWorse,
+}
+
+impl Verdict {
+    /// The label written into metrics (`adjust.<sources>.verdict`).
+    pub fn label(self) -> &'static str {
+        match self {
+            Verdict::Corrected => "corrected",
+            Verdict::NothingCorrected => "nothing_corrected",
+            Verdict::CheckpointsWorse => "checkpoints_worse",
+        }
+    }
+}
+
+impl AdjustReport {
+    /// See [`Verdict`]. Only a [`Verdict::Corrected`] adjustment is delivered as the adjusted trajectory.
+    pub fn verdict(&self) -> Verdict {
+        let (before, after) = (&self.multi_view.before, &self.multi_view.after);
+        if !observes_control(&self.run).contains(&true) {
+            Verdict::NothingCorrected
+        } else if before.count > 0 && after.d2 > before.d2 + 0.001 {
+            Verdict::CheckpointsWorse
+        } else {
+            Verdict::Corrected
+        }
+    }
+}
+
+/// Median, 95th percentile (nearest rank) and maximum of finite values; nulls when there are none.
+fn spread(mut values: Vec<f64>) -> serde_json::Value {
+    values.retain(|v| v.is_finite());
+    values.sort_by(f64::total_cmp);
+    let at = |q: f64| {
+        (!values.is_empty())
+            .then(|| values[((q * values.len() as f64).ceil() as usize).clamp(1, values.len()) - 1])
+    };
+    serde_json::json!({"median": at(0.5), "p95": at(0.95), "max": values.last()})
 }
 
 /// The adjustment node. Inputs: snapshot, panorama files (snapshot order), the nadir windows' tie points and

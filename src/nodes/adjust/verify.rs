@@ -1,13 +1,18 @@
-//! `verify`: without adjusting, how far off are the recorded positions? Per trajectory segment, aerial control
-//! points vs the same points triangulated from the MM data alone (thesis Table 5-13;
-//! `skytie_stages::adjustment::verify`), with a pass/fail flag against a tolerance.
+//! `verify`: how far off is a trajectory? Per trajectory segment, aerial control points vs the same points
+//! triangulated from the MM data alone (thesis Table 5-13; `skytie_stages::adjustment::verify`), with a
+//! pass/fail flag against a tolerance. The node verifies the recorded positions (no adjustment given: the
+//! thesis' verification without adjusting) or, given the adjustment's result, the adjusted ones.
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::nodes::adjust::adjustment::AdjustReport;
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::panorama_sizes::pano_sizes;
+use skytie_stages::adjustment::from_correspondences::RunRecording;
 use skytie_stages::adjustment::verify::{verify, Verification, VerifyConfig};
+use skytie_stages::campaign::Recording;
 use skytie_stages::correspondence::AerialControlPoint;
 use skytie_stages::nadir::RecordingControl;
+use std::collections::HashMap;
 use std::sync::Arc;
 
 crate::serde_artifact!(Verification);
@@ -28,6 +33,7 @@ pub fn verify_metrics(v: &Verification) -> serde_json::Value {
         "passed": v.passed(),
         "segments": v.segments.len(),
         "segments_failed": v.segments.iter().filter(|s| s.status.label() == "fail").count(),
+        "segments_insufficient": v.segments.iter().filter(|s| s.status.label() == "insufficient").count(),
         "overall": seg(&v.overall),
         "skipped_single_aerial": v.skipped_single_aerial,
         "skipped_mm": v.skipped_mm,
@@ -39,22 +45,26 @@ pub struct VerifyStage;
 
 impl Stage for VerifyStage {
     const NAME: &'static str = "verify";
-    const VERSION: &'static str = "2";
+    const VERSION: &'static str = "3";
     type Params = VerifyConfig;
     type Output = Verification;
+    /// The campaign, its panoramas, the aerial control points, and no or one adjustment whose poses replace the
+    /// recorded ones.
     type Inputs = (
         Handle<CampaignSnapshot>,
         Vec<RawFile>,
         Vec<Handle<RecordingControl>>,
+        Vec<Handle<AdjustReport>>,
     );
 
     fn run(
         &self,
         config: &VerifyConfig,
-        (snap, panos, control): (
+        (snap, panos, control, adjusted): (
             Arc<CampaignSnapshot>,
             Vec<RawFileValue>,
             Vec<Arc<RecordingControl>>,
+            Vec<Arc<AdjustReport>>,
         ),
         _: &NodeCtx,
     ) -> Result<Verification, StageError> {
@@ -63,6 +73,32 @@ impl Stage for VerifyStage {
             .iter()
             .flat_map(|r| r.points.iter().cloned())
             .collect();
-        verify(&snap.campaign.recordings, &sizes, &points, config).map_err(StageError::new)
+        let recordings = match adjusted.first() {
+            Some(report) => adjusted_recordings(&snap.campaign.recordings, report),
+            None => snap.campaign.recordings.clone(),
+        };
+        verify(&recordings, &sizes, &points, config).map_err(StageError::new)
     }
+}
+
+/// The campaign's recordings at their adjusted poses (position, and yaw where the adjustment estimated it);
+/// recordings the adjustment did not contain keep their recorded pose.
+fn adjusted_recordings(recorded: &[Recording], report: &AdjustReport) -> Vec<Recording> {
+    let adjusted: HashMap<&str, &RunRecording> = report
+        .run
+        .recordings
+        .iter()
+        .map(|r| (r.image_id.as_str(), r))
+        .collect();
+    recorded
+        .iter()
+        .map(|rec| {
+            let mut rec = rec.clone();
+            if let Some(a) = adjusted.get(rec.image_id.as_str()) {
+                [rec.x, rec.y, rec.z] = a.adjusted_world;
+                rec.yaw_deg += a.yaw_correction_deg;
+            }
+            rec
+        })
+        .collect()
 }
