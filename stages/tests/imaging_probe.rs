@@ -18,26 +18,46 @@ fn encode(img: image::DynamicImage, format: image::ImageFormat) -> Vec<u8> {
 }
 
 fn jpeg(w: u32, h: u32) -> Vec<u8> {
-    encode(image::DynamicImage::ImageRgb8(texture(w, h)), image::ImageFormat::Jpeg)
+    encode(
+        image::DynamicImage::ImageRgb8(texture(w, h)),
+        image::ImageFormat::Jpeg,
+    )
 }
 
 fn png(w: u32, h: u32) -> Vec<u8> {
-    encode(image::DynamicImage::ImageRgb8(texture(w, h)), image::ImageFormat::Png)
+    encode(
+        image::DynamicImage::ImageRgb8(texture(w, h)),
+        image::ImageFormat::Png,
+    )
 }
 
 fn tiff16(w: u32, h: u32) -> Vec<u8> {
-    let img = image::ImageBuffer::<image::Luma<u16>, _>::from_fn(w, h, |x, y| image::Luma([(x * 300 + y) as u16]));
-    encode(image::DynamicImage::ImageLuma16(img), image::ImageFormat::Tiff)
+    let img = image::ImageBuffer::<image::Luma<u16>, _>::from_fn(w, h, |x, y| {
+        image::Luma([(x * 300 + y) as u16])
+    });
+    encode(
+        image::DynamicImage::ImageLuma16(img),
+        image::ImageFormat::Tiff,
+    )
 }
 
 #[test]
 fn headers_are_read_by_content() {
     let h = probe_bytes(&jpeg(70, 35)).unwrap();
-    assert_eq!((h.format, h.width, h.height, h.channels, h.bit_depth), (ImageFormat::Jpeg, 70, 35, 3, 8));
+    assert_eq!(
+        (h.format, h.width, h.height, h.channels, h.bit_depth),
+        (ImageFormat::Jpeg, 70, 35, 3, 8)
+    );
     let h = probe_bytes(&png(33, 17)).unwrap();
-    assert_eq!((h.format, h.width, h.height, h.channels, h.bit_depth), (ImageFormat::Png, 33, 17, 3, 8));
+    assert_eq!(
+        (h.format, h.width, h.height, h.channels, h.bit_depth),
+        (ImageFormat::Png, 33, 17, 3, 8)
+    );
     let h = probe_bytes(&tiff16(40, 30)).unwrap();
-    assert_eq!((h.format, h.width, h.height, h.channels, h.bit_depth), (ImageFormat::Tiff, 40, 30, 1, 16));
+    assert_eq!(
+        (h.format, h.width, h.height, h.channels, h.bit_depth),
+        (ImageFormat::Tiff, 40, 30, 1, 16)
+    );
     assert!(matches!(h.layout, Layout::Strips { .. }), "{:?}", h.layout);
     // A PNG named .jpg is what it is.
     let dir = tempfile::tempdir().unwrap();
@@ -50,17 +70,37 @@ fn headers_are_read_by_content() {
 
 #[test]
 fn every_truncation_is_found() {
-    for (name, bytes) in [("jpeg", jpeg(64, 32)), ("png", png(64, 32)), ("tiff", tiff16(64, 32))] {
+    for (name, bytes) in [
+        ("jpeg", jpeg(64, 32)),
+        ("png", png(64, 32)),
+        ("tiff", tiff16(64, 32)),
+    ] {
         assert!(probe_bytes(&bytes).is_ok(), "{name}");
         for cut in 0..bytes.len() {
             let r = probe_bytes(&bytes[..cut]);
-            assert!(r.is_err(), "{name} cut to {cut} of {} bytes passed", bytes.len());
+            assert!(
+                r.is_err(),
+                "{name} cut to {cut} of {} bytes passed",
+                bytes.len()
+            );
         }
     }
     let bytes = jpeg(200, 100);
     let e = probe_bytes(&bytes[..bytes.len() / 10]).unwrap_err();
-    assert!(matches!(e, ProbeError::Truncated { format: ImageFormat::Jpeg, .. }), "{e:?}");
-    assert!(e.to_string().starts_with("is a truncated JPEG file ("), "{e}");
+    assert!(
+        matches!(
+            e,
+            ProbeError::Truncated {
+                format: ImageFormat::Jpeg,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    assert!(
+        e.to_string().starts_with("is a truncated JPEG file ("),
+        "{e}"
+    );
     let bytes = png(200, 100);
     let e = probe_bytes(&bytes[..bytes.len() / 2]).unwrap_err();
     assert!(e.to_string().starts_with("is a truncated PNG file"), "{e}");
@@ -84,13 +124,26 @@ fn absurd_dimensions_are_rejected_from_the_header() {
     let crc = crc(&bytes[12..29]);
     bytes[29..33].copy_from_slice(&crc.to_be_bytes());
     let e = probe_bytes(&bytes).unwrap_err();
-    assert!(matches!(e, ProbeError::AbsurdSize { width: 100_000, height: 100_000, .. }), "{e:?}");
+    assert!(
+        matches!(
+            e,
+            ProbeError::AbsurdSize {
+                width: 100_000,
+                height: 100_000,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
     assert!(e.to_string().contains("100000×100000 px"), "{e}");
     // The same for a JPEG frame header (65000 × 65000).
     let mut bytes = jpeg(16, 16);
     let sof = bytes.windows(2).position(|w| w == [0xFF, 0xC0]).unwrap();
     bytes[sof + 5..sof + 9].copy_from_slice(&[0xFD, 0xE8, 0xFD, 0xE8]);
-    assert!(matches!(probe_bytes(&bytes), Err(ProbeError::AbsurdSize { .. })));
+    assert!(matches!(
+        probe_bytes(&bytes),
+        Err(ProbeError::AbsurdSize { .. })
+    ));
 }
 
 fn crc(bytes: &[u8]) -> u32 {

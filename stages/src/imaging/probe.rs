@@ -106,6 +106,8 @@ pub enum ProbeError {
     },
     /// A valid file of a kind the decoders do not read (e.g. 12-bit or arithmetic-coded JPEG).
     Unsupported { format: ImageFormat, detail: String },
+    /// Structurally sound, but the decoder rejects the pixel data (found only by decoding).
+    Undecodable { format: ImageFormat, detail: String },
 }
 
 impl ProbeError {
@@ -119,6 +121,7 @@ impl ProbeError {
             ProbeError::Corrupt { .. } => "image_corrupt",
             ProbeError::AbsurdSize { .. } => "image_absurd_size",
             ProbeError::Unsupported { .. } => "image_unsupported",
+            ProbeError::Undecodable { .. } => "image_undecodable",
         }
     }
 
@@ -130,7 +133,9 @@ impl ProbeError {
                 "copy the complete file again (it was cut off, e.g. by an interrupted transfer)"
             }
             ProbeError::UnknownFormat(_) => "convert it to JPEG, PNG or TIFF",
-            ProbeError::Corrupt { .. } | ProbeError::AbsurdSize { .. } => {
+            ProbeError::Corrupt { .. }
+            | ProbeError::AbsurdSize { .. }
+            | ProbeError::Undecodable { .. } => {
                 "the file is damaged: copy it again from the original source"
             }
             ProbeError::Unsupported { .. } => {
@@ -163,6 +168,9 @@ impl fmt::Display for ProbeError {
             ),
             ProbeError::Unsupported { format, detail } => {
                 write!(f, "is a {format} file of a kind skytie cannot decode ({detail})")
+            }
+            ProbeError::Undecodable { format, detail } => {
+                write!(f, "is a {format} file whose image data does not decode ({detail})")
             }
         }
     }
@@ -211,7 +219,10 @@ pub fn probe_reader<R: Read + Seek>(r: &mut R, len: u64) -> Result<ImageHeader, 
         super::probe_tiff::probe_tiff(&mut src)
     } else {
         let shown: Vec<String> = magic.iter().take(4).map(|b| format!("{b:02X}")).collect();
-        Err(ProbeError::UnknownFormat(format!("bytes {}", shown.join(" "))))
+        Err(ProbeError::UnknownFormat(format!(
+            "bytes {}",
+            shown.join(" ")
+        )))
     }
 }
 
@@ -328,7 +339,10 @@ mod tests {
     fn unknown_and_empty_inputs_are_named() {
         assert_eq!(probe_bytes(&[]), Err(ProbeError::Empty));
         let e = probe_bytes(b"GIF89a......").unwrap_err();
-        assert_eq!(e.to_string(), "is not a JPEG, PNG or TIFF file (it starts with bytes 47 49 46 38)");
+        assert_eq!(
+            e.to_string(),
+            "is not a JPEG, PNG or TIFF file (it starts with bytes 47 49 46 38)"
+        );
         assert_eq!(e.kind(), "image_format");
     }
 
@@ -336,7 +350,10 @@ mod tests {
     fn size_bound_rejects_what_no_compression_can_store() {
         assert!(check_size(ImageFormat::Png, 100_000, 100_000, 1024).is_err());
         assert!(check_size(ImageFormat::Png, 0, 10, 1024).is_err());
-        assert_eq!(check_size(ImageFormat::Jpeg, 26_460, 17_004, 20_000_000).unwrap(), (26_460, 17_004));
+        assert_eq!(
+            check_size(ImageFormat::Jpeg, 26_460, 17_004, 20_000_000).unwrap(),
+            (26_460, 17_004)
+        );
     }
 
     #[test]

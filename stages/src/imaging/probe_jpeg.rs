@@ -25,7 +25,9 @@ struct Frame {
     progressive: bool,
 }
 
-pub(crate) fn probe_jpeg<R: Read + Seek>(src: &mut Source<'_, R>) -> Result<ImageHeader, ProbeError> {
+pub(crate) fn probe_jpeg<R: Read + Seek>(
+    src: &mut Source<'_, R>,
+) -> Result<ImageHeader, ProbeError> {
     src.seek(2)?;
     let mut frame: Option<Frame> = None;
     let mut scans = 0usize;
@@ -39,7 +41,11 @@ pub(crate) fn probe_jpeg<R: Read + Seek>(src: &mut Source<'_, R>) -> Result<Imag
         match marker {
             0xD9 => break,
             0xD0..=0xD7 | 0x01 => continue,
-            0xD8 => return Err(corrupt(format!("a second start-of-image marker at byte {at}"))),
+            0xD8 => {
+                return Err(corrupt(format!(
+                    "a second start-of-image marker at byte {at}"
+                )))
+            }
             _ => {}
         }
         let mut lb = [0u8; 2];
@@ -48,7 +54,9 @@ pub(crate) fn probe_jpeg<R: Read + Seek>(src: &mut Source<'_, R>) -> Result<Imag
         }
         let length = u64::from(u16::from_be_bytes(lb));
         if length < 2 {
-            return Err(corrupt(format!("segment FF{marker:02X} at byte {at} has length {length}")));
+            return Err(corrupt(format!(
+                "segment FF{marker:02X} at byte {at} has length {length}"
+            )));
         }
         let body = src.pos();
         let end = body + length - 2;
@@ -67,7 +75,9 @@ pub(crate) fn probe_jpeg<R: Read + Seek>(src: &mut Source<'_, R>) -> Result<Imag
             }
             0xDA => {
                 if frame.is_none() {
-                    return Err(corrupt(format!("scan at byte {at} before any frame header")));
+                    return Err(corrupt(format!(
+                        "scan at byte {at} before any frame header"
+                    )));
                 }
                 src.seek(end)?;
                 pending = Some(skip_entropy_data(src)?);
@@ -79,10 +89,14 @@ pub(crate) fn probe_jpeg<R: Read + Seek>(src: &mut Source<'_, R>) -> Result<Imag
         src.seek(end)?;
     }
     let Some(fr) = frame else {
-        return Err(corrupt("no frame header (no image size) before the end-of-image marker".into()));
+        return Err(corrupt(
+            "no frame header (no image size) before the end-of-image marker".into(),
+        ));
     };
     if scans == 0 {
-        return Err(corrupt("no image data (no scan) before the end-of-image marker".into()));
+        return Err(corrupt(
+            "no image data (no scan) before the end-of-image marker".into(),
+        ));
     }
     Ok(ImageHeader {
         format: F,
@@ -111,7 +125,10 @@ fn read_marker<R: Read + Seek>(src: &mut Source<'_, R>) -> Result<u8, ProbeError
         return Err(ends_without_eoi(src.len));
     }
     if b[0] != 0xFF {
-        return Err(corrupt(format!("expected a marker at byte {at}, found byte {:02X}", b[0])));
+        return Err(corrupt(format!(
+            "expected a marker at byte {at}, found byte {:02X}",
+            b[0]
+        )));
     }
     loop {
         if src.read_exact(&mut b)?.is_none() {
@@ -132,7 +149,9 @@ fn read_frame<R: Read + Seek>(
 ) -> Result<Frame, ProbeError> {
     let mut h = [0u8; 6];
     if length < 8 || src.read_exact(&mut h)?.is_none() {
-        return Err(corrupt(format!("frame header at byte {at} is too short ({length} bytes)")));
+        return Err(corrupt(format!(
+            "frame header at byte {at} is too short ({length} bytes)"
+        )));
     }
     let precision = h[0];
     let height = u64::from(u16::from_be_bytes([h[1], h[2]]));

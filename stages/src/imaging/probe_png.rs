@@ -14,7 +14,9 @@ fn corrupt(detail: String) -> ProbeError {
 fn ends_without_iend(len: u64) -> ProbeError {
     ProbeError::Truncated {
         format: F,
-        detail: format!("it ends at byte {len} before its IEND chunk, so part of the image is missing"),
+        detail: format!(
+            "it ends at byte {len} before its IEND chunk, so part of the image is missing"
+        ),
     }
 }
 
@@ -31,7 +33,9 @@ fn channels(colour_type: u8, bit_depth: u8) -> Option<u8> {
     }
 }
 
-pub(crate) fn probe_png<R: Read + Seek>(src: &mut Source<'_, R>) -> Result<ImageHeader, ProbeError> {
+pub(crate) fn probe_png<R: Read + Seek>(
+    src: &mut Source<'_, R>,
+) -> Result<ImageHeader, ProbeError> {
     src.seek(8)?;
     let mut header: Option<ImageHeader> = None;
     let mut idat_chunks = 0usize;
@@ -45,7 +49,9 @@ pub(crate) fn probe_png<R: Read + Seek>(src: &mut Source<'_, R>) -> Result<Image
         let kind = [head[4], head[5], head[6], head[7]];
         let name = String::from_utf8_lossy(&kind).into_owned();
         if length > 0x7FFF_FFFF || !kind.iter().all(u8::is_ascii_alphabetic) {
-            return Err(corrupt(format!("chunk at byte {at} has an invalid type or length")));
+            return Err(corrupt(format!(
+                "chunk at byte {at} has an invalid type or length"
+            )));
         }
         if header.is_none() && &kind != b"IHDR" {
             return Err(corrupt(format!("the first chunk is {name}, not IHDR")));
@@ -68,7 +74,9 @@ pub(crate) fn probe_png<R: Read + Seek>(src: &mut Source<'_, R>) -> Result<Image
             header = Some(read_ihdr(&first, length, src.len)?);
         }
         if crc.finalize() != u32::from_be_bytes(stored) {
-            return Err(corrupt(format!("chunk {name} at byte {at} fails its CRC check")));
+            return Err(corrupt(format!(
+                "chunk {name} at byte {at} fails its CRC check"
+            )));
         }
         match &kind {
             b"IDAT" => idat_chunks += 1,
@@ -86,14 +94,25 @@ fn read_ihdr(data: &[u8], length: u64, file_bytes: u64) -> Result<ImageHeader, P
     if length != 13 || data.len() < 13 {
         return Err(corrupt(format!("IHDR has {length} bytes, not 13")));
     }
-    let be = |i: usize| u64::from(u32::from_be_bytes([data[i], data[i + 1], data[i + 2], data[i + 3]]));
+    let be = |i: usize| {
+        u64::from(u32::from_be_bytes([
+            data[i],
+            data[i + 1],
+            data[i + 2],
+            data[i + 3],
+        ]))
+    };
     let (width, height) = check_size(F, be(0), be(4), file_bytes)?;
     let (bit_depth, colour_type, interlace) = (data[8], data[9], data[12]);
     let channels = channels(colour_type, bit_depth).ok_or_else(|| {
-        corrupt(format!("colour type {colour_type} with bit depth {bit_depth} is not a PNG combination"))
+        corrupt(format!(
+            "colour type {colour_type} with bit depth {bit_depth} is not a PNG combination"
+        ))
     })?;
     if data[10] != 0 || data[11] != 0 || interlace > 1 {
-        return Err(corrupt("IHDR names an unknown compression, filter or interlace method".into()));
+        return Err(corrupt(
+            "IHDR names an unknown compression, filter or interlace method".into(),
+        ));
     }
     Ok(ImageHeader {
         format: F,

@@ -82,7 +82,9 @@ fn type_size(kind: u16) -> u64 {
     }
 }
 
-pub(crate) fn probe_tiff<R: Read + Seek>(src: &mut Source<'_, R>) -> Result<ImageHeader, ProbeError> {
+pub(crate) fn probe_tiff<R: Read + Seek>(
+    src: &mut Source<'_, R>,
+) -> Result<ImageHeader, ProbeError> {
     let mut head = [0u8; 16];
     let n = src.read_up_to(&mut head)?;
     let big_endian = head[0] == b'M';
@@ -104,7 +106,11 @@ pub(crate) fn probe_tiff<R: Read + Seek>(src: &mut Source<'_, R>) -> Result<Imag
             }
             t.u64(&head[8..])
         }
-        v => return Err(ProbeError::UnknownFormat(format!("a TIFF byte order but version {v}"))),
+        v => {
+            return Err(ProbeError::UnknownFormat(format!(
+                "a TIFF byte order but version {v}"
+            )))
+        }
     };
     let entries = read_directory(&t, src, ifd)?;
     image_header(&t, src, &entries)
@@ -126,9 +132,15 @@ fn read_directory<R: Read + Seek>(
     src.seek(ifd)?;
     let mut cb = [0u8; 8];
     src.read_exact(&mut cb[..count_size as usize])?;
-    let count = if t.big { t.u64(&cb) } else { u64::from(t.u16(&cb)) };
+    let count = if t.big {
+        t.u64(&cb)
+    } else {
+        u64::from(t.u16(&cb))
+    };
     if count == 0 || count > MAX_ENTRIES {
-        return Err(t.corrupt(format!("its image directory at byte {ifd} claims {count} entries")));
+        return Err(t.corrupt(format!(
+            "its image directory at byte {ifd} claims {count} entries"
+        )));
     }
     // The entries and the next directory's offset after them.
     let offset_size = if t.big { 8 } else { 4 };
@@ -158,7 +170,14 @@ fn read_directory<R: Read + Seek>(
                 src.len
             )));
         }
-        entries.insert(tag, Entry { kind, count, value: v });
+        entries.insert(
+            tag,
+            Entry {
+                kind,
+                count,
+                value: v,
+            },
+        );
     }
     Ok(entries)
 }
@@ -172,7 +191,10 @@ fn values<R: Read + Seek>(
 ) -> Result<Vec<u64>, ProbeError> {
     let size = type_size(e.kind);
     if !matches!(e.kind, 1 | 3 | 4 | 16) {
-        return Err(t.corrupt(format!("tag {tag} has field type {} instead of an unsigned integer", e.kind)));
+        return Err(t.corrupt(format!(
+            "tag {tag} has field type {} instead of an unsigned integer",
+            e.kind
+        )));
     }
     let inline = if t.big { 8 } else { 4 };
     let bytes = e.count.saturating_mul(size);
@@ -212,7 +234,8 @@ fn first<R: Read + Seek>(
 ) -> Result<u64, ProbeError> {
     match entries.get(&tag) {
         Some(e) if e.count > 0 => Ok(values(t, src, tag, e)?[0]),
-        _ => default.ok_or_else(|| t.corrupt(format!("required tag {tag} ({}) is missing", tag_name(tag)))),
+        _ => default
+            .ok_or_else(|| t.corrupt(format!("required tag {tag} ({}) is missing", tag_name(tag)))),
     }
 }
 
@@ -301,7 +324,12 @@ fn image_header<R: Read + Seek>(
         )));
     }
     let row_bytes = |px: u64| (px * samples_per_plane * bits).div_ceil(8);
-    for (i, (&at, &n)) in offsets.iter().zip(&counts).take(expected as usize).enumerate() {
+    for (i, (&at, &n)) in offsets
+        .iter()
+        .zip(&counts)
+        .take(expected as usize)
+        .enumerate()
+    {
         let what = if tiled { "tile" } else { "strip" };
         if at.saturating_add(n) > src.len {
             return Err(t.truncated(format!(
