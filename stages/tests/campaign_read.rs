@@ -426,7 +426,9 @@ n5,n5.png,255030,463000,300,0,0,0,100,40,30,80,60\r\n";
             report.checkpoints,
             report.observations
         ),
-        (4, 3, 1, 2)
+        // The truncated and the 1:1 panorama, the wrongly sized nadir frame and the observation outside its
+        // panorama are not usable.
+        (2, 2, 1, 1)
     );
     assert!(!report.is_clean());
     let rendered = report.render();
