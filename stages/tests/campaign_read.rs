@@ -417,7 +417,7 @@ n5,n5.png,255030,463000,300,0,0,0,100,40,30,80,60\r\n";
     assert!(shown("aerial/nadir/cameras.csv", 6, "file")
         .contains("is 80×60 px but its row says width 100, height 60"));
     assert!(shown("aerial/nadir/cameras.csv", 7, "image_id")
-        .contains("'n5' sees none of the 4 recording positions"));
+        .contains("'n5' sees none of the 2 recording positions"));
     assert!(shown("control/observations.csv", 4, "u").contains("u must be < 64"));
     assert_eq!(
         (
