@@ -441,7 +441,7 @@ n5,n5.png,255030,463000,300,0,0,0,100,40,30,80,60\r\n";
         "{rendered}"
     );
     assert!(rendered.ends_with(
-        "19 errors, 2 warnings: 4 recordings, 3 nadir and 0 oblique images, 1 check points, 2 observations usable\n"
+        "19 errors, 2 warnings: 2 recordings, 2 nadir and 0 oblique images, 1 check points, 1 observations usable\n"
     ));
 }
 
