@@ -28,6 +28,7 @@ pub mod summary;
 pub mod synth;
 pub mod transform;
 pub mod transform_agreement;
+pub mod validate;
 pub mod verify;
 
 pub use campaign::{

@@ -2,7 +2,7 @@
 //! points vs the same points triangulated from the MM data alone (thesis Table 5-13;
 //! `skytie_stages::adjustment::verify`), with a pass/fail flag against a tolerance.
 
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, NodeCtx, Optional, RawFile, RawFileValue, Stage, StageError};
 use crate::nodes::adjust::pano_sizes;
 use crate::nodes::campaign::CampaignSnapshot;
 use skytie_stages::adjustment::verify::{verify, Verification, VerifyConfig};
@@ -45,7 +45,7 @@ impl Stage for VerifyStage {
     type Inputs = (
         Handle<CampaignSnapshot>,
         Vec<RawFile>,
-        Vec<Handle<RecordingControl>>,
+        Vec<Optional<RecordingControl>>,
     );
 
     fn run(
@@ -54,13 +54,14 @@ impl Stage for VerifyStage {
         (snap, panos, control): (
             Arc<CampaignSnapshot>,
             Vec<RawFileValue>,
-            Vec<Arc<RecordingControl>>,
+            Vec<Option<Arc<RecordingControl>>>,
         ),
         _: &NodeCtx,
     ) -> Result<Verification, StageError> {
         let sizes = pano_sizes(&panos)?;
         let points: Vec<AerialControlPoint> = control
             .iter()
+            .flatten()
             .flat_map(|r| r.points.iter().cloned())
             .collect();
         verify(&snap.campaign.recordings, &sizes, &points, config).map_err(StageError::new)

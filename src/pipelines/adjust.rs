@@ -5,7 +5,7 @@
 use super::nadir::{NadirHandles, RecordingItem};
 use super::oblique::ObliqueHandles;
 use super::wf_err;
-use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
+use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::adjust::{AdjustReport, AdjustStage};
 use crate::nodes::adjust_grade::{AdjustGrade, GradeAdjust};
 use crate::nodes::campaign::CampaignSnapshot;
@@ -88,10 +88,10 @@ pub fn add_adjust(
             (
                 snap,
                 panos.clone(),
-                windows,
-                control,
-                clouds,
-                oblique_result,
+                optional_all(&windows),
+                optional_all(&control),
+                optional_all(&clouds),
+                optional_all(&oblique_result),
             ),
         )?;
         b.metrics(report, "adjust", |r: &AdjustReport| r.metrics());
@@ -119,7 +119,7 @@ pub fn add_adjust(
             VerifyStage,
             "",
             config,
-            (snap, panos, nadir.control.clone()),
+            (snap, panos, optional_all(&nadir.control)),
         )?;
         b.metrics(v, "verify", verify_metrics);
         out.verification = Some(v);

@@ -274,7 +274,7 @@ fn without_shared_images(
 }
 
 /// Order problems by file (in reading order) and row, keeping the order of problems on the same row.
-pub(crate) fn sort_problems(problems: &mut [Problem]) {
+pub fn sort_problems(problems: &mut [Problem]) {
     const ORDER: [&str; 6] = [TOML, RECORDINGS, NADIR, OBLIQUE, CHECKPOINTS, OBSERVATIONS];
     problems.sort_by_key(|p| {
         let rank = ORDER
