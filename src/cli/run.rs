@@ -6,8 +6,11 @@
 //!
 //! Exit code rule: **0** when the run produced something useful — at least one requested output of the
 //! last phase (e.g. the final report/metrics node of one variant) was produced, or, if the pipeline
-//! requests no outputs, at least one node succeeded — even when other nodes failed (they are listed and
-//! counted in `engine.nodes_failed` / `engine.nodes_skipped`). **1** when nothing useful was produced:
+//! requests no outputs, at least one node succeeded — and nothing was lost: no input row dropped by
+//! validation, no node failed or skipped. **3** (partial success) when it produced something useful but input
+//! rows were dropped (counted in `campaign.input_errors`, `campaign.dropped_rows`) or nodes failed or were
+//! skipped (`engine.nodes_failed` / `engine.nodes_skipped`); the outputs cover the rest. The last line of
+//! the output says which, with the counts, also with `--quiet`. **1** when nothing useful was produced:
 //! the pipeline stopped with an error (e.g. the campaign could not be generated or read) or every
 //! requested output failed or was skipped. **2** for usage/setup errors before anything ran (workflow does
 //! not load, unknown pipeline, cache cannot be opened) or when the output files cannot be written.
@@ -123,7 +126,6 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
         eprintln!("error: {e}");
     }
     let t = &summary.total;
-    let failed_items = t.failed + t.skipped;
     println!(
         "{} nodes: {} executed, {} cached, {} failed, {} skipped ({wall:.0} s{})",
         summary.nodes_total,
@@ -156,28 +158,10 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
         ),
         Err(_) => println!("outputs: {}", out_dir.display()),
     }
-    let exit_code = if result.is_err() || !useful {
-        1
-    } else if warning || failed_items > 0 {
-        PARTIAL_EXIT_CODE
-    } else {
-        0
-    };
-    if exit_code == PARTIAL_EXIT_CODE {
-        let mut why = Vec::new();
-        if failed_items > 0 {
-            why.push(format!(
-                "{failed_items} item(s) failed or were skipped (listed above)"
-            ));
-        }
-        if warning {
-            why.push("the result must not be used as it is (see the first line above)".to_string());
-        }
-        println!(
-            "finished with warnings: {} — exit code {PARTIAL_EXIT_CODE}",
-            why.join("; ")
-        );
-    }
+    let mut outcome = RunOutcome::of(&session, result.is_ok() && useful);
+    outcome.result_warning = warning;
+    println!("{}", outcome.last_line(&out_dir));
+    let exit_code = outcome.exit_code();
     Ok(RunResult {
         exit_code,
         out_dir,
@@ -185,7 +169,90 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
     })
 }
 
-/// The exit-code rule (see the module documentation).
+/// What the run's last line and exit code say.
+struct RunOutcome {
+    useful: bool,
+    rows_dropped: u64,
+    input_errors: u64,
+    failed: usize,
+    skipped: usize,
+    /// The headline's status asks for attention (nothing corrected, check points worse).
+    result_warning: bool,
+}
+
+impl RunOutcome {
+    fn of(session: &Session<'_>, useful: bool) -> Self {
+        let campaign = session
+            .metrics()
+            .find(|(_, ns, _)| ns == "campaign")
+            .map(|(_, _, v)| v.clone())
+            .unwrap_or_default();
+        let count = |k: &str| campaign.get(k).and_then(|v| v.as_u64()).unwrap_or(0);
+        let count_status =
+            |f: fn(&NodeStatus) -> bool| session.reports().filter(|r| f(&r.status)).count();
+        RunOutcome {
+            useful,
+            rows_dropped: count("rows_dropped"),
+            input_errors: count("input_errors"),
+            failed: count_status(|s| matches!(s, NodeStatus::Failed(_))),
+            skipped: count_status(|s| matches!(s, NodeStatus::Skipped { .. })),
+            result_warning: false,
+        }
+    }
+
+    fn partial(&self) -> bool {
+        self.input_errors > 0 || self.failed > 0 || self.skipped > 0 || self.result_warning
+    }
+
+    fn exit_code(&self) -> i32 {
+        match (self.useful, self.partial()) {
+            (false, _) => 1,
+            (true, true) => PARTIAL_EXIT_CODE,
+            (true, false) => 0,
+        }
+    }
+
+    /// One line saying whether everything was processed, what was dropped or failed, and the exit code.
+    fn last_line(&self, out_dir: &Path) -> String {
+        let mut lost = Vec::new();
+        if self.input_errors > 0 {
+            lost.push(format!(
+                "{} input error(s), {} row(s) dropped (metrics.json campaign.dropped_rows; `skytie check` lists them)",
+                self.input_errors, self.rows_dropped
+            ));
+        }
+        if self.failed > 0 {
+            lost.push(format!("{} node(s) failed", self.failed));
+        }
+        if self.skipped > 0 {
+            lost.push(format!("{} skipped because an input failed", self.skipped));
+        }
+        if self.result_warning {
+            lost.push(
+                "the result must not be used as it is (first line of the summary)".to_string(),
+            );
+        }
+        let code = self.exit_code();
+        match (self.useful, lost.is_empty()) {
+            (true, true) => format!(
+                "run complete: every item processed; outputs in {} (exit 0)",
+                out_dir.display()
+            ),
+            (true, false) => format!(
+                "run PARTIAL: {}; outputs in {} cover the rest (exit {code})",
+                lost.join(", "),
+                out_dir.display()
+            ),
+            (false, _) => format!(
+                "run FAILED: no usable result{}{} (exit {code})",
+                if lost.is_empty() { "" } else { "; " },
+                lost.join(", ")
+            ),
+        }
+    }
+}
+
+/// Whether the run produced anything useful (see the module documentation).
 pub fn produced_something(session: &Session<'_>) -> bool {
     let Some(last) = session.phases.last() else {
         return false;

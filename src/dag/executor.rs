@@ -16,7 +16,7 @@
 //! re-enter the lock on the same thread).
 
 use crate::dag::builder::Dag;
-use crate::dag::inputs::{InputRef, InputValue, NodeId, RawFileValue};
+use crate::dag::inputs::{absent_hash, InputRef, InputValue, NodeId, RawFileValue};
 use crate::dag::key::node_key;
 use crate::dag::node::{AnyValue, Node};
 use crate::dag::progress::Progress;
@@ -30,6 +30,9 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
+
+/// The recorded hash of an optional input that was absent.
+pub const ABSENT: &str = "absent";
 
 /// Run the stages, or only say what would run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -294,6 +297,14 @@ impl<'a> Exec<'a> {
         }
     }
 
+    /// Whether node `id` failed or was skipped (an optional input of it is absent).
+    fn unavailable(&self, id: NodeId) -> bool {
+        matches!(
+            self.slot(id).status,
+            Some(NodeStatus::Failed(_) | NodeStatus::Skipped { .. })
+        )
+    }
+
     fn set_status(&self, id: NodeId, status: NodeStatus) {
         self.slot(id).status = Some(status);
     }
@@ -354,6 +365,7 @@ impl<'a> Exec<'a> {
             let mut needed: Vec<NodeId> = to_run
                 .iter()
                 .flat_map(|(id, _)| self.dag.nodes[*id].upstream_ids())
+                .filter(|&u| !self.unavailable(u))
                 .collect();
             needed.sort_unstable();
             needed.dedup();
@@ -426,7 +438,15 @@ impl<'a> Exec<'a> {
         let mut upstream_running = Vec::new();
         for (label, r) in &node.inputs {
             match r {
-                InputRef::Node(u) => {
+                InputRef::OptionalNode(u) if self.unavailable(*u) => {
+                    hashes.push(absent_hash());
+                    recorded.push(RecordedInput {
+                        label: label.clone(),
+                        source: self.dag.nodes[*u].identity(),
+                        hash: ABSENT.to_string(),
+                    });
+                }
+                InputRef::Node(u) | InputRef::OptionalNode(u) => {
                     let s = self.slot(*u);
                     let source = self.dag.nodes[*u].identity();
                     match &s.status {
@@ -624,6 +644,7 @@ impl<'a> Exec<'a> {
         let mut upstream: Vec<NodeId> = recompute
             .iter()
             .flat_map(|&id| self.dag.nodes[id].upstream_ids())
+            .filter(|&u| !self.unavailable(u))
             .collect();
         upstream.sort_unstable();
         upstream.dedup();
@@ -679,7 +700,11 @@ impl<'a> Exec<'a> {
         let mut hashes = Vec::with_capacity(node.inputs.len());
         for (_, r) in &node.inputs {
             match r {
-                InputRef::Node(u) => {
+                InputRef::OptionalNode(u) if self.unavailable(*u) => {
+                    values.push(InputValue::Absent);
+                    hashes.push(absent_hash());
+                }
+                InputRef::Node(u) | InputRef::OptionalNode(u) => {
                     let s = self.slot(*u);
                     match (&s.value, s.hash) {
                         (Some(v), Some(h)) => {

@@ -5,7 +5,7 @@
 use super::nadir::{NadirHandles, RecordingItem};
 use super::oblique::ObliqueHandles;
 use super::wf_err;
-use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
+use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::adjust::adjustment::{AdjustReport, AdjustStage};
 use crate::nodes::adjust::grade::{AdjustGrade, GradeAdjust};
 use crate::nodes::adjust::verify::{verify_metrics, VerifyStage};
@@ -92,10 +92,10 @@ pub fn add_adjust(
             (
                 snap,
                 panos.clone(),
-                windows,
-                control,
-                clouds,
-                oblique_result,
+                optional_all(&windows),
+                optional_all(&control),
+                optional_all(&clouds),
+                optional_all(&oblique_result),
             ),
         )?;
         b.metrics(report, "adjust", |r: &AdjustReport| r.metrics());
@@ -123,7 +123,12 @@ pub fn add_adjust(
             VerifyStage,
             "recorded",
             config.clone(),
-            (snap, panos.clone(), nadir.control.clone(), Vec::new()),
+            (
+                snap,
+                panos.clone(),
+                optional_all(&nadir.control),
+                Vec::new(),
+            ),
         )?;
         b.metrics(v, "verify", verify_metrics);
         out.verification = Some(v);
@@ -132,7 +137,7 @@ pub fn add_adjust(
                 VerifyStage,
                 "adjusted",
                 config,
-                (snap, panos, nadir.control.clone(), vec![report]),
+                (snap, panos, optional_all(&nadir.control), vec![report]),
             )?;
             b.metrics(v, "verify_adjusted", verify_metrics);
             out.verification_adjusted = Some(v);

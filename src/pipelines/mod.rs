@@ -6,6 +6,7 @@ pub mod adjust;
 pub mod nadir;
 pub mod oblique;
 pub mod skytie;
+pub mod validate;
 
 use crate::dag::{Pipeline, PipelineError};
 use crate::workflow::Workflow;

@@ -5,7 +5,7 @@
 //! `truth/` — the evaluation node `grade_nadir`.
 
 use super::{distance_m, missing_upstream, wf_err};
-use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
+use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::campaign::aerial::{SelectAerial, SelectAerialParams};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::summary::SummaryParams;
@@ -257,7 +257,7 @@ pub fn add_nadir(
                 ControlStage,
                 &label,
                 control_params.clone(),
-                (window, rec_refinements, rec_aerials),
+                (window, optional_all(&rec_refinements), rec_aerials),
             )?);
         }
     }
@@ -268,10 +268,10 @@ pub fn add_nadir(
             SummaryParams::default(),
             (
                 snap,
-                windows.clone(),
-                transforms,
-                refinements.clone(),
-                control.clone(),
+                optional_all(&windows),
+                optional_all(&transforms),
+                optional_all(&refinements),
+                optional_all(&control),
             ),
         )?;
         b.metrics(summary, "nadir", |s: &NadirSummary| s.metrics());

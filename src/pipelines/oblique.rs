@@ -9,7 +9,7 @@
 
 use super::nadir::RecordingItem;
 use super::{distance_m, missing_upstream, wf_err};
-use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
+use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::campaign::aerial::{SelectAerial, SelectAerialParams};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::summary::SummaryParams;
@@ -215,7 +215,13 @@ pub fn add_oblique(
         ConsensusStage,
         "",
         options.consensus.clone(),
-        (snap, panos.clone(), clouds.clone(), all_facades, sets),
+        (
+            snap,
+            panos.clone(),
+            optional_all(&clouds),
+            optional_all(&all_facades),
+            optional_all(&sets),
+        ),
     )?;
     b.metrics(result, "oblique", |o: &ObliqueOutput| o.summary.metrics());
     out.result = Some(result);

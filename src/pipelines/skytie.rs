@@ -10,8 +10,9 @@
 //! After phase 3 the exports of every variant are written into `OUT` (`OUT/variants/<name>/` in a sweep).
 //! A stage name the pipeline does not know is refused with the list of available ones.
 
+use super::validate::add_validated_snapshot;
 use super::{adjust, nadir, oblique, wf_err};
-use crate::dag::{DagBuilder, Pipeline, PipelineError, RawFile, Session};
+use crate::dag::{optional_all, DagBuilder, Pipeline, PipelineError, RawFile, Session};
 use crate::exports::{write_exports, ExportInputs};
 use crate::nodes::campaign::load::{listing_hash, metadata_inputs};
 use crate::nodes::{
@@ -108,7 +109,13 @@ impl Pipeline for SkytiePipeline {
         let snap_h = b.add(LoadCampaign, "", load_params.clone(), inputs.clone())?;
         b.request(snap_h);
         let values = session.execute("load", b.build());
-        let snapshot = values.require(snap_h, "the campaign")?;
+        let loaded = values.require(snap_h, "the campaign")?;
+        // Phase 2b: its images, probed by content (the validation `skytie check` applies).
+        let mut b = DagBuilder::new();
+        let valid_h = add_validated_snapshot(&mut b, &root, &load_params, &inputs, &loaded)?;
+        b.request(valid_h);
+        let values = session.execute("validate", b.build());
+        let snapshot = values.require(valid_h, "the validated campaign")?;
         if !snapshot.problems.is_empty() {
             eprintln!(
                 "campaign {}: {} problem(s) in the input; affected items are skipped (run `skytie check {}` for the list)",
@@ -125,7 +132,7 @@ impl Pipeline for SkytiePipeline {
         let mut exports = Vec::new();
         for variant in wf.variants() {
             b.set_variant(&variant);
-            let snap = b.add(LoadCampaign, "", load_params.clone(), inputs.clone())?;
+            let snap = add_validated_snapshot(&mut b, &root, &load_params, &inputs, &loaded)?;
             let ortho: OrthoParams = wf.params("ortho", &variant).map_err(wf_err)?;
             let mut orthos = Vec::new();
             let mut items = Vec::new();
@@ -196,7 +203,7 @@ impl Pipeline for SkytiePipeline {
                 SummarizeCampaign,
                 "",
                 SummaryParams::default(),
-                (snap, orthos),
+                (snap, optional_all(&orthos)),
             )?;
             b.metrics(summary, "campaign", |s: &CampaignSummary| s.metrics().0);
             b.metrics(summary, "ortho", |s: &CampaignSummary| s.metrics().1);

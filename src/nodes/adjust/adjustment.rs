@@ -4,7 +4,7 @@
 //! before/after (thesis 3.5.3: check points triangulated from their panorama observations with the recorded
 //! and the adjusted poses, two-view and multi-view). Check points are never used as control.
 
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, NodeCtx, Optional, RawFile, RawFileValue, Stage, StageError};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::panorama_sizes::pano_sizes;
 use crate::nodes::oblique::consensus::ObliqueOutput;
@@ -215,10 +215,10 @@ impl Stage for AdjustStage {
     type Inputs = (
         Handle<CampaignSnapshot>,
         Vec<RawFile>,
-        Vec<Handle<MmWindowMatch>>,
-        Vec<Handle<RecordingControl>>,
-        Vec<Handle<SparseCloud>>,
-        Vec<Handle<ObliqueOutput>>,
+        Vec<Optional<MmWindowMatch>>,
+        Vec<Optional<RecordingControl>>,
+        Vec<Optional<SparseCloud>>,
+        Vec<Optional<ObliqueOutput>>,
     );
 
     fn run(
@@ -227,13 +227,16 @@ impl Stage for AdjustStage {
         (snap, panos, windows, control, clouds, oblique): (
             Arc<CampaignSnapshot>,
             Vec<RawFileValue>,
-            Vec<Arc<MmWindowMatch>>,
-            Vec<Arc<RecordingControl>>,
-            Vec<Arc<SparseCloud>>,
-            Vec<Arc<ObliqueOutput>>,
+            Vec<Option<Arc<MmWindowMatch>>>,
+            Vec<Option<Arc<RecordingControl>>>,
+            Vec<Option<Arc<SparseCloud>>>,
+            Vec<Option<Arc<ObliqueOutput>>>,
         ),
         _: &NodeCtx,
     ) -> Result<AdjustReport, StageError> {
+        // Items whose nodes failed are absent: the adjustment uses the rest (the failures are counted).
+        let (windows, control, clouds, oblique) =
+            (flat(windows), flat(control), flat(clouds), flat(oblique));
         let c = &snap.campaign;
         let sizes = pano_sizes(&panos)?;
         let tie_points: Vec<MmTiePoint> = windows
@@ -287,4 +290,9 @@ impl Stage for AdjustStage {
             two_view,
         })
     }
+}
+
+/// The present values of optional inputs, in order.
+fn flat<T>(values: Vec<Option<Arc<T>>>) -> Vec<Arc<T>> {
+    values.into_iter().flatten().collect()
 }

@@ -3,7 +3,7 @@
 //! pass/fail flag against a tolerance. The node verifies the recorded positions (no adjustment given: the
 //! thesis' verification without adjusting) or, given the adjustment's result, the adjusted ones.
 
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, NodeCtx, Optional, RawFile, RawFileValue, Stage, StageError};
 use crate::nodes::adjust::adjustment::AdjustReport;
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::panorama_sizes::pano_sizes;
@@ -53,7 +53,7 @@ impl Stage for VerifyStage {
     type Inputs = (
         Handle<CampaignSnapshot>,
         Vec<RawFile>,
-        Vec<Handle<RecordingControl>>,
+        Vec<Optional<RecordingControl>>,
         Vec<Handle<AdjustReport>>,
     );
 
@@ -63,7 +63,7 @@ impl Stage for VerifyStage {
         (snap, panos, control, adjusted): (
             Arc<CampaignSnapshot>,
             Vec<RawFileValue>,
-            Vec<Arc<RecordingControl>>,
+            Vec<Option<Arc<RecordingControl>>>,
             Vec<Arc<AdjustReport>>,
         ),
         _: &NodeCtx,
@@ -71,6 +71,7 @@ impl Stage for VerifyStage {
         let sizes = pano_sizes(&panos)?;
         let points: Vec<AerialControlPoint> = control
             .iter()
+            .flatten()
             .flat_map(|r| r.points.iter().cloned())
             .collect();
         let recordings = match adjusted.first() {

@@ -9,7 +9,9 @@
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
-use skytie_stages::campaign::{read_campaign, Campaign, Problem, Recording};
+use skytie_stages::campaign::{
+    read_sourced, Campaign, Problem, Recording, SourceRows, SourcedCampaign,
+};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -43,7 +45,27 @@ impl StageParams for LoadCampaignParams {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CampaignSnapshot {
     pub campaign: Campaign,
+    /// The row each item came from (parallel to the campaign's vectors).
+    pub rows: SourceRows,
     pub problems: Vec<Problem>,
+}
+
+impl CampaignSnapshot {
+    pub fn new(sourced: SourcedCampaign, problems: Vec<Problem>) -> Self {
+        CampaignSnapshot {
+            campaign: sourced.campaign,
+            rows: sourced.rows,
+            problems,
+        }
+    }
+
+    /// The campaign with its rows (a copy).
+    pub fn sourced(&self) -> SourcedCampaign {
+        SourcedCampaign {
+            campaign: self.campaign.clone(),
+            rows: self.rows.clone(),
+        }
+    }
 }
 crate::serde_artifact!(CampaignSnapshot, Recording);
 
@@ -68,12 +90,12 @@ pub fn listing_hash(root: &Path) -> std::io::Result<String> {
     Ok(h.finalize().to_hex().to_string())
 }
 
-/// Reads the campaign (validation without decoding images; `skytie check` decodes them too).
+/// Reads the campaign and validates its rows (the images are validated by `nodes::validate`).
 pub struct LoadCampaign;
 
 impl Stage for LoadCampaign {
     const NAME: &'static str = "load";
-    const VERSION: &'static str = "1";
+    const VERSION: &'static str = "2";
     type Params = LoadCampaignParams;
     type Output = CampaignSnapshot;
     type Inputs = Vec<RawFile>;
@@ -84,9 +106,9 @@ impl Stage for LoadCampaign {
         _files: Vec<RawFileValue>,
         _: &NodeCtx,
     ) -> Result<CampaignSnapshot, StageError> {
-        let (campaign, problems) = read_campaign(Path::new(&p.root))
+        let (sourced, problems) = read_sourced(Path::new(&p.root))
             .map_err(|e| StageError::new(format!("cannot read the campaign: {e}")))?;
-        Ok(CampaignSnapshot { campaign, problems })
+        Ok(CampaignSnapshot::new(sourced, problems))
     }
 }
 

@@ -9,3 +9,4 @@ pub mod load;
 pub mod panorama_sizes;
 pub mod summary;
 pub mod synth;
+pub mod validate;

@@ -1,11 +1,11 @@
 //! `summary`: a global node over the campaign snapshot and the per-recording ortho images: counts, input
 //! problems and ortho coverage, contributed to `metrics.json` under `campaign` and `ortho`.
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, NodeCtx, Optional, Stage, StageError};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
-use skytie_stages::campaign::Severity;
+use skytie_stages::campaign::{InputAccount, Severity};
 use skytie_stages::nadir::OrthoImage;
 use std::sync::Arc;
 
@@ -31,6 +31,8 @@ pub struct CampaignSummary {
     pub observations: usize,
     pub input_errors: usize,
     pub input_warnings: usize,
+    /// Errors per kind and rows dropped per file.
+    pub input: InputAccount,
     /// Every input problem, rendered (`file:row: field …`).
     pub problems: Vec<String>,
     /// Recordings whose ortho image was produced.
@@ -53,6 +55,10 @@ impl CampaignSummary {
                 "observations": self.observations,
                 "input_errors": self.input_errors,
                 "input_warnings": self.input_warnings,
+                "input_errors_by_kind": self.input.errors_by_kind,
+                "dropped_rows": self.input.dropped_rows,
+                "rows_dropped": self.input.rows_dropped(),
+                "files_with_errors": self.input.files_with_errors,
             }),
             serde_json::json!({
                 "images": self.ortho_images,
@@ -67,17 +73,18 @@ pub struct SummarizeCampaign;
 
 impl Stage for SummarizeCampaign {
     const NAME: &'static str = "summary";
-    const VERSION: &'static str = "1";
+    const VERSION: &'static str = "2";
     type Params = SummaryParams;
     type Output = CampaignSummary;
-    type Inputs = (Handle<CampaignSnapshot>, Vec<Handle<OrthoImage>>);
+    type Inputs = (Handle<CampaignSnapshot>, Vec<Optional<OrthoImage>>);
 
     fn run(
         &self,
         _: &SummaryParams,
-        (snap, orthos): (Arc<CampaignSnapshot>, Vec<Arc<OrthoImage>>),
+        (snap, orthos): (Arc<CampaignSnapshot>, Vec<Option<Arc<OrthoImage>>>),
         _: &NodeCtx,
     ) -> Result<CampaignSummary, StageError> {
+        let orthos: Vec<Arc<OrthoImage>> = orthos.into_iter().flatten().collect();
         let c = &snap.campaign;
         let valid_fraction = |o: &OrthoImage| {
             let n = o.valid.len().max(1);
@@ -105,6 +112,7 @@ impl Stage for SummarizeCampaign {
                 .iter()
                 .filter(|p| p.severity == Severity::Warning)
                 .count(),
+            input: InputAccount::of(&snap.problems),
             problems: snap.problems.iter().map(|p| p.to_string()).collect(),
             ortho_images: orthos.len(),
             ortho_valid_fraction_mean: mean,

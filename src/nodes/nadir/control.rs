@@ -2,7 +2,7 @@
 //! consistency and triangulated from the aerial images → aerial control points (thesis 3.4.5.4,
 //! `skytie_stages::nadir::control_points`).
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, NodeCtx, Optional, Stage, StageError};
 use skytie_stages::campaign::AerialImage;
 use skytie_stages::nadir::control_points::{aerial_control_points, ControlParams};
 use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, RecordingControl};
@@ -20,7 +20,7 @@ impl Stage for ControlStage {
     type Output = RecordingControl;
     type Inputs = (
         Handle<MmWindowMatch>,
-        Vec<Handle<AerialRefinement>>,
+        Vec<Optional<AerialRefinement>>,
         Vec<Handle<AerialImage>>,
     );
 
@@ -29,7 +29,7 @@ impl Stage for ControlStage {
         p: &ControlParams,
         (window, refinements, aerials): (
             Arc<MmWindowMatch>,
-            Vec<Arc<AerialRefinement>>,
+            Vec<Option<Arc<AerialRefinement>>>,
             Vec<Arc<AerialImage>>,
         ),
         _: &NodeCtx,
@@ -42,7 +42,8 @@ impl Stage for ControlStage {
         let pairs: Vec<(&AerialImage, &AerialRefinement)> = aerials
             .iter()
             .map(|a| a.as_ref())
-            .zip(refinements.iter().map(|r| r.as_ref()))
+            .zip(&refinements)
+            .filter_map(|(a, r)| r.as_deref().map(|r| (a, r)))
             .collect();
         Ok(RecordingControl {
             recording_id: window.recording_id.clone(),

@@ -1,7 +1,7 @@
 //! `nadir`: the global summary of the nadir pipeline — counts of MM pairs, tie points, transforms,
 //! correspondences and control points (`skytie_stages::nadir::summary`), contributed to metrics as `nadir`.
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, NodeCtx, Optional, Stage, StageError};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::summary::SummaryParams;
 use skytie_stages::nadir::summary::NadirSummary;
@@ -21,10 +21,10 @@ impl Stage for SummarizeNadir {
     type Output = NadirSummary;
     type Inputs = (
         Handle<CampaignSnapshot>,
-        Vec<Handle<MmWindowMatch>>,
-        Vec<Handle<TransformOutcome>>,
-        Vec<Handle<AerialRefinement>>,
-        Vec<Handle<RecordingControl>>,
+        Vec<Optional<MmWindowMatch>>,
+        Vec<Optional<TransformOutcome>>,
+        Vec<Optional<AerialRefinement>>,
+        Vec<Optional<RecordingControl>>,
     );
 
     fn run(
@@ -32,17 +32,17 @@ impl Stage for SummarizeNadir {
         _: &SummaryParams,
         (snap, windows, transforms, refinements, control): (
             Arc<CampaignSnapshot>,
-            Vec<Arc<MmWindowMatch>>,
-            Vec<Arc<TransformOutcome>>,
-            Vec<Arc<AerialRefinement>>,
-            Vec<Arc<RecordingControl>>,
+            Vec<Option<Arc<MmWindowMatch>>>,
+            Vec<Option<Arc<TransformOutcome>>>,
+            Vec<Option<Arc<AerialRefinement>>>,
+            Vec<Option<Arc<RecordingControl>>>,
         ),
         _: &NodeCtx,
     ) -> Result<NadirSummary, StageError> {
-        let w: Vec<&MmWindowMatch> = windows.iter().map(|x| x.as_ref()).collect();
-        let t: Vec<&TransformOutcome> = transforms.iter().map(|x| x.as_ref()).collect();
-        let r: Vec<&AerialRefinement> = refinements.iter().map(|x| x.as_ref()).collect();
-        let c: Vec<&RecordingControl> = control.iter().map(|x| x.as_ref()).collect();
+        let w: Vec<&MmWindowMatch> = windows.iter().flatten().map(|x| x.as_ref()).collect();
+        let t: Vec<&TransformOutcome> = transforms.iter().flatten().map(|x| x.as_ref()).collect();
+        let r: Vec<&AerialRefinement> = refinements.iter().flatten().map(|x| x.as_ref()).collect();
+        let c: Vec<&RecordingControl> = control.iter().flatten().map(|x| x.as_ref()).collect();
         Ok(NadirSummary::from_parts(
             snap.campaign.recordings.len(),
             &w,

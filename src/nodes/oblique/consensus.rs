@@ -2,7 +2,7 @@
 //! registration set, optional consensus tracking, and the oblique control points (thesis 4.4.7,
 //! `skytie_stages::oblique::consensus`), with the pipeline's own counts (`oblique.*` metrics that need no truth).
 
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, NodeCtx, Optional, RawFile, RawFileValue, Stage, StageError};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::panorama_sizes::pano_sizes;
 use serde::{Deserialize, Serialize};
@@ -31,9 +31,9 @@ impl Stage for ConsensusStage {
     type Inputs = (
         Handle<CampaignSnapshot>,
         Vec<RawFile>,
-        Vec<Handle<SparseCloud>>,
-        Vec<Handle<TripletFacades>>,
-        Vec<Handle<PatchRegistrationSet>>,
+        Vec<Optional<SparseCloud>>,
+        Vec<Optional<TripletFacades>>,
+        Vec<Optional<PatchRegistrationSet>>,
     );
 
     fn run(
@@ -42,17 +42,19 @@ impl Stage for ConsensusStage {
         (snap, panos, clouds, facades, sets): (
             Arc<CampaignSnapshot>,
             Vec<RawFileValue>,
-            Vec<Arc<SparseCloud>>,
-            Vec<Arc<TripletFacades>>,
-            Vec<Arc<PatchRegistrationSet>>,
+            Vec<Option<Arc<SparseCloud>>>,
+            Vec<Option<Arc<TripletFacades>>>,
+            Vec<Option<Arc<PatchRegistrationSet>>>,
         ),
         _: &NodeCtx,
     ) -> Result<ObliqueOutput, StageError> {
         let c = &snap.campaign;
         let sizes = pano_sizes(&panos)?;
-        let clouds: Vec<SparseCloud> = clouds.iter().map(|x| (**x).clone()).collect();
-        let facades: Vec<TripletFacades> = facades.iter().map(|x| (**x).clone()).collect();
-        let sets: Vec<PatchRegistrationSet> = sets.iter().map(|x| (**x).clone()).collect();
+        let clouds: Vec<SparseCloud> = clouds.iter().flatten().map(|x| (**x).clone()).collect();
+        let facades: Vec<TripletFacades> =
+            facades.iter().flatten().map(|x| (**x).clone()).collect();
+        let sets: Vec<PatchRegistrationSet> =
+            sets.iter().flatten().map(|x| (**x).clone()).collect();
         let result = consensus(&sets, &clouds, &c.recordings, &c.oblique, &sizes, p);
         let summary = ObliqueSummary::from_parts(&clouds, &facades, &sets, &result);
         Ok(ObliqueOutput { result, summary })

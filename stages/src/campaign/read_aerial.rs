@@ -3,6 +3,7 @@
 
 use super::model::AerialImage;
 use super::problem::Problem;
+use super::ranges;
 use super::read_recordings::check_file_exists;
 use super::table::read_table;
 use super::unique::Sourced;
@@ -53,25 +54,15 @@ pub(crate) fn read_aerial_rows(
                 );
             }
         }
-        if focal_px <= 0.0 {
-            f.error(
-                "focal_px",
-                format!("{focal_px} is not a principal distance"),
-                "give the principal distance in pixels, > 0",
-            );
-        }
+        ranges::coordinates(&mut f, x, y, z);
+        ranges::angle(&mut f, "kappa", kappa_deg, -360.0, 360.0);
+        ranges::frame_camera(&mut f, focal_px, width_px, height_px);
         for (column, c, size) in [("cx", cx_px, width_px), ("cy", cy_px, height_px)] {
             if size > 0 && !(0.0..=f64::from(size)).contains(&c) {
                 f.error(column, format!("principal point {c} px lies outside the image (0..{size} px)"), "give the principal point in continuous pixel coordinates of this image (centre = size/2)");
             }
         }
-        if sigma_px <= 0.0 {
-            f.error(
-                "sigma_px",
-                format!("{sigma_px} is not a standard deviation"),
-                "write a value > 0 px, or leave the cell empty for the default 0.5",
-            );
-        }
+        ranges::sigma_px(&mut f, sigma_px);
         if check_files && !file.is_empty() {
             check_file_exists(&mut f, root, dir, &file);
         }
