@@ -13,7 +13,7 @@ use super::error::AdjustError;
 use super::linearization::linearize;
 use super::prepared::Prepared;
 use super::residuals::State;
-use super::schur::{reduce, ReduceError};
+use super::schur::{ReduceError, ReducedSystem};
 use super::sparse::SelectedInverse;
 use nalgebra::Matrix4;
 
@@ -33,7 +33,8 @@ pub fn recording_covariances(
     state: &State,
 ) -> Result<RecordingCovariances, AdjustError> {
     let lin = linearize(prep, state);
-    let system = reduce(prep, &lin, 0.0).map_err(|e| match e {
+    let mut system = ReducedSystem::new(prep);
+    system.reduce(prep, &lin, 0.0).map_err(|e| match e {
         ReduceError::Pivot(p) => AdjustError::Singular {
             recording: p.block,
             parameter: p.component,

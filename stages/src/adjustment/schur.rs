@@ -28,71 +28,98 @@ pub enum ReduceError {
 /// Per point: V⁻¹ and V⁻¹·b_p (zero for undetermined points).
 pub type PointElimination = (Matrix3<f64>, Vector3<f64>);
 
-/// A factorised reduced camera system and what back-substitution needs.
+/// A factorised reduced camera system and what back-substitution needs. Its buffers are reused from one
+/// damping trial to the next (no page faults for every trial on big blocks).
 pub struct ReducedSystem {
     pub factor: Factor,
     /// b_c − W·V⁻¹·b_p per recording (zero for fixed parameters).
     pub rhs: Vec<BlockVector>,
     pub points: Vec<PointElimination>,
+    /// The blocks of S row by row (the order of `ReducedStructure::rows`).
+    values: Vec<Block>,
 }
 
-/// Forms and factorises the system damped by `lambda`.
-pub fn reduce(
-    prep: &Prepared,
-    lin: &Linearization,
-    lambda: f64,
-) -> Result<ReducedSystem, ReduceError> {
-    let points = point_inverses(prep, lin, lambda)?;
-    let structure = &prep.structure;
-    let n_rec = structure.rows.rows();
-    let mut values = vec![Block::zeros(); structure.rows.len()];
-    let mut rhs = vec![BlockVector::zeros(); n_rec];
-    let row_chunks = chunks(n_rec);
-    let row_ends: Vec<usize> = row_chunks.iter().map(|&(_, e)| e).collect();
-    let value_ends: Vec<usize> = row_ends
-        .iter()
-        .map(|&e| structure.rows.row_start(e))
-        .collect();
-    let active = active_mask(prep);
-    row_chunks
-        .iter()
-        .zip(split_at_ends(&mut values, &value_ends))
-        .zip(split_at_ends(&mut rhs, &row_ends))
-        .collect::<Vec<_>>()
-        .into_par_iter()
-        .for_each(|((&(first, end), values), rhs)| {
-            let base = structure.rows.row_start(first);
-            for r in first..end {
-                let start = structure.rows.row_start(r) - base;
-                let len = structure.rows.row(r).len();
-                rhs[r - first] = reduced_row(
-                    prep,
-                    lin,
-                    &points,
-                    lambda,
-                    r,
-                    &mut values[start..start + len],
-                );
-                mask_row(
-                    &active,
-                    &mut values[start..start + len],
-                    &mut rhs[r - first],
-                );
-            }
-        });
-    let mut factor = Factor::zeros(&structure.symbolic);
-    for (slot, value) in structure.slots.iter().zip(&values) {
-        factor.add(*slot, value);
+impl ReducedSystem {
+    /// Buffers for the systems of `prep`.
+    pub fn new(prep: &Prepared) -> Self {
+        let structure = &prep.structure;
+        Self {
+            factor: Factor::zeros(&structure.symbolic),
+            rhs: vec![BlockVector::zeros(); structure.rows.rows()],
+            points: vec![(Matrix3::zeros(), Vector3::zeros()); prep.point_active.len()],
+            values: vec![Block::zeros(); structure.rows.len()],
+        }
     }
-    drop(values);
-    factor
-        .factorize(&structure.symbolic)
-        .map_err(ReduceError::Pivot)?;
-    Ok(ReducedSystem {
-        factor,
-        rhs,
-        points,
-    })
+
+    /// Forms and factorises the system damped by `lambda`.
+    pub fn reduce(
+        &mut self,
+        prep: &Prepared,
+        lin: &Linearization,
+        lambda: f64,
+    ) -> Result<(), ReduceError> {
+        point_inverses(prep, lin, lambda, &mut self.points)?;
+        let structure = &prep.structure;
+        let n_rec = structure.rows.rows();
+        let row_chunks = chunks(n_rec);
+        let row_ends: Vec<usize> = row_chunks.iter().map(|&(_, e)| e).collect();
+        let value_ends: Vec<usize> = row_ends
+            .iter()
+            .map(|&e| structure.rows.row_start(e))
+            .collect();
+        let active = active_mask(prep);
+        let points = &self.points;
+        row_chunks
+            .iter()
+            .zip(split_at_ends(&mut self.values, &value_ends))
+            .zip(split_at_ends(&mut self.rhs, &row_ends))
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .for_each(|((&(first, end), values), rhs)| {
+                let base = structure.rows.row_start(first);
+                for r in first..end {
+                    let start = structure.rows.row_start(r) - base;
+                    let row = &mut values[start..start + structure.rows.row(r).len()];
+                    rhs[r - first] = reduced_row(prep, lin, points, lambda, r, row);
+                    mask_row(&active, row, &mut rhs[r - first]);
+                }
+            });
+        self.factor.clear();
+        for (slot, value) in structure.slots.iter().zip(&self.values) {
+            self.factor.add(*slot, value);
+        }
+        self.factor
+            .factorize(&structure.symbolic)
+            .map_err(ReduceError::Pivot)
+    }
+
+    /// Solves the system formed by the last successful [`Self::reduce`]: (camera step per recording over
+    /// (x, y, z, ψ), point steps).
+    pub fn step(
+        &self,
+        prep: &Prepared,
+        lin: &Linearization,
+    ) -> (Vec<BlockVector>, Vec<Vector3<f64>>) {
+        let mut camera_step = self.rhs.clone();
+        self.factor
+            .solve_in_place(&prep.structure.symbolic, &mut camera_step);
+        let layout = &prep.layout;
+        let point_step = (0..prep.point_active.len())
+            .into_par_iter()
+            .with_min_len(super::parallel::CHUNK)
+            .map(|p| {
+                if !prep.point_active[p] {
+                    return Vector3::zeros();
+                }
+                let mut b = lin.point_rhs[p];
+                for pos in layout.positions_of_point(p) {
+                    b -= lin.couplings[pos].tr_mul(&camera_step[layout.recording_of[pos]]);
+                }
+                self.points[p].0 * b
+            })
+            .collect();
+        (camera_step, point_step)
+    }
 }
 
 /// Which of (x, y, z, ψ) are estimated.
@@ -104,27 +131,29 @@ fn active_mask(prep: &Prepared) -> [bool; 4] {
     active
 }
 
-/// V_p(λ)⁻¹ and V_p(λ)⁻¹·b_p of every determined point.
+/// V_p(λ)⁻¹ and V_p(λ)⁻¹·b_p of every determined point, into `out` (one per point).
 fn point_inverses(
     prep: &Prepared,
     lin: &Linearization,
     lambda: f64,
-) -> Result<Vec<PointElimination>, ReduceError> {
-    (0..prep.point_active.len())
-        .into_par_iter()
+    out: &mut [PointElimination],
+) -> Result<(), ReduceError> {
+    out.par_iter_mut()
+        .enumerate()
         .with_min_len(super::parallel::CHUNK)
-        .map(|p| {
+        .try_for_each(|(p, slot)| {
             if !prep.point_active[p] {
-                return Ok((Matrix3::zeros(), Vector3::zeros()));
+                *slot = (Matrix3::zeros(), Vector3::zeros());
+                return Ok(());
             }
             let mut v = lin.point_diag[p];
             for d in 0..3 {
                 v[(d, d)] *= 1.0 + lambda;
             }
             let inv = v.cholesky().ok_or(ReduceError::Point(p))?.inverse();
-            Ok((inv, inv * lin.point_rhs[p]))
+            *slot = (inv, inv * lin.point_rhs[p]);
+            Ok(())
         })
-        .collect()
 }
 
 /// Row r of S (blocks for the columns of `structure.rows.row(r)`, written to `out`) and its right-hand side.
@@ -187,35 +216,4 @@ fn mask_row(active: &[bool; 4], out: &mut [Block], rhs: &mut BlockVector) {
     for f in (0..4).filter(|&f| !active[f]) {
         rhs[f] = 0.0;
     }
-}
-
-/// Solves the damped normal equations: (camera step per recording over (x, y, z, ψ), point steps).
-pub fn step(
-    prep: &Prepared,
-    lin: &Linearization,
-    lambda: f64,
-) -> Result<(Vec<BlockVector>, Vec<Vector3<f64>>), ReduceError> {
-    let ReducedSystem {
-        factor,
-        mut rhs,
-        points,
-    } = reduce(prep, lin, lambda)?;
-    factor.solve_in_place(&prep.structure.symbolic, &mut rhs);
-    let camera_step = rhs;
-    let layout = &prep.layout;
-    let point_step = (0..prep.point_active.len())
-        .into_par_iter()
-        .with_min_len(super::parallel::CHUNK)
-        .map(|p| {
-            if !prep.point_active[p] {
-                return Vector3::zeros();
-            }
-            let mut b = lin.point_rhs[p];
-            for pos in layout.positions_of_point(p) {
-                b -= lin.couplings[pos].tr_mul(&camera_step[layout.recording_of[pos]]);
-            }
-            points[p].0 * b
-        })
-        .collect();
-    Ok((camera_step, point_step))
 }

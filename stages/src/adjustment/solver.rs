@@ -12,7 +12,7 @@ use super::linearization::linearize;
 use super::prepared::Prepared;
 use super::problem::LmOptions;
 use super::residuals::State;
-use super::schur::{step, ReduceError};
+use super::schur::{ReduceError, ReducedSystem};
 
 /// Largest damping before giving up on finding a decreasing step.
 const MAX_LAMBDA: f64 = 1e16;
@@ -55,6 +55,7 @@ pub fn solve(
     let initial_cost = cost;
     let mut iterations = 0usize;
     let mut last_failure = None;
+    let mut system = ReducedSystem::new(prep);
     let termination = 'outer: loop {
         if cost == 0.0 {
             break Termination::ZeroCost;
@@ -64,8 +65,9 @@ pub fn solve(
         }
         let lin = linearize(prep, state);
         loop {
-            match step(prep, &lin, lambda) {
-                Ok((camera_step, point_step)) => {
+            match system.reduce(prep, &lin, lambda) {
+                Ok(()) => {
+                    let (camera_step, point_step) = system.step(prep, &lin);
                     let candidate = state.apply(&camera_step, &point_step);
                     let new_cost = prep.cost(&candidate);
                     if new_cost < cost {

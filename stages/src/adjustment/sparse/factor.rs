@@ -77,16 +77,19 @@ impl Factor {
             for k in start..start + rows.len() {
                 self.lower[k] = block4::right_solve_lower_transpose(&self.lower[k], &ljj);
             }
-            // Update the later columns: A(i1, i2) −= L(i1, j)·L(i2, j)ᵀ for i1 ≥ i2 in column j.
+            // Update the later columns: A(i1, i2) −= L(i1, j)·L(i2, j)ᵀ for i1 ≥ i2 in column j. The rows
+            // after i2 in column j are a subset of column i2's rows, both ascending: one merge walk finds them.
             for (a, &i2) in rows.iter().enumerate() {
                 let l2t = self.lower[start + a].transpose();
                 let diag_update = self.lower[start + a] * l2t;
                 self.diagonal[i2] -= diag_update;
+                let mut target = symbolic.column_positions(i2);
                 for (b, &i1) in rows.iter().enumerate().skip(a + 1) {
+                    let k = target
+                        .find(|&(_, row)| row == i1)
+                        .expect("the fill of column j lies in L's structure")
+                        .0;
                     let update = self.lower[start + b] * l2t;
-                    let k = symbolic
-                        .position(i1, i2)
-                        .expect("the fill of column j lies in L's structure");
                     self.lower[k] -= update;
                 }
             }

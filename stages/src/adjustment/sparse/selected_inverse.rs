@@ -32,40 +32,40 @@ impl SelectedInverse {
             diagonal: vec![Block::zeros(); n],
             lower: vec![Block::zeros(); symbolic.lower_blocks()],
         };
+        let mut acc: Vec<Block> = Vec::new();
         for j in (0..n).rev() {
             let l_inv = block4::invert_lower(factor.diagonal(j));
             let start = symbolic.column_start(j);
             let rows = symbolic.column(j);
-            for (a, &i) in rows.iter().enumerate() {
-                let mut acc = Block::zeros();
-                for (b, &k) in rows.iter().enumerate() {
-                    acc += z.block(symbolic, i, k) * factor.lower(start + b);
+            // acc[a] = Σ_{k∈S_j} Z(rows[a], k)·L(k, j), visiting each pair (i > k) of S_j once through column
+            // k of Z (a merge walk, as in the factorisation) and using Z(k, i) = Z(i, k)ᵀ.
+            acc.clear();
+            acc.resize(rows.len(), Block::zeros());
+            for (a, &k) in rows.iter().enumerate() {
+                let l_kj = factor.lower(start + a);
+                acc[a] += z.diagonal[k] * l_kj;
+                let mut column_k = symbolic.column_positions(k);
+                for (b, &i) in rows.iter().enumerate().skip(a + 1) {
+                    let position = column_k
+                        .find(|&(_, row)| row == i)
+                        .expect("a column's structure is a clique of L's structure")
+                        .0;
+                    let z_ik = &z.lower[position];
+                    acc[b] += z_ik * l_kj;
+                    acc[a] += z_ik.tr_mul(factor.lower(start + b));
                 }
-                z.lower[start + a] = -acc * l_inv;
             }
-            let mut acc = Block::zeros();
-            for (b, _) in rows.iter().enumerate() {
-                acc += factor.lower(start + b).tr_mul(&z.lower[start + b]);
+            for (a, sum) in acc.iter().enumerate() {
+                z.lower[start + a] = -sum * l_inv;
             }
-            let d = l_inv.tr_mul(&(l_inv - acc));
+            let mut sum = Block::zeros();
+            for a in 0..rows.len() {
+                sum += factor.lower(start + a).tr_mul(&z.lower[start + a]);
+            }
+            let d = l_inv.tr_mul(&(l_inv - sum));
             z.diagonal[j] = (d + d.transpose()) * 0.5;
         }
         z
-    }
-
-    /// Z(i, k) in new numbering, for i and k in one column's structure (or equal).
-    fn block(&self, symbolic: &Symbolic, i: usize, k: usize) -> Block {
-        match i.cmp(&k) {
-            std::cmp::Ordering::Equal => self.diagonal[i],
-            std::cmp::Ordering::Greater => self.lower[Self::position(symbolic, i, k)],
-            std::cmp::Ordering::Less => self.lower[Self::position(symbolic, k, i)].transpose(),
-        }
-    }
-
-    fn position(symbolic: &Symbolic, i: usize, j: usize) -> usize {
-        symbolic
-            .position(i, j)
-            .expect("a column's structure is a clique of L's structure")
     }
 
     /// The diagonal block of A⁻¹ for block row `old` (the caller's numbering).

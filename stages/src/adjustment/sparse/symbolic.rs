@@ -99,6 +99,15 @@ impl Symbolic {
         self.columns.row_start(j)
     }
 
+    /// (storage position, row) of the strictly lower blocks of new column `j`, rows ascending.
+    pub fn column_positions(&self, j: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let start = self.column_start(j);
+        self.column(j)
+            .iter()
+            .enumerate()
+            .map(move |(k, &row)| (start + k, row))
+    }
+
     /// Strictly lower blocks of L.
     pub fn lower_blocks(&self) -> usize {
         self.columns.len()
