@@ -129,7 +129,7 @@ impl Factor {
 pub(crate) mod tests {
     use super::*;
     use crate::adjustment::sparse::csr::Csr;
-    use crate::estimators::rng::SplitMix64;
+    use crate::rng::SplitMix64;
     use nalgebra::DMatrix;
 
     /// A random symmetric positive definite block matrix: a chain plus random long-range couplings. Returns

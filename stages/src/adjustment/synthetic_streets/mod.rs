@@ -10,7 +10,7 @@ pub mod points;
 pub mod route;
 
 use super::problem::{Block, BlockRecording, ControlPoint, PanoObservation, RelativeConstraint};
-use crate::estimators::rng::{mix_seed, SplitMix64};
+use crate::rng::{mix_seed, SplitMix64};
 use crate::geometry::{triangulate_rays, PanoramaCamera};
 use nalgebra::Vector3;
 use points::{crossing_points, observe, roadside_points, TiePoint};

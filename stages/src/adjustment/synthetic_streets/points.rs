@@ -4,7 +4,7 @@
 //! its own random stream, so the block is the same whatever the thread count.
 
 use super::route::{ground_z, ORIGIN};
-use crate::estimators::rng::{mix_seed, SplitMix64};
+use crate::rng::{mix_seed, SplitMix64};
 use crate::geometry::PanoramaCamera;
 use nalgebra::Vector3;
 use rayon::prelude::*;

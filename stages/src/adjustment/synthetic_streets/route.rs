@@ -5,7 +5,7 @@
 //! (Gaussian knots every `drift_length` recordings, linearly interpolated — multipath and blocked satellites
 //! give errors correlated over tens to hundreds of metres) and white noise.
 
-use crate::estimators::rng::{mix_seed, SplitMix64};
+use crate::rng::{mix_seed, SplitMix64};
 use nalgebra::Vector3;
 
 /// Camera height above the road, metres.
