@@ -11,9 +11,10 @@
 
 use super::adjust::{adjust, ObservationCounts};
 use super::config::{AdjustConfig, ControlWeighting};
+use super::error::AdjustError;
 use super::problem::{
-    AdjustError, AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint,
-    PanoObservation, RelativeConstraint,
+    AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, PanoObservation,
+    RelativeConstraint,
 };
 use crate::campaign::{AerialImage, AerialKind, Recording};
 use crate::correspondence::{AerialControlPoint, MmTiePoint};
