@@ -15,6 +15,7 @@ pub mod features;
 pub mod formats;
 pub mod geometry;
 pub mod imaging;
+pub mod import;
 pub mod matching;
 pub mod nadir;
 pub mod oblique;

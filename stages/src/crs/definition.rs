@@ -148,6 +148,20 @@ impl Crs {
         })
     }
 
+    /// Latitude/longitude with ellipsoidal heights on this CRS's datum (e.g. for earth-centred coordinates
+    /// of a Metashape chunk in this CRS).
+    pub fn own_geographic(&self) -> Self {
+        Self {
+            text: format!("geographic 3D of {}", self.text),
+            horizontal_code: self.horizontal_code,
+            kind: HorizontalKind::Geographic,
+            vertical: VerticalDatum::Ellipsoidal,
+            proj: self.geographic.clone(),
+            geographic: self.geographic.clone(),
+            ellipsoid: self.ellipsoid,
+        }
+    }
+
     /// True for map coordinates (easting, northing).
     pub fn is_projected(&self) -> bool {
         self.kind == HorizontalKind::Projected

@@ -66,11 +66,8 @@ impl Ellipsoid {
         for _ in 0..20 {
             let s = lat.sin();
             let n = self.a_m / (1.0 - e2 * s * s).sqrt();
-            h = if lat.cos().abs() > 1e-3 {
-                rho / lat.cos() - n
-            } else {
-                p.z / s - n * (1.0 - e2)
-            };
+            // Stable at every latitude: h = ρ cos φ + (z + e² N sin φ) sin φ − N.
+            h = rho * lat.cos() + (p.z + e2 * n * s) * s - n;
             let next = p.z.atan2(rho * (1.0 - e2 * n / (n + h)));
             let done = (next - lat).abs() < 1e-14;
             lat = next;

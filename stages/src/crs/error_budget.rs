@@ -7,7 +7,8 @@
 //! tangent frame, expressed in the map frame with the camera's attitude turned by the meridian convergence
 //! at C (what an exact import of the orientation gives), and intersected with P's map height. The
 //! horizontal distance between that intersection and P's map position is the error a map-frame ray
-//! intersection makes; it is ≈ (k − 1)·d (scale) − d³/(2 R H) (curvature).
+//! intersection makes; it is ≈ (1 − k)·d (scale: the map stretches the ground by k but not the ray) −
+//! d³/(2 R H) (curvature: the ground falls away below the flat map).
 
 use super::definition::Crs;
 use super::ellipsoid::LocalTangentFrame;
@@ -26,7 +27,7 @@ pub struct RayErrorBudget {
     pub across_m: f64,
     /// Point scale factor at G.
     pub scale_factor: f64,
-    /// Closed-form estimate of the scale part, (k − 1)·d, m.
+    /// Closed-form estimate of the scale part, (1 − k)·d, m.
     pub scale_part_m: f64,
     /// Closed-form estimate of the curvature part, −d³/(2 R H), m.
     pub curvature_part_m: f64,
@@ -66,7 +67,7 @@ pub fn map_frame_ray_error(
         along_m: err.dot(&along_dir),
         across_m: err.dot(&across_dir),
         scale_factor: k,
-        scale_part_m: (k - 1.0) * offset_m,
+        scale_part_m: (1.0 - k) * offset_m,
         curvature_part_m: -offset_m.powi(3) / (2.0 * r * flying_height_m),
     })
 }

@@ -173,8 +173,17 @@ impl GeoidGrid {
         );
         let (fr, fc) = (r - r0 as f64, c - c0 as f64);
         let at = |i: usize, j: usize| f64::from(self.values_m[i * self.cols + j]);
-        let v = (1.0 - fr) * ((1.0 - fc) * at(r0, c0) + fc * at(r0, c0 + 1))
-            + fr * ((1.0 - fc) * at(r0 + 1, c0) + fc * at(r0 + 1, c0 + 1));
+        // Nodes with zero weight do not count (a point on a valid edge next to a void is fine).
+        let v: f64 = [
+            ((1.0 - fr) * (1.0 - fc), r0, c0),
+            ((1.0 - fr) * fc, r0, c0 + 1),
+            (fr * (1.0 - fc), r0 + 1, c0),
+            (fr * fc, r0 + 1, c0 + 1),
+        ]
+        .iter()
+        .filter(|(w, _, _)| *w > 0.0)
+        .map(|&(w, i, j)| w * at(i, j))
+        .sum();
         if v.is_finite() {
             Ok(v)
         } else {

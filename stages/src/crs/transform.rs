@@ -75,6 +75,12 @@ impl HorizontalTransform {
 
     /// Transform one native pair (see the module doc for the order).
     pub fn apply(&self, a: f64, b: f64) -> Result<(f64, f64), TransformError> {
+        self.apply3(a, b, 0.0).map(|(x, y, _)| (x, y))
+    }
+
+    /// Transform a native pair with an ellipsoidal height (m); across datums the height follows the
+    /// geocentric datum shift.
+    pub fn apply3(&self, a: f64, b: f64, h_m: f64) -> Result<(f64, f64, f64), TransformError> {
         let fail = |reason: String| TransformError {
             a,
             b,
@@ -91,18 +97,18 @@ impl HorizontalTransform {
                     "latitude must lie in [−90°, 90°], longitude in [−360°, 360°]".into(),
                 ));
             }
-            (b.to_radians(), a.to_radians(), 0.0)
+            (b.to_radians(), a.to_radians(), h_m)
         } else {
-            (a, b, 0.0)
+            (a, b, h_m)
         };
         proj4rs::transform::transform(&self.from, &self.to, &mut p)
             .map_err(|e| fail(e.to_string()))?;
         let out = if self.to_geographic {
-            (p.1.to_degrees(), p.0.to_degrees())
+            (p.1.to_degrees(), p.0.to_degrees(), p.2)
         } else {
-            (p.0, p.1)
+            (p.0, p.1, p.2)
         };
-        if out.0.is_finite() && out.1.is_finite() {
+        if out.0.is_finite() && out.1.is_finite() && out.2.is_finite() {
             Ok(out)
         } else {
             Err(fail("outside the domain of the projection".into()))

@@ -10,6 +10,7 @@ pub mod angles;
 pub mod camera_model;
 pub mod events;
 pub mod gps_time;
+pub mod metashape_xml;
 
 pub mod opk_list;
 
