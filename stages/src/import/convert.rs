@@ -17,6 +17,8 @@ const NORTH_STEP_DEG: f64 = 1e-5;
 #[derive(Clone)]
 pub struct Converter {
     source: Crs,
+    /// Source and campaign share the horizontal CRS: coordinates and attitudes pass unchanged (exactly).
+    same_horizontal: bool,
     forward: HorizontalTransform,
     /// Source native → ETRS89 latitude/longitude (where geoid models are given).
     to_geoid_lookup: HorizontalTransform,
@@ -43,6 +45,8 @@ impl Converter {
         let etrs89 = Crs::parse("EPSG:4258").expect("ETRS89 is a known CRS");
         Ok(Self {
             source: source.clone(),
+            same_horizontal: source.horizontal_code == campaign.horizontal_code
+                && source.kind == campaign.kind,
             forward: HorizontalTransform::new(source, campaign),
             to_geoid_lookup: HorizontalTransform::new(source, &etrs89),
             heights: HeightConversion::new(heights, campaign.vertical, geoid)?,
@@ -54,7 +58,11 @@ impl Converter {
     /// Ellipsoidal heights are first taken to ETRS89 through the datum shift (a source on another datum has
     /// its own ellipsoid), then reduced by the geoid separation there.
     pub fn position(&self, a: f64, b: f64, h_m: f64) -> Result<(f64, f64, f64), ConvertError> {
-        let (x, y) = self.forward.apply(a, b)?;
+        let (x, y) = if self.same_horizontal {
+            (a, b)
+        } else {
+            self.forward.apply(a, b)?
+        };
         let z = match self.heights {
             HeightConversion::Identity => h_m,
             _ => {
@@ -67,6 +75,9 @@ impl Converter {
 
     /// Grid azimuth (campaign, degrees) of the source's north direction at a source native pair.
     pub fn north_azimuth_deg(&self, a: f64, b: f64) -> Result<f64, TransformError> {
+        if self.same_horizontal {
+            return Ok(0.0);
+        }
         let (da, db) = if self.source.is_projected() {
             (0.0, NORTH_STEP_M)
         } else {
@@ -119,7 +130,11 @@ pub struct Inverse {
 impl Inverse {
     /// Source native pair and height of a campaign point.
     pub fn position(&self, x: f64, y: f64, z: f64) -> Result<(f64, f64, f64), ConvertError> {
-        let (a, b) = self.backward.apply(x, y)?;
+        let (a, b) = if self.forward.same_horizontal {
+            (x, y)
+        } else {
+            self.backward.apply(x, y)?
+        };
         let h = match self.heights {
             HeightConversion::Identity => z,
             _ => {
