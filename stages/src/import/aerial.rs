@@ -4,18 +4,13 @@ use super::config::{AerialFormat, AerialKindName, AerialSource};
 use super::context::ImportContext;
 use super::convert::Converter;
 use super::report::SourceReport;
+use super::source_pose::{missing, SourcePose};
 use crate::campaign::{AerialImage, Problem};
 use crate::formats::camera_model::CameraModel;
-use crate::formats::opk_list::{read_opk_list, OpkListFormat, PoseRow};
+use crate::formats::opk_list::{read_opk_list, OpkListFormat};
 use crate::formats::pix4d::read_pix4d_cam;
 use crate::geometry::matrix_to_opk;
 use std::path::Path;
-
-/// An oriented image as read, before conversion: pose in the source CRS, camera in campaign convention.
-pub(crate) struct SourcePose {
-    pub pose: PoseRow,
-    pub camera: CameraModel,
-}
 
 /// Import one source; returns the campaign rows (with `file` = the image's file name) and the report.
 pub fn import_aerial(src: &AerialSource, ctx: &ImportContext) -> (Vec<AerialImage>, SourceReport) {
@@ -71,16 +66,6 @@ fn format_name(f: AerialFormat) -> &'static str {
         AerialFormat::MetashapeOpk => "metashape-opk",
         AerialFormat::OpkList => "opk-list",
     }
-}
-
-pub(crate) fn missing(file: &Path, key: &str, hint: &str) -> Problem {
-    Problem::error(
-        "import configuration",
-        None,
-        Some(key),
-        format!("is required for {}", file.display()),
-        hint,
-    )
 }
 
 fn read_list(

@@ -2,10 +2,10 @@
 //! earth-centred coordinates of the chunk CRS's datum, then latitude/longitude/ellipsoidal height and
 //! east-north-up axes there; the converter takes them into the campaign CRS like any geographic source.
 
-use super::aerial::{missing, SourcePose};
 use super::config::AerialSource;
 use super::context::ImportContext;
 use super::report::SourceReport;
+use super::source_pose::{missing, SourcePose};
 use crate::campaign::Problem;
 use crate::crs::{Crs, Ellipsoid};
 use crate::formats::camera_model::CameraModel;

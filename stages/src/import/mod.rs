@@ -12,6 +12,7 @@ pub mod mm;
 pub mod pose;
 pub mod report;
 pub mod run;
+mod source_pose;
 
 pub use config::ImportConfig;
 pub use report::ImportReport;
