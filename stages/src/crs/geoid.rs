@@ -91,7 +91,9 @@ impl GeoidGrid {
         let n = |i: usize| i32::from_be_bytes(bytes[i..i + 4].try_into().expect("4 bytes"));
         let (south, mut west, dlat, dlon) = (f(0), f(8), f(16), f(24));
         let (rows, cols) = (n(32), n(36));
-        if !(rows > 1 && cols > 1 && dlat > 0.0 && dlon > 0.0) || !(-90.0..=90.0).contains(&south) {
+        let header_ok =
+            rows > 1 && cols > 1 && dlat > 0.0 && dlon > 0.0 && (-90.0..=90.0).contains(&south);
+        if !header_ok {
             return Err(bad(format!(
                 "header says {rows} rows × {cols} columns, spacing {dlat}° × {dlon}°, south {south}°"
             )));

@@ -192,7 +192,7 @@ pub fn read_metashape_xml(path: &Path) -> Result<(MetashapeDocument, Vec<Problem
                 )),
             }
         }
-        if !(c.f > 0.0) {
+        if c.f.is_nan() || c.f <= 0.0 {
             fatal.push(err(
                 Some(line(cal)),
                 Some("f"),
@@ -282,7 +282,7 @@ pub fn read_metashape_xml(path: &Path) -> Result<(MetashapeDocument, Vec<Problem
 pub fn write_metashape_xml(path: &Path, doc: &MetashapeDocument) -> std::io::Result<()> {
     use std::fmt::Write;
     let mut s = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<document version=\"1.5.0\">\n  <chunk label=\"Chunk 1\" enabled=\"true\">\n    <sensors next_id=\"");
-    let _ = write!(s, "{}\">\n", doc.sensors.len());
+    let _ = writeln!(s, "{}\">", doc.sensors.len());
     for se in &doc.sensors {
         let c = &se.calibration;
         let _ = write!(s, "      <sensor id=\"{}\" label=\"{}\" type=\"frame\">\n        <resolution width=\"{}\" height=\"{}\"/>\n        <calibration type=\"frame\" class=\"adjusted\">\n          <resolution width=\"{}\" height=\"{}\"/>\n", se.id, se.label, c.width_px, c.height_px, c.width_px, c.height_px);

@@ -110,7 +110,7 @@ pub fn read_points(path: &Path, f: &PointFormat) -> (Vec<PointRow>, Vec<Problem>
         let mut sigma = |present: bool, r: &mut RowReader| {
             present.then(|| {
                 let v = r.number(cols[next], names[next]);
-                if !(v > 0.0) && v.is_finite() {
+                if v.is_finite() && v <= 0.0 {
                     r.error(
                         names[next],
                         format!("{v} is not a standard deviation"),
