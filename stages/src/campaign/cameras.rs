@@ -92,6 +92,7 @@ mod tests {
                 k2: 0.02,
                 p1: 1e-3,
                 p2: -1e-3,
+                ..BrownDistortion::NONE
             },
         );
         assert_eq!(cam, expected);
