@@ -10,6 +10,8 @@ pub mod cache;
 pub mod check;
 pub mod common;
 pub mod explain;
+pub mod import;
+pub mod init;
 pub mod plan;
 pub mod report;
 pub mod run;
@@ -50,6 +52,10 @@ pub enum Command {
     Check(check::CheckArgs),
     /// List the built-in workflows, or print one (`show NAME`).
     Workflows(workflows::WorkflowsArgs),
+    /// Turn vendor files (Pix4D, Metashape, SBET, ...) into a campaign folder (docs/import.md).
+    Import(import::ImportArgs),
+    /// Write an empty campaign skeleton with commented table headers.
+    Init(init::InitArgs),
     /// Building blocks on plain files (ortho, kaze, forstner, wallis, phasecorr, ncc), CSV/plain output.
     #[command(subcommand)]
     Tool(tool::ToolCommand),
@@ -66,6 +72,8 @@ pub fn main() -> i32 {
         Command::Cache(a) => cache::main(a),
         Command::Synth(a) => synth::main(a),
         Command::Check(a) => check::main(a),
+        Command::Import(a) => import::main(a),
+        Command::Init(a) => init::main(a),
         Command::Tool(t) => tool::main(t),
         Command::Workflows(a) => workflows::main(a),
     }

@@ -8,11 +8,14 @@
 pub mod adjustment;
 pub mod campaign;
 pub mod correspondence;
+pub mod crs;
 pub mod estimators;
 pub mod export;
 pub mod features;
+pub mod formats;
 pub mod geometry;
 pub mod imaging;
+pub mod import;
 pub mod matching;
 pub mod nadir;
 pub mod oblique;

@@ -189,6 +189,10 @@ impl SyntheticCampaignSpec {
                 k2: 0.0,
                 p1,
                 p2: 0.0,
+                k3: 0.0,
+                k4: 0.0,
+                b1: 0.0,
+                b2: 0.0,
                 sigma_px: self.aerial_sigma_px,
             };
             cameras.push(FrameCamera::from_aerial(&row));

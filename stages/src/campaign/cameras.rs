@@ -21,8 +21,12 @@ impl FrameCamera {
             BrownDistortion {
                 k1: img.k1,
                 k2: img.k2,
+                k3: img.k3,
+                k4: img.k4,
                 p1: img.p1,
                 p2: img.p2,
+                a1: img.b1 / img.focal_px,
+                a2: img.b2 / img.focal_px,
             },
         )
     }
@@ -66,6 +70,10 @@ mod tests {
             k2: 0.02,
             p1: 1e-3,
             p2: -1e-3,
+            k3: 0.0,
+            k4: 0.0,
+            b1: 0.0,
+            b2: 0.0,
             sigma_px: 0.5,
         };
         let cam = FrameCamera::from_aerial(&img);
@@ -84,6 +92,7 @@ mod tests {
                 k2: 0.02,
                 p1: 1e-3,
                 p2: -1e-3,
+                ..BrownDistortion::NONE
             },
         );
         assert_eq!(cam, expected);

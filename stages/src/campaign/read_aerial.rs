@@ -43,6 +43,12 @@ pub(crate) fn read_aerial_rows(
             f.number_or("p1", 0.0),
             f.number_or("p2", 0.0),
         );
+        let (k3, k4, b1, b2) = (
+            f.number_or("k3", 0.0),
+            f.number_or("k4", 0.0),
+            f.number_or("b1", 0.0),
+            f.number_or("b2", 0.0),
+        );
         let sigma_px = f.number_or("sigma_px", 0.5);
         // campaign-format.md: ω and φ tilt the view axis away from the nadir; beyond ±90° it looks up.
         for (column, angle) in [("omega", omega_deg), ("phi", phi_deg)] {
@@ -85,6 +91,10 @@ pub(crate) fn read_aerial_rows(
                 k2,
                 p1,
                 p2,
+                k3,
+                k4,
+                b1,
+                b2,
                 sigma_px,
             };
             rows.push(Sourced {

@@ -189,6 +189,7 @@ fn distortion_jacobian_matches_finite_differences() {
         k2: 0.03,
         p1: 2e-3,
         p2: -1.5e-3,
+        ..BrownDistortion::NONE
     };
     for &(x, y) in &[(0.1, 0.2), (-0.4, 0.3), (0.55, -0.35)] {
         let j = d.distort_jacobian(x, y);
@@ -211,6 +212,7 @@ fn undistort_inverts_distort_to_1e12() {
         k2: 0.03,
         p1: 2e-3,
         p2: -1.5e-3,
+        ..BrownDistortion::NONE
     };
     for i in -12..=12 {
         for j in -8..=8 {
@@ -250,12 +252,14 @@ fn pixel_ray_pixel_round_trip_whole_image() {
             k2: 0.03,
             p1: 2e-3,
             p2: -1.5e-3,
+            ..BrownDistortion::NONE
         },
         BrownDistortion {
             k1: 0.08,
             k2: -0.01,
             p1: -1e-3,
             p2: 1e-3,
+            ..BrownDistortion::NONE
         },
     ];
     for d in distortions {
@@ -311,6 +315,7 @@ fn monotonic_limit_of_the_distortion() {
         k2: 0.02,
         p1: 0.0,
         p2: 0.0,
+        ..BrownDistortion::NONE
     };
     let s = d.max_monotonic_r2();
     assert!(s.is_finite() && (1.0 + 3.0 * d.k1 * s + 5.0 * d.k2 * s * s).abs() < 1e-12);

@@ -273,6 +273,7 @@ fn panorama_and_aerial_pixels_triangulate_a_ground_point() {
         k2: 0.01,
         p1: 1e-4,
         p2: -2e-4,
+        ..BrownDistortion::NONE
     };
     let aerial = [
         FrameCamera::from_opk(
