@@ -11,6 +11,7 @@ pub mod dag;
 pub mod explain;
 pub mod exports;
 pub mod hashing;
+pub mod headline;
 pub mod metrics;
 pub mod nodes;
 pub mod pipelines;
