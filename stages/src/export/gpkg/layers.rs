@@ -12,7 +12,7 @@
 //! Corrections and residuals follow one sign convention: adjusted (or estimated) minus recorded (or
 //! reference), i.e. what was added.
 
-use super::writer::{FieldType, Geometry, Layer, Value};
+use super::writer::{FieldType, Geometry, GeometryType, Layer, Value};
 use crate::adjustment::verify::Verification;
 use crate::adjustment::AdjustmentRun;
 use crate::campaign::{CheckPoint, Recording};
@@ -95,6 +95,7 @@ fn recording_layers(x: &RunLayers<'_>) -> Vec<Layer> {
     let after = segment_status(x.recordings, x.verification_adjusted);
     let mut recorded = Layer {
         name: "recordings_recorded".into(),
+        geometry: GeometryType::Point,
         description: "recorded panorama positions (mm/recordings.csv)".into(),
         fields: fields(&[
             ("image_id", FieldType::Text),
@@ -107,6 +108,7 @@ fn recording_layers(x: &RunLayers<'_>) -> Vec<Layer> {
     };
     let mut adjusted = Layer {
         name: "recordings_adjusted".into(),
+        geometry: GeometryType::Point,
         description: "adjusted panorama positions with posterior sigma".into(),
         fields: fields(&[
             ("image_id", FieldType::Text),
@@ -130,6 +132,7 @@ fn recording_layers(x: &RunLayers<'_>) -> Vec<Layer> {
     };
     let mut vectors = Layer {
         name: "corrections".into(),
+        geometry: GeometryType::LineString,
         description: "correction vectors, recorded to adjusted position".into(),
         fields: fields(&[
             ("image_id", FieldType::Text),
@@ -194,6 +197,7 @@ fn control_layer(x: &RunLayers<'_>) -> Layer {
         .collect();
     let mut l = Layer {
         name: "control_points".into(),
+        geometry: GeometryType::Point,
         description: "aerial control points at their aerial triangulation".into(),
         fields: fields(&[
             ("source", FieldType::Text),
@@ -240,6 +244,7 @@ fn checkpoint_layer(x: &RunLayers<'_>) -> Layer {
         .collect();
     let mut l = Layer {
         name: "check_points".into(),
+        geometry: GeometryType::Point,
         description:
             "surveyed check points with their errors (estimated - surveyed) before and after".into(),
         fields: fields(&[
@@ -276,6 +281,7 @@ fn checkpoint_layer(x: &RunLayers<'_>) -> Layer {
 fn verification_layer(x: &RunLayers<'_>) -> Layer {
     let mut l = Layer {
         name: "verification_segments".into(),
+        geometry: GeometryType::LineString,
         description:
             "per trajectory segment: MM minus aerial control-point offsets (thesis Table 5-13)"
                 .into(),

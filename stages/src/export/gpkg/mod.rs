@@ -8,7 +8,7 @@ pub mod layers;
 pub mod writer;
 
 pub use layers::{run_layers, RunLayers};
-pub use writer::{write_geopackage, FieldType, Geometry, Layer, Srs, Value};
+pub use writer::{write_geopackage, FieldType, Geometry, GeometryType, Layer, Srs, Value};
 
 /// The spatial reference system for a campaign `crs` string; `Err` carries the warning for an unknown one
 /// (the layers are then written with the undefined Cartesian system).

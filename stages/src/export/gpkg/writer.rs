@@ -45,13 +45,6 @@ pub enum Geometry {
 }
 
 impl Geometry {
-    fn type_name(&self) -> &'static str {
-        match self {
-            Geometry::PointZ(_) => "POINT",
-            Geometry::LineStringZ(_) => "LINESTRING",
-        }
-    }
-
     fn points(&self) -> &[[f64; 3]] {
         match self {
             Geometry::PointZ(p) => std::slice::from_ref(p),
@@ -113,11 +106,36 @@ pub enum FieldType {
     Integer,
 }
 
+/// The geometry type of a layer's features (all with Z).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GeometryType {
+    Point,
+    LineString,
+}
+
+impl GeometryType {
+    fn name(self) -> &'static str {
+        match self {
+            GeometryType::Point => "POINT",
+            GeometryType::LineString => "LINESTRING",
+        }
+    }
+
+    fn admits(self, g: &Geometry) -> bool {
+        matches!(
+            (self, g),
+            (GeometryType::Point, Geometry::PointZ(_))
+                | (GeometryType::LineString, Geometry::LineStringZ(_))
+        )
+    }
+}
+
 /// One feature layer.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Layer {
     /// Table name (letters, digits, `_`).
     pub name: String,
+    pub geometry: GeometryType,
     pub description: String,
     pub fields: Vec<(String, FieldType)>,
     /// (geometry, one value per field).
@@ -213,10 +231,7 @@ fn add_layer(
     l: &Layer,
     last_change: &str,
 ) -> rusqlite::Result<()> {
-    let geometry_type = l
-        .features
-        .first()
-        .map_or("GEOMETRY", |(g, _)| g.type_name());
+    let geometry_type = l.geometry.name();
     let columns: Vec<String> = l
         .fields
         .iter()
@@ -246,6 +261,12 @@ fn add_layer(
         marks.concat()
     ))?;
     for (g, values) in &l.features {
+        if !l.geometry.admits(g) || values.len() != l.fields.len() {
+            return Err(rusqlite::Error::InvalidParameterName(format!(
+                "layer {}: a feature does not match the layer's geometry type or fields",
+                l.name
+            )));
+        }
         for p in g.points() {
             for k in 0..2 {
                 lo[k] = lo[k].min(p[k]);
@@ -302,6 +323,7 @@ mod tests {
         let p = d.path().join("t.gpkg");
         let layer = Layer {
             name: "pts".into(),
+            geometry: GeometryType::Point,
             description: "test".into(),
             fields: vec![
                 ("name".into(), FieldType::Text),
@@ -355,6 +377,7 @@ mod tests {
         let d = tempfile::tempdir().unwrap();
         let layer = Layer {
             name: "bad name".into(),
+            geometry: GeometryType::Point,
             description: String::new(),
             fields: vec![],
             features: vec![],
