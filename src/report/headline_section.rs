@@ -1,12 +1,12 @@
-//! The report's first section: the answer a surveyor reads in five seconds ([`crate::headline`], the same
-//! numbers the terminal prints), the sign convention, and the verification of the adjusted trajectory per
+//! The report's first section: the answer a surveyor reads in five seconds ([`super::headline`], the same
+//! numbers the terminal can print), the sign convention, and the verification of the adjusted trajectory per
 //! segment.
 
 use super::html::{escape, Page};
 use super::inputs::ResultSet;
 use super::tables::{fmt_num, Origin, Table};
 use super::Builder;
-use crate::headline::{Headline, SegmentLine, Status};
+use super::headline::{Headline, SegmentLine, Status};
 
 /// The sentence stating the sign conventions of every number in the report and the output files.
 pub const SIGN_CONVENTION: &str = "Sign convention everywhere: a correction is adjusted − recorded position; a \

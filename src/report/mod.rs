@@ -10,6 +10,7 @@
 //! finished — go to `OUT/report/run-log/` instead, so that re-running a workflow reproduces `tables/`
 //! byte-identically (a warm rerun executes nothing and takes less time, which is all that changes).
 
+pub mod headline;
 pub mod headline_section;
 pub mod html;
 pub mod image_cache;

@@ -1,5 +1,6 @@
 //! The answer a surveyor reads in five seconds, computed from a run's output folder (or one variant's folder of
-//! a sweep) alone, so the terminal summary of `skytie run` and the HTML report say the same: how far off the
+//! a sweep) alone, so the terminal summary of `skytie run` ([`Headline::from_dir`] then [`Headline::lines`]) and
+//! the HTML report say the same: how far off the
 //! recordings were, how far they moved and their σ after the adjustment, how many could not be corrected and
 //! why, and the verification of the adjusted trajectory per segment — plus a status that says loudly when
 //! nothing was corrected or the check points got worse.
@@ -11,7 +12,7 @@
 //! Sources: `metrics.json` (`adjust.*`, `verify.*`), `corrections.csv` (rows of kind `recording`),
 //! `verification.csv` and `verification_adjusted.csv`.
 
-use crate::report::inputs::{num_at, obj_at, read_csv_opt, CsvTable};
+use super::inputs::{num_at, obj_at, read_csv_opt, CsvTable};
 use serde_json::Value;
 use skytie_stages::export::Support;
 use std::path::Path;
