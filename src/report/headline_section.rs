@@ -2,11 +2,11 @@
 //! numbers the terminal can print), the sign convention, and the verification of the adjusted trajectory per
 //! segment.
 
+use super::headline::{Headline, SegmentLine, Status};
 use super::html::{escape, Page};
 use super::inputs::ResultSet;
 use super::tables::{fmt_num, Origin, Table};
 use super::Builder;
-use super::headline::{Headline, SegmentLine, Status};
 
 /// The sentence stating the sign conventions of every number in the report and the output files.
 pub const SIGN_CONVENTION: &str = "Sign convention everywhere: a correction is adjusted − recorded position; a \

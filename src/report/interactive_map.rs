@@ -37,7 +37,7 @@ pub fn write_assets(report_dir: &Path) -> Result<(), String> {
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     for (name, bytes) in ASSETS {
         let p = dir.join(name);
-        skytie_stages::fsutil::atomic_write(&p, bytes)
+        skytie_util::fsutil::atomic_write(&p, bytes)
             .map_err(|e| format!("{}: cannot write: {e}", p.display()))?;
     }
     Ok(())
@@ -361,7 +361,7 @@ pub fn map_section(
         serde_json::to_string(&id).map_err(|e| e.to_string())?,
         serde_json::to_string(&doc).map_err(|e| e.to_string())?
     );
-    skytie_stages::fsutil::atomic_write(&path, text.as_bytes())
+    skytie_util::fsutil::atomic_write(&path, text.as_bytes())
         .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
     b.wrote_figure(path);
     page.head(&head_html());
