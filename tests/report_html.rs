@@ -122,7 +122,10 @@ fn report_of_a_tiny_run() {
     assert!(pos("id=\"accuracy\"") < pos("id=\"summary\""));
     assert!(pos("id=\"summary\"") < pos("id=\"table-summary-engine\""));
     assert!(html.contains("Sign convention everywhere"));
-    assert!(!html.contains("aerial minus MM"));
+    assert!(
+        html.contains("Per segment, recorded poses: MM − aerial"),
+        "our offsets are labelled MM − aerial"
+    );
     assert!(
         !html.contains("centre_offset_n_m"),
         "rejection reasons must be words"

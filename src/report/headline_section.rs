@@ -77,6 +77,39 @@ pub fn headline_section(
         "<p class=\"convention\">{}</p>\n",
         escape(SIGN_CONVENTION)
     ));
+    // Only the segments that did not pass, so the map stays on the first screen; all segments follow in the
+    // verification section.
+    if let Some(v) = &h.verification_after {
+        let open: Vec<SegmentLine> = v
+            .segments
+            .iter()
+            .filter(|s| s.status != "pass")
+            .cloned()
+            .collect();
+        if !open.is_empty() {
+            b.table(
+                page,
+                segment_table(
+                    &format!("{prefix}verification-adjusted-open"),
+                    "Segments of the adjusted trajectory that did not pass (MM − aerial control, adjusted poses)",
+                    &open,
+                ),
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The full per-segment verification of the adjusted trajectory (in the verification section).
+pub fn adjusted_verification_table(
+    b: &mut Builder,
+    page: &mut Page,
+    set: &ResultSet,
+    prefix: &str,
+) -> Result<(), String> {
+    let Ok(h) = Headline::from_dir(&set.dir) else {
+        return Ok(());
+    };
     if let Some(v) = &h.verification_after {
         b.table(
             page,

@@ -36,6 +36,7 @@ pub fn results_sections(
     headline_section(b, page, set, &prefix)?;
     let mut rest = Page::new("");
     accuracy_section(b, &mut rest, set, &prefix, &title_suffix)?;
+    super::headline_section::adjusted_verification_table(b, &mut rest, set, &prefix)?;
     verification_section(b, &mut rest, set, &prefix)?;
     nadir_section(b, &mut rest, &set.metrics, &prefix);
     registration::registration_section(b, &mut rest, set, &prefix)?;
