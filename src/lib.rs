@@ -11,7 +11,6 @@ pub mod dag;
 pub mod explain;
 pub mod exports;
 pub mod hashing;
-pub mod headline;
 pub mod metrics;
 pub mod nodes;
 pub mod pipelines;

@@ -19,7 +19,7 @@ use crate::cli::common::{load_workflow, CacheOpt, ThreadsOpt, DEFAULT_WORKFLOW};
 use crate::dag::progress::{Progress, ProgressMode};
 use crate::dag::{Mode, NodeStatus, PipelineError, Session};
 use crate::hashing::StatCache;
-use crate::headline::{headline, PARTIAL_EXIT_CODE};
+use crate::report::headline::{Headline, Status};
 use crate::metrics::{add_sections, sweep_csv, write_json, Summary};
 use crate::workflow::Workflow;
 use clap::Args;
@@ -140,14 +140,29 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
         }
     );
     let mut warning = false;
-    for (variant, doc) in &metrics {
-        let h = headline(doc);
-        warning |= h.status.is_warning();
+    for (variant, _) in &metrics {
+        let dir = if metrics.len() > 1 {
+            out_dir.join("variants").join(variant)
+        } else {
+            out_dir.clone()
+        };
+        let h = match Headline::from_dir(&dir) {
+            Ok(h) => h,
+            Err(e) => {
+                progress.warn(&format!("no summary: {e}"));
+                continue;
+            }
+        };
+        warning |= matches!(h.status, Status::NotCorrected(_) | Status::Worse(_));
+        let lines = h.lines();
         if metrics.len() > 1 {
-            println!("[{variant}] {}", h.lines[0]);
+            println!("[{variant}] {}", lines.first().map_or("", String::as_str));
         } else {
             println!();
-            print!("{}", h.render());
+            for l in &lines {
+                println!("{l}");
+            }
+            println!("(signs: corrections are adjusted − recorded; offsets MM − aerial; docs/outputs.md)");
         }
     }
     match &report {
@@ -168,6 +183,10 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
         summary,
     })
 }
+
+/// Exit code of a run that finished but whose result must not be used as it is: input rows dropped, nodes
+/// failed or skipped, nothing corrected, or check points worse (the last line says which).
+pub const PARTIAL_EXIT_CODE: i32 = 3;
 
 /// What the run's last line and exit code say.
 struct RunOutcome {

@@ -209,7 +209,7 @@ pub struct AdjustStage;
 
 impl Stage for AdjustStage {
     const NAME: &'static str = "adjust";
-    const VERSION: &'static str = "2";
+    const VERSION: &'static str = "3";
     type Params = AdjustConfig;
     type Output = AdjustReport;
     type Inputs = (

@@ -109,6 +109,8 @@ pub struct RunRecording {
     pub yaw_correction_deg: f64,
     /// Posterior σ of x, y, z, metres: a posteriori (scaled by σ̂0) when there is redundancy, else a priori.
     pub sigma_m: [f64; 3],
+    /// σ of the yaw correction, degrees, scaled like `sigma_m` (0 when yaw is not estimated).
+    pub sigma_yaw_deg: f64,
     pub sigma_is_a_posteriori: bool,
 }
 
@@ -462,12 +464,17 @@ pub fn run(inputs: &AdjustInputs, config: &AdjustConfig) -> Result<AdjustmentRun
                 Some(s) => (s, true),
                 None => (a.sigma_a_priori_m, false),
             };
+            let yaw_scale = match (posterior, adj.variance_factor) {
+                (true, Some(f)) => f.sqrt(),
+                _ => 1.0,
+            };
             RunRecording {
                 image_id: id.clone(),
                 recorded_world: rec.camera.center_world.into(),
                 adjusted_world: a.position_world.into(),
                 yaw_correction_deg: a.yaw_correction_deg,
                 sigma_m: sigma.into(),
+                sigma_yaw_deg: a.sigma_yaw_a_priori_deg * yaw_scale,
                 sigma_is_a_posteriori: posterior,
             }
         })
