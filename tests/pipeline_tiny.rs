@@ -41,7 +41,7 @@ fn stage(m: &serde_json::Value, stage: &str, what: &str) -> u64 {
 
 /// `skytie run WF --cache CACHE --out OUT --quiet`, then OUT's metrics.
 fn run_workflow(wf: &Path, cache: &Path, out: &Path) -> serde_json::Value {
-    cli::run_workflow(wf, cache, out);
+    let _ = cli::run_workflow(wf, cache, out);
     metrics(out)
 }
 

