@@ -24,10 +24,14 @@
 //!
 //! Attributes before `struct` (doc comments, extra derives such as `#[derive(Copy)]`) are kept. Range
 //! keywords, each optional, in this order: `min` (≥), `above` (>), `max` (≤), `below` (<). Numbers
-//! (integers, floats, `Option` of them, vectors of them) are checked; a NaN never passes a range. A field
-//! holding another parameter struct is declared with `section`: its violations come prefixed with the field
-//! name (`consensus.threshold_m`). Checks that relate several fields go into an optional
-//! `check(self, v) { … }` block after the fields, pushing [`Violation`]s into `v`.
+//! (integers, floats, `Option`s, vectors and arrays of them) are checked. A bounded number must be finite: a
+//! NaN never passes, an infinity only when a bound admits it explicitly (`max f64::INFINITY` allows `inf`). A
+//! field holding another parameter struct is declared with `section`: its violations come prefixed with the
+//! field name (`consensus.threshold_m`). Checks that relate several fields, or that only require a finite
+//! value ([`check_finite`]), go into an optional `check(p, v) { … }` block after the fields, pushing
+//! [`Violation`]s into `v`.
+
+pub mod self_check;
 
 use std::fmt;
 
@@ -67,13 +71,20 @@ impl Range {
         self.min.is_some() || self.above.is_some() || self.max.is_some() || self.below.is_some()
     }
 
-    /// Whether `v` lies in the range (NaN never does when a bound is set).
+    /// Whether `v` lies in the range. With any bound set, NaN never does, and an infinity only when an
+    /// infinite inclusive bound admits it (`max = +inf` for `+inf`, `min = −inf` for `−inf`).
     pub fn contains(&self, v: f64) -> bool {
-        self.min.is_none_or(|m| v >= m)
+        if !self.is_bounded() {
+            return true;
+        }
+        let finite_or_admitted = v.is_finite()
+            || (v == f64::INFINITY && self.max == Some(f64::INFINITY))
+            || (v == f64::NEG_INFINITY && self.min == Some(f64::NEG_INFINITY));
+        finite_or_admitted
+            && self.min.is_none_or(|m| v >= m)
             && self.above.is_none_or(|m| v > m)
             && self.max.is_none_or(|m| v <= m)
             && self.below.is_none_or(|m| v < m)
-            && (!self.is_bounded() || !v.is_nan())
     }
 }
 
@@ -135,6 +146,22 @@ impl Violation {
     }
 }
 
+/// `field: message`, e.g. `min_peak: must be in [0, 1), got 1.5`.
+impl fmt::Display for Violation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.field, self.message)
+    }
+}
+
+/// Every violation as `field: message`, joined by `; ` (for error messages of a whole parameter set).
+pub fn describe(violations: &[Violation]) -> String {
+    violations
+        .iter()
+        .map(Violation::to_string)
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
 /// A parameter struct declared with [`params!`](crate::params!).
 pub trait Params: Default + Clone {
     /// Every field's documentation, in declaration order.
@@ -181,6 +208,12 @@ impl<T: RangeChecked> RangeChecked for Vec<T> {
     }
 }
 
+impl<T: RangeChecked, const N: usize> RangeChecked for [T; N] {
+    fn checked_values(&self) -> Vec<f64> {
+        self.iter().flat_map(T::checked_values).collect()
+    }
+}
+
 /// Pushes a violation when a value of `value` lies outside `range` (used by [`params!`](crate::params!)).
 pub fn check_range<T: RangeChecked>(
     field: &str,
@@ -199,15 +232,28 @@ pub fn check_range<T: RangeChecked>(
         } else {
             format!(" {unit}")
         };
+        let finite = if bad.is_finite() {
+            ""
+        } else {
+            "a finite number "
+        };
+        let two_sided = range.min.is_some() != range.above.is_some()
+            && range.max.is_some() != range.below.is_some();
+        let in_ = if two_sided { "in " } else { "" };
         out.push(Violation::new(
             field,
-            if range.min.is_some() != range.above.is_some()
-                && range.max.is_some() != range.below.is_some()
-            {
-                format!("must be in {range}{unit}, got {bad}")
-            } else {
-                format!("must be {range}{unit}, got {bad}")
-            },
+            format!("must be {finite}{in_}{range}{unit}, got {bad}"),
+        ));
+    }
+}
+
+/// Pushes a violation when a value of `value` is NaN or infinite (for parameters that take any finite number;
+/// call it from a `check` block).
+pub fn check_finite<T: RangeChecked>(field: &str, value: &T, out: &mut Vec<Violation>) {
+    if let Some(bad) = value.checked_values().into_iter().find(|v| !v.is_finite()) {
+        out.push(Violation::new(
+            field,
+            format!("must be a finite number, got {bad}"),
         ));
     }
 }
@@ -347,6 +393,9 @@ macro_rules! params {
 }
 
 #[cfg(test)]
+mod declared_types;
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
@@ -416,7 +465,10 @@ mod tests {
             vec![
                 ("count".into(), "must be ≥ 4, got 3".into()),
                 ("ratio".into(), "must be in (0, 1], got 0".into()),
-                ("angle_deg".into(), "must be in [0, 90) deg, got NaN".into()),
+                (
+                    "angle_deg".into(),
+                    "must be a finite number in [0, 90) deg, got NaN".into()
+                ),
                 ("limit_m".into(), "must be > 0 m, got -1".into()),
                 ("weights".into(), "must be ≥ 0, got -2".into()),
                 ("inner.threshold_m".into(), "must be > 0 m, got 0".into()),
@@ -455,5 +507,46 @@ mod tests {
         assert_eq!(specs[1].doc.trim(), "A ratio.");
         let inner = (specs[6].section.expect("a section"))();
         assert_eq!(inner[0].name, "threshold_m");
+    }
+
+    crate::params! {
+        /// Infinities and arrays.
+        pub struct Limits {
+            /// May be infinite (no limit).
+            box_m: f64 = 2.0, unit "m", above 0.0, max f64::INFINITY;
+            /// Must be finite.
+            band_m: f64 = 0.5, unit "m", above 0.0;
+            /// Any finite angles.
+            yaws_deg: [f64; 3] = [300.0, 270.0, 240.0], unit "deg";
+        }
+        check(p, v) {
+            check_finite("yaws_deg", &p.yaws_deg, v);
+        }
+    }
+
+    #[test]
+    fn infinities_pass_only_an_infinite_bound() {
+        let ok = Limits {
+            box_m: f64::INFINITY,
+            ..Limits::default()
+        };
+        assert_eq!(ok.validate(), Ok(()));
+        assert_eq!(Limits::specs()[0].range.to_string(), "(0, inf]");
+        let bad = Limits {
+            band_m: f64::INFINITY,
+            yaws_deg: [0.0, f64::NEG_INFINITY, 1.0],
+            ..Limits::default()
+        };
+        assert_eq!(
+            bad.violations(),
+            vec![
+                Violation::new("band_m", "must be a finite number > 0 m, got inf"),
+                Violation::new("yaws_deg", "must be a finite number, got -inf"),
+            ]
+        );
+        assert_eq!(
+            describe(&bad.violations()),
+            "band_m: must be a finite number > 0 m, got inf; yaws_deg: must be a finite number, got -inf"
+        );
     }
 }

@@ -25,6 +25,7 @@ use skytie_stages::nadir::initial_transform::{
     centre_offset_world, initial_transform, reuse_neighbour, TransformParams,
 };
 use skytie_stages::nadir::{ortho_project, OrthoGeoref, OrthoImage, OrthoParams, TransformOutcome};
+use skytie_stages::params::Params;
 use skytie_stages::synth::{generate, Preset, SynthOptions};
 use std::collections::HashMap;
 use std::path::Path;
@@ -357,7 +358,7 @@ fn blank_or_mismatched_aerial_is_rejected_with_a_reason() {
         ..p.clone()
     };
     let errs = bad.validate().unwrap_err();
-    assert_eq!(errs[0].0, "max_localisation_error_m");
+    assert_eq!(errs[0].field, "max_localisation_error_m");
     let parsed: Result<TransformParams, _> = toml::from_str("max_localisation_error = 2.0");
     assert!(parsed.is_err(), "unknown fields are refused");
     let parsed: TransformParams = toml::from_str("max_localisation_error_m = 2.0").unwrap();

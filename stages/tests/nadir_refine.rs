@@ -13,6 +13,7 @@ use skytie_stages::nadir::{
     AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch, OrthoGeoref, OrthoImage,
     OrthoParams,
 };
+use skytie_stages::params::Params;
 use skytie_stages::rng::SplitMix64;
 
 // ---------------------------------------------------------------------------------------------------------
@@ -458,7 +459,7 @@ fn refine_params_validate_and_reject_unknown_keys() {
         ..RefineParams::default()
     };
     let errs = bad.validate().unwrap_err();
-    let fields: Vec<&str> = errs.iter().map(|(f, _)| f.as_str()).collect();
+    let fields: Vec<&str> = errs.iter().map(|v| v.field.as_str()).collect();
     assert_eq!(fields, ["template_px", "min_peak"]);
     let parsed: RefineParams = toml::from_str("template_px = 64\nwindow = \"blackman\"").unwrap();
     assert_eq!(parsed.template_px, 64);

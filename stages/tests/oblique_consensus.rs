@@ -12,6 +12,7 @@ use skytie_stages::oblique::{
     PatchMatch, PatchRegistrationSet, PatchStats, SparseCloud, SparseCloudStats, SparsePoint,
     StreetSide,
 };
+use skytie_stages::params::Params;
 use skytie_stages::rng::SplitMix64;
 
 const E0: f64 = 500_000.0;
@@ -371,7 +372,7 @@ fn invalid_params_are_reported() {
         ..ConsensusParams::default()
     };
     let e = p.validate().unwrap_err();
-    let fields: Vec<&str> = e.iter().map(|(f, _)| f.as_str()).collect();
+    let fields: Vec<&str> = e.iter().map(|v| v.field.as_str()).collect();
     assert_eq!(fields, vec!["threshold_m", "min_set_size"]);
     assert!(ConsensusParams::default().validate().is_ok());
 }

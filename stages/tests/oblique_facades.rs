@@ -18,6 +18,7 @@ use skytie_stages::oblique::facades::visibility::{
 };
 use skytie_stages::oblique::facades::{find_facades, FacadeParams, ThinningSplit};
 use skytie_stages::oblique::{SparseCloud, SparseCloudStats, SparsePoint, StreetSide};
+use skytie_stages::params::Params;
 
 const X0: f64 = 92_000.0;
 const Y0: f64 = 437_000.0;

@@ -17,6 +17,7 @@ use skytie_stages::oblique::types::{
     FacadePlane, FacadeStats, ObliqueView, SparseCloud, SparseCloudStats, SparsePoint, StreetSide,
     TripletFacades,
 };
+use skytie_stages::params::Params;
 use std::sync::OnceLock;
 
 /// The façade: the plane y = FACADE_Y (normal −y towards the street), x ∈ [X0 − 40, X0 + 40], z ∈ [0, 25].

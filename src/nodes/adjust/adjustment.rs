@@ -204,8 +204,8 @@ fn spread(mut values: Vec<f64>) -> serde_json::Value {
 pub struct AdjustStage;
 
 impl Stage for AdjustStage {
-    const NAME: &'static str = "adjust";
-    const VERSION: &'static str = "3";
+    const NAME: &'static str = skytie_stages::adjustment::from_correspondences::STAGE.name;
+    const VERSION: &'static str = skytie_stages::adjustment::from_correspondences::STAGE.version;
     type Params = AdjustConfig;
     type Output = AdjustReport;
     type Inputs = (

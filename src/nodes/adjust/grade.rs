@@ -7,6 +7,7 @@ use crate::nodes::adjust::adjustment::AdjustReport;
 use crate::nodes::campaign::summary::SummaryParams;
 use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::read_recordings_csv;
+use skytie_stages::params::StageId;
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -58,12 +59,19 @@ impl AdjustGrade {
     }
 }
 
+/// The stage's identity in cache keys (the computation lives in this node); bump the version whenever its
+/// output for the same inputs and parameters changes.
+pub const STAGE: StageId = StageId {
+    name: "grade_adjust",
+    version: "1",
+};
+
 /// The adjustment grading node.
 pub struct GradeAdjust;
 
 impl Stage for GradeAdjust {
-    const NAME: &'static str = "grade_adjust";
-    const VERSION: &'static str = "1";
+    const NAME: &'static str = STAGE.name;
+    const VERSION: &'static str = STAGE.version;
     type Params = SummaryParams;
     type Output = AdjustGrade;
     type Inputs = (RawFile, Handle<AdjustReport>);

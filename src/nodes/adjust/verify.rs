@@ -44,8 +44,8 @@ pub fn verify_metrics(v: &Verification) -> serde_json::Value {
 pub struct VerifyStage;
 
 impl Stage for VerifyStage {
-    const NAME: &'static str = "verify";
-    const VERSION: &'static str = "3";
+    const NAME: &'static str = skytie_stages::adjustment::verify::STAGE.name;
+    const VERSION: &'static str = skytie_stages::adjustment::verify::STAGE.version;
     type Params = VerifyConfig;
     type Output = Verification;
     /// The campaign, its panoramas, the aerial control points, and no or one adjustment whose poses replace the

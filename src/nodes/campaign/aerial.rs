@@ -4,42 +4,35 @@
 
 use crate::dag::{Handle, NodeCtx, Stage, StageError};
 use crate::nodes::campaign::load::CampaignSnapshot;
-use crate::workflow::{ParamError, StageParams};
-use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::{AerialImage, AerialKind};
+use skytie_stages::params::StageId;
 use std::sync::Arc;
 
 crate::serde_artifact!(AerialImage);
 
-/// Parameters of the aerial-row selector (set by the pipeline).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SelectAerialParams {
-    pub image_id: String,
-    pub kind: AerialKind,
-}
-
-impl StageParams for SelectAerialParams {
-    fn validate(&self) -> Result<(), Vec<ParamError>> {
-        Ok(())
+skytie_stages::params! {
+    /// Parameters of the aerial-row selector (set by the pipeline).
+    pub struct SelectAerialParams {
+        /// The aerial image's id.
+        image_id: String = String::new();
+        /// Nadir or oblique.
+        kind: AerialKind = AerialKind::Nadir;
     }
 }
 
-impl Default for SelectAerialParams {
-    fn default() -> Self {
-        Self {
-            image_id: String::new(),
-            kind: AerialKind::Nadir,
-        }
-    }
-}
+/// The stage's identity in cache keys (the computation lives in this node); bump the version whenever its
+/// output for the same inputs and parameters changes.
+pub const STAGE: StageId = StageId {
+    name: "aerial",
+    version: "1",
+};
 
 /// One aerial image's row of the snapshot.
 pub struct SelectAerial;
 
 impl Stage for SelectAerial {
-    const NAME: &'static str = "aerial";
-    const VERSION: &'static str = "1";
+    const NAME: &'static str = STAGE.name;
+    const VERSION: &'static str = STAGE.version;
     type Params = SelectAerialParams;
     type Output = AerialImage;
     type Inputs = Handle<CampaignSnapshot>;

@@ -7,8 +7,8 @@
 //! new or edited recordings' downstream nodes run again.
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
-use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
+use skytie_stages::params::StageId;
 use skytie_stages::campaign::{
     read_sourced, Campaign, Problem, Recording, SourceRows, SourcedCampaign,
 };
@@ -25,19 +25,13 @@ pub const METADATA_FILES: [&str; 6] = [
     "control/observations.csv",
 ];
 
-/// Parameters of the load node (set by the pipeline, not by users).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct LoadCampaignParams {
-    /// The campaign folder (absolute).
-    pub root: String,
-    /// blake3 of the sorted list of every file name below the folder (so file presence is part of the key).
-    pub listing_hash: String,
-}
-
-impl StageParams for LoadCampaignParams {
-    fn validate(&self) -> Result<(), Vec<ParamError>> {
-        Ok(())
+skytie_stages::params! {
+    /// Parameters of the load node (set by the pipeline, not by users).
+    pub struct LoadCampaignParams {
+        /// The campaign folder (absolute).
+        root: String = String::new();
+        /// blake3 of the sorted list of every file name below the folder (so file presence is part of the key).
+        listing_hash: String = String::new();
     }
 }
 
@@ -94,8 +88,8 @@ pub fn listing_hash(root: &Path) -> std::io::Result<String> {
 pub struct LoadCampaign;
 
 impl Stage for LoadCampaign {
-    const NAME: &'static str = "load";
-    const VERSION: &'static str = "2";
+    const NAME: &'static str = skytie_stages::campaign::read::STAGE.name;
+    const VERSION: &'static str = skytie_stages::campaign::read::STAGE.version;
     type Params = LoadCampaignParams;
     type Output = CampaignSnapshot;
     type Inputs = Vec<RawFile>;
@@ -112,25 +106,27 @@ impl Stage for LoadCampaign {
     }
 }
 
-/// Parameters of the per-recording selector (set by the pipeline).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct SelectRecordingParams {
-    pub image_id: String,
-}
-
-impl StageParams for SelectRecordingParams {
-    fn validate(&self) -> Result<(), Vec<ParamError>> {
-        Ok(())
+skytie_stages::params! {
+    /// Parameters of the per-recording selector (set by the pipeline).
+    pub struct SelectRecordingParams {
+        /// The recording's `image_id`.
+        image_id: String = String::new();
     }
 }
+
+/// The stage's identity in cache keys (the computation lives in this node); bump the version whenever its
+/// output for the same inputs and parameters changes.
+pub const RECORDING_STAGE: StageId = StageId {
+    name: "recording",
+    version: "1",
+};
 
 /// One recording's row of the snapshot.
 pub struct SelectRecording;
 
 impl Stage for SelectRecording {
-    const NAME: &'static str = "recording";
-    const VERSION: &'static str = "1";
+    const NAME: &'static str = RECORDING_STAGE.name;
+    const VERSION: &'static str = RECORDING_STAGE.version;
     type Params = SelectRecordingParams;
     type Output = Recording;
     type Inputs = Handle<CampaignSnapshot>;

@@ -3,21 +3,15 @@
 
 use crate::dag::{Handle, NodeCtx, Optional, Stage, StageError};
 use crate::nodes::campaign::load::CampaignSnapshot;
-use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::{InputAccount, Severity};
 use skytie_stages::nadir::OrthoImage;
+use skytie_stages::params::StageId;
 use std::sync::Arc;
 
-/// The summary has no tunable parameters.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SummaryParams {}
-
-impl StageParams for SummaryParams {
-    fn validate(&self) -> Result<(), Vec<ParamError>> {
-        Ok(())
-    }
+skytie_stages::params! {
+    /// The summary has no tunable parameters.
+    pub struct SummaryParams {}
 }
 
 /// What the campaign holds and how much of it the per-recording stages covered.
@@ -68,12 +62,19 @@ impl CampaignSummary {
     }
 }
 
+/// The stage's identity in cache keys (the computation lives in this node); bump the version whenever its
+/// output for the same inputs and parameters changes.
+pub const STAGE: StageId = StageId {
+    name: "summary",
+    version: "2",
+};
+
 /// The summary node.
 pub struct SummarizeCampaign;
 
 impl Stage for SummarizeCampaign {
-    const NAME: &'static str = "summary";
-    const VERSION: &'static str = "2";
+    const NAME: &'static str = STAGE.name;
+    const VERSION: &'static str = STAGE.version;
     type Params = SummaryParams;
     type Output = CampaignSummary;
     type Inputs = (Handle<CampaignSnapshot>, Vec<Optional<OrthoImage>>);

@@ -7,49 +7,49 @@
 //! folder whose files went missing or changed size is regenerated.
 
 use crate::dag::{NodeCtx, Stage, StageError};
-use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
-use skytie_stages::synth::{generate_resumable, Deterioration, Preset, SynthOptions, SynthSummary};
+use skytie_stages::params::Violation;
+use skytie_stages::synth::{
+    generate_resumable, Deterioration, Preset, SynthError, SynthOptions, SynthSummary,
+};
 use std::path::{Path, PathBuf};
 
-/// Parameters of the `[synth]` workflow table (preset and seed come from `campaign = "synth:<preset>"` and `seed`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct SynthParams {
-    /// `tiny`, `demo` or `paper`.
-    pub preset: String,
-    pub seed: u64,
-    /// Recorded-position deterioration: `thesis` (0.80 m systematic + N(0, 0.10 m), thesis 3.5.1.2) or `none`.
-    pub deterioration: String,
-    /// Override of the panorama width in pixels (even; 0 = the preset's).
-    pub panorama_width_px: u32,
-    /// Override of the number of recordings per route (0 = the preset's).
-    pub max_recordings_per_route: usize,
-}
-
-impl Default for SynthParams {
-    fn default() -> Self {
-        Self {
-            preset: "demo".into(),
-            seed: 1,
-            deterioration: "thesis".into(),
-            panorama_width_px: 0,
-            max_recordings_per_route: 0,
+skytie_stages::params! {
+    /// Parameters of the `[synth]` workflow table (preset and seed come from `campaign = "synth:<preset>"` and
+    /// `seed`).
+    pub struct SynthParams {
+        /// Preset: `tiny`, `demo` or `paper`.
+        preset: String = "demo".into();
+        /// Seed of the generator.
+        seed: u64 = 1;
+        /// Recorded-position deterioration: `thesis` (0.80 m systematic + N(0, 0.10 m), thesis 3.5.1.2) or
+        /// `none`.
+        deterioration: String = "thesis".into();
+        /// Override of the panorama width (even; 0 = the preset's).
+        panorama_width_px: u32 = 0, unit "px";
+        /// Override of the number of recordings per route (0 = the preset's).
+        max_recordings_per_route: usize = 0;
+    }
+    check(p, v) {
+        if let Err(violation) = p.options() {
+            v.push(violation);
         }
     }
 }
 
 impl SynthParams {
-    /// The generator options these parameters stand for.
-    pub fn options(&self) -> Result<SynthOptions, String> {
-        let preset = Preset::from_name(&self.preset).map_err(|e| e.to_string())?;
+    /// The generator options these parameters stand for; the error names the parameter at fault.
+    pub fn options(&self) -> Result<SynthOptions, Violation> {
+        let preset =
+            Preset::from_name(&self.preset).map_err(|e| Violation::new("preset", e.to_string()))?;
         let mut o = SynthOptions::new(preset, self.seed);
         o.deterioration = match self.deterioration.as_str() {
             "thesis" => Deterioration::Thesis,
             "none" => Deterioration::None,
             other => {
-                return Err(format!(
-                    "unknown deterioration '{other}': use \"thesis\" or \"none\""
+                return Err(Violation::new(
+                    "deterioration",
+                    format!("unknown deterioration '{other}': use \"thesis\" or \"none\""),
                 ))
             }
         };
@@ -59,17 +59,11 @@ impl SynthParams {
         if self.max_recordings_per_route != 0 {
             o.max_recordings_per_route = Some(self.max_recordings_per_route);
         }
-        o.params().map_err(|e| e.to_string())?;
+        o.params().map_err(|e| match e {
+            SynthError::InvalidOption { option, message } => Violation::new(option, message),
+            other => Violation::new("preset", other.to_string()),
+        })?;
         Ok(o)
-    }
-}
-
-impl StageParams for SynthParams {
-    fn validate(&self) -> Result<(), Vec<ParamError>> {
-        match self.options() {
-            Ok(_) => Ok(()),
-            Err(m) => Err(vec![ParamError::new("synth", m)]),
-        }
     }
 }
 
@@ -121,14 +115,16 @@ pub fn list_files(root: &Path) -> std::io::Result<Vec<(String, u64)>> {
 pub struct SynthCampaign;
 
 impl Stage for SynthCampaign {
-    const NAME: &'static str = "synth";
-    const VERSION: &'static str = "1";
+    const NAME: &'static str = skytie_stages::synth::generate::STAGE.name;
+    const VERSION: &'static str = skytie_stages::synth::generate::STAGE.version;
     type Params = SynthParams;
     type Output = GeneratedCampaign;
     type Inputs = ();
 
     fn run(&self, p: &SynthParams, _: (), ctx: &NodeCtx) -> Result<GeneratedCampaign, StageError> {
-        let options = p.options().map_err(StageError::new)?;
+        let options = p
+            .options()
+            .map_err(|v| StageError::new(format!("synth parameter {v}")))?;
         let tmp = ctx.output_dir_tmp()?;
         let (summary, reused) =
             generate_resumable(&options, &tmp.join("campaign"), &ctx.partial_dir()).map_err(|e| {

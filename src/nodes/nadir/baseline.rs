@@ -13,8 +13,8 @@ use std::sync::Arc;
 pub struct BaselineStage;
 
 impl Stage for BaselineStage {
-    const NAME: &'static str = "baseline";
-    const VERSION: &'static str = "3";
+    const NAME: &'static str = skytie_stages::nadir::baseline::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::baseline::STAGE.version;
     type Params = BaselineParams;
     type Output = AerialRefinement;
     type Inputs = (

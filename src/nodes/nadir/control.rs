@@ -14,8 +14,8 @@ crate::serde_artifact!(RecordingControl);
 pub struct ControlStage;
 
 impl Stage for ControlStage {
-    const NAME: &'static str = "control";
-    const VERSION: &'static str = "1";
+    const NAME: &'static str = skytie_stages::nadir::control_points::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::control_points::STAGE.version;
     type Params = ControlParams;
     type Output = RecordingControl;
     type Inputs = (

@@ -110,8 +110,8 @@ pub fn load_truth(
 pub struct GradeNadir;
 
 impl Stage for GradeNadir {
-    const NAME: &'static str = "grade_nadir";
-    const VERSION: &'static str = "3";
+    const NAME: &'static str = skytie_stages::nadir::grading::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::grading::STAGE.version;
     type Params = SummaryParams;
     type Output = NadirGrade;
     type Inputs = (

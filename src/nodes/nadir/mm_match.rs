@@ -15,9 +15,8 @@ crate::serde_artifact!(MmWindowMatch);
 pub struct MmMatch;
 
 impl Stage for MmMatch {
-    const NAME: &'static str = "mm_match";
-    // 2: windows carry each neighbour view's corner on its ortho ground plane (the parallax check of `refine`).
-    const VERSION: &'static str = "2";
+    const NAME: &'static str = skytie_stages::nadir::mm_matching::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::mm_matching::STAGE.version;
     type Params = MmMatchParams;
     type Output = MmWindowMatch;
     type Inputs = (

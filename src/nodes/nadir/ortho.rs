@@ -12,8 +12,8 @@ crate::serde_artifact!(OrthoImage);
 pub struct OrthoProject;
 
 impl Stage for OrthoProject {
-    const NAME: &'static str = "ortho";
-    const VERSION: &'static str = "3";
+    const NAME: &'static str = skytie_stages::nadir::ortho::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::ortho::STAGE.version;
     type Params = OrthoParams;
     type Output = OrthoImage;
     type Inputs = (Handle<Recording>, RawFile);

@@ -15,8 +15,8 @@ use std::sync::Arc;
 pub struct OrthoForAerial;
 
 impl Stage for OrthoForAerial {
-    const NAME: &'static str = "ortho_aerial";
-    const VERSION: &'static str = "3";
+    const NAME: &'static str = skytie_stages::nadir::aerial_patch::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::aerial_patch::STAGE.version;
     type Params = OrthoParams;
     type Output = OrthoImage;
     type Inputs = (Handle<Recording>, RawFile, Handle<AerialImage>);

@@ -20,12 +20,8 @@ crate::serde_artifact!(AerialRefinement);
 pub struct RefineStage;
 
 impl Stage for RefineStage {
-    const NAME: &'static str = "refine";
-    // 2: phase correlation refines on the 3×3 direct-DFT surface and cuts near-zero bins relative to the RMS.
-    // 3: the parallax check against the window's neighbouring recordings (their orthos are inputs).
-    // 4: `min_located`. 5: the shift-consistency check (`max_shift_spread_px`). 6: its consensus by
-    // `estimators::median_consensus` (Euclidean deviation; non-finite corrections never inliers).
-    const VERSION: &'static str = "6";
+    const NAME: &'static str = skytie_stages::nadir::refine::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::refine::STAGE.version;
     type Params = RefineParams;
     type Output = AerialRefinement;
     type Inputs = (

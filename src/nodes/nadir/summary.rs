@@ -14,9 +14,8 @@ crate::serde_artifact!(NadirSummary);
 pub struct SummarizeNadir;
 
 impl Stage for SummarizeNadir {
-    const NAME: &'static str = "nadir";
-    // 2: counts `parallax_rejected`. 3: counts `unconfirmed`. 4: counts `shift_inconsistent`.
-    const VERSION: &'static str = "4";
+    const NAME: &'static str = skytie_stages::nadir::summary::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::summary::STAGE.version;
     type Params = SummaryParams;
     type Output = NadirSummary;
     type Inputs = (

@@ -15,9 +15,8 @@ crate::serde_artifact!(TransformOutcome);
 pub struct InitialTransformStage;
 
 impl Stage for InitialTransformStage {
-    const NAME: &'static str = "transform";
-    // 3: accepted transforms carry the implied offset as a vector (`centre_offset_world_m`).
-    const VERSION: &'static str = "3";
+    const NAME: &'static str = skytie_stages::nadir::initial_transform::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::initial_transform::STAGE.version;
     type Params = TransformParams;
     type Output = TransformOutcome;
     type Inputs = (

@@ -12,8 +12,8 @@ use std::sync::Arc;
 pub struct TransformAgreementStage;
 
 impl Stage for TransformAgreementStage {
-    const NAME: &'static str = "transform_agreement";
-    const VERSION: &'static str = "1";
+    const NAME: &'static str = skytie_stages::nadir::transform_agreement::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::transform_agreement::STAGE.version;
     type Params = TransformParams;
     type Output = TransformOutcome;
     type Inputs = (Handle<TransformOutcome>, Vec<Handle<TransformOutcome>>);

@@ -24,8 +24,8 @@ crate::serde_artifact!(ObliqueOutput);
 pub struct ConsensusStage;
 
 impl Stage for ConsensusStage {
-    const NAME: &'static str = "oblique";
-    const VERSION: &'static str = "1";
+    const NAME: &'static str = skytie_stages::oblique::consensus::STAGE.name;
+    const VERSION: &'static str = skytie_stages::oblique::consensus::STAGE.version;
     type Params = ConsensusParams;
     type Output = ObliqueOutput;
     type Inputs = (

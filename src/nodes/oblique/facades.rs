@@ -17,8 +17,8 @@ crate::serde_artifact!(TripletFacades);
 pub struct FacadesStage;
 
 impl Stage for FacadesStage {
-    const NAME: &'static str = "facades";
-    const VERSION: &'static str = "4";
+    const NAME: &'static str = skytie_stages::oblique::facades::STAGE.name;
+    const VERSION: &'static str = skytie_stages::oblique::facades::STAGE.version;
     type Params = FacadeParams;
     type Output = TripletFacades;
     type Inputs = (

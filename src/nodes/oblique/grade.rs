@@ -35,8 +35,8 @@ impl GradeOblique {
 }
 
 impl Stage for GradeOblique {
-    const NAME: &'static str = "grade_oblique";
-    const VERSION: &'static str = "3";
+    const NAME: &'static str = skytie_stages::oblique::grading::STAGE.name;
+    const VERSION: &'static str = skytie_stages::oblique::grading::STAGE.version;
     type Params = SummaryParams;
     type Output = ObliqueGrade;
     type Inputs = (

@@ -17,9 +17,8 @@ crate::serde_artifact!(PatchRegistrationSet);
 pub struct PatchesStage;
 
 impl Stage for PatchesStage {
-    const NAME: &'static str = "patches";
-    // 4: Mattes MI weights the bilinear samples with per-evaluation weights (scores differ in the last bits).
-    const VERSION: &'static str = "6";
+    const NAME: &'static str = skytie_stages::oblique::patch_registration::STAGE.name;
+    const VERSION: &'static str = skytie_stages::oblique::patch_registration::STAGE.version;
     type Params = PatchParams;
     type Output = PatchRegistrationSet;
     type Inputs = (

@@ -16,8 +16,8 @@ crate::serde_artifact!(SparseCloud);
 pub struct SparseCloudStage;
 
 impl Stage for SparseCloudStage {
-    const NAME: &'static str = "sparse_cloud";
-    const VERSION: &'static str = "1";
+    const NAME: &'static str = skytie_stages::oblique::sparse_cloud::STAGE.name;
+    const VERSION: &'static str = skytie_stages::oblique::sparse_cloud::STAGE.version;
     type Params = SparseCloudParams;
     type Output = SparseCloud;
     type Inputs = (Vec<Handle<Recording>>, Vec<RawFile>);

@@ -19,9 +19,17 @@ use super::problem::{
 use crate::campaign::{AerialImage, AerialKind, Recording};
 use crate::correspondence::{AerialControlPoint, MmTiePoint};
 use crate::geometry::{triangulate_rays, FrameCamera, PanoramaCamera};
+use crate::params::{describe, Params, StageId};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "adjust",
+    version: "3",
+};
 
 /// The inputs of one adjustment.
 #[derive(Clone, Copy, Debug)]
@@ -154,10 +162,9 @@ pub fn build_block(
     config: &AdjustConfig,
 ) -> Result<BlockBuild, AdjustError> {
     if let Err(problems) = config.validate() {
-        let (field, problem) = problems[0].clone();
         return Err(AdjustError::InvalidInput {
-            item: format!("adjust parameter {field}"),
-            problem,
+            item: "adjust parameters".to_string(),
+            problem: describe(&problems),
         });
     }
     let n_rec = inputs.recordings.len();

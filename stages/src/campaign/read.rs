@@ -9,8 +9,16 @@ use super::read_aerial::read_aerial_rows;
 use super::read_control::{read_checkpoint_rows, read_observation_rows};
 use super::read_recordings::{read_recording_rows, sort_by_time};
 use super::unique::{keep_unique, Sourced};
+use crate::params::StageId;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "load",
+    version: "2",
+};
 
 /// The folder holds nothing usable as a campaign.
 #[derive(Debug, thiserror::Error)]

@@ -18,9 +18,17 @@ use crate::imaging::bilinear_many::sample_bilinear_many;
 use crate::imaging::border::Border;
 use crate::imaging::sample::{floor_fast, sample_bilinear};
 use crate::imaging::GrayImage;
+use crate::params::StageId;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "ortho",
+    version: "3",
+};
 
 crate::params! {
     /// Parameters of one ortho-projection.

@@ -41,8 +41,16 @@ use crate::campaign::{AerialImage, Recording};
 use crate::geometry::local_frame::LocalOrigin;
 use crate::geometry::FrameCamera;
 use crate::oblique::types::{FacadePlane, FacadeStats, SparseCloud, StreetSide, TripletFacades};
+use crate::params::{Params, StageId};
 use crate::rng::mix_seed;
 use nalgebra::Vector3;
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "facades",
+    version: "4",
+};
 
 /// FNV-1a hash of a string: a stable item id for seeding (independent of platform and run).
 fn stable_hash(s: &str) -> u64 {
