@@ -15,9 +15,9 @@ use skytie_stages::campaign::format_time_iso;
 use skytie_stages::correspondence::AerialControlPoint;
 use skytie_stages::export::gpkg::{run_layers, srs_for, write_geopackage, RunLayers};
 use skytie_stages::export::{
-    adjusted_recordings, write_adjusted_trajectory, write_checkpoint_errors_csv,
-    write_colmap_model, write_corrections_csv, write_correspondences_csv, write_ground_control,
-    write_run_geojson, write_tie_points_ply, CorrectionSeries,
+    write_adjusted_trajectory, write_checkpoint_errors_csv, write_colmap_model,
+    write_corrections_csv, write_correspondences_csv, write_ground_control, write_run_geojson,
+    write_tie_points_ply, CorrectionSeries,
 };
 use skytie_stages::imaging::io::dimensions;
 use skytie_stages::nadir::RecordingControl;
@@ -99,7 +99,8 @@ pub fn write_exports(dir: &Path, x: &ExportInputs<'_>) -> Vec<String> {
 }
 
 /// The files that present the trajectory as adjusted; only a [`Verdict::Corrected`] adjustment writes them.
-const ADJUSTED_TRAJECTORY_FILES: [&str; 3] = ["trajectory_adjusted.csv", "corrections.csv", "skytie.gpkg"];
+const ADJUSTED_TRAJECTORY_FILES: [&str; 3] =
+    ["trajectory_adjusted.csv", "corrections.csv", "skytie.gpkg"];
 
 /// The exports that need an adjustment.
 fn adjusted_exports(

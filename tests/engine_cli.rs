@@ -224,7 +224,11 @@ fn exit_codes_say_failed_partial_or_complete() {
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(
-        stdout.trim_end().lines().last().is_some_and(|l| l.starts_with("run PARTIAL: 1 node(s) failed")),
+        stdout
+            .trim_end()
+            .lines()
+            .last()
+            .is_some_and(|l| l.starts_with("run PARTIAL: 1 node(s) failed")),
         "{stdout}"
     );
     assert_eq!(engine(&t.metrics(&t.out()), "nodes_failed"), 1);

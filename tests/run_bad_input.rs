@@ -88,7 +88,9 @@ fn assert_complete_input(code: i32, text: &str) {
     assert!(matches!(code, 0 | 3), "{text}");
     assert!(
         last.starts_with("run complete")
-            || (!last.contains("input error") && !last.contains("failed") && !last.contains("skipped")),
+            || (!last.contains("input error")
+                && !last.contains("failed")
+                && !last.contains("skipped")),
         "{text}"
     );
 }

@@ -251,9 +251,9 @@ impl Headline {
                  trajectory is the recorded one"
                     .to_string(),
             )
-        } else if let Some((b, a, _)) = checkpoints
-            .filter(|(b, a, _)| verdict == Some("checkpoints_worse") || (verdict.is_none() && a > b))
-        {
+        } else if let Some((b, a, _)) = checkpoints.filter(|(b, a, _)| {
+            verdict == Some("checkpoints_worse") || (verdict.is_none() && a > b)
+        }) {
             Status::Worse(format!(
                 "the check points got worse ({b:.3} m → {a:.3} m RMSE 2D): check the registration before \
                  using the adjusted trajectory"
@@ -331,7 +331,11 @@ impl Headline {
             out.push(format!("Check points after: {a:.3} m RMSE 2D."));
         }
         if self.support[0] * 2 < self.recordings {
-            out.extend(self.registration.iter().map(|l| format!("Registration: {l}.")));
+            out.extend(
+                self.registration
+                    .iter()
+                    .map(|l| format!("Registration: {l}.")),
+            );
         }
         if let Some(v) = &self.verification_after {
             out.push(format!(

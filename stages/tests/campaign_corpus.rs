@@ -45,8 +45,12 @@ fn aerial(id: &str, file: &str, y: f64, omega_deg: f64) -> AerialImage {
         height_px: 60,
         k1: 0.0,
         k2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
         p1: 0.0,
         p2: 0.0,
+        b1: 0.0,
+        b2: 0.0,
         sigma_px: 0.5,
     }
 }

@@ -97,8 +97,12 @@ fn campaign(crs: &str) -> Campaign {
         height_px: 3000,
         k1: 0.0,
         k2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
         p1: 0.0,
         p2: 0.0,
+        b1: 0.0,
+        b2: 0.0,
         sigma_px: 0.5,
     };
     Campaign {

@@ -31,7 +31,10 @@ pub fn run_finished(cmd: &mut Command) -> String {
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
-    assert!(matches!(out.status.code(), Some(0 | 3)), "{cmd:?} failed: {text}");
+    assert!(
+        matches!(out.status.code(), Some(0 | 3)),
+        "{cmd:?} failed: {text}"
+    );
     text
 }
 

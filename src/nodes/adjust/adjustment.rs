@@ -12,9 +12,7 @@ use serde::{Deserialize, Serialize};
 use skytie_stages::adjustment::campaign_checkpoints::{compare_checkpoints, CheckPointComparison};
 use skytie_stages::adjustment::config::AdjustConfig;
 use skytie_stages::adjustment::evaluate::MULTI_VIEW_RADIUS_M;
-use skytie_stages::adjustment::from_correspondences::{
-    run, AdjustInputs, AdjustmentRun,
-};
+use skytie_stages::adjustment::from_correspondences::{run, AdjustInputs, AdjustmentRun};
 use skytie_stages::adjustment::{RmseSummary, ViewSelection};
 use skytie_stages::correspondence::{AerialControlPoint, MmTiePoint};
 use skytie_stages::export::{checkpoint_rows, recording_support, CheckPointRow, Support};

@@ -8,9 +8,6 @@ pub use skytie_util::huge_pages;
 pub mod image;
 pub mod io;
 pub mod probe;
-mod probe_jpeg;
-mod probe_png;
-mod probe_tiff;
 
 pub mod bilinear_many;
 pub mod border;

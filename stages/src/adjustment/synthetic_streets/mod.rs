@@ -10,8 +10,8 @@ pub mod points;
 pub mod route;
 
 use super::problem::{Block, BlockRecording, ControlPoint, PanoObservation, RelativeConstraint};
-use crate::rng::{mix_seed, SplitMix64};
 use crate::geometry::{triangulate_rays, PanoramaCamera};
+use crate::rng::{mix_seed, SplitMix64};
 use nalgebra::Vector3;
 use points::{crossing_points, observe, roadside_points, TiePoint};
 use rayon::prelude::*;

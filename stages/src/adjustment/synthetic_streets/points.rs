@@ -4,8 +4,8 @@
 //! its own random stream, so the block is the same whatever the thread count.
 
 use super::route::{ground_z, ORIGIN};
-use crate::rng::{mix_seed, SplitMix64};
 use crate::geometry::PanoramaCamera;
+use crate::rng::{mix_seed, SplitMix64};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use std::collections::BTreeMap;

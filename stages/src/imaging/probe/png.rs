@@ -2,7 +2,7 @@
 //! against the file size first, then every chunk walked to `IEND` with its CRC-32 verified (PNG specification,
 //! 3rd edition, section 5). A file cut off ends before `IEND`; flipped bits fail a CRC.
 
-use super::probe::{check_size, ImageFormat, ImageHeader, Layout, ProbeError, Source};
+use super::header::{check_size, ImageFormat, ImageHeader, Layout, ProbeError, Source};
 use std::io::{Read, Seek};
 
 const F: ImageFormat = ImageFormat::Png;

@@ -3,7 +3,7 @@
 //! skipping each scan's entropy-coded data up to the next marker. A file cut off anywhere ends before its
 //! end-of-image marker; a decoder would fill the missing part with grey, so this is where it is caught.
 
-use super::probe::{check_size, ImageFormat, ImageHeader, Layout, ProbeError, Source};
+use super::header::{check_size, ImageFormat, ImageHeader, Layout, ProbeError, Source};
 use std::io::{Read, Seek};
 
 const F: ImageFormat = ImageFormat::Jpeg;

@@ -3,7 +3,7 @@
 //! strip or tile must lie inside the file, and an uncompressed one must hold the bytes its rows need. A TIFF
 //! cut off loses the strips or tiles at its end (or its directory, which writers often put last).
 
-use super::probe::{check_size, ImageFormat, ImageHeader, Layout, ProbeError, Source};
+use super::header::{check_size, ImageFormat, ImageHeader, Layout, ProbeError, Source};
 use std::collections::HashMap;
 use std::io::{Read, Seek};
 
