@@ -240,14 +240,17 @@ fn check_map_in_chromium(chromium: &Path, index: &Path, profile: &Path, out: &Pa
         .parse()
         .unwrap();
     assert!(n > 0 && drawn == n, "{drawn} of {n} recordings drawn");
-    let first = std::fs::read_to_string(out.join("corrections.csv"))
+    // A recording to select: the first one of the run's GeoJSON (written whether or not anything was
+    // corrected).
+    let geojson: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("trajectory.geojson")).unwrap())
+            .unwrap();
+    let first = geojson["features"]
+        .as_array()
         .unwrap()
-        .lines()
-        .nth(1)
-        .unwrap()
-        .split(',')
-        .nth(2)
-        .unwrap()
+        .iter()
+        .find_map(|f| f["properties"]["image_id"].as_str())
+        .expect("a recording in trajectory.geojson")
         .to_string();
     let dom = dump_dom_fragment(chromium, index, &format!("#select={first}"), profile);
     assert_eq!(

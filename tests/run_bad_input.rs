@@ -64,10 +64,11 @@ fn run(wf: &Path, campaign: &Path, cache: &Path, out: &Path) -> (i32, String) {
         .arg("--quiet")
         .output()
         .unwrap();
+    // Warnings (stderr) first: the run's own last line is the last line of stdout.
     let text = format!(
         "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
+        String::from_utf8_lossy(&o.stderr),
+        String::from_utf8_lossy(&o.stdout)
     );
     (o.status.code().unwrap_or(-1), text)
 }

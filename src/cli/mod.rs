@@ -12,6 +12,7 @@ pub mod common;
 pub mod explain;
 pub mod import;
 pub mod init;
+pub mod params;
 pub mod plan;
 pub mod report;
 pub mod run;
@@ -50,6 +51,8 @@ pub enum Command {
     Synth(synth::SynthArgs),
     /// Validate a campaign folder and list every problem.
     Check(check::CheckArgs),
+    /// Every workflow parameter with default, unit, range and meaning (`skytie params refine`).
+    Params(params::ParamsArgs),
     /// List the built-in workflows, or print one (`show NAME`).
     Workflows(workflows::WorkflowsArgs),
     /// Turn vendor files (Pix4D, Metashape, SBET, ...) into a campaign folder (docs/import.md).
@@ -76,5 +79,6 @@ pub fn main() -> i32 {
         Command::Init(a) => init::main(a),
         Command::Tool(t) => tool::main(t),
         Command::Workflows(a) => workflows::main(a),
+        Command::Params(a) => params::main(a),
     }
 }

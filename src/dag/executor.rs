@@ -26,7 +26,7 @@ pub use crate::dag::status::NodeStatus;
 use crate::hashing::{ContentHash, NodeKey, StatCache};
 use crate::store::{EntryMeta, Loaded, Store};
 use rayon::prelude::*;
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
@@ -609,6 +609,16 @@ impl<'a> Exec<'a> {
     /// recompute those whose artifact is gone or corrupt (after ensuring their own inputs). Returns the ids
     /// that could not be provided, with the reason.
     fn ensure_values(&self, ids: &[NodeId]) -> Vec<(NodeId, String)> {
+        self.ensure_values_keeping(ids, &HashSet::new())
+    }
+
+    /// [`Self::ensure_values`], never releasing the values in `keep` (those an enclosing call still needs:
+    /// in a diamond, a node can be both an input and an input's input of what is being recomputed).
+    fn ensure_values_keeping(
+        &self,
+        ids: &[NodeId],
+        keep: &HashSet<NodeId>,
+    ) -> Vec<(NodeId, String)> {
         let missing: Vec<NodeId> = ids
             .iter()
             .copied()
@@ -648,8 +658,15 @@ impl<'a> Exec<'a> {
             .collect();
         upstream.sort_unstable();
         upstream.dedup();
-        let upstream_failures: HashMap<NodeId, String> =
-            self.ensure_values(&upstream).into_iter().collect();
+        let mut keep_upstream = keep.clone();
+        keep_upstream.extend(ids.iter().copied());
+        keep_upstream.extend(upstream.iter().copied());
+        let upstream_failures: HashMap<NodeId, String> = self
+            .ensure_values_keeping(&upstream, &keep_upstream)
+            .into_iter()
+            .collect();
+        // A node recomputed as an upstream of another one in this set is not run twice.
+        recompute.retain(|&id| self.slot(id).value.is_none());
         let results: Vec<(NodeId, Result<f64, String>)> = recompute
             .par_iter()
             .map(|&id| {
@@ -685,6 +702,9 @@ impl<'a> Exec<'a> {
         }
         // Release recomputed upstream values nobody will read again.
         for &u in &upstream {
+            if keep.contains(&u) || ids.contains(&u) {
+                continue;
+            }
             let mut s = self.slot(u);
             if s.consumers_left == 0 && !self.dag.nodes[u].requested {
                 s.value = None;

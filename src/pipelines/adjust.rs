@@ -4,6 +4,7 @@
 
 use super::nadir::{NadirHandles, RecordingItem};
 use super::oblique::ObliqueHandles;
+use super::stage;
 use super::wf_err;
 use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::adjust::adjustment::{AdjustReport, AdjustStage};
@@ -44,7 +45,7 @@ pub fn add_adjust(
         verification: None,
         verification_adjusted: None,
     };
-    if !(on("adjust") || on("verify") || on("grade_adjust")) {
+    if !(on(stage::ADJUST) || on(stage::VERIFY) || on(stage::GRADE_ADJUST)) {
         return Ok(out);
     }
     let nadir = nadir.filter(|n| !n.control.is_empty() || !n.windows.is_empty());
@@ -58,8 +59,8 @@ pub fn add_adjust(
         )));
     }
     let panos: Vec<RawFile> = items.iter().map(|i| i.pano.clone()).collect();
-    if on("adjust") {
-        let config: AdjustConfig = wf.params("adjust", variant).map_err(wf_err)?;
+    if on(stage::ADJUST) {
+        let config: AdjustConfig = wf.params(stage::ADJUST, variant).map_err(wf_err)?;
         let use_nadir = matches!(config.sources, Sources::Nadir | Sources::Combined);
         let use_oblique = matches!(config.sources, Sources::Oblique | Sources::Combined);
         let missing = match (
@@ -101,7 +102,7 @@ pub fn add_adjust(
         b.metrics(report, "adjust", |r: &AdjustReport| r.metrics());
         out.report = Some(report);
         let truth = root.join(TRUTH_RECORDINGS);
-        if on("grade_adjust") && truth.is_file() {
+        if on(stage::GRADE_ADJUST) && truth.is_file() {
             let grade = b.add(
                 GradeAdjust,
                 "",
@@ -111,8 +112,8 @@ pub fn add_adjust(
             b.metrics(grade, "adjust", |g: &AdjustGrade| g.metrics());
         }
     }
-    if on("verify") {
-        let config: VerifyConfig = wf.params("verify", variant).map_err(wf_err)?;
+    if on(stage::VERIFY) {
+        let config: VerifyConfig = wf.params(stage::VERIFY, variant).map_err(wf_err)?;
         let Some(nadir) = nadir else {
             return Err(wf_err(format!(
                 "{}: 'verify' compares aerial nadir control points with the MM data: enable the nadir chain",

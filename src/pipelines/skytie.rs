@@ -11,7 +11,7 @@
 //! A stage name the pipeline does not know is refused with the list of available ones.
 
 use super::validate::add_validated_snapshot;
-use super::{adjust, nadir, oblique, wf_err};
+use super::{adjust, nadir, oblique, stage, wf_err};
 use crate::dag::{optional_all, DagBuilder, Pipeline, PipelineError, RawFile, Session};
 use crate::exports::{write_exports, ExportInputs};
 use crate::nodes::campaign::load::{listing_hash, metadata_inputs};
@@ -27,28 +27,7 @@ use std::path::{Path, PathBuf};
 pub struct SkytiePipeline;
 
 /// Stage names a workflow may enable in `stages = [...]`.
-pub const STAGES: [&str; 20] = [
-    "synth",
-    "load",
-    "ortho",
-    "summary",
-    "mm_match",
-    "ortho_aerial",
-    "transform",
-    "refine",
-    "control",
-    "nadir",
-    "grade_nadir",
-    "adjust",
-    "grade_adjust",
-    "verify",
-    "baseline",
-    "sparse_cloud",
-    "facades",
-    "patches",
-    "oblique",
-    "grade_oblique",
-];
+pub const STAGES: [&str; 20] = stage::ALL;
 
 /// Absolute form of a campaign folder (keys must not depend on the working directory's spelling).
 fn absolute(p: &Path) -> PathBuf {
@@ -62,6 +41,10 @@ impl Pipeline for SkytiePipeline {
 
     fn stage_names(&self) -> Vec<&'static str> {
         STAGES.to_vec()
+    }
+
+    fn validate(&self, wf: &Workflow) -> Result<(), String> {
+        super::catalogue::validate(wf)
     }
 
     fn run(&self, wf: &Workflow, session: &mut Session<'_>) -> Result<(), PipelineError> {
@@ -78,7 +61,7 @@ impl Pipeline for SkytiePipeline {
         let root: PathBuf = match &wf.campaign {
             CampaignSource::Path(p) => absolute(p),
             CampaignSource::Synth { preset, seed } => {
-                let mut params: SynthParams = wf.params("synth", "default").map_err(wf_err)?;
+                let mut params: SynthParams = wf.params(stage::SYNTH, "default").map_err(wf_err)?;
                 params.preset = preset.clone();
                 params.seed = *seed;
                 let mut b = DagBuilder::new();
@@ -125,7 +108,7 @@ impl Pipeline for SkytiePipeline {
             );
         }
         // Phase 3: per-recording stages and the summary, for every variant.
-        let ortho_on = wf.stages.iter().any(|s| s == "ortho");
+        let ortho_on = wf.stages.iter().any(|s| s == stage::ORTHO);
         let nadir_on = nadir::enabled(wf)?;
         let oblique_on = oblique::enabled(wf)?;
         let mut b = DagBuilder::new();
@@ -133,7 +116,7 @@ impl Pipeline for SkytiePipeline {
         for variant in wf.variants() {
             b.set_variant(&variant);
             let snap = add_validated_snapshot(&mut b, &root, &load_params, &inputs, &loaded)?;
-            let ortho: OrthoParams = wf.params("ortho", &variant).map_err(wf_err)?;
+            let ortho: OrthoParams = wf.params(stage::ORTHO, &variant).map_err(wf_err)?;
             let mut orthos = Vec::new();
             let mut items = Vec::new();
             for rec in &snapshot.campaign.recordings {

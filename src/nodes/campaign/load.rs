@@ -8,10 +8,10 @@
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
 use serde::{Deserialize, Serialize};
-use skytie_stages::params::StageId;
 use skytie_stages::campaign::{
     read_sourced, Campaign, Problem, Recording, SourceRows, SourcedCampaign,
 };
+use skytie_stages::params::StageId;
 use std::path::Path;
 use std::sync::Arc;
 

@@ -10,9 +10,10 @@ use super::table::Fields;
 pub(crate) const MAX_ABS_XY_M: f64 = 1e8;
 /// Largest |z|, metres: no camera or surveyed point on Earth is farther from sea level.
 pub(crate) const MAX_ABS_Z_M: f64 = 1e4;
-/// A-priori σ of a position, metres: below 0.1 mm no GNSS/INS or survey is that good (the adjustment would
-/// freeze the point); above 1 km the value is no position at all.
-pub(crate) const SIGMA_M: (f64, f64) = (1e-4, 1e3);
+/// A-priori σ of a position, metres: below 1 µm the value is no measurement precision (a unit mistake; an
+/// adjusted trajectory read back as input may carry posterior σ well below a millimetre, so the bound sits
+/// lower than any survey); above 1 km the value is no position at all.
+pub(crate) const SIGMA_M: (f64, f64) = (1e-6, 1e3);
 /// Image measurement σ, pixels.
 pub(crate) const SIGMA_PX: (f64, f64) = (1e-3, 100.0);
 /// Field of view of a frame camera across its image diagonal, degrees: outside it the principal distance does
