@@ -7,8 +7,8 @@ use crate::workflow::Workflow;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
-/// Default workflow file.
-pub const DEFAULT_WORKFLOW: &str = "workflows/default.toml";
+/// The workflow `skytie run` runs when none is named (built in, see [`super::builtin_workflows`]).
+pub const DEFAULT_WORKFLOW: &str = "default";
 
 /// `--cache DIR` (default: `$SKYTIE_CACHE`, else `cache/` in the working directory).
 #[derive(Args, Debug, Clone, Default)]
@@ -66,7 +66,7 @@ pub fn load_workflow(
     path: &Path,
     campaign: Option<&Path>,
 ) -> Result<(Workflow, &'static dyn Pipeline), String> {
-    let mut wf = Workflow::load(path).map_err(|e| e.to_string())?;
+    let mut wf = super::builtin_workflows::load(path).map_err(|e| e.to_string())?;
     if let Some(c) = campaign {
         wf.override_campaign(c.to_path_buf());
     }

@@ -16,7 +16,7 @@ pub mod status;
 pub use builder::{BuildError, Dag, DagBuilder};
 pub use error::StageError;
 pub use executor::{execute, Env, Mode, NodeReport, NodeStatus, Outcome};
-pub use inputs::{Handle, InputSet, NodeId, RawFile, RawFileValue};
+pub use inputs::{optional_all, Handle, InputSet, NodeId, Optional, RawFile, RawFileValue};
 pub use stage::{NodeCtx, Stage};
 pub mod pipeline;
 pub mod session;

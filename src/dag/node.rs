@@ -89,14 +89,7 @@ impl Node {
     }
     /// Ids of the nodes this node reads (each once, ascending).
     pub fn upstream_ids(&self) -> Vec<usize> {
-        let mut ids: Vec<usize> = self
-            .inputs
-            .iter()
-            .filter_map(|(_, r)| match r {
-                InputRef::Node(id) => Some(*id),
-                InputRef::File(_) => None,
-            })
-            .collect();
+        let mut ids: Vec<usize> = self.inputs.iter().filter_map(|(_, r)| r.node()).collect();
         ids.sort_unstable();
         ids.dedup();
         ids

@@ -1,4 +1,4 @@
-//! The HTML report of a run (issue 7): `skytie report OUT [--campaign DIR]`, also written at the end of
+//! The HTML report of a run: `skytie report OUT [--campaign DIR]`, also written at the end of
 //! `skytie run`. A pure function of the output folder OUT (plus, optionally, the campaign folder for images
 //! and `truth/`): it never runs the pipeline.
 //!
@@ -10,11 +10,16 @@
 //! finished — go to `OUT/report/run-log/` instead, so that re-running a workflow reproduces `tables/`
 //! byte-identically (a warm rerun executes nothing and takes less time, which is all that changes).
 
+pub mod headline;
+pub mod headline_section;
 pub mod html;
 pub mod image_cache;
 pub mod inputs;
+pub mod interactive_map;
+pub mod map_background;
 pub mod map_data;
 pub mod plots;
+pub mod reasons;
 pub mod registration;
 pub mod results;
 pub mod summary;
@@ -81,6 +86,8 @@ pub struct Builder {
     pub images: std::sync::Arc<image_cache::ImageCache>,
     /// The registration views' campaign, truth and drawn views, shared with the variants' builders.
     pub views: std::sync::Arc<registration::SharedViews>,
+    /// Registration views of the current result set per recording id: (href, caption), for the map's panel.
+    pub recording_views: std::collections::HashMap<String, Vec<(String, String)>>,
 }
 
 /// Folder names inside `OUT/report/`.
@@ -139,6 +146,7 @@ impl Builder {
             notes: Vec::new(),
             images: std::sync::Arc::clone(&self.images),
             views: std::sync::Arc::clone(&self.views),
+            recording_views: Default::default(),
         }
     }
 
@@ -211,7 +219,9 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
         notes: Vec::new(),
         images: Default::default(),
         views: Default::default(),
+        recording_views: Default::default(),
     };
+    interactive_map::write_assets(&report_dir)?;
     if b.campaign.is_none() {
         b.notes.push(
             "campaign folder not found (give --campaign DIR): no true positions, no registration views"
@@ -228,7 +238,6 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
                 .and_then(|s| inputs::str_at(&s.metrics, "campaign.name")))
             .unwrap_or("run")
     ));
-    summary::summary_section(&mut b, &mut index, &run);
     if run.is_sweep {
         sweep::sweep_section(&mut b, &mut index, &run)?;
         index.heading("variants", "Variants");
@@ -262,6 +271,8 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
     } else if let Some(set) = run.sets.first() {
         results::results_sections(&mut b, &mut index, set, &run)?;
     }
+    // Diagnostics last: the run, rejected items with their reasons, engine counters and stage timings.
+    summary::summary_section(&mut b, &mut index, &run);
     if !b.notes.is_empty() {
         index.heading("notes", "Notes on this report");
         let mut ul = String::from("<ul>\n");

@@ -5,7 +5,7 @@
 //! ([`super::budget`]); the pipeline reads windows of pyramids instead ([`super::pyramid`]).
 
 use super::decode::collect::GreyCollector;
-use super::decode::limits::{check_claimed_size, reserve};
+use super::decode::limits::reserve;
 use super::{GrayImage, RgbImage};
 use std::path::Path;
 
@@ -30,23 +30,17 @@ fn err(path: &Path, message: impl Into<String>) -> ImageIoError {
     ImageIoError::new(path, message)
 }
 
-/// Decodes `path` with the `image` crate, its allocation limit replaced by the memory budget (the crate's
-/// default of 512 MiB refuses valid large frames).
+/// Decodes `path` with the `image` crate after [`probe`](super::probe::probe) found it complete (a truncated
+/// file, which the decoders would fill with grey, or an absurd header is an error before anything is
+/// allocated), its allocation limit replaced by the memory budget (the crate's default of 512 MiB refuses
+/// valid large frames).
 fn open(path: &Path) -> Result<image::DynamicImage, ImageIoError> {
-    let (w, h) = dimensions(path)?;
-    let file_len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-    let format = super::decode::detect_format(path)?;
-    let max_px_per_byte = match format {
-        super::decode::FileFormat::Jpeg => super::decode::limits::px_per_byte::JPEG,
-        super::decode::FileFormat::Png => super::decode::limits::px_per_byte::PNG,
-        _ => super::decode::limits::px_per_byte::TIFF,
-    };
-    let (w, h) = (w as usize, h as usize);
-    check_claimed_size(path, format.name(), w, h, file_len, max_px_per_byte)?;
+    let header = super::probe::probe(path).map_err(|e| err(path, format!("{e}; {}", e.hint())))?;
+    let (w, h) = (header.width as usize, header.height as usize);
     // The decoded RGB(A) image at up to 16 bits, and its 32-bit float RGB copy.
     let _reservation = reserve(
         path,
-        format.name(),
+        header.format.name(),
         w,
         h,
         w * h * (8 + 12),

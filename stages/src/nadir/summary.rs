@@ -1,12 +1,20 @@
-//! Counts of one run of the nadir pipeline (issue 4's `nadir.*` metrics that need no truth): MM pairs and
+//! Counts of one run of the nadir pipeline (the `nadir.*` metrics that need no truth): MM pairs and
 //! how they were related, MM tie points, initial transforms accepted/rejected, MM–aerial correspondences,
 //! aerial control points. Truth-based grades live in `grading.rs`.
 
 use super::registration::{
     AerialRefinement, MmWindowMatch, PairMethod, RecordingControl, TransformOutcome,
 };
+use crate::params::StageId;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "nadir",
+    version: "4",
+};
 
 /// See the module documentation. Counts, not grades.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]

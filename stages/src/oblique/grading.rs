@@ -1,4 +1,4 @@
-//! Grading the oblique pipeline against a synthetic campaign's `truth/` (issue 5's `oblique.*` truth metrics).
+//! Grading the oblique pipeline against a synthetic campaign's `truth/` (the `oblique.*` truth metrics).
 //! Evaluation only: the pipeline never calls this. Uses the nadir grading's [`Truth`] and [`ErrorStats`].
 //!
 //! **Rule for a correct oblique correspondence** (one patch match: panorama observation `mm` ↔ oblique pixel
@@ -42,7 +42,15 @@ use super::types::{ObliqueResult, PatchMatch, SparseCloud, StreetSide};
 use crate::correspondence::{MmTiePoint, PanoObservation};
 use crate::geometry::{closest_approach, FrameCamera, PanoramaCamera};
 pub use crate::nadir::grading::{ErrorStats, Truth};
+use crate::params::StageId;
 pub use crate::synth::scene_truth::SceneOracle;
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "grade_oblique",
+    version: "3",
+};
 
 /// Largest closest-approach distance of the panorama and oblique rays of a correct correspondence, m.
 pub const CLOSEST_APPROACH_TOLERANCE_M: f64 = 0.15;
@@ -131,7 +139,7 @@ fn ratio(a: usize, n: usize) -> f64 {
 }
 
 impl ObliqueGrade {
-    /// The `oblique.*` truth metrics of issue 5 (to be put under the `oblique` namespace).
+    /// The `oblique.*` truth metrics (to be put under the `oblique` namespace).
     pub fn metrics(&self) -> serde_json::Value {
         let side = |s: &SideCounts| {
             json!({

@@ -23,11 +23,19 @@ use super::SynthError;
 use crate::campaign::write as cw;
 use crate::campaign::{AerialImage, Recording};
 use crate::geometry::{FrameCamera, PanoramaCamera};
+use crate::params::StageId;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "synth",
+    version: "1",
+};
 
 /// What to generate.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -1,0 +1,55 @@
+//! `ortho`: per recording, the panorama ortho-projected onto the ground plane — thesis 3.4.3
+//! (`skytie_stages::nadir::ortho_project`). Inputs: the recording's row and its ingested panorama, of which only
+//! the bands of rows and pyramid levels the projection samples are read.
+
+use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::nodes::campaign::image_tiles;
+use crate::nodes::campaign::ingest::IngestedImage;
+use skytie_stages::campaign::Recording;
+use skytie_stages::imaging::equirect::PanoramaLevels;
+use skytie_stages::imaging::pyramid::TileSource;
+use skytie_stages::nadir::ortho::panorama_bands;
+use skytie_stages::nadir::{ortho_project, OrthoImage, OrthoParams};
+use std::sync::Arc;
+
+crate::serde_artifact!(OrthoImage);
+
+/// The bands of `pano` that the ortho-projection of `rec` with `p` samples; an error when the panorama is not
+/// equirectangular (W = 2H).
+pub fn panorama_for_ortho(
+    pano: &IngestedImage,
+    rec: &Recording,
+    p: &OrthoParams,
+) -> Result<PanoramaLevels, StageError> {
+    if pano.width != 2 * pano.height {
+        return Err(StageError::new(format!(
+            "{}: panorama is {}×{} px; an equirectangular panorama must be twice as wide as high",
+            pano.source, pano.width, pano.height
+        )));
+    }
+    let pyramid = image_tiles::open(pano)?;
+    let size = (pano.width as usize, pano.height as usize);
+    let bands = panorama_bands(rec, p, size, pyramid.layout().levels() - 1);
+    PanoramaLevels::read_bands(&pyramid, &bands).map_err(|e| StageError::new(e.to_string()))
+}
+
+/// The ortho-projection node.
+pub struct OrthoProject;
+
+impl Stage for OrthoProject {
+    const NAME: &'static str = skytie_stages::nadir::ortho::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::ortho::STAGE.version;
+    type Params = OrthoParams;
+    type Output = OrthoImage;
+    type Inputs = (Handle<Recording>, Handle<IngestedImage>);
+
+    fn run(
+        &self,
+        p: &OrthoParams,
+        (rec, pano): (Arc<Recording>, Arc<IngestedImage>),
+        _: &NodeCtx,
+    ) -> Result<OrthoImage, StageError> {
+        let panorama = panorama_for_ortho(&pano, &rec, p)?;
+        Ok(ortho_project(&panorama, &rec, p))
+    }
+}

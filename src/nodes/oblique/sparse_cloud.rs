@@ -1,0 +1,56 @@
+//! `sparse_cloud`: per panorama triplet (recordings i−1, i, i+1 along the trajectory) the façade sparse cloud
+//! (thesis 4.4.1, `skytie_stages::oblique::sparse_cloud`): perspective views per side, AGAST + DAISY, trifocal
+//! outlier removal, triangulation in the original equirectangular geometry. Inputs: the three recording rows
+//! and panorama files (hashed by content).
+
+use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::nodes::campaign::image_tiles;
+use crate::nodes::campaign::ingest::IngestedImage;
+use skytie_stages::campaign::Recording;
+use skytie_stages::imaging::equirect::PanoramaLevels;
+use skytie_stages::imaging::pyramid::TileSource;
+use skytie_stages::oblique::sparse_cloud::{panorama_bands, sparse_cloud, SparseCloudParams};
+use skytie_stages::oblique::SparseCloud;
+use std::sync::Arc;
+
+crate::serde_artifact!(SparseCloud);
+
+/// The sparse-cloud node; the triplet's members are in trajectory order, the centre second.
+pub struct SparseCloudStage;
+
+impl Stage for SparseCloudStage {
+    const NAME: &'static str = skytie_stages::oblique::sparse_cloud::STAGE.name;
+    const VERSION: &'static str = skytie_stages::oblique::sparse_cloud::STAGE.version;
+    type Params = SparseCloudParams;
+    type Output = SparseCloud;
+    type Inputs = (Vec<Handle<Recording>>, Vec<Handle<IngestedImage>>);
+
+    fn run(
+        &self,
+        p: &SparseCloudParams,
+        (recs, panos): (Vec<Arc<Recording>>, Vec<Arc<IngestedImage>>),
+        _: &NodeCtx,
+    ) -> Result<SparseCloud, StageError> {
+        if recs.len() != 3 || panos.len() != 3 {
+            return Err(StageError::new(
+                "internal: sparse_cloud needs exactly three recordings and panoramas",
+            ));
+        }
+        let images = recs
+            .iter()
+            .zip(&panos)
+            .map(|(rec, pano)| {
+                let pyramid = image_tiles::open(pano)?;
+                let size = (pano.width as usize, pano.height as usize);
+                let bands = panorama_bands(rec, p, size, pyramid.layout().levels() - 1);
+                PanoramaLevels::read_bands(&pyramid, &bands)
+                    .map_err(|e| StageError::new(e.to_string()))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(sparse_cloud(
+            [&recs[0], &recs[1], &recs[2]],
+            [&images[0], &images[1], &images[2]],
+            p,
+        ))
+    }
+}
