@@ -3,7 +3,7 @@
 //! `image` crate's reader) and must decode to the expected grey; bad files fail with their name.
 
 use skytie_stages::imaging::decode::grey::{luma16, luma8};
-use skytie_stages::imaging::decode::{decode_grey, detect_format, FileFormat};
+use skytie_stages::imaging::decode::{decode_grey, probe_file, ImageFormat};
 use skytie_stages::imaging::ingest::ingest_with_tiles;
 use skytie_stages::imaging::io::load_gray;
 use skytie_stages::imaging::pyramid::{read_window, PixelRect, SampleDepth, TiledPyramid};
@@ -106,13 +106,13 @@ fn tiled_tiffs_of_every_compression_depth_and_kind_decode_exactly() {
     for (i, &(channels, bytes, compression, big)) in cases.iter().enumerate() {
         let path = dir.path().join(format!("t{i}.tif"));
         write_tiled(&path, channels, bytes, compression, big);
-        let format = detect_format(&path).unwrap();
+        let format = probe_file(&path).unwrap().format;
         assert_eq!(
             format,
             if big {
-                FileFormat::BigTiff
+                ImageFormat::BigTiff
             } else {
-                FileFormat::Tiff
+                ImageFormat::Tiff
             }
         );
         let img = load_gray(&path).unwrap();
@@ -214,7 +214,7 @@ fn sixteen_bit_lzw_strips_and_bigtiff_from_the_tiff_crate() {
     let mut enc = TiffEncoder::new_big(std::fs::File::create(&p).unwrap()).unwrap();
     enc.write_image::<colortype::Gray16>(W as u32, H as u32, &data)
         .unwrap();
-    assert_eq!(detect_format(&p).unwrap(), FileFormat::BigTiff);
+    assert_eq!(probe_file(&p).unwrap().format, ImageFormat::BigTiff);
     assert_eq!(
         load_gray(&p).unwrap().get(299, 169),
         f32::from(data[169 * W + 299]) / 65535.0

@@ -10,7 +10,7 @@ use crate::dag::{
 };
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
-use skytie_stages::imaging::decode::{FileFormat, GeoTiffTags};
+use skytie_stages::imaging::decode::{GeoTiffTags, ImageFormat};
 use skytie_stages::imaging::ingest::ingest_with_tiles;
 use skytie_stages::imaging::pyramid::{SampleDepth, DEFAULT_TILE_SIDE};
 
@@ -52,7 +52,7 @@ impl StageParams for IngestParams {
 pub struct IngestedImage {
     /// The source file (for messages).
     pub source: String,
-    pub format: FileFormat,
+    pub format: ImageFormat,
     pub width: u64,
     pub height: u64,
     pub depth: SampleDepth,

@@ -3,8 +3,8 @@
 //! ends before its end-of-image marker, or whose entropy-coded data is corrupt, is an error, not a grey
 //! image with a missing bottom.
 
-use super::limits::{check_claimed_size, px_per_byte, reserve, MAX_SIDE_PX};
-use super::{sink_error, FileFormat, GreyInfo, GreyRowSink};
+use super::limits::{reserve, MAX_SIDE_PX};
+use super::{sink_error, GreyInfo, GreyRowSink, ImageFormat, ImageHeader};
 use crate::imaging::io::ImageIoError;
 use crate::imaging::pyramid::SampleDepth;
 use std::path::Path;
@@ -46,13 +46,14 @@ fn header(path: &Path) -> Result<(usize, usize, bool), ImageIoError> {
     ))
 }
 
-/// Decodes the JPEG `path` into `sink` as 8-bit grey (its Y plane).
-pub fn decode(path: &Path, sink: &mut dyn GreyRowSink) -> Result<GreyInfo, ImageIoError> {
-    let file_len = std::fs::metadata(path)
-        .map_err(|e| ImageIoError::new(path, format!("cannot read ({e})")))?
-        .len();
+/// Decodes the JPEG `path` (probed as `probed`) into `sink` as 8-bit grey (its Y plane).
+pub fn decode(
+    path: &Path,
+    probed: &ImageHeader,
+    sink: &mut dyn GreyRowSink,
+) -> Result<GreyInfo, ImageIoError> {
+    let file_len = probed.file_bytes;
     let (width, height, progressive) = header(path)?;
-    check_claimed_size(path, "JPEG", width, height, file_len, px_per_byte::JPEG)?;
     let plane = width * height;
     let extra = if progressive {
         plane * PROGRESSIVE_EXTRA_BYTES_PER_PX
@@ -96,7 +97,7 @@ pub fn decode(path: &Path, sink: &mut dyn GreyRowSink) -> Result<GreyInfo, Image
         width,
         height,
         depth: SampleDepth::U8,
-        format: FileFormat::Jpeg,
+        format: ImageFormat::Jpeg,
         geotiff: None,
     };
     sink.begin(&info).map_err(|e| sink_error(path, e))?;

@@ -2,8 +2,8 @@
 //! (Adam7) images whole. Palettes and grey below 8 bits are expanded to 8 bits; 16-bit images stay 16-bit.
 
 use super::grey::{grey_row16, grey_row8, Channels};
-use super::limits::{check_claimed_size, px_per_byte, reserve};
-use super::{sink_error, FileFormat, GreyInfo, GreyRowSink};
+use super::limits::reserve;
+use super::{sink_error, GreyInfo, GreyRowSink, ImageFormat};
 use crate::imaging::io::ImageIoError;
 use crate::imaging::pyramid::SampleDepth;
 use png::{BitDepth, ColorType, Transformations};
@@ -52,14 +52,10 @@ fn decoding_error(path: &Path, e: png::DecodingError) -> ImageIoError {
     )
 }
 
-/// Decodes the PNG `path` into `sink` as grey.
+/// Decodes the PNG `path` (probed before) into `sink` as grey.
 pub fn decode(path: &Path, sink: &mut dyn GreyRowSink) -> Result<GreyInfo, ImageIoError> {
     let file = std::fs::File::open(path)
         .map_err(|e| ImageIoError::new(path, format!("cannot open ({e})")))?;
-    let file_len = file
-        .metadata()
-        .map_err(|e| ImageIoError::new(path, format!("cannot read ({e})")))?
-        .len();
     let mut decoder = png::Decoder::new(BufReader::new(file));
     decoder.set_transformations(Transformations::EXPAND);
     let header = decoder
@@ -67,7 +63,6 @@ pub fn decode(path: &Path, sink: &mut dyn GreyRowSink) -> Result<GreyInfo, Image
         .map_err(|e| decoding_error(path, e))?;
     let (width, height) = (header.width as usize, header.height as usize);
     let interlaced = header.interlaced;
-    check_claimed_size(path, "PNG", width, height, file_len, px_per_byte::PNG)?;
     // Row buffers of the decoder: a few rows of at most 8 bytes per pixel.
     let row_bytes = width * 8;
     let whole = if interlaced { height * row_bytes } else { 0 };
@@ -97,7 +92,7 @@ pub fn decode(path: &Path, sink: &mut dyn GreyRowSink) -> Result<GreyInfo, Image
         } else {
             SampleDepth::U8
         },
-        format: FileFormat::Png,
+        format: ImageFormat::Png,
         geotiff: None,
     };
     let mut conv = RowConverter {

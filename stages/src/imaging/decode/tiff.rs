@@ -5,9 +5,9 @@
 
 use super::geotiff::GeoTiffTags;
 use super::grey::{grey_row16, grey_row8, Channels};
-use super::limits::{check_claimed_size, px_per_byte, reserve};
+use super::limits::reserve;
 use super::tiff_lzw::{read_lzw_chunk, ChunkCoding};
-use super::{sink_error, FileFormat, GreyInfo, GreyRowSink};
+use super::{sink_error, GreyInfo, GreyRowSink, ImageHeader};
 use crate::imaging::io::ImageIoError;
 use crate::imaging::pyramid::SampleDepth;
 use std::io::BufReader;
@@ -322,20 +322,20 @@ impl Band {
     }
 }
 
-/// Decodes the TIFF or BigTIFF `path` into `sink` as grey, one row of strips or tiles at a time.
-pub fn decode(path: &Path, sink: &mut dyn GreyRowSink) -> Result<GreyInfo, ImageIoError> {
+/// Decodes the TIFF or BigTIFF `path` (probed as `probed`) into `sink` as grey, one row of strips or tiles at
+/// a time.
+pub fn decode(
+    path: &Path,
+    probed: &ImageHeader,
+    sink: &mut dyn GreyRowSink,
+) -> Result<GreyInfo, ImageIoError> {
     let file = std::fs::File::open(path)
         .map_err(|e| ImageIoError::new(path, format!("cannot open ({e})")))?;
-    let file_len = file
-        .metadata()
-        .map_err(|e| ImageIoError::new(path, format!("cannot read ({e})")))?
-        .len();
     let raw = file
         .try_clone()
         .map_err(|e| ImageIoError::new(path, format!("cannot read ({e})")))?;
     let mut dec = Decoder::new(BufReader::new(file)).map_err(|e| tiff_error(path, e))?;
     let s = structure(path, &mut dec)?;
-    check_claimed_size(path, "TIFF", s.width, s.height, file_len, px_per_byte::TIFF)?;
     let bytes = s.depth.bytes();
     let chunk_bytes = s.chunk_w * s.chunk_h * s.channels.samples() * bytes;
     let band_bytes = s.width * s.chunk_h * bytes;
@@ -359,11 +359,7 @@ pub fn decode(path: &Path, sink: &mut dyn GreyRowSink) -> Result<GreyInfo, Image
         width: s.width,
         height: s.height,
         depth: s.depth,
-        format: if file_is_bigtiff(path) {
-            FileFormat::BigTiff
-        } else {
-            FileFormat::Tiff
-        },
+        format: probed.format,
         geotiff: GeoTiffTags::read(&mut dec),
     };
     sink.begin(&info).map_err(|e| sink_error(path, e))?;
@@ -400,8 +396,4 @@ pub fn decode(path: &Path, sink: &mut dyn GreyRowSink) -> Result<GreyInfo, Image
         }
     }
     Ok(info)
-}
-
-fn file_is_bigtiff(path: &Path) -> bool {
-    matches!(super::detect_format(path), Ok(FileFormat::BigTiff))
 }
