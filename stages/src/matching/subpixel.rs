@@ -27,7 +27,7 @@ pub fn quadratic_peak_2d(n: &[[f64; 3]; 3]) -> Option<(f64, f64)> {
     let g = (row(0) + row(2) - 2.0 * row(1)) / 6.0;
     // Solve [2d e; e 2g]·δ = −[b; c].
     let det = 4.0 * d * g - e * e;
-    if !(d < 0.0 && g < 0.0 && det > 0.0) || !det.is_finite() {
+    if !(d < 0.0 && g < 0.0 && det > 0.0 && det.is_finite()) {
         return None;
     }
     let dx = (-b * 2.0 * g + c * e) / det;
