@@ -1,5 +1,5 @@
 //! Tapering windows (Hann, Blackman) and their separable 2-D application, used before Fourier-domain matching
-//! to suppress the wrap-around edge (ALGORITHMS.md §4).
+//! to suppress the wrap-around edge (Kuglin & Hines 1975; Reddy & Chatterji 1996).
 
 use super::image::GrayImage;
 

@@ -1,5 +1,5 @@
 //! Phase correlation: translation between two images from the normalised cross-power spectrum
-//! (thesis 3.4.5.3, eq. 3/1; Kuglin & Hines 1975, Reddy & Chatterji 1996; ALGORITHMS.md §4).
+//! (thesis 3.4.5.3, eq. 3/1; Kuglin & Hines 1975, Reddy & Chatterji 1996; Kuglin & Hines 1975; Reddy & Chatterji 1996).
 //!
 //! Convention (same sign and axis order as OpenCV's `phaseCorrelate`): if `moving(x) = reference(x − t)`, i.e.
 //! content at p in `reference` appears at p + t in `moving`, the result is `(dx, dy) = t` in pixels.

@@ -1,4 +1,4 @@
-//! Nonlinear diffusion of the KAZE scale space (ALGORITHMS.md §1; KAZE paper §3–4; thesis 3.4.4.2 uses it
+//! Nonlinear diffusion of the KAZE scale space (Alcantarilla, Bartoli & Davison 2012; KAZE paper §3–4; thesis 3.4.4.2 uses it
 //! through KAZE): conductance images, the AOS scheme with a Thomas tridiagonal solver, and Fast Explicit
 //! Diffusion (FED) cycles.
 //!
