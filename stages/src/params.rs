@@ -266,7 +266,7 @@ pub fn prefixed(prefix: &str, violations: Vec<Violation>) -> impl Iterator<Item 
     })
 }
 
-/// Declares a stage's parameter struct; see the [module documentation](crate::params).
+/// Declares a stage's parameter struct; see the [module documentation](mod@crate::params).
 #[macro_export]
 macro_rules! params {
     (
@@ -391,9 +391,6 @@ macro_rules! params {
         );
     };
 }
-
-#[cfg(test)]
-mod declared_types;
 
 #[cfg(test)]
 mod tests {

@@ -264,7 +264,8 @@ fn side_cloud(
 }
 
 /// The sparse cloud of the triplet `recs` (trajectory order; `panos[i]` is the panorama of `recs[i]`, with
-/// the bands of [`panorama_bands`]). Parameters are assumed valid ([`SparseCloudParams::validate`]).
+/// the bands of [`panorama_bands`]). Parameters are assumed valid
+/// ([`Params::validate`](crate::params::Params::validate)).
 pub fn sparse_cloud(
     recs: [&Recording; 3],
     panos: [&PanoramaLevels; 3],
