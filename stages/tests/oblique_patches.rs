@@ -323,6 +323,13 @@ fn patches_of_a_textured_facade_from_two_cameras_agree_and_resolution_ratio_foll
     assert_eq!(fill_from_frame(&away, &cam_o, &obl_img).valid_pixels, 0);
 }
 
+/// `img` (0..255) scaled to 0..1.
+fn unit_range(img: &GrayImage) -> GrayImage {
+    let mut out = img.clone();
+    out.data.iter_mut().for_each(|v| *v /= 255.0);
+    out
+}
+
 fn run(
     rec_true: &Recording,
     shift_x_m: f64,
@@ -344,10 +351,11 @@ fn run(
     let mut recorded = rec_true.clone();
     recorded.x += shift_x_m;
     let (cloud, facades) = cloud_and_facades(&recorded, points, shift_x_m, resolution_m);
+    // Pyramids hold images as decoded files are: 0..1 (the renders are in 0..255).
     let pyramids = PYRAMIDS.get_or_init(|| {
         (
-            MemoryPyramid::from_gray(pano),
-            MemoryPyramid::from_gray(obl_img),
+            MemoryPyramid::from_gray(&unit_range(pano)),
+            MemoryPyramid::from_gray(&unit_range(obl_img)),
         )
     });
     register_patches(

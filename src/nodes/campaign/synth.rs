@@ -30,10 +30,12 @@ skytie_stages::params! {
         panorama_width_px: u32 = 0, unit "px";
         /// Override of the number of recordings per route (0 = the preset's).
         max_recordings_per_route: usize = 0;
-        /// Override of the nadir camera size, `"WIDTHxHEIGHT"` (empty = the preset's; the footprint is kept).
-        nadir_size_px: String = String::new();
-        /// Override of the oblique camera size, `"WIDTHxHEIGHT"` (empty = the preset's; the footprint is kept).
-        oblique_size_px: String = String::new();
+        /// Override of the nadir camera size, `"WIDTHxHEIGHT"` in pixels (empty = the preset's; the footprint is
+        /// kept).
+        nadir_size: String = String::new();
+        /// Override of the oblique camera size, `"WIDTHxHEIGHT"` in pixels (empty = the preset's; the footprint is
+        /// kept).
+        oblique_size: String = String::new();
         /// Aerial file format: `jpeg` or `tiff` (tiled; empty = the preset's).
         aerial_format: String = String::new();
         /// Compression of tiled TIFF aerial frames: `jpeg`, `lzw`, `deflate` or `none`.
@@ -74,16 +76,13 @@ impl SynthParams {
         if self.max_recordings_per_route != 0 {
             o.max_recordings_per_route = Some(self.max_recordings_per_route);
         }
-        if !self.nadir_size_px.is_empty() {
-            o.sizes.nadir_px = Some(
-                parse_size_px(&self.nadir_size_px)
-                    .map_err(|m| Violation::new("nadir_size_px", m))?,
-            );
+        if !self.nadir_size.is_empty() {
+            o.sizes.nadir_px =
+                Some(parse_size_px(&self.nadir_size).map_err(|m| Violation::new("nadir_size", m))?);
         }
-        if !self.oblique_size_px.is_empty() {
+        if !self.oblique_size.is_empty() {
             o.sizes.oblique_px = Some(
-                parse_size_px(&self.oblique_size_px)
-                    .map_err(|m| Violation::new("oblique_size_px", m))?,
+                parse_size_px(&self.oblique_size).map_err(|m| Violation::new("oblique_size", m))?,
             );
         }
         if !self.aerial_format.is_empty() {

@@ -228,7 +228,8 @@ mod tests {
     #[test]
     fn render_factors_divide_both_sides() {
         assert_eq!(render_factor(26460, 17004, Some(2400)), 12);
-        assert_eq!(render_factor(14192, 10640, Some(2400)), 16);
+        assert_eq!(render_factor(14192, 10640, Some(2400)), 8); // 1774 × 1330
+        assert_eq!(render_factor(14192, 10640, Some(1000)), 16); // 887 × 665
         assert_eq!(render_factor(8192, 4096, Some(2048)), 4);
         assert_eq!(render_factor(1600, 800, Some(2048)), 1);
         assert_eq!(render_factor(1600, 800, None), 1);

@@ -139,9 +139,9 @@ impl Preset {
                 aerial_spp_axis: 2,
                 ..PresetParams::common()
             },
-            // Rendered at 2205 × 1417 (nadir, ÷ 12), 887 × 665 (obliques, ÷ 16) and 2048 × 1024 (panoramas, ÷ 4),
-            // each at ≈ 10 cm on the ground like the demo; the footprints are the rendered images', so the GSD of
-            // the real-size files is 10 cm / 12 and / 16. Twelve recordings: a 55 m street.
+            // Rendered at 2205 × 1417 (nadir, ÷ 12), 1774 × 1330 (obliques, ÷ 8) and 2048 × 1024 (panoramas, ÷ 4),
+            // the aerial images at ≈ 10 cm on the ground like the demo; the footprints are the rendered images', so
+            // the GSD of the real-size files is 10 cm / 12 and / 8. Twelve recordings: a 55 m street.
             Preset::Realsize => PresetParams {
                 panorama_width_px: 8192,
                 panorama_spp_axis: 2,
@@ -151,8 +151,8 @@ impl Preset {
                     ..nadir(26460, 17004)
                 },
                 oblique: ObliquePlan {
-                    gsd_center_m: 0.10 / 16.0,
-                    corner_distortion_px: 2.0 * 16.0,
+                    gsd_center_m: 0.10 / 8.0,
+                    corner_distortion_px: 2.0 * 8.0,
                     ..oblique(14192, 10640)
                 },
                 aerial_spp_axis: 2,

@@ -59,11 +59,12 @@ crate::params! {
         min_valid_fraction: f64 = 0.5, above 0.0, max 1.0;
         /// Largest patch side: a finer theoretical resolution is coarsened to keep patches at most this size.
         max_patch_px: usize = 256, unit "px", min 8, max 4096;
-        /// Coarsest resolution on the façade the patches are made at: an oblique image finer than this (at the
-        /// finest of the node's façade points) is read from the coarsest level of its pyramid whose resolution
-        /// does not exceed it, and the theoretical resolution is that level's (0.12 m: the thesis' 5–15 cm
-        /// obliques are used at full resolution; a 150-megapixel frame at 1.5 cm is read at 12 cm).
-        registration_resolution_m: f64 = 0.12, unit "m", min 0.001, max 10.0;
+        /// Coarsest resolution on the façade the patches are made at: an oblique image more than twice as fine
+        /// as this (at the finest of the node's façade points) is read from the coarsest level of its pyramid
+        /// whose resolution does not exceed it, and the theoretical resolution is that level's (0.10 m: obliques
+        /// coarser than 5 cm on the façade, as in the thesis, are used at full resolution; a 150-megapixel frame
+        /// at 1.5 cm is read at 6 cm).
+        registration_resolution_m: f64 = 0.10, unit "m", min 0.001, max 10.0;
         /// Seed of the MI sampling and the ES; each registration derives its own from it, the point id and the
         /// oblique image id.
         seed: u64 = 0;
