@@ -5,10 +5,11 @@
 //! `.ci/run` runs.
 //!
 //! Which commands run: help and version requests, `workflows`, `init`, `synth --preset tiny`, `cache` without
-//! absolute paths, and `check` / `tool` when every input they name exists in the scratch folder (for example a
-//! campaign an earlier `synth` or `init` line of the same document wrote). The others — `run`, `plan`,
-//! `explain`, `report`, `import`, and anything naming the user's own data — are parse-only: they need a campaign,
-//! vendor files or a finished run that a documentation example cannot provide.
+//! absolute paths, `plan` of a built-in workflow or of a file the document wrote (planning stops before the
+//! campaign phase, so it loads and checks the workflow), and `check` / `tool` when every input they name exists
+//! in the scratch folder (for example a campaign an earlier `synth` or `init` line of the same document wrote).
+//! The others — `run`, `explain`, `report`, `import`, and anything naming the user's own data — are parse-only:
+//! they need a campaign, vendor files or a finished run that a documentation example cannot provide.
 
 use clap::error::ErrorKind;
 use clap::Parser;
@@ -289,10 +290,17 @@ fn run_for_real(c: &DocCommand, dir: &Path) -> Option<&'static [i32]> {
         "workflows" | "init" => Some(&[0]),
         "synth" if args.windows(2).any(|w| w == ["--preset", "tiny"]) => Some(&[0]),
         "cache" => Some(&[0]),
+        // Planning stops before the campaign phase has run, so it only loads and checks the workflow.
+        "plan" if args.len() > 1 && builtin_or_file(args[1], dir) => Some(&[0]),
         "check" if inputs_exist() => Some(&[0, 1]),
         "tool" if inputs_exist() => Some(&[0]),
         _ => None,
     }
+}
+
+/// A built-in workflow's name, or a file that exists in the scratch folder.
+fn builtin_or_file(workflow: &str, dir: &Path) -> bool {
+    skytie::cli::builtin_workflows::names().contains(&workflow) || dir.join(workflow).is_file()
 }
 
 #[test]
@@ -350,24 +358,65 @@ fn links(text: &str) -> Vec<(usize, String)> {
     out
 }
 
+/// The anchors of a Markdown text's headings, as GitHub makes them: lower case, letters, digits, `-` and `_`
+/// kept, spaces turned into `-`, everything else dropped.
+fn anchors(text: &str) -> Vec<String> {
+    let mut in_code = false;
+    let mut out = Vec::new();
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            in_code = !in_code;
+        }
+        let Some(heading) = line.strip_prefix('#').filter(|_| !in_code) else {
+            continue;
+        };
+        let title = heading.trim_start_matches('#').trim();
+        out.push(
+            title
+                .to_lowercase()
+                .chars()
+                .filter_map(|c| match c {
+                    ' ' => Some('-'),
+                    c if c.is_alphanumeric() || c == '-' || c == '_' => Some(c),
+                    _ => None,
+                })
+                .collect(),
+        );
+    }
+    out
+}
+
 #[test]
 fn relative_links_resolve() {
     let mut broken = Vec::new();
     for doc in documents() {
         let text = std::fs::read_to_string(&doc).unwrap();
         for (line, target) in links(&text) {
-            let path = target.split('#').next().unwrap_or("");
-            if path.is_empty() || path.contains("://") || path.starts_with("mailto:") {
+            if target.contains("://") || target.starts_with("mailto:") {
                 continue;
             }
-            if !doc.parent().unwrap().join(path).exists() {
+            let (path, anchor) = target.split_once('#').unwrap_or((&target, ""));
+            let file = if path.is_empty() {
+                doc.clone()
+            } else {
+                doc.parent().unwrap().join(path)
+            };
+            let found = if !file.exists() {
+                false
+            } else if anchor.is_empty() || file.is_dir() {
+                true
+            } else {
+                let linked = std::fs::read_to_string(&file).unwrap_or_default();
+                anchors(&linked).iter().any(|a| a == anchor)
+            };
+            if !found {
                 broken.push(format!("{}:{line}: {target}", rel(&doc)));
             }
         }
     }
     assert!(
         broken.is_empty(),
-        "links to files that do not exist:\n{}",
+        "links to files or headings that do not exist:\n{}",
         broken.join("\n")
     );
 }
@@ -386,19 +435,25 @@ fn user_facing_files() -> Vec<PathBuf> {
     files
 }
 
-#[test]
-fn nothing_refers_to_a_path_outside_the_repository() {
+/// `file:line: text` of every line of the user-facing files for which `bad` holds.
+fn offending_lines(bad: impl Fn(&str) -> bool) -> Vec<String> {
     let mut found = Vec::new();
     for file in user_facing_files() {
         let text = std::fs::read_to_string(&file).unwrap();
-        for (i, line) in text.lines().enumerate() {
-            for needle in ["../shared", "shared/docs/", "shared/reference/", "/work/"] {
-                if line.contains(needle) {
-                    found.push(format!("{}:{}: {}", rel(&file), i + 1, line.trim()));
-                }
-            }
+        for (i, line) in text.lines().enumerate().filter(|(_, l)| bad(l)) {
+            found.push(format!("{}:{}: {}", rel(&file), i + 1, line.trim()));
         }
     }
+    found
+}
+
+#[test]
+fn nothing_refers_to_a_path_outside_the_repository() {
+    let found = offending_lines(|line| {
+        ["../shared", "shared/docs/", "shared/reference/", "/work/"]
+            .iter()
+            .any(|needle| line.contains(needle))
+    });
     assert!(
         found.is_empty(),
         "paths outside the repository:\n{}",
@@ -437,34 +492,31 @@ fn has_bare_date(line: &str) -> bool {
     })
 }
 
+/// Whether a line speaks of the project's history: an issue number, a session, a to-do, a dated finding.
+fn is_history(line: &str) -> bool {
+    let p = prose(line);
+    let words: Vec<&str> = p
+        .split(|c: char| !c.is_alphanumeric() && c != '#')
+        .filter(|w| !w.is_empty())
+        .collect();
+    let number = |w: &str| {
+        w.trim_start_matches('#')
+            .starts_with(|c: char| c.is_ascii_digit())
+    };
+    let issue_ref = words.windows(2).any(|w| w[0] == "issue" && number(w[1]))
+        || words
+            .iter()
+            .any(|w| w.starts_with('#') && w[1..].parse::<u32>().is_ok());
+    let process = words
+        .iter()
+        .any(|w| matches!(*w, "session" | "todo" | "fixme"))
+        || p.contains("known failing");
+    issue_ref || process || has_bare_date(line)
+}
+
 #[test]
 fn user_documents_carry_no_development_history() {
-    let mut found = Vec::new();
-    for file in user_facing_files() {
-        let text = std::fs::read_to_string(&file).unwrap();
-        for (i, line) in text.lines().enumerate() {
-            let p = prose(line);
-            let words: Vec<&str> = p
-                .split(|c: char| !c.is_alphanumeric() && c != '#')
-                .filter(|w| !w.is_empty())
-                .collect();
-            let issue_ref = words.windows(2).any(|w| {
-                w[0] == "issue"
-                    && w[1]
-                        .trim_start_matches('#')
-                        .starts_with(|c: char| c.is_ascii_digit())
-            }) || words
-                .iter()
-                .any(|w| w.starts_with('#') && w[1..].parse::<u32>().is_ok());
-            let process = words
-                .iter()
-                .any(|w| matches!(*w, "session" | "todo" | "fixme"))
-                || p.contains("known failing");
-            if issue_ref || process || has_bare_date(line) {
-                found.push(format!("{}:{}: {}", rel(&file), i + 1, line.trim()));
-            }
-        }
-    }
+    let found = offending_lines(is_history);
     assert!(
         found.is_empty(),
         "development history belongs in commit messages, not in user documents:\n{}",
@@ -521,4 +573,13 @@ fn the_extraction_knows_the_shell_forms() {
     assert!(has_bare_date("measured 2026-11-24 on"));
     assert!(!has_bare_date("time 2019-06-14T10:31:07Z"));
     assert!(!has_bare_date("EPSG:28992+5709"));
+    assert!(is_history("as issue 6 (b) asked"));
+    assert!(is_history("fixed in this session"));
+    assert!(is_history("measured 2026-11-24"));
+    assert!(!is_history("`Session` (staged phases), `Pipeline`"));
+    assert!(!is_history("see [cli.md](cli.md#exit-codes) and ## Sweeps"));
+    assert_eq!(
+        anchors("# A\n## `skytie plan` — what would run, and why\n```\n# not a heading\n```\n### Façades 4.4.2"),
+        ["a", "skytie-plan--what-would-run-and-why", "façades-442"]
+    );
 }
