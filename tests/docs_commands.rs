@@ -4,7 +4,7 @@
 //! relative link resolves; nothing names a path outside the repository; the README's test command is the one
 //! `.ci/run` runs.
 //!
-//! Which commands run: help and version requests, `workflows`, `init`, `synth --preset tiny`, `cache` without
+//! Which commands run: help and version requests, `workflows`, `params`, `init`, `synth --preset tiny`, `cache` without
 //! absolute paths, `plan` of a built-in workflow or of a file the document wrote (planning stops before the
 //! campaign phase, so it loads and checks the workflow), and `check` / `tool` when every input they name exists
 //! in the scratch folder (for example a campaign an earlier `synth` or `init` line of the same document wrote).
@@ -287,7 +287,7 @@ fn run_for_real(c: &DocCommand, dir: &Path) -> Option<&'static [i32]> {
         ok
     };
     match args[0] {
-        "workflows" | "init" => Some(&[0]),
+        "workflows" | "init" | "params" => Some(&[0]),
         "synth" if args.windows(2).any(|w| w == ["--preset", "tiny"]) => Some(&[0]),
         "cache" => Some(&[0]),
         // Planning stops before the campaign phase has run, so it only loads and checks the workflow.
