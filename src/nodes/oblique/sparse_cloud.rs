@@ -3,12 +3,11 @@
 //! outlier removal, triangulation in the original equirectangular geometry. Inputs: the three recording rows
 //! and panorama files (hashed by content).
 
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RunResult, Stage, StageError};
 use crate::nodes::campaign::decoded_images;
 use skytie_stages::campaign::Recording;
 use skytie_stages::oblique::sparse_cloud::{sparse_cloud, SparseCloudParams};
 use skytie_stages::oblique::SparseCloud;
-use std::sync::Arc;
 
 crate::serde_artifact!(SparseCloud);
 
@@ -16,18 +15,11 @@ crate::serde_artifact!(SparseCloud);
 pub struct SparseCloudStage;
 
 impl Stage for SparseCloudStage {
-    const NAME: &'static str = skytie_stages::oblique::sparse_cloud::STAGE.name;
-    const VERSION: &'static str = skytie_stages::oblique::sparse_cloud::STAGE.version;
-    type Params = SparseCloudParams;
-    type Output = SparseCloud;
+    crate::nodes::stage_types!(skytie_stages::oblique::sparse_cloud::STAGE, SparseCloudParams => SparseCloud);
     type Inputs = (Vec<Handle<Recording>>, Vec<RawFile>);
 
-    fn run(
-        &self,
-        p: &SparseCloudParams,
-        (recs, panos): (Vec<Arc<Recording>>, Vec<RawFileValue>),
-        _: &NodeCtx,
-    ) -> Result<SparseCloud, StageError> {
+    fn run(&self, p: &SparseCloudParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (recs, panos) = inputs;
         if recs.len() != 3 || panos.len() != 3 {
             return Err(StageError::new(
                 "internal: sparse_cloud needs exactly three recordings and panoramas",
