@@ -4,7 +4,7 @@
 mod support;
 
 use nalgebra::Vector3;
-use skytie_stages::campaign::{AerialImage, Recording};
+use skytie_stages::campaign::Recording;
 use skytie_stages::correspondence::{MmTiePoint, PanoObservation};
 use skytie_stages::geometry::FrameCamera;
 use skytie_stages::oblique::consensus::{
