@@ -2,7 +2,7 @@
 //! registration set, optional consensus tracking, and the oblique control points (thesis 4.4.7,
 //! `skytie_stages::oblique::consensus`), with the pipeline's own counts (`oblique.*` metrics that need no truth).
 
-use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RawFile, RunResult, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RawFile, RunResult, Stage};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::panorama_sizes::pano_sizes;
 use serde::{Deserialize, Serialize};

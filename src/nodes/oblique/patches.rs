@@ -3,7 +3,7 @@
 //! image that the visibility hypothesis did not accept for any plane gives an empty set. The sparse clouds
 //! are the same list as the `facades` node's (the triplet's own first, then its neighbours).
 
-use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RunResult, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RunResult, Stage};
 use crate::nodes::campaign::decoded_images;
 use crate::nodes::oblique::facades::neighbourhood_cloud;
 use skytie_stages::campaign::{AerialImage, Recording};
