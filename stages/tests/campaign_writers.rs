@@ -164,7 +164,7 @@ fn other_tables_and_toml_have_documented_columns() {
         file: "n1.png".into(),
         ..AerialImage::ideal("n,1", [1.5, 2.5, 500.0], [0.0; 3], 1000.0, [100, 80])
     };
-    write_aerial_cameras_csv(&d.join("nadir.csv"), &[a.clone()]).unwrap();
+    write_aerial_cameras_csv(&d.join("nadir.csv"), std::slice::from_ref(&a)).unwrap();
     assert_eq!(
         std::fs::read_to_string(d.join("nadir.csv")).unwrap(),
         "image_id,file,x,y,z,omega,phi,kappa,focal_px,cx,cy,width,height\n\"n,1\",n1.png,1.5,2.5,500,0,0,0,1000,50,40,100,80\n"

@@ -3,7 +3,7 @@
 //! true poses, check points and their observations, written in the campaign format
 //! (shared/docs/campaign-format.md). It is skytie's embedded default data and the judge of every stage.
 //!
-//! Entry points: [`generate`] / [`generate_preset`]; the pieces ([`render`], [`aerial_plan`], [`trajectory`],
+//! Entry points: [`generate`](mod@generate) / [`generate_preset`]; the pieces ([`render`], [`aerial_plan`], [`trajectory`],
 //! [`deteriorate`], [`control`], [`postprocess`], [`vehicle`]) are public for tests and benchmarks.
 
 pub mod noise;
