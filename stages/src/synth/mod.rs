@@ -1,7 +1,7 @@
 //! The synthetic urban campaign: a procedural street scene (by "scene": [`scene`], [`noise`], [`texture`])
 //! rendered into mobile-mapping panoramas and aerial nadir/oblique frames, with deteriorated recorded positions,
 //! true poses, check points and their observations, written in the campaign format
-//! (shared/docs/campaign-format.md). It is skytie's embedded default data and the judge of every stage.
+//! (docs/campaign-format.md). It is skytie's embedded default data and the judge of every stage.
 //!
 //! Entry points: [`generate`](mod@generate) / [`generate_preset`]; the pieces ([`render`], [`aerial_plan`], [`trajectory`],
 //! [`deteriorate`], [`control`], [`postprocess`], [`vehicle`]) are public for tests and benchmarks.
