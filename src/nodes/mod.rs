@@ -34,4 +34,4 @@ pub use campaign::{
 };
 pub use ortho::OrthoProject;
 pub use summary::{CampaignSummary, SummarizeCampaign, SummaryParams};
-pub use synth::{GeneratedCampaign, SynthCampaign, SynthParams};
+pub use synth::{GeneratedCampaign, RenderCampaign, SynthCampaign, SynthParams};

@@ -1,40 +1,69 @@
-//! `synth`: the synthetic campaign generator as a cached node (`campaign = "synth:<preset>"` in a workflow).
+//! The synthetic campaign generator as two cached nodes (`campaign = "synth:<preset>"` in a workflow):
+//! `render` renders the error-free campaign of a preset and seed (the images depend only on the render
+//! identity: preset, seed, size overrides and the `lens`/`epoch` profile components), and `synth` applies the
+//! error profile of the `[synth]` table to it, writing new tables and hard-linking the images. So a workflow or
+//! an evaluation that runs one scene under several table-only profiles renders it once.
 //!
-//! The node writes the whole campaign folder into its own cache folder (`<cache>/dirs/<key>/campaign`), so a
-//! second run — or any workflow naming the same preset, seed and options — reuses it. Finished images are kept
-//! in the node's partial folder (`<cache>/dirs/.partial-<key>`) until the campaign is complete, so an interrupted
-//! generation resumes (`skytie_stages::synth::render_store`). The output records every file's size; a cached
-//! folder whose files went missing or changed size is regenerated.
+//! Each node writes its folder into its own cache folder (`<cache>/dirs/<key>/campaign`), so a second run — or
+//! any workflow naming the same options — reuses it. Finished images are kept in the render node's partial
+//! folder (`<cache>/dirs/.partial-<key>`) until the rendering is complete, so an interrupted generation resumes
+//! (`skytie_stages::synth::render_store`). The outputs record every file's size; a cached folder whose files
+//! went missing or changed size is regenerated.
 
-use crate::dag::{NodeCtx, Stage, StageError};
+use crate::dag::{Handle, NodeCtx, Stage, StageError};
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
-use skytie_stages::synth::{generate_resumable, Deterioration, Preset, SynthOptions, SynthSummary};
+use skytie_stages::synth::generate::RenderIdentity;
+use skytie_stages::synth::profile::{
+    AerialEoParams, ComponentParams, EpochParams, InsParams, LensParams, OutageParams,
+    ThesisParams, VerticalParams,
+};
+use skytie_stages::synth::{
+    apply_profile, render_campaign, Preset, Profile, SynthOptions, SynthSummary,
+};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
-/// Parameters of the `[synth]` workflow table (preset and seed come from `campaign = "synth:<preset>"` and `seed`).
+/// Parameters of the `[synth]` workflow table (preset and seed come from `campaign = "synth:<preset>"` and
+/// `seed`); the component tables `[synth.outage]`, `[synth.ins]`, … override a component's defaults.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SynthParams {
     /// `tiny`, `demo` or `paper`.
     pub preset: String,
     pub seed: u64,
-    /// Recorded-position deterioration: `thesis` (0.80 m systematic + N(0, 0.10 m), thesis 3.5.1.2) or `none`.
-    pub deterioration: String,
+    /// Error profile: components joined by `+` (`thesis`, `outage`, `ins`, `vertical`, `aerial`, `lens`,
+    /// `lens-unknown`, `epoch`), or `none`, or `all`; see docs/error-profiles.md.
+    pub profile: String,
     /// Override of the panorama width in pixels (even; 0 = the preset's).
     pub panorama_width_px: u32,
     /// Override of the number of recordings per route (0 = the preset's).
     pub max_recordings_per_route: usize,
+    pub thesis: ThesisParams,
+    pub outage: OutageParams,
+    pub ins: InsParams,
+    pub vertical: VerticalParams,
+    pub aerial: AerialEoParams,
+    pub lens: LensParams,
+    pub epoch: EpochParams,
 }
 
 impl Default for SynthParams {
     fn default() -> Self {
+        let c = ComponentParams::default();
         Self {
             preset: "demo".into(),
             seed: 1,
-            deterioration: "thesis".into(),
+            profile: "thesis".into(),
             panorama_width_px: 0,
             max_recordings_per_route: 0,
+            thesis: c.thesis,
+            outage: c.outage,
+            ins: c.ins,
+            vertical: c.vertical,
+            aerial: c.aerial,
+            lens: c.lens,
+            epoch: c.epoch,
         }
     }
 }
@@ -44,15 +73,17 @@ impl SynthParams {
     pub fn options(&self) -> Result<SynthOptions, String> {
         let preset = Preset::from_name(&self.preset).map_err(|e| e.to_string())?;
         let mut o = SynthOptions::new(preset, self.seed);
-        o.deterioration = match self.deterioration.as_str() {
-            "thesis" => Deterioration::Thesis,
-            "none" => Deterioration::None,
-            other => {
-                return Err(format!(
-                    "unknown deterioration '{other}': use \"thesis\" or \"none\""
-                ))
-            }
+        let mut profile = Profile::parse(&self.profile).map_err(|e| e.to_string())?;
+        profile.params = ComponentParams {
+            thesis: self.thesis.clone(),
+            outage: self.outage.clone(),
+            ins: self.ins.clone(),
+            vertical: self.vertical.clone(),
+            aerial: self.aerial.clone(),
+            lens: self.lens.clone(),
+            epoch: self.epoch.clone(),
         };
+        o.profile = profile;
         if self.panorama_width_px != 0 {
             o.panorama_width_px = Some(self.panorama_width_px);
         }
@@ -66,9 +97,19 @@ impl SynthParams {
 
 impl StageParams for SynthParams {
     fn validate(&self) -> Result<(), Vec<ParamError>> {
-        match self.options() {
-            Ok(_) => Ok(()),
-            Err(m) => Err(vec![ParamError::new("synth", m)]),
+        let problems: Vec<ParamError> = match self.options() {
+            Ok(o) => o
+                .profile
+                .problems()
+                .into_iter()
+                .map(|(field, message)| ParamError::new(&field, message))
+                .collect(),
+            Err(m) => vec![ParamError::new("profile", m)],
+        };
+        if problems.is_empty() {
+            Ok(())
+        } else {
+            Err(problems)
         }
     }
 }
@@ -87,6 +128,24 @@ crate::serde_artifact!(GeneratedCampaign);
 impl GeneratedCampaign {
     pub fn path(&self) -> PathBuf {
         PathBuf::from(&self.dir)
+    }
+
+    /// The campaign as written into `tmp` (the node's temporary folder) and recorded at `ctx`'s final folder.
+    fn record(tmp: &Path, ctx: &NodeCtx, summary: SynthSummary) -> Result<Self, StageError> {
+        Ok(GeneratedCampaign {
+            dir: ctx
+                .output_dir()
+                .join("campaign")
+                .to_string_lossy()
+                .into_owned(),
+            files: list_files(&tmp.join("campaign"))?,
+            summary,
+        })
+    }
+
+    /// Whether the folder still holds exactly the recorded files (by size).
+    fn intact(&self) -> bool {
+        list_files(&self.path()).is_ok_and(|files| files == self.files)
     }
 }
 
@@ -117,46 +176,78 @@ pub fn list_files(root: &Path) -> std::io::Result<Vec<(String, u64)>> {
     Ok(out)
 }
 
-/// The generator node.
-pub struct SynthCampaign;
+/// The render node: the error-free campaign of a render identity.
+pub struct RenderCampaign;
 
-impl Stage for SynthCampaign {
-    const NAME: &'static str = "synth";
+impl Stage for RenderCampaign {
+    const NAME: &'static str = "render";
     const VERSION: &'static str = "1";
-    type Params = SynthParams;
+    type Params = RenderIdentity;
     type Output = GeneratedCampaign;
     type Inputs = ();
 
-    fn run(&self, p: &SynthParams, _: (), ctx: &NodeCtx) -> Result<GeneratedCampaign, StageError> {
-        let options = p.options().map_err(StageError::new)?;
+    fn run(
+        &self,
+        identity: &RenderIdentity,
+        _: (),
+        ctx: &NodeCtx,
+    ) -> Result<GeneratedCampaign, StageError> {
+        let options = SynthOptions::rendering(identity);
         let tmp = ctx.output_dir_tmp()?;
-        let (summary, reused) =
-            generate_resumable(&options, &tmp.join("campaign"), &ctx.partial_dir()).map_err(|e| {
+        let (summary, reused) = render_campaign(&options, &tmp.join("campaign"), &ctx.partial_dir())
+            .map_err(|e| {
                 StageError::new(format!(
-                    "synthetic campaign generation failed: {e} (the images rendered so far are kept in {}; \
+                    "synthetic campaign rendering failed: {e} (the images rendered so far are kept in {}; \
                      the next run resumes from them)",
                     ctx.partial_dir().display()
                 ))
             })?;
         if reused > 0 {
             eprintln!(
-                "synth: resumed an interrupted generation: {reused} images taken from {}",
+                "render: resumed an interrupted rendering: {reused} images taken from {}",
                 ctx.partial_dir().display()
             );
         }
-        let files = list_files(&tmp.join("campaign"))?;
-        let dir = ctx.output_dir().join("campaign");
-        Ok(GeneratedCampaign {
-            dir: dir.to_string_lossy().into_owned(),
-            files,
-            summary,
-        })
+        GeneratedCampaign::record(&tmp, ctx, summary)
     }
 
     fn cached_output_ok(&self, out: &GeneratedCampaign, _ctx: &NodeCtx) -> bool {
-        match list_files(&out.path()) {
-            Ok(files) => files == out.files,
-            Err(_) => false,
-        }
+        out.intact()
+    }
+}
+
+/// The generator node: the rendered campaign with the `[synth]` error profile applied.
+pub struct SynthCampaign;
+
+impl Stage for SynthCampaign {
+    const NAME: &'static str = "synth";
+    const VERSION: &'static str = "2";
+    type Params = SynthParams;
+    type Output = GeneratedCampaign;
+    type Inputs = Handle<GeneratedCampaign>;
+
+    fn run(
+        &self,
+        p: &SynthParams,
+        rendered: Arc<GeneratedCampaign>,
+        ctx: &NodeCtx,
+    ) -> Result<GeneratedCampaign, StageError> {
+        let options = p.options().map_err(StageError::new)?;
+        let tmp = ctx.output_dir_tmp()?;
+        apply_profile(&rendered.path(), &options, &tmp.join("campaign")).map_err(|e| {
+            StageError::new(format!(
+                "applying the error profile '{}' failed: {e}",
+                options.profile.name()
+            ))
+        })?;
+        let summary = SynthSummary {
+            name: options.campaign_name(),
+            ..rendered.summary.clone()
+        };
+        GeneratedCampaign::record(&tmp, ctx, summary)
+    }
+
+    fn cached_output_ok(&self, out: &GeneratedCampaign, _ctx: &NodeCtx) -> bool {
+        out.intact()
     }
 }

@@ -15,8 +15,9 @@ use crate::dag::{DagBuilder, Pipeline, PipelineError, RawFile, Session};
 use crate::exports::{verification_table, write_exports, ExportInputs};
 use crate::nodes::campaign::{listing_hash, metadata_inputs};
 use crate::nodes::{
-    CampaignSummary, LoadCampaign, LoadCampaignParams, OrthoProject, SelectRecording,
-    SelectRecordingParams, SummarizeCampaign, SummaryParams, SynthCampaign, SynthParams,
+    CampaignSummary, LoadCampaign, LoadCampaignParams, OrthoProject, RenderCampaign,
+    SelectRecording, SelectRecordingParams, SummarizeCampaign, SummaryParams, SynthCampaign,
+    SynthParams,
 };
 use crate::workflow::{CampaignSource, Workflow};
 use skytie_stages::nadir::OrthoParams;
@@ -80,8 +81,10 @@ impl Pipeline for SkytiePipeline {
                 let mut params: SynthParams = wf.params("synth", "default").map_err(wf_err)?;
                 params.preset = preset.clone();
                 params.seed = *seed;
+                let options = params.options().map_err(PipelineError::Workflow)?;
                 let mut b = DagBuilder::new();
-                let h = b.add(SynthCampaign, preset, params, ())?;
+                let rendered = b.add(RenderCampaign, preset, options.render_identity(), ())?;
+                let h = b.add(SynthCampaign, preset, params, rendered)?;
                 b.request(h);
                 let values = session.execute("campaign", b.build());
                 values.require(h, "the synthetic campaign")?.path()

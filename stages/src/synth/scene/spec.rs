@@ -6,6 +6,8 @@
 //! rotation by `street_heading_deg` about Z plus the offset `origin_world` (so no street is gifted as
 //! being grid-aligned).
 
+use super::epoch_changes::EpochChangeSpec;
+
 /// Sun position: azimuth clockwise from grid north, elevation above the horizon.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SunSpec {
@@ -125,6 +127,8 @@ pub struct SceneSpec {
     pub route: RouteSpec,
     pub sun_mobile_mapping: SunSpec,
     pub sun_aerial: SunSpec,
+    /// Differences between the epochs beyond sun and cars (markings, roadworks, grown crowns); `None` = none.
+    pub changes: Option<EpochChangeSpec>,
 }
 
 impl SceneSpec {
@@ -210,6 +214,7 @@ impl SceneSpec {
                 azimuth_deg: 205.0,
                 elevation_deg: 47.0,
             },
+            changes: None,
         }
     }
 
