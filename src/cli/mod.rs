@@ -8,6 +8,7 @@
 pub mod cache;
 pub mod check;
 pub mod common;
+pub mod eval;
 pub mod explain;
 pub mod plan;
 pub mod report;
@@ -46,6 +47,8 @@ pub enum Command {
     Synth(synth::SynthArgs),
     /// Validate a campaign folder and list every problem.
     Check(check::CheckArgs),
+    /// Held-out evaluation: presets × error profiles × seeds, one table, compared with a baseline.
+    Eval(eval::EvalArgs),
     /// Building blocks on plain files (ortho, kaze, forstner, wallis, phasecorr, ncc), CSV/plain output.
     #[command(subcommand)]
     Tool(tool::ToolCommand),
@@ -62,6 +65,7 @@ pub fn main() -> i32 {
         Command::Cache(a) => cache::main(a),
         Command::Synth(a) => synth::main(a),
         Command::Check(a) => check::main(a),
+        Command::Eval(a) => eval::main(a),
         Command::Tool(t) => tool::main(t),
     }
 }

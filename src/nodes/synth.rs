@@ -181,7 +181,8 @@ pub struct RenderCampaign;
 
 impl Stage for RenderCampaign {
     const NAME: &'static str = "render";
-    const VERSION: &'static str = "1";
+    /// Bump whenever the generator renders differently (scenes, presets, cameras, looks).
+    const VERSION: &'static str = "2";
     type Params = RenderIdentity;
     type Output = GeneratedCampaign;
     type Inputs = ();

@@ -104,6 +104,8 @@ impl Preset {
         match self {
             Preset::Tiny => PresetParams {
                 panorama_width_px: 1024,
+                // Three check points along the 25 m route instead of one.
+                checkpoint_spacing_m: 8.0,
                 panorama_spp_axis: 2,
                 max_recordings_per_route: 6,
                 nadir: nadir(512, 384),

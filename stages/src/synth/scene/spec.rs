@@ -132,11 +132,18 @@ pub struct SceneSpec {
 }
 
 impl SceneSpec {
-    /// About 30 m of straight street, one block on each side, no junction: fast tests.
+    /// About 45 m of straight street ending at a T-junction, one block on each side: fast tests. The route
+    /// (six panoramas) sees the junction approach's zebra crossing, stop line and arrow as well as dashes and
+    /// manholes, so the nadir chain has road markings to register.
     pub fn tiny() -> Self {
         Self {
-            street_length_m: 30.0,
-            cross_street: None,
+            street_length_m: 45.0,
+            cross_street: Some(CrossStreetSpec {
+                at_x_m: 38.0,
+                half_width_m: 4.0,
+                extent_right_m: 0.0,
+                extent_left_m: 20.0,
+            }),
             manhole_spacing_m: 12.0,
             setback_m: [1.0, 1.0],
             building_width_m: [26.0, 26.0],
@@ -144,12 +151,12 @@ impl SceneSpec {
             tree_spacing_m: 14.0,
             buildings_on_cross_street: false,
             route: RouteSpec {
-                start_x_m: 2.0,
+                start_x_m: 8.0,
                 lane_offset_m: 1.5,
                 turn_right: false,
                 turn_radius_m: 6.0,
                 length_after_junction_m: 0.0,
-                end_x_m: 28.0,
+                end_x_m: 36.0,
             },
             ..Self::demo()
         }
