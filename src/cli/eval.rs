@@ -45,7 +45,10 @@ pub struct EvalArgs {
 }
 
 /// Run (or only grade) every selected cell; the rows of the table input.
-fn run_cells(a: &EvalArgs, matrix: &Matrix) -> Result<Vec<(String, u64, Option<crate::eval::CellMetrics>)>, String> {
+fn run_cells(
+    a: &EvalArgs,
+    matrix: &Matrix,
+) -> Result<Vec<(String, u64, Option<crate::eval::CellMetrics>)>, String> {
     let dir = a.matrix.parent().unwrap_or(Path::new("."));
     let cells = matrix.cells(dir, &a.presets, &a.profiles, a.seeds);
     if cells.is_empty() {
@@ -61,7 +64,12 @@ fn run_cells(a: &EvalArgs, matrix: &Matrix) -> Result<Vec<(String, u64, Option<c
             match run_cell(&exe, cell, &a.out, &a.cache)? {
                 CellRun::Done(out) => Some(out),
                 CellRun::Failed(why) => {
-                    eprintln!("[{}/{}] {}: run failed: {why}", i + 1, cells.len(), cell.label());
+                    eprintln!(
+                        "[{}/{}] {}: run failed: {why}",
+                        i + 1,
+                        cells.len(),
+                        cell.label()
+                    );
                     None
                 }
             }
@@ -69,7 +77,12 @@ fn run_cells(a: &EvalArgs, matrix: &Matrix) -> Result<Vec<(String, u64, Option<c
         let metrics = match out.map(|o| grade_cell(&o)) {
             Some(Ok(m)) => Some(m),
             Some(Err(e)) => {
-                eprintln!("[{}/{}] {}: cannot grade: {e}", i + 1, cells.len(), cell.label());
+                eprintln!(
+                    "[{}/{}] {}: cannot grade: {e}",
+                    i + 1,
+                    cells.len(),
+                    cell.label()
+                );
                 None
             }
             None => None,
@@ -83,7 +96,11 @@ fn run_cells(a: &EvalArgs, matrix: &Matrix) -> Result<Vec<(String, u64, Option<c
                 start.elapsed().as_secs_f64()
             );
         }
-        rows.push((format!("{}/{}", cell.preset, cell.profile), cell.seed, metrics));
+        rows.push((
+            format!("{}/{}", cell.preset, cell.profile),
+            cell.seed,
+            metrics,
+        ));
     }
     Ok(rows)
 }
@@ -93,7 +110,8 @@ fn write(path: &Path, text: &str) -> Result<(), String> {
     if let Some(d) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(d).map_err(|e| format!("{}: {e}", d.display()))?;
     }
-    skytie_stages::fsutil::atomic_write(path, text.as_bytes()).map_err(|e| format!("{}: {e}", path.display()))
+    skytie_stages::fsutil::atomic_write(path, text.as_bytes())
+        .map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// The command line that made the table (for the baseline and the docs).
@@ -106,7 +124,8 @@ fn command_line() -> String {
 /// Compare `table` with the baseline file; prints the findings, returns whether any regressed.
 fn guard(path: &Path, table: &Table) -> Result<bool, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let base: Baseline = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let base: Baseline =
+        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
     let findings = compare(&base.table, table);
     let regressions = findings.iter().filter(|f| f.regression).count();
     for f in &findings {

@@ -34,7 +34,14 @@ fn worsening(old: f64, new: f64, better: Better) -> f64 {
 }
 
 /// Compare one metric of one row.
-fn compare_metric(row: &str, title: &str, better: Better, floor: f64, old: &Summary, new: &Summary) -> Vec<Finding> {
+fn compare_metric(
+    row: &str,
+    title: &str,
+    better: Better,
+    floor: f64,
+    old: &Summary,
+    new: &Summary,
+) -> Vec<Finding> {
     let mut out = Vec::new();
     let band_mean = floor.max(old.sd / (old.n.max(1) as f64).sqrt());
     let band_worst = floor.max(old.sd);
@@ -81,7 +88,9 @@ pub fn compare(baseline: &Table, new: &Table) -> Vec<Finding> {
         }
         for d in METRICS.iter().filter(|d| d.better != Better::Shown) {
             match (old.metrics.get(d.key), row.metrics.get(d.key)) {
-                (Some(o), Some(n)) => out.extend(compare_metric(key, d.title, d.better, d.floor, o, n)),
+                (Some(o), Some(n)) => {
+                    out.extend(compare_metric(key, d.title, d.better, d.floor, o, n))
+                }
                 (Some(_), None) => out.push(Finding {
                     row: key.clone(),
                     what: format!("{} missing (the baseline has it)", d.title),
@@ -101,7 +110,12 @@ mod tests {
     use std::collections::BTreeMap;
 
     fn row(inl: (f64, f64, f64), cp: (f64, f64, f64)) -> Row {
-        let s = |(mean, worst, sd): (f64, f64, f64)| Summary { mean, worst, sd, n: 4 };
+        let s = |(mean, worst, sd): (f64, f64, f64)| Summary {
+            mean,
+            worst,
+            sd,
+            n: 4,
+        };
         Row {
             seeds: vec![1, 2, 3, 4],
             failed: 0,
@@ -114,16 +128,36 @@ mod tests {
 
     #[test]
     fn worse_beyond_the_band_fails_and_within_it_passes() {
-        let base = Table::from([("demo/thesis".into(), row((0.98, 0.95, 0.02), (0.05, 0.08, 0.02)))]);
+        let base = Table::from([(
+            "demo/thesis".into(),
+            row((0.98, 0.95, 0.02), (0.05, 0.08, 0.02)),
+        )]);
         // Within the bands: mean band max(0.005, 0.02/2) = 0.01, worst band 0.02.
-        let same = Table::from([("demo/thesis".into(), row((0.975, 0.94, 0.02), (0.058, 0.095, 0.02)))]);
-        assert!(compare(&base, &same).iter().all(|f| !f.regression), "{:?}", compare(&base, &same));
+        let same = Table::from([(
+            "demo/thesis".into(),
+            row((0.975, 0.94, 0.02), (0.058, 0.095, 0.02)),
+        )]);
+        assert!(
+            compare(&base, &same).iter().all(|f| !f.regression),
+            "{:?}",
+            compare(&base, &same)
+        );
         // Check points 2 cm worse on average: beyond the 1 cm band.
-        let worse = Table::from([("demo/thesis".into(), row((0.98, 0.95, 0.02), (0.07, 0.08, 0.02)))]);
+        let worse = Table::from([(
+            "demo/thesis".into(),
+            row((0.98, 0.95, 0.02), (0.07, 0.08, 0.02)),
+        )]);
         let f = compare(&base, &worse);
-        assert!(f.iter().any(|f| f.regression && f.what.contains("cp 2D after mean")), "{f:?}");
+        assert!(
+            f.iter()
+                .any(|f| f.regression && f.what.contains("cp 2D after mean")),
+            "{f:?}"
+        );
         // Better is reported, not failed; a lost metric and failed runs fail.
-        let better = Table::from([("demo/thesis".into(), row((0.99, 0.97, 0.01), (0.03, 0.04, 0.01)))]);
+        let better = Table::from([(
+            "demo/thesis".into(),
+            row((0.99, 0.97, 0.01), (0.03, 0.04, 0.01)),
+        )]);
         assert!(compare(&base, &better).iter().all(|f| !f.regression));
         let mut lost = row((0.98, 0.95, 0.02), (0.05, 0.08, 0.02));
         lost.metrics.remove("cp_2d_after");

@@ -35,21 +35,96 @@ pub const SEGMENT_GOOD_M: f64 = 0.2;
 
 /// Every metric, in table order.
 pub const METRICS: [MetricDef; 15] = [
-    MetricDef { key: "nadir_inlier", title: "nadir inlier", better: Better::Higher, floor: 0.005 },
-    MetricDef { key: "nadir_registered", title: "rec. w/ aerial", better: Better::Higher, floor: 0.03 },
-    MetricDef { key: "oblique_inlier", title: "obl. inlier", better: Better::Higher, floor: 0.01 },
-    MetricDef { key: "oblique_inlier_nm", title: "obl. inl. +nm", better: Better::Higher, floor: 0.01 },
-    MetricDef { key: "rec_2d_before", title: "rec 2D before", better: Better::Shown, floor: 0.0 },
-    MetricDef { key: "rec_2d_after", title: "rec 2D after", better: Better::Lower, floor: 0.005 },
-    MetricDef { key: "rec_3d_after", title: "rec 3D after", better: Better::Lower, floor: 0.01 },
-    MetricDef { key: "rec_max_2d_after", title: "rec max 2D", better: Better::Lower, floor: 0.01 },
-    MetricDef { key: "cp_2d_before", title: "cp 2D before", better: Better::Shown, floor: 0.0 },
-    MetricDef { key: "cp_2d_after", title: "cp 2D after", better: Better::Lower, floor: 0.005 },
-    MetricDef { key: "cp_3d_after", title: "cp 3D after", better: Better::Lower, floor: 0.01 },
-    MetricDef { key: "cp_max_2d_after", title: "cp max 2D", better: Better::Lower, floor: 0.01 },
-    MetricDef { key: "segments_off", title: "seg. off", better: Better::Shown, floor: 0.0 },
-    MetricDef { key: "verify_detected", title: "off flagged", better: Better::Higher, floor: 0.001 },
-    MetricDef { key: "verify_false", title: "false flags", better: Better::Lower, floor: 0.0 },
+    MetricDef {
+        key: "nadir_inlier",
+        title: "nadir inlier",
+        better: Better::Higher,
+        floor: 0.005,
+    },
+    MetricDef {
+        key: "nadir_registered",
+        title: "rec. w/ aerial",
+        better: Better::Higher,
+        floor: 0.03,
+    },
+    MetricDef {
+        key: "oblique_inlier",
+        title: "obl. inlier",
+        better: Better::Higher,
+        floor: 0.01,
+    },
+    MetricDef {
+        key: "oblique_inlier_nm",
+        title: "obl. inl. +nm",
+        better: Better::Higher,
+        floor: 0.01,
+    },
+    MetricDef {
+        key: "rec_2d_before",
+        title: "rec 2D before",
+        better: Better::Shown,
+        floor: 0.0,
+    },
+    MetricDef {
+        key: "rec_2d_after",
+        title: "rec 2D after",
+        better: Better::Lower,
+        floor: 0.005,
+    },
+    MetricDef {
+        key: "rec_3d_after",
+        title: "rec 3D after",
+        better: Better::Lower,
+        floor: 0.01,
+    },
+    MetricDef {
+        key: "rec_max_2d_after",
+        title: "rec max 2D",
+        better: Better::Lower,
+        floor: 0.01,
+    },
+    MetricDef {
+        key: "cp_2d_before",
+        title: "cp 2D before",
+        better: Better::Shown,
+        floor: 0.0,
+    },
+    MetricDef {
+        key: "cp_2d_after",
+        title: "cp 2D after",
+        better: Better::Lower,
+        floor: 0.005,
+    },
+    MetricDef {
+        key: "cp_3d_after",
+        title: "cp 3D after",
+        better: Better::Lower,
+        floor: 0.01,
+    },
+    MetricDef {
+        key: "cp_max_2d_after",
+        title: "cp max 2D",
+        better: Better::Lower,
+        floor: 0.01,
+    },
+    MetricDef {
+        key: "segments_off",
+        title: "seg. off",
+        better: Better::Shown,
+        floor: 0.0,
+    },
+    MetricDef {
+        key: "verify_detected",
+        title: "off flagged",
+        better: Better::Higher,
+        floor: 0.001,
+    },
+    MetricDef {
+        key: "verify_false",
+        title: "false flags",
+        better: Better::Lower,
+        floor: 0.0,
+    },
 ];
 
 /// The numbers of one cell (a metric is absent when the run did not produce it).
@@ -119,12 +194,25 @@ pub fn grade_cell(out: &Path) -> Result<CellMetrics, String> {
             c.insert(k.to_string(), v);
         }
     };
-    put("nadir_inlier", num_at(m, "nadir.inlier_ratio"));
-    put("nadir_registered", num_at(m, "nadir.recordings_with_aerial_fraction"));
-    put("oblique_inlier", num_at(m, "oblique.inlier_ratio_after_consensus"));
+    // A ratio of nothing is no ratio: only with graded correspondences.
+    let graded = |k: &str| num_at(m, k).is_some_and(|n| n > 0.0);
+    put(
+        "nadir_inlier",
+        num_at(m, "nadir.inlier_ratio").filter(|_| graded("nadir.graded_tie_points")),
+    );
+    put(
+        "nadir_registered",
+        num_at(m, "nadir.recordings_with_aerial_fraction"),
+    );
+    let oblique =
+        graded("oblique.inliers_after_consensus") || graded("oblique.outliers_after_consensus");
+    put(
+        "oblique_inlier",
+        num_at(m, "oblique.inlier_ratio_after_consensus").filter(|_| oblique),
+    );
     put(
         "oblique_inlier_nm",
-        num_at(m, "oblique.inlier_ratio_after_consensus_incl_non_matchable"),
+        num_at(m, "oblique.inlier_ratio_after_consensus_incl_non_matchable").filter(|_| oblique),
     );
     if let Some(a) = adjust_section(m) {
         put("rec_2d_before", num_at(a, "recordings.before.rmse_2d"));
@@ -136,9 +224,12 @@ pub fn grade_cell(out: &Path) -> Result<CellMetrics, String> {
         put("cp_3d_after", num_at(a, "checkpoints.after.3d"));
     }
     put("cp_max_2d_after", checkpoint_max_after(out)?);
-    let campaign = run
-        .campaign_dir()
-        .ok_or_else(|| format!("{}: provenance.json names no campaign folder", out.display()))?;
+    let campaign = run.campaign_dir().ok_or_else(|| {
+        format!(
+            "{}: provenance.json names no campaign folder",
+            out.display()
+        )
+    })?;
     if campaign.join("truth/recordings.csv").is_file() {
         let segments = segment_truth(out, &campaign)?;
         let off: Vec<bool> = segments

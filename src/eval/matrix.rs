@@ -63,8 +63,7 @@ impl Cell {
 impl Matrix {
     /// Read and check `path`; the error names the file and what is wrong.
     pub fn load(path: &Path) -> Result<Self, String> {
-        let text =
-            std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
         let m: Matrix = toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
         m.check().map_err(|e| format!("{}: {e}", path.display()))?;
         Ok(m)

@@ -51,7 +51,10 @@ pub fn summarize(values: &[f64], better: Better) -> Option<Summary> {
 pub fn build_table(cells: &[(String, u64, Option<CellMetrics>)]) -> Table {
     let mut grouped: BTreeMap<String, Vec<(u64, Option<&CellMetrics>)>> = BTreeMap::new();
     for (key, seed, m) in cells {
-        grouped.entry(key.clone()).or_default().push((*seed, m.as_ref()));
+        grouped
+            .entry(key.clone())
+            .or_default()
+            .push((*seed, m.as_ref()));
     }
     grouped
         .into_iter()
@@ -138,6 +141,9 @@ mod tests {
         assert!((inl.sd - 0.02f64.hypot(0.0) / 2f64.sqrt()).abs() < 1e-12);
         assert_eq!(row.metrics["cp_2d_after"].worst, 0.06);
         let md = render_markdown(&t);
-        assert!(md.contains("| demo/thesis | 3 (1 failed) | 0.970 (0.960) |"), "{md}");
+        assert!(
+            md.contains("| demo/thesis | 3 (1 failed) | 0.970 (0.960) |"),
+            "{md}"
+        );
     }
 }

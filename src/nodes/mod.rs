@@ -27,6 +27,7 @@ pub mod summary;
 pub mod synth;
 pub mod transform;
 pub mod transform_agreement;
+pub mod vehicle;
 pub mod verify;
 
 pub use campaign::{

@@ -182,7 +182,7 @@ pub struct RenderCampaign;
 impl Stage for RenderCampaign {
     const NAME: &'static str = "render";
     /// Bump whenever the generator renders differently (scenes, presets, cameras, looks).
-    const VERSION: &'static str = "2";
+    const VERSION: &'static str = "3";
     type Params = RenderIdentity;
     type Output = GeneratedCampaign;
     type Inputs = ();

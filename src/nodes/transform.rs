@@ -17,7 +17,7 @@ pub struct InitialTransformStage;
 impl Stage for InitialTransformStage {
     const NAME: &'static str = "transform";
     // 3: accepted transforms carry the implied offset as a vector (`centre_offset_world_m`).
-    const VERSION: &'static str = "3";
+    const VERSION: &'static str = "4";
     type Params = TransformParams;
     type Output = TransformOutcome;
     type Inputs = (

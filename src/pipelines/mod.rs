@@ -5,6 +5,7 @@ pub mod adjust;
 pub mod nadir;
 pub mod oblique;
 pub mod skytie;
+pub mod vehicle;
 
 use crate::dag::PipelineError;
 use crate::workflow::Workflow;

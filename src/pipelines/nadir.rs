@@ -104,11 +104,11 @@ pub fn add_nadir(
     snapshot: &CampaignSnapshot,
     snap: Handle<CampaignSnapshot>,
     items: &[RecordingItem<'_>],
+    ortho_base: &OrthoParams,
 ) -> Result<NadirHandles, PipelineError> {
     let on = |s: &str| wf.stages.iter().any(|x| x == s);
     let options: NadirOptions = wf.params("nadir", variant).map_err(wf_err)?;
     let mm_params: MmMatchParams = wf.params("mm_match", variant).map_err(wf_err)?;
-    let ortho_base: OrthoParams = wf.params("ortho", variant).map_err(wf_err)?;
     let transform_params: TransformParams = wf.params("transform", variant).map_err(wf_err)?;
     let refine_params: RefineParams = wf.params("refine", variant).map_err(wf_err)?;
     let control_params: ControlParams = wf.params("control", variant).map_err(wf_err)?;

@@ -2,7 +2,8 @@
 //!
 //! Phases (each built from the values of the previous one — staged planning):
 //! 1. `campaign`: the synthetic generator node when the workflow says `campaign = "synth:<preset>"`;
-//! 2. `load`: read and validate the campaign;
+//! 2. `load`: read and validate the campaign; then `vehicle`: the recording vehicle found in a sample of the
+//!    panoramas (`pipelines::vehicle`), which masks every ortho image;
 //! 3. `items`, per sweep variant: per recording `recording` → `ortho` (thesis 3.4.3), the nadir chain
 //!    (`pipelines::nadir`, thesis chapter 3), the oblique chain (`pipelines::oblique`, chapter 4), the
 //!    adjustment, grading and verification (`pipelines::adjust`, chapter 5), then the global `summary`.
@@ -10,7 +11,7 @@
 //! After phase 3 the exports of every variant are written into `OUT` (`OUT/variants/<name>/` in a sweep).
 //! A stage name the pipeline does not know is refused with the list of available ones.
 
-use super::{adjust, nadir, oblique, wf_err};
+use super::{adjust, nadir, oblique, vehicle, wf_err};
 use crate::dag::{DagBuilder, Pipeline, PipelineError, RawFile, Session};
 use crate::exports::{verification_table, write_exports, ExportInputs};
 use crate::nodes::campaign::{listing_hash, metadata_inputs};
@@ -120,6 +121,8 @@ impl Pipeline for SkytiePipeline {
                 root.display()
             );
         }
+        // Phase 2b: the recording vehicle, found in the panoramas (masks every ortho image).
+        let vehicle = vehicle::detect(wf, session, &root, &snapshot, (&load_params, &inputs))?;
         // Phase 3: per-recording stages and the summary, for every variant.
         let ortho_on = wf.stages.iter().any(|s| s == "ortho");
         let nadir_on = nadir::enabled(wf)?;
@@ -129,7 +132,7 @@ impl Pipeline for SkytiePipeline {
         for variant in wf.variants() {
             b.set_variant(&variant);
             let snap = b.add(LoadCampaign, "", load_params.clone(), inputs.clone())?;
-            let ortho: OrthoParams = wf.params("ortho", &variant).map_err(wf_err)?;
+            let ortho: OrthoParams = vehicle::ortho_params(wf, &variant, vehicle.as_ref())?;
             let mut orthos = Vec::new();
             let mut items = Vec::new();
             for rec in &snapshot.campaign.recordings {
@@ -159,7 +162,7 @@ impl Pipeline for SkytiePipeline {
             }
             let nadir_handles = if nadir_on {
                 Some(nadir::add_nadir(
-                    &mut b, wf, &variant, &root, &snapshot, snap, &items,
+                    &mut b, wf, &variant, &root, &snapshot, snap, &items, &ortho,
                 )?)
             } else {
                 None

@@ -23,7 +23,7 @@
 use super::aerial_patch::{aerial_ground_similarity, extract_patch};
 use super::ortho::{OrthoGeoref, OrthoImage};
 use super::registration::{InitialTransform, TransformOutcome};
-use super::translation_consensus::translation_consensus;
+use super::translation_consensus::{false_alarms, translation_consensus};
 use crate::campaign::{AerialImage, Recording};
 use crate::estimators::{mix_seed, ransac_filtered, RansacParams};
 use crate::features::kaze::{detect_and_describe, Features, KazeParams};
@@ -101,6 +101,11 @@ pub struct TransformParams {
     /// corrected by the refinement, which then confirms whatever repeats there. Measured on demo seeds 1–3:
     /// implied offsets of one recording differ by 0.07 m (median), 0.5 m (p90); the aliased ones by 1.6–2.2 m.
     pub max_offset_disagreement_m: f64,
+    /// A-contrario test of the translation consensus (translation mode): reject it when random matches would
+    /// give a consensus as large this often or more (expected number of false alarms,
+    /// [`super::translation_consensus::false_alarms`]). 0.01: with 105 matches in ±15 px windows a consensus of 7
+    /// (a chance one, NFA ≈ 0.5) is rejected, 6 of 8 (NFA < 10⁻³) is kept.
+    pub max_false_alarms: f64,
 }
 
 impl Default for TransformParams {
@@ -133,6 +138,7 @@ impl Default for TransformParams {
             min_inlier_ratio: 0.0,
             min_consensus_margin: 1.0,
             max_offset_disagreement_m: 1.2,
+            max_false_alarms: 0.01,
         }
     }
 }
@@ -248,6 +254,14 @@ impl TransformParams {
             self.min_inlier_ratio.is_finite() && (0.0..=1.0).contains(&self.min_inlier_ratio),
             "min_inlier_ratio",
             format!("must be in [0, 1], got {}", self.min_inlier_ratio),
+        );
+        need(
+            self.max_false_alarms.is_finite() && self.max_false_alarms > 0.0,
+            "max_false_alarms",
+            format!(
+                "must be > 0 (expected chance consensus; large = no test), got {}",
+                self.max_false_alarms
+            ),
         );
         need(
             self.min_consensus_margin.is_finite() && self.min_consensus_margin >= 1.0,
@@ -624,6 +638,18 @@ pub fn initial_transform(
                 format!(
                     "{n_matches} matches: ambiguous translation ({n} inliers, a competing one has {})",
                     c.runner_up
+                ),
+                n_matches,
+                n,
+            );
+        }
+        let nfa = false_alarms(n_matches, n, p.ransac_threshold_px, window_px);
+        if nfa > p.max_false_alarms {
+            return reject(
+                format!(
+                    "{n_matches} matches: a consensus of {n} is what chance gives (expected {nfa:.2} among \
+                     random matches > {})",
+                    p.max_false_alarms
                 ),
                 n_matches,
                 n,

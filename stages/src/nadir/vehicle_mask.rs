@@ -15,6 +15,9 @@ use serde::{Deserialize, Serialize};
 pub struct VehicleMask {
     /// Mask the vehicle at all.
     pub enabled: bool,
+    /// Find the box in the panoramas (the `vehicle` stage) and use the values below only when that fails;
+    /// `false` = use the values below (an override for a known vehicle).
+    pub detect: bool,
     /// Vertical distance from the projection centre down to the vehicle's top face, m.
     pub roof_drop_m: f64,
     /// Extent of the body ahead of the projection centre (bonnet), m.
@@ -29,6 +32,7 @@ impl Default for VehicleMask {
     fn default() -> Self {
         Self {
             enabled: true,
+            detect: true,
             roof_drop_m: 0.4,
             front_m: 0.75,
             rear_m: 1.25,

@@ -30,7 +30,7 @@ pub struct OutageParams {
 impl Default for OutageParams {
     fn default() -> Self {
         Self {
-            length_m: [60.0, 120.0],
+            length_m: [80.0, 150.0],
             peak_m: [1.5, 2.0],
             max_route_fraction: 0.8,
             random_walk_step_m: 0.04,

@@ -160,7 +160,7 @@ fn outage_with_its_noise_stays_near_the_smooth_drift_and_keeps_centimetres_outsi
     let (_, e) = errors(&p, 5);
     let routes = Routes::of(&truth().recordings);
     let o = p.params.outage.draw(5, 0, routes.length_m[0]);
-    assert!(o.length_m <= 0.8 * 200.0 + 1e-9 && o.length_m >= 60.0);
+    assert!(o.length_m <= 0.8 * 200.0 + 1e-9 && o.length_m >= 80.0);
     for (i, err) in e.iter().enumerate().take(41) {
         let size = err[0].hypot(err[1]);
         match o.phase(routes.along_m[i]) {

@@ -132,31 +132,32 @@ pub struct SceneSpec {
 }
 
 impl SceneSpec {
-    /// About 45 m of straight street ending at a T-junction, one block on each side: fast tests. The route
-    /// (six panoramas) sees the junction approach's zebra crossing, stop line and arrow as well as dashes and
-    /// manholes, so the nadir chain has road markings to register.
+    /// About 60 m of straight street ending at a T-junction, buildings on both sides: fast tests. The route (six
+    /// panoramas, 20–45 m) runs between façades on both sides up to the junction approach, whose arrow, stop line
+    /// and zebra crossing it sees along with dashes and manholes, so both the nadir chain (road markings) and the
+    /// oblique chain (façades on both sides) have content to register.
     pub fn tiny() -> Self {
         Self {
-            street_length_m: 45.0,
+            street_length_m: 60.0,
             cross_street: Some(CrossStreetSpec {
-                at_x_m: 38.0,
+                at_x_m: 55.0,
                 half_width_m: 4.0,
                 extent_right_m: 0.0,
                 extent_left_m: 20.0,
             }),
             manhole_spacing_m: 12.0,
             setback_m: [1.0, 1.0],
-            building_width_m: [26.0, 26.0],
-            building_gap_m: [0.0, 0.0],
+            building_width_m: [9.0, 13.0],
+            building_gap_m: [0.0, 1.0],
             tree_spacing_m: 14.0,
             buildings_on_cross_street: false,
             route: RouteSpec {
-                start_x_m: 8.0,
+                start_x_m: 20.0,
                 lane_offset_m: 1.5,
                 turn_right: false,
                 turn_radius_m: 6.0,
                 length_after_junction_m: 0.0,
-                end_x_m: 36.0,
+                end_x_m: 47.0,
             },
             ..Self::demo()
         }
