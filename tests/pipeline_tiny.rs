@@ -225,6 +225,13 @@ fn tiny_campaign_end_to_end() {
         m["oblique"]["inlier_ratio_after_consensus"].is_number(),
         "{m}"
     );
+    // Each street side's oblique correspondences are reported, so a side without façade matches shows.
+    for side in ["left", "right"] {
+        assert!(
+            m["oblique"]["sides"][side]["correspondences"].is_u64(),
+            "{m}"
+        );
+    }
     // The generator wrote truth/scene.toml, so the grading compares with the seen surface and can tell
     // non-matchable correspondences (a count, not null).
     assert_eq!(

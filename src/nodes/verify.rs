@@ -39,7 +39,7 @@ pub struct VerifyStage;
 
 impl Stage for VerifyStage {
     const NAME: &'static str = "verify";
-    const VERSION: &'static str = "2";
+    const VERSION: &'static str = "3";
     type Params = VerifyConfig;
     type Output = Verification;
     type Inputs = (
