@@ -5,9 +5,9 @@
 //!
 //! `cargo bench --bench engine` (SKYTIE_BENCH_ITEMS overrides the item count).
 
+use skytie::dag::progress::{Progress, ProgressMode};
 use skytie::dag::{execute, Dag, DagBuilder, Env, Mode, RawFile};
 use skytie::hashing::StatCache;
-use skytie::progress::{Progress, ProgressMode};
 use skytie::store::Store;
 use skytie::testing::toy::{write_item, ToyParse, ToyScale, ToySum};
 use std::path::PathBuf;

@@ -4,29 +4,28 @@
 //! An encoded artifact starts with [`FORMAT_VERSION`] (one byte) and a 4-byte kind magic, then the body:
 //! - `SERD`: bincode 2 (serde, standard config) of the value — used by [`serde_artifact!`] types and the
 //!   built-in scalars/vectors;
-//! - `GRAY` / `RGB3`: image width and height (u64 little-endian) followed by the raw `f32` samples as
-//!   little-endian bytes (memcpy speed; a 4000×3000 image is 48 MB);
+//! - rasters (kinds chosen by the type, e.g. `GRAY` / `RGB3` for the node layer's images): width and height
+//!   (u64 little-endian) followed by the raw `f32` samples as little-endian bytes (memcpy speed; a 4000×3000
+//!   grey image is 48 MB) — [`encode_raster`], [`read_raster`];
 //! - `BYTE`: length (u64 little-endian) and raw bytes (`Vec<u8>`); `JSON`: JSON text (`serde_json::Value`).
 //!
 //! Decoding checks version, kind and length and returns a [`CodecError`] that says what is wrong; it never
 //! panics and never allocates more than a bounded multiple of the input on garbage.
 //!
 //! Every artifact can also be written to / read from a stream ([`Artifact::encode_to`],
-//! [`Artifact::decode_from`]) with exactly the same bytes; for images that is the fast path of the store: the
+//! [`Artifact::decode_from`]) with exactly the same bytes; for rasters that is the fast path of the store: the
 //! samples go from the image's memory to the entry file in one write and come back with one read straight
-//! into the new image's buffer.
+//! into the new buffer. The engine knows no image type: the node layer (`nodes::image_artifact`) implements
+//! [`Artifact`] for the photogrammetry crate's images with these raster functions.
 
 use serde::de::DeserializeOwned;
 use serde::Serialize;
-use skytie_stages::imaging::{GrayImage, RgbImage};
 use std::io::{self, Read, Write};
 
 /// Version of the artifact encoding; bump it whenever any encoding below changes.
 pub const FORMAT_VERSION: u8 = 1;
 
 const KIND_SERDE: &[u8; 4] = b"SERD";
-const KIND_GRAY: &[u8; 4] = b"GRAY";
-const KIND_RGB: &[u8; 4] = b"RGB3";
 const KIND_BYTES: &[u8; 4] = b"BYTE";
 const KIND_JSON: &[u8; 4] = b"JSON";
 
@@ -286,6 +285,12 @@ impl Artifact for serde_json::Value {
     }
 }
 
+// ---- dense f32 rasters ------------------------------------------------------------------------------------
+//
+// Images are not an engine type: the node layer implements [`Artifact`] for its image types with the functions
+// below, which encode any dense `f32` raster (width × height × channels samples) as frame + width + height (u64
+// little-endian) + the raw little-endian samples, and read it back straight into a freshly allocated buffer.
+
 /// The in-memory bytes of `samples` (no copy).
 fn sample_bytes(samples: &[f32]) -> &[u8] {
     // SAFETY: `f32` has no padding and every bit pattern is a valid `u8` sequence; `u8` needs no alignment;
@@ -343,12 +348,9 @@ fn zeroed_samples(count: usize) -> Vec<f32> {
     samples
 }
 
-/// Huge pages for a mapped or allocated buffer (`skytie_stages::imaging::huge_pages`).
+/// Huge pages for a mapped or allocated buffer (`skytie_util::huge_pages`).
 fn advise_huge_pages(memory: &mut [u8]) {
-    skytie_stages::imaging::huge_pages::advise_huge_pages(
-        memory.as_mut_ptr() as usize,
-        memory.len(),
-    );
+    skytie_util::huge_pages::advise_huge_pages(memory.as_mut_ptr() as usize, memory.len());
 }
 
 /// Turns samples whose memory holds little-endian `f32` bytes into native values (a no-op on little-endian
@@ -373,7 +375,13 @@ fn image_head(kind: &[u8; 4], width: usize, height: usize) -> [u8; IMAGE_HEAD_LE
     head
 }
 
-fn encode_image(out: &mut Vec<u8>, kind: &[u8; 4], width: usize, height: usize, samples: &[f32]) {
+pub fn encode_raster(
+    out: &mut Vec<u8>,
+    kind: &[u8; 4],
+    width: usize,
+    height: usize,
+    samples: &[f32],
+) {
     out.reserve(IMAGE_HEAD_LEN + samples.len() * 4);
     out.extend_from_slice(&image_head(kind, width, height));
     if cfg!(target_endian = "little") {
@@ -385,7 +393,7 @@ fn encode_image(out: &mut Vec<u8>, kind: &[u8; 4], width: usize, height: usize, 
     }
 }
 
-fn encode_image_to(
+pub fn encode_raster_to(
     sink: &mut dyn Write,
     kind: &[u8; 4],
     width: usize,
@@ -428,7 +436,7 @@ fn image_shape(
 }
 
 /// Decodes an image body; `channels` samples per pixel. Returns (width, height, samples).
-fn decode_image(
+pub fn decode_raster(
     bytes: &[u8],
     kind: &[u8; 4],
     type_name: &str,
@@ -446,7 +454,7 @@ fn decode_image(
 
 /// Reads an image of `len` bytes from `source`: the head, then the samples with one `read_exact` straight
 /// into the image's buffer (allocated once, zeroed lazily by the OS).
-fn read_image(
+pub fn read_raster(
     source: &mut dyn Read,
     len: u64,
     kind: &[u8; 4],
@@ -471,54 +479,42 @@ fn read_image(
     Ok((width, height, samples))
 }
 
-impl Artifact for GrayImage {
-    fn encode(&self, out: &mut Vec<u8>) {
-        encode_image(out, KIND_GRAY, self.width, self.height, &self.data);
-    }
-    fn decode(bytes: &[u8]) -> Result<Self, CodecError> {
-        let (width, height, data) = decode_image(bytes, KIND_GRAY, "gray image", 1)?;
-        Ok(GrayImage {
-            width,
-            height,
-            data,
-        })
-    }
-    fn encode_to(&self, sink: &mut dyn Write) -> io::Result<()> {
-        encode_image_to(sink, KIND_GRAY, self.width, self.height, &self.data)
-    }
-    fn decode_from(source: &mut dyn Read, len: u64) -> Result<Self, CodecError> {
-        let (width, height, data) = read_image(source, len, KIND_GRAY, "gray image", 1)?;
-        Ok(GrayImage {
-            width,
-            height,
-            data,
-        })
-    }
-}
-
-impl Artifact for RgbImage {
-    fn encode(&self, out: &mut Vec<u8>) {
-        encode_image(out, KIND_RGB, self.width, self.height, &self.data);
-    }
-    fn decode(bytes: &[u8]) -> Result<Self, CodecError> {
-        let (width, height, data) = decode_image(bytes, KIND_RGB, "RGB image", 3)?;
-        Ok(RgbImage {
-            width,
-            height,
-            data,
-        })
-    }
-    fn encode_to(&self, sink: &mut dyn Write) -> io::Result<()> {
-        encode_image_to(sink, KIND_RGB, self.width, self.height, &self.data)
-    }
-    fn decode_from(source: &mut dyn Read, len: u64) -> Result<Self, CodecError> {
-        let (width, height, data) = read_image(source, len, KIND_RGB, "RGB image", 3)?;
-        Ok(RgbImage {
-            width,
-            height,
-            data,
-        })
-    }
+/// Implements [`Artifact`](crate::codec::Artifact) for a dense `f32` raster type with public fields `width`,
+/// `height` (usize) and `data` (`Vec<f32>`, `channels` samples per pixel, row-major) through the raster
+/// encoding: `skytie::raster_artifact!(GrayImage, b"GRAY", "gray image", 1);`
+#[macro_export]
+macro_rules! raster_artifact {
+    ($t:ty, $kind:expr, $name:expr, $channels:expr) => {
+        impl $crate::codec::Artifact for $t {
+            fn encode(&self, out: &mut ::std::vec::Vec<u8>) {
+                $crate::codec::encode_raster(out, $kind, self.width, self.height, &self.data);
+            }
+            fn decode(bytes: &[u8]) -> ::std::result::Result<Self, $crate::codec::CodecError> {
+                let (width, height, data) =
+                    $crate::codec::decode_raster(bytes, $kind, $name, $channels)?;
+                Ok(Self {
+                    width,
+                    height,
+                    data,
+                })
+            }
+            fn encode_to(&self, sink: &mut dyn ::std::io::Write) -> ::std::io::Result<()> {
+                $crate::codec::encode_raster_to(sink, $kind, self.width, self.height, &self.data)
+            }
+            fn decode_from(
+                source: &mut dyn ::std::io::Read,
+                len: u64,
+            ) -> ::std::result::Result<Self, $crate::codec::CodecError> {
+                let (width, height, data) =
+                    $crate::codec::read_raster(source, len, $kind, $name, $channels)?;
+                Ok(Self {
+                    width,
+                    height,
+                    data,
+                })
+            }
+        }
+    };
 }
 
 #[cfg(test)]
@@ -526,6 +522,47 @@ mod tests {
     use super::*;
     use serde::Deserialize;
     use std::collections::BTreeMap;
+
+    /// One- and three-channel rasters shaped like the node layer's images.
+    #[derive(Debug, PartialEq)]
+    struct GrayImage {
+        width: usize,
+        height: usize,
+        data: Vec<f32>,
+    }
+    #[derive(Debug, PartialEq)]
+    struct RgbImage {
+        width: usize,
+        height: usize,
+        data: Vec<f32>,
+    }
+    raster_artifact!(GrayImage, b"GRAY", "gray image", 1);
+    raster_artifact!(RgbImage, b"RGB3", "RGB image", 3);
+    impl GrayImage {
+        fn from_vec(width: usize, height: usize, data: Vec<f32>) -> Option<Self> {
+            (data.len() == width * height).then_some(GrayImage {
+                width,
+                height,
+                data,
+            })
+        }
+        fn filled(width: usize, height: usize, v: f32) -> Self {
+            GrayImage {
+                width,
+                height,
+                data: vec![v; width * height],
+            }
+        }
+    }
+    impl RgbImage {
+        fn filled(width: usize, height: usize, v: [f32; 3]) -> Self {
+            RgbImage {
+                width,
+                height,
+                data: v.repeat(width * height),
+            }
+        }
+    }
 
     fn round_trip<T: Artifact + PartialEq + std::fmt::Debug>(value: T) {
         let mut bytes = Vec::new();

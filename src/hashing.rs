@@ -345,7 +345,7 @@ impl StatCache {
             records.sort_by(|a, b| a.path.cmp(&b.path));
             encode_stat_cache(&records)?
         };
-        skytie_stages::fsutil::atomic_write(&self.file, &bytes)
+        skytie_util::fsutil::atomic_write(&self.file, &bytes)
     }
 
     fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<PathBuf, (FileStamp, ContentHash)>> {

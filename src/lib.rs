@@ -16,7 +16,6 @@ pub mod metrics;
 pub mod nodes;
 pub mod pipelines;
 pub mod plan;
-pub mod progress;
 pub mod provenance;
 pub mod report;
 pub mod store;

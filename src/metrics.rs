@@ -241,7 +241,7 @@ fn csv_field(s: &str) -> String {
 pub fn write_json(path: &Path, v: &Value) -> io::Result<()> {
     let mut bytes = serde_json::to_vec_pretty(v).map_err(io::Error::other)?;
     bytes.push(b'\n');
-    skytie_stages::fsutil::atomic_write(path, &bytes)
+    skytie_util::fsutil::atomic_write(path, &bytes)
 }
 
 #[cfg(test)]

@@ -109,8 +109,12 @@ fn run_twice_then_plan_and_explain() {
     assert_eq!(m["toy"]["sum"], 20.0);
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(
-        stdout.contains("toy_scale") && stdout.contains("total"),
-        "summary table: {stdout}"
+        stdout.contains("9 nodes: 9 executed, 0 cached, 0 failed, 0 skipped"),
+        "node counts: {stdout}"
+    );
+    assert!(
+        stdout.trim_end().ends_with("(exit 0)"),
+        "last line: {stdout}"
     );
     let prov: Value =
         serde_json::from_slice(&std::fs::read(t.out().join("provenance.json")).unwrap()).unwrap();
@@ -195,7 +199,7 @@ fn sweep_writes_per_variant_metrics_and_sweep_csv() {
 }
 
 #[test]
-fn exit_code_is_nonzero_only_when_nothing_useful_was_produced() {
+fn exit_codes_say_failed_partial_or_complete() {
     // The only output fails: exit 1, failure listed.
     let t = Toy::new(3, "[toy_scale.faults]\nfail_item = \"item_001\"\n");
     let o = t.run();
@@ -214,10 +218,19 @@ fn exit_code_is_nonzero_only_when_nothing_useful_was_produced() {
         (engine(&m, "nodes_failed"), engine(&m, "nodes_skipped")),
         (1, 1)
     );
-    // One variant of two fails: still useful, exit 0.
+    // One variant of two fails: still useful, but partial: exit 3, said in the last line.
     t.workflow("[[sweep.variant]]\nname = \"ok\"\n\n[[sweep.variant]]\nname = \"bad\"\n\"toy_sum.faults.panic_item\" = \"*\"\n");
     let o = t.run();
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout
+            .trim_end()
+            .lines()
+            .last()
+            .is_some_and(|l| l.starts_with("run PARTIAL: 1 node(s) failed")),
+        "{stdout}"
+    );
     assert_eq!(engine(&t.metrics(&t.out()), "nodes_failed"), 1);
     // A workflow error: exit 2 with file:line:col.
     t.workflow("[toy_scale]\nfactr = 1.0\n");

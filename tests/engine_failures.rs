@@ -3,11 +3,11 @@
 
 mod support;
 
+use skytie::dag::progress::{Progress, ProgressMode};
 use skytie::dag::record::{self, FailureRecord};
 use skytie::dag::{Mode, Session};
 use skytie::hashing::StatCache;
 use skytie::plan::plan_text;
-use skytie::progress::{Progress, ProgressMode};
 use skytie::store::Store;
 use support::*;
 
@@ -32,7 +32,7 @@ fn session(
         .count();
     if mode == Mode::Run {
         // Idempotent: a session that records failures itself writes the same record.
-        let n = record::save_failures(&store, &phase.dag, &phase.reports).unwrap();
+        let n = skytie::dag::failures::save_failures(&store, &phase.dag, &phase.reports).unwrap();
         assert_eq!(n, failed);
     }
     (plan_text(&s, None), failed)

@@ -2,9 +2,9 @@
 
 mod support;
 
+use skytie::dag::progress::{Progress, ProgressMode};
 use skytie::dag::{DagBuilder, Mode, NodeStatus, RawFile, Session};
 use skytie::hashing::StatCache;
-use skytie::progress::{Progress, ProgressMode};
 use skytie::store::Store;
 use skytie::testing::toy::{
     item_label, list_items, ToyDir, ToyGen, ToyGenParams, ToyParse, ToySum,
@@ -72,7 +72,7 @@ fn plan_names_the_reason_each_node_will_run() {
 
 fn write_item_value(path: &std::path::Path, v: f64) {
     // Different size than before so the stat cache sees the change immediately.
-    skytie_stages::fsutil::atomic_write(path, format!("{v}.000\n").as_bytes()).unwrap();
+    skytie_util::fsutil::atomic_write(path, format!("{v}.000\n").as_bytes()).unwrap();
 }
 
 /// Phase 1 generates the campaign folder; phase 2 is built from it.

@@ -43,7 +43,7 @@ fn stage(m: &serde_json::Value, stage: &str, what: &str) -> u64 {
 
 /// `skytie run WF --cache CACHE --out OUT --quiet`, then OUT's metrics.
 fn run_workflow(wf: &Path, cache: &Path, out: &Path) -> serde_json::Value {
-    cli::run_workflow(wf, cache, out);
+    let _ = cli::run_workflow(wf, cache, out);
     metrics(out)
 }
 
@@ -239,8 +239,17 @@ fn tiny_campaign_end_to_end() {
         "{m}"
     );
     assert!(m["oblique"]["non_matchable"].is_u64(), "{m}");
+    // The adjusted trajectory is delivered only when the adjustment corrected something; otherwise the run
+    // says so (exit 3, verdict in the metrics) and withholds it.
+    let corrected = m["adjust"]
+        .to_string()
+        .contains("\"verdict\":\"corrected\"");
+    assert_eq!(
+        out3.join("trajectory_adjusted.csv").is_file(),
+        corrected,
+        "trajectory_adjusted.csv must exist exactly when the verdict is 'corrected': {m}"
+    );
     for f in [
-        "trajectory_adjusted.csv",
         "trajectory.geojson",
         "tie_points.ply",
         "checkpoints.csv",
@@ -255,8 +264,10 @@ fn tiny_campaign_end_to_end() {
             .unwrap_or(0);
         assert!(len > 0, "{f} missing or empty");
     }
-    let adjusted = std::fs::read_to_string(out3.join("trajectory_adjusted.csv")).unwrap();
-    assert_eq!(adjusted.lines().count() as u64, recordings + 1);
+    if corrected {
+        let adjusted = std::fs::read_to_string(out3.join("trajectory_adjusted.csv")).unwrap();
+        assert_eq!(adjusted.lines().count() as u64, recordings + 1);
+    }
     let m = run_workflow(&shipped, &cache, &out3);
     assert_eq!(m["engine"]["nodes_executed"].as_u64(), Some(0), "{m}");
 }

@@ -2,7 +2,10 @@
 //! (the run writes `OUT/report/`), then `skytie report OUT` rebuilds it byte-identically in ≤ 10 s; every
 //! image and table file the page references exists and is non-empty; with `chromium` on PATH the page is
 //! rendered headless, every image must load with a non-zero natural size, and a screenshot is written.
-//! A second test builds a sweep report from a hand-made OUT whose tables have known values.
+//! The page opens with the answer (`#answer`) and the interactive map (`#map-run`, Leaflet from `assets/`),
+//! diagnostics last; in Chromium the map must initialise, draw the recordings and show a recording's numbers
+//! when selected (`#select=<id>`, the click's code path). A second test builds a sweep report from a hand-made
+//! OUT whose tables have known values; a third a map of 10⁴ recordings from a hand-made OUT.
 
 #[path = "support/cli.rs"]
 mod cli;
@@ -38,7 +41,7 @@ fn report_of_a_tiny_run() {
     let tmp = tempfile::tempdir().unwrap();
     let (cache, out) = (tmp.path().join("cache"), tmp.path().join("out"));
     let wf = Path::new(env!("CARGO_MANIFEST_DIR")).join("workflows/tiny.toml");
-    run_workflow(&wf, &cache, &out);
+    let _ = run_workflow(&wf, &cache, &out);
     let report = out.join("report");
     let index = report.join("index.html");
     assert!(
@@ -109,6 +112,32 @@ fn report_of_a_tiny_run() {
         assert!(!report.join("tables").join(format!("{id}.csv")).exists());
     }
     assert!(html.contains("thesis (Rotterdam data)") && html.contains("skytie (this campaign)"));
+    // Answer first, then the map; diagnostics (engine counters) after the results.
+    let pos = |needle: &str| {
+        html.find(needle)
+            .unwrap_or_else(|| panic!("{needle} missing from the page"))
+    };
+    assert!(pos("id=\"answer\"") < pos("id=\"map\""));
+    assert!(pos("id=\"map\"") < pos("id=\"accuracy\""));
+    assert!(pos("id=\"accuracy\"") < pos("id=\"summary\""));
+    assert!(pos("id=\"summary\"") < pos("id=\"table-summary-engine\""));
+    assert!(html.contains("Sign convention everywhere"));
+    assert!(
+        html.contains("Per segment, recorded poses: MM − aerial"),
+        "our offsets are labelled MM − aerial"
+    );
+    assert!(
+        !html.contains("centre_offset_n_m"),
+        "rejection reasons must be words"
+    );
+    for f in [
+        "assets/leaflet.js",
+        "assets/leaflet.css",
+        "assets/map.js",
+        "figures/map-data.js",
+    ] {
+        assert!(report.join(f).is_file(), "{f} missing");
+    }
     let md = std::fs::read_to_string(report.join("run-log/summary-stages.md")).unwrap();
     assert!(
         md.contains("| stage | executed | cached | failed | skipped | seconds |"),
@@ -141,7 +170,7 @@ fn report_of_a_tiny_run() {
     // Re-running the workflow (warm cache: nothing executes) reproduces every result table byte-identically;
     // only the run log (times, nodes executed / cached) differs.
     let rerun = tmp.path().join("out-rerun");
-    run_workflow(&wf, &cache, &rerun);
+    let _ = run_workflow(&wf, &cache, &rerun);
     let (tables, tables_rerun) = (
         snapshot(&report.join("tables")),
         snapshot(&rerun.join("report/tables")),
@@ -167,9 +196,10 @@ fn report_of_a_tiny_run() {
     let profile = tmp.path().join("chromium-profile");
     let dom = dump_dom(&chromium, &index, &profile);
     let sizes = image_sizes(&dom);
+    // `imgs` also holds the scripts' src (Leaflet, the map and its data); the page's images are its <img> tags.
     assert_eq!(
         sizes.len(),
-        imgs.len(),
+        html.matches("<img ").count(),
         "images in the rendered DOM vs the page"
     );
     for (src, w, h) in &sizes {
@@ -189,6 +219,48 @@ fn report_of_a_tiny_run() {
         "chromium: {} images loaded; screenshot {}",
         sizes.len(),
         png.display()
+    );
+    check_map_in_chromium(&chromium, &index, &profile, &out);
+}
+
+/// The map initialises, draws the recordings and shows a selected recording's numbers.
+fn check_map_in_chromium(chromium: &Path, index: &Path, profile: &Path, out: &Path) {
+    let dom = dump_dom(chromium, index, profile);
+    assert_eq!(
+        element_attr(&dom, "map-run", "data-ready").as_deref(),
+        Some("1"),
+        "the map did not initialise"
+    );
+    let n: usize = element_attr(&dom, "map-run", "data-recordings")
+        .unwrap()
+        .parse()
+        .unwrap();
+    let drawn: usize = element_attr(&dom, "map-run", "data-drawn")
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(n > 0 && drawn == n, "{drawn} of {n} recordings drawn");
+    // A recording to select: the first one of the run's GeoJSON (written whether or not anything was
+    // corrected).
+    let geojson: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("trajectory.geojson")).unwrap())
+            .unwrap();
+    let first = geojson["features"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find_map(|f| f["properties"]["image_id"].as_str())
+        .expect("a recording in trajectory.geojson")
+        .to_string();
+    let dom = dump_dom_fragment(chromium, index, &format!("#select={first}"), profile);
+    assert_eq!(
+        element_attr(&dom, "panel-run", "data-selected").as_deref(),
+        Some(first.as_str())
+    );
+    assert!(dom.contains("moved horizontally"), "panel without numbers");
+    println!(
+        "map: {n} recordings drawn, init {} ms",
+        element_attr(&dom, "map-run", "data-init-ms").unwrap_or_default()
     );
 }
 
@@ -314,4 +386,110 @@ fn sweep_report_from_a_fixture_has_known_tables() {
     } else {
         println!("SKIPPED: chromium not installed (apt-get install -y chromium); the HTML checks above ran");
     }
+}
+
+/// A hand-made OUT with `n` recordings along a winding street, each moved by a known correction.
+fn large_run(out: &Path, n: usize) {
+    let pos = |i: usize| {
+        let s = i as f64 * 5.0;
+        [85_000.0 + s, 445_000.0 + 200.0 * (s / 2000.0).sin()]
+    };
+    let mut features = Vec::new();
+    let mut corr = String::from(
+        "time,time_s,image_id,kind,support,de_m,dn_m,du_m,dyaw_deg,sigma_e_m,sigma_n_m,sigma_u_m,sigma_yaw_deg\n",
+    );
+    for i in 0..n {
+        let p = pos(i);
+        let (de, dn) = (0.8 + 0.1 * (i as f64 * 0.01).sin(), -0.2);
+        let support = ["controlled", "bridged", "extrapolated", "uncorrected"][i % 4];
+        for (layer, x, y) in [("recorded", p[0], p[1]), ("adjusted", p[0] + de, p[1] + dn)] {
+            features.push(serde_json::json!({"type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [x, y, 1.0]},
+                "properties": {"layer": layer, "image_id": format!("r{i:05}")}}));
+        }
+        corr.push_str(&format!(
+            "2020-01-01T00:00:00Z,{},r{i:05},recording,{support},{de},{dn},0,0,0.03,0.03,0.05,0\n",
+            1_577_836_800 + i
+        ));
+    }
+    write(
+        &out.join("trajectory.geojson"),
+        &serde_json::json!({"type": "FeatureCollection", "features": features}).to_string(),
+    );
+    write(&out.join("corrections.csv"), &corr);
+    let mut ver = String::from(
+        "segment,first_image_id,last_image_id,recordings,points,mean_x,mean_y,mean_z,status\n",
+    );
+    for s in 0..n / 100 {
+        let status = if s % 7 == 3 { "fail" } else { "pass" };
+        ver.push_str(&format!(
+            "{s},r{:05},r{:05},100,12,0.02,0.01,0.0,{status}\n",
+            s * 100,
+            s * 100 + 99
+        ));
+    }
+    write(&out.join("verification_adjusted.csv"), &ver);
+    write(
+        &out.join("metrics.json"),
+        &serde_json::json!({
+            "campaign": {"name": "large", "recordings": n},
+            "adjust": {"combined": {"checkpoints": {
+                "before": {"2d": 0.8, "count": 10}, "after": {"2d": 0.05, "count": 10}}}}
+        })
+        .to_string(),
+    );
+}
+
+#[test]
+fn map_of_ten_thousand_recordings() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let n = 10_000;
+    large_run(&out, n);
+    let t0 = Instant::now();
+    let s =
+        skytie::report::build_report(&out, &skytie::report::ReportOptions::standard(None)).unwrap();
+    println!(
+        "report of {n} recordings built in {:.2} s",
+        t0.elapsed().as_secs_f64()
+    );
+    let html = std::fs::read_to_string(&s.index).unwrap();
+    assert!(
+        html.contains("7500 of 10000 recordings corrected"),
+        "headline"
+    );
+    assert!(html.contains("2500 not corrected"));
+    assert!(html.contains("id=\"table-verification-adjusted\""));
+    let Some(chromium) = find_chromium() else {
+        println!("SKIPPED: chromium not installed (apt-get install -y chromium); the HTML checks above ran");
+        return;
+    };
+    let profile = tmp.path().join("chromium-profile");
+    let dom = dump_dom_fragment(&chromium, &s.index, "#select=r05000", &profile);
+    assert_eq!(
+        element_attr(&dom, "map-run", "data-ready").as_deref(),
+        Some("1")
+    );
+    assert_eq!(
+        element_attr(&dom, "map-run", "data-recordings").as_deref(),
+        Some("10000")
+    );
+    assert_eq!(
+        element_attr(&dom, "panel-run", "data-selected").as_deref(),
+        Some("r05000")
+    );
+    let ms = |a: &str| element_attr(&dom, "map-run", a).unwrap_or_default();
+    println!(
+        "map of {n} recordings in headless Chromium: init {} ms, last redraw {} ms",
+        ms("data-init-ms"),
+        ms("data-redraw-ms")
+    );
+    screenshot(
+        &chromium,
+        &s.index,
+        &screenshot_dir().join("large-index.png"),
+        &profile,
+        1400,
+        1400,
+    );
 }

@@ -1,9 +1,9 @@
-//! `skytie check CAMPAIGN`: validate a campaign folder and list every problem at once (file, row, field, what
-//! to do). Exit code 0 when there are no errors (warnings allowed), 1 when there are errors, 2 when the folder
+//! `skytie check CAMPAIGN [--deep]`: validate a campaign folder and list every problem at once (file, row,
+//! field, what to do) — the same validation `skytie run` applies before it builds the per-item stages. Exit code 0 when there are no errors (warnings allowed), 1 when there are errors, 2 when the folder
 //! is not a campaign at all.
 
 use clap::Args;
-use skytie_stages::campaign::check_campaign;
+use skytie_stages::campaign::check_campaign_with;
 use std::path::PathBuf;
 
 /// Arguments of `skytie check`.
@@ -14,6 +14,10 @@ pub struct CheckArgs {
     /// Print the report as JSON instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Also decode every image in full (slow at real sizes; without it each image's header and structure are
+    /// checked, which finds truncated and damaged files without decoding).
+    #[arg(long)]
+    pub deep: bool,
 }
 
 /// Run `skytie check`; returns the exit code.
@@ -25,7 +29,7 @@ pub fn main(a: &CheckArgs) -> i32 {
         );
         return 2;
     }
-    let report = check_campaign(&a.campaign);
+    let report = check_campaign_with(&a.campaign, a.deep);
     if a.json {
         match serde_json::to_string_pretty(&report) {
             Ok(s) => println!("{s}"),

@@ -1,13 +1,14 @@
 //! Options and setup shared by subcommands: cache location, thread pool, workflow loading.
 
-use crate::dag::{pipeline_by_name, Pipeline};
+use crate::dag::Pipeline;
+use crate::pipelines::pipeline_by_name;
 use crate::store::Store;
 use crate::workflow::Workflow;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
-/// Default workflow file.
-pub const DEFAULT_WORKFLOW: &str = "workflows/default.toml";
+/// The workflow `skytie run` runs when none is named (built in, see [`super::builtin_workflows`]).
+pub const DEFAULT_WORKFLOW: &str = "default";
 
 /// `--cache DIR` (default: `$SKYTIE_CACHE`, else `cache/` in the working directory).
 #[derive(Args, Debug, Clone, Default)]
@@ -65,7 +66,7 @@ pub fn load_workflow(
     path: &Path,
     campaign: Option<&Path>,
 ) -> Result<(Workflow, &'static dyn Pipeline), String> {
-    let mut wf = Workflow::load(path).map_err(|e| e.to_string())?;
+    let mut wf = super::builtin_workflows::load(path).map_err(|e| e.to_string())?;
     if let Some(c) = campaign {
         wf.override_campaign(c.to_path_buf());
     }
@@ -90,7 +91,7 @@ pub fn with_plan_session<T>(
         Option<crate::dag::PipelineError>,
     ) -> Result<T, (i32, String)>,
 ) -> Result<T, (i32, String)> {
-    use crate::progress::{Progress, ProgressMode};
+    use crate::dag::progress::{Progress, ProgressMode};
     let (wf, pipeline) = load_workflow(workflow, campaign).map_err(|e| (2, e))?;
     let store = cache.open().map_err(|e| (2, e))?;
     let stat_cache = crate::hashing::StatCache::open(store.root());
@@ -101,6 +102,17 @@ pub fn with_plan_session<T>(
         .install(|| pipeline.run(&wf, &mut session))
         .map_err(|e| (2, e))?;
     let _ = stat_cache.save();
-    let stopped = crate::cli::run::plan_stop(result).map_err(|e| (1, e.to_string()))?;
+    let stopped = plan_stop(result).map_err(|e| (1, e.to_string()))?;
     report(&session, stopped)
+}
+
+/// Turn a pipeline error of a plan into "planning stopped here" (not an error) or a real error.
+pub fn plan_stop(
+    result: Result<(), crate::dag::PipelineError>,
+) -> Result<Option<crate::dag::PipelineError>, crate::dag::PipelineError> {
+    match result {
+        Ok(()) => Ok(None),
+        Err(e @ crate::dag::PipelineError::NotYetAvailable(_)) => Ok(Some(e)),
+        Err(e) => Err(e),
+    }
 }

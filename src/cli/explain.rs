@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug, Clone)]
 pub struct ExplainArgs {
-    /// Workflow file.
+    /// Workflow: a built-in name (`skytie workflows` lists them) or a TOML file.
     pub workflow: PathBuf,
     /// Node identity, e.g. `toy_scale[item_003]`.
     pub node: String,

@@ -5,16 +5,21 @@
 //! verify` found bad entries; 2 = usage or setup error (workflow does not load, unknown pipeline, cache or
 //! output folder not usable).
 
+pub mod builtin_workflows;
 pub mod cache;
 pub mod check;
 pub mod common;
 pub mod eval;
 pub mod explain;
+pub mod import;
+pub mod init;
+pub mod params;
 pub mod plan;
 pub mod report;
 pub mod run;
 pub mod synth;
 pub mod tool;
+pub mod workflows;
 
 use clap::{Parser, Subcommand};
 
@@ -49,6 +54,14 @@ pub enum Command {
     Check(check::CheckArgs),
     /// Held-out evaluation: presets × error profiles × seeds, one table, compared with a baseline.
     Eval(eval::EvalArgs),
+    /// Every workflow parameter with default, unit, range and meaning (`skytie params refine`).
+    Params(params::ParamsArgs),
+    /// List the built-in workflows, or print one (`show NAME`).
+    Workflows(workflows::WorkflowsArgs),
+    /// Turn vendor files (Pix4D, Metashape, SBET, ...) into a campaign folder (docs/import.md).
+    Import(import::ImportArgs),
+    /// Write an empty campaign skeleton with commented table headers.
+    Init(init::InitArgs),
     /// Building blocks on plain files (ortho, kaze, forstner, wallis, phasecorr, ncc), CSV/plain output.
     #[command(subcommand)]
     Tool(tool::ToolCommand),
@@ -66,6 +79,10 @@ pub fn main() -> i32 {
         Command::Synth(a) => synth::main(a),
         Command::Check(a) => check::main(a),
         Command::Eval(a) => eval::main(a),
+        Command::Import(a) => import::main(a),
+        Command::Init(a) => init::main(a),
         Command::Tool(t) => tool::main(t),
+        Command::Workflows(a) => workflows::main(a),
+        Command::Params(a) => params::main(a),
     }
 }

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug, Clone)]
 pub struct PlanArgs {
-    /// Workflow file.
+    /// Workflow: a built-in name (`skytie workflows` lists them) or a TOML file.
     pub workflow: PathBuf,
     /// Use this campaign folder instead of the workflow's `campaign`.
     #[arg(long, value_name = "DIR")]

@@ -6,17 +6,21 @@
 //!
 //! Exit code rule: **0** when the run produced something useful — at least one requested output of the
 //! last phase (e.g. the final report/metrics node of one variant) was produced, or, if the pipeline
-//! requests no outputs, at least one node succeeded — even when other nodes failed (they are listed and
-//! counted in `engine.nodes_failed` / `engine.nodes_skipped`). **1** when nothing useful was produced:
+//! requests no outputs, at least one node succeeded — and nothing was lost: no input row dropped by
+//! validation, no node failed or skipped. **3** (partial success) when it produced something useful but input
+//! rows were dropped (counted in `campaign.input_errors`, `campaign.dropped_rows`) or nodes failed or were
+//! skipped (`engine.nodes_failed` / `engine.nodes_skipped`); the outputs cover the rest. The last line of
+//! the output says which, with the counts, also with `--quiet`. **1** when nothing useful was produced:
 //! the pipeline stopped with an error (e.g. the campaign could not be generated or read) or every
 //! requested output failed or was skipped. **2** for usage/setup errors before anything ran (workflow does
 //! not load, unknown pipeline, cache cannot be opened) or when the output files cannot be written.
 
 use crate::cli::common::{load_workflow, CacheOpt, ThreadsOpt, DEFAULT_WORKFLOW};
+use crate::dag::progress::{Progress, ProgressMode};
 use crate::dag::{Mode, NodeStatus, PipelineError, Session};
 use crate::hashing::StatCache;
 use crate::metrics::{add_sections, sweep_csv, write_json, Summary};
-use crate::progress::{Progress, ProgressMode};
+use crate::report::headline::{Headline, Status};
 use crate::workflow::Workflow;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -24,7 +28,7 @@ use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
 #[derive(Args, Debug, Clone)]
 pub struct RunArgs {
-    /// Workflow file.
+    /// Workflow: a built-in name (`skytie workflows` lists them) or a TOML file.
     #[arg(default_value = DEFAULT_WORKFLOW)]
     pub workflow: PathBuf,
     /// Use this campaign folder instead of the workflow's `campaign`.
@@ -40,6 +44,9 @@ pub struct RunArgs {
     /// Print only errors and the final summary.
     #[arg(long)]
     pub quiet: bool,
+    /// Also print the per-stage table (nodes executed / cached / failed / skipped, seconds).
+    #[arg(long)]
+    pub timings: bool,
 }
 
 /// What a finished run reports back (for the exit code and for tests).
@@ -96,31 +103,82 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
         progress.warn(&format!("could not save the stat cache: {e}"));
     }
     let summary = Summary::of(session.reports());
-    write_outputs(&wf, &session, &out_dir, started_unix_s, wall).map_err(|e| {
+    let metrics = write_outputs(&wf, &session, &out_dir, started_unix_s, wall).map_err(|e| {
         (
             2,
             format!("cannot write outputs to {}: {e}", out_dir.display()),
         )
     })?;
     // The HTML report (a failure is a warning: the run's outputs are already written).
-    match crate::report::build_report(
+    let report = crate::report::build_report(
         &out_dir,
         &crate::report::ReportOptions::standard(args.campaign.clone()),
-    ) {
-        Ok(r) if !args.quiet => println!("report: {}", r.index.display()),
-        Ok(_) => {}
-        Err(e) => progress.warn(&format!("the HTML report was not written: {e}")),
+    );
+    if let Err(e) = &report {
+        progress.warn(&format!("the HTML report was not written: {e}"));
     }
-    print!("{}", summary.table(wall));
+    if args.timings {
+        print!("{}", summary.table(wall));
+    }
     print_problems(&session);
     let useful = produced_something(&session);
     if let Err(e) = &result {
         eprintln!("error: {e}");
     }
-    let exit_code = if result.is_ok() && useful { 0 } else { 1 };
-    if !args.quiet {
-        println!("outputs in {}", out_dir.display());
+    let t = &summary.total;
+    println!(
+        "{} nodes: {} executed, {} cached, {} failed, {} skipped ({wall:.0} s{})",
+        summary.nodes_total,
+        t.executed,
+        t.cached,
+        t.failed,
+        t.skipped,
+        if args.timings {
+            ""
+        } else {
+            "; per-stage times with --timings"
+        }
+    );
+    let mut warning = false;
+    // The headline speaks of campaigns (the engine's test pipeline has none).
+    let campaign_run = metrics.iter().any(|(_, m)| m.get("campaign").is_some());
+    for (variant, _) in metrics.iter().filter(|_| campaign_run) {
+        let dir = if metrics.len() > 1 {
+            out_dir.join("variants").join(variant)
+        } else {
+            out_dir.clone()
+        };
+        let h = match Headline::from_dir(&dir) {
+            Ok(h) => h,
+            Err(e) => {
+                progress.warn(&format!("no summary: {e}"));
+                continue;
+            }
+        };
+        warning |= matches!(h.status, Status::NotCorrected(_) | Status::Worse(_));
+        let lines = h.lines();
+        if metrics.len() > 1 {
+            println!("[{variant}] {}", lines.first().map_or("", String::as_str));
+        } else {
+            println!();
+            for l in &lines {
+                println!("{l}");
+            }
+            println!("(signs: corrections are adjusted − recorded; offsets MM − aerial; docs/outputs.md)");
+        }
     }
+    match &report {
+        Ok(r) => println!(
+            "outputs: {} (report: {})",
+            out_dir.display(),
+            r.index.display()
+        ),
+        Err(_) => println!("outputs: {}", out_dir.display()),
+    }
+    let mut outcome = RunOutcome::of(&session, result.is_ok() && useful);
+    outcome.result_warning = warning;
+    println!("{}", outcome.last_line(&out_dir));
+    let exit_code = outcome.exit_code();
     Ok(RunResult {
         exit_code,
         out_dir,
@@ -128,7 +186,94 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
     })
 }
 
-/// The exit-code rule (see the module documentation).
+/// Exit code of a run that finished but whose result must not be used as it is: input rows dropped, nodes
+/// failed or skipped, nothing corrected, or check points worse (the last line says which).
+pub const PARTIAL_EXIT_CODE: i32 = 3;
+
+/// What the run's last line and exit code say.
+struct RunOutcome {
+    useful: bool,
+    rows_dropped: u64,
+    input_errors: u64,
+    failed: usize,
+    skipped: usize,
+    /// The headline's status asks for attention (nothing corrected, check points worse).
+    result_warning: bool,
+}
+
+impl RunOutcome {
+    fn of(session: &Session<'_>, useful: bool) -> Self {
+        let campaign = session
+            .metrics()
+            .find(|(_, ns, _)| ns == "campaign")
+            .map(|(_, _, v)| v.clone())
+            .unwrap_or_default();
+        let count = |k: &str| campaign.get(k).and_then(|v| v.as_u64()).unwrap_or(0);
+        let count_status =
+            |f: fn(&NodeStatus) -> bool| session.reports().filter(|r| f(&r.status)).count();
+        RunOutcome {
+            useful,
+            rows_dropped: count("rows_dropped"),
+            input_errors: count("input_errors"),
+            failed: count_status(|s| matches!(s, NodeStatus::Failed(_))),
+            skipped: count_status(|s| matches!(s, NodeStatus::Skipped { .. })),
+            result_warning: false,
+        }
+    }
+
+    fn partial(&self) -> bool {
+        self.input_errors > 0 || self.failed > 0 || self.skipped > 0 || self.result_warning
+    }
+
+    fn exit_code(&self) -> i32 {
+        match (self.useful, self.partial()) {
+            (false, _) => 1,
+            (true, true) => PARTIAL_EXIT_CODE,
+            (true, false) => 0,
+        }
+    }
+
+    /// One line saying whether everything was processed, what was dropped or failed, and the exit code.
+    fn last_line(&self, out_dir: &Path) -> String {
+        let mut lost = Vec::new();
+        if self.input_errors > 0 {
+            lost.push(format!(
+                "{} input error(s), {} row(s) dropped (metrics.json campaign.dropped_rows; `skytie check` lists them)",
+                self.input_errors, self.rows_dropped
+            ));
+        }
+        if self.failed > 0 {
+            lost.push(format!("{} node(s) failed", self.failed));
+        }
+        if self.skipped > 0 {
+            lost.push(format!("{} skipped because an input failed", self.skipped));
+        }
+        if self.result_warning {
+            lost.push(
+                "the result must not be used as it is (first line of the summary)".to_string(),
+            );
+        }
+        let code = self.exit_code();
+        match (self.useful, lost.is_empty()) {
+            (true, true) => format!(
+                "run complete: every item processed; outputs in {} (exit 0)",
+                out_dir.display()
+            ),
+            (true, false) => format!(
+                "run PARTIAL: {}; outputs in {} cover the rest (exit {code})",
+                lost.join(", "),
+                out_dir.display()
+            ),
+            (false, _) => format!(
+                "run FAILED: no usable result{}{} (exit {code})",
+                if lost.is_empty() { "" } else { "; " },
+                lost.join(", ")
+            ),
+        }
+    }
+}
+
+/// Whether the run produced anything useful (see the module documentation).
 pub fn produced_something(session: &Session<'_>) -> bool {
     let Some(last) = session.phases.last() else {
         return false;
@@ -175,14 +320,16 @@ fn print_problems(session: &Session<'_>) {
     }
 }
 
-/// Write metrics.json, provenance.json and, for sweeps, per-variant metrics and sweep.csv.
+/// Write metrics.json, provenance.json and, for sweeps, per-variant metrics and sweep.csv. Returns the metrics
+/// of each variant (one, `default`, without a sweep).
 pub fn write_outputs(
     wf: &Workflow,
     session: &Session<'_>,
     out_dir: &Path,
     started_unix_s: u64,
     wall_seconds: f64,
-) -> std::io::Result<()> {
+) -> std::io::Result<Vec<(String, serde_json::Value)>> {
+    let mut per_variant = Vec::new();
     let warnings: usize = session.phases.iter().map(|p| p.warnings.len()).sum();
     let summary = Summary::of(session.reports());
     let mut doc = summary.to_json(wall_seconds, warnings);
@@ -206,6 +353,7 @@ pub fn write_outputs(
                 &out_dir.join("variants").join(v).join("metrics.json"),
                 &vdoc,
             )?;
+            per_variant.push((v.clone(), vdoc));
             // sweep.csv: the contributed sections.
             let mut row = serde_json::json!({});
             add_sections(
@@ -217,10 +365,7 @@ pub fn write_outputs(
             );
             rows.push((v.clone(), row));
         }
-        skytie_stages::fsutil::atomic_write(
-            &out_dir.join("sweep.csv"),
-            sweep_csv(&rows).as_bytes(),
-        )?;
+        skytie_util::fsutil::atomic_write(&out_dir.join("sweep.csv"), sweep_csv(&rows).as_bytes())?;
     } else {
         add_sections(
             &mut doc,
@@ -230,16 +375,8 @@ pub fn write_outputs(
     write_json(&out_dir.join("metrics.json"), &doc)?;
     let prov = crate::provenance::provenance(wf, session, started_unix_s, wall_seconds);
     write_json(&out_dir.join("provenance.json"), &prov)?;
-    Ok(())
-}
-
-/// Turn a pipeline error of a plan into "planning stopped here" (not an error) or a real error.
-pub fn plan_stop(
-    result: Result<(), PipelineError>,
-) -> Result<Option<PipelineError>, PipelineError> {
-    match result {
-        Ok(()) => Ok(None),
-        Err(e @ PipelineError::NotYetAvailable(_)) => Ok(Some(e)),
-        Err(e) => Err(e),
+    if per_variant.is_empty() {
+        per_variant.push(("default".to_string(), doc));
     }
+    Ok(per_variant)
 }

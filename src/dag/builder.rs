@@ -97,7 +97,7 @@ impl DagBuilder {
         let mut refs = Vec::new();
         inputs.collect_refs("", &mut refs);
         for (label, r) in &refs {
-            if let InputRef::Node(id) = r {
+            if let Some(id) = r.node().as_ref() {
                 if *id >= self.nodes.len() {
                     return Err(BuildError {
                         message: format!(
@@ -127,13 +127,7 @@ impl DagBuilder {
         let id = self.nodes.len();
         let gid = self.graph.add_node(id);
         debug_assert_eq!(gid.index(), id);
-        let mut upstream: Vec<NodeId> = refs
-            .iter()
-            .filter_map(|(_, r)| match r {
-                InputRef::Node(u) => Some(*u),
-                InputRef::File(_) => None,
-            })
-            .collect();
+        let mut upstream: Vec<NodeId> = refs.iter().filter_map(|(_, r)| r.node()).collect();
         upstream.sort_unstable();
         upstream.dedup();
         for u in upstream {
@@ -170,7 +164,7 @@ impl DagBuilder {
     ) -> BuildError {
         let first = &self.nodes[other];
         let mut differences = Vec::new();
-        crate::dag::record::diff_json("", &first.params_json, params_json, &mut differences);
+        crate::dag::json_diff::diff_json("", &first.params_json, params_json, &mut differences);
         let what = if differences.is_empty() {
             "same params but different inputs or stage version".to_string()
         } else {
@@ -268,6 +262,10 @@ fn structural_hash(
         match r {
             InputRef::Node(id) => {
                 field(b"node");
+                field(&(*id as u64).to_le_bytes());
+            }
+            InputRef::OptionalNode(id) => {
+                field(b"optional node");
                 field(&(*id as u64).to_le_bytes());
             }
             InputRef::File(p) => {

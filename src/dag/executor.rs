@@ -16,46 +16,29 @@
 //! re-enter the lock on the same thread).
 
 use crate::dag::builder::Dag;
-use crate::dag::inputs::{InputRef, InputValue, NodeId, RawFileValue};
+use crate::dag::inputs::{absent_hash, InputRef, InputValue, NodeId, RawFileValue};
 use crate::dag::key::node_key;
 use crate::dag::node::{AnyValue, Node};
+use crate::dag::progress::Progress;
 use crate::dag::record::{self, NodeRecord, RecordedInput};
 use crate::dag::stage::{dirs_root, tmp_dir_for, NodeCtx};
+pub use crate::dag::status::NodeStatus;
 use crate::hashing::{ContentHash, NodeKey, StatCache};
-use crate::progress::Progress;
 use crate::store::{EntryMeta, Loaded, Store};
 use rayon::prelude::*;
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Mutex;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
+
+/// The recorded hash of an optional input that was absent.
+pub const ABSENT: &str = "absent";
 
 /// Run the stages, or only say what would run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
     Run,
     Plan,
-}
-
-/// What happened to a node.
-#[derive(Clone, Debug, PartialEq)]
-pub enum NodeStatus {
-    /// The stage ran (or was recomputed because its cached artifact was corrupt or missing).
-    Executed,
-    /// The output came from the cache.
-    Cached,
-    /// The stage returned an error or panicked; nothing was stored.
-    Failed(String),
-    /// Not run because an upstream node failed (identity of that node).
-    Skipped { upstream: String },
-    /// Plan mode: the node will run, with the reasons.
-    WillRun { reasons: Vec<String> },
-}
-
-impl NodeStatus {
-    pub fn is_ok(&self) -> bool {
-        matches!(self, NodeStatus::Executed | NodeStatus::Cached)
-    }
 }
 
 /// The outcome of one node.
@@ -314,6 +297,14 @@ impl<'a> Exec<'a> {
         }
     }
 
+    /// Whether node `id` failed or was skipped (an optional input of it is absent).
+    fn unavailable(&self, id: NodeId) -> bool {
+        matches!(
+            self.slot(id).status,
+            Some(NodeStatus::Failed(_) | NodeStatus::Skipped { .. })
+        )
+    }
+
     fn set_status(&self, id: NodeId, status: NodeStatus) {
         self.slot(id).status = Some(status);
     }
@@ -374,6 +365,7 @@ impl<'a> Exec<'a> {
             let mut needed: Vec<NodeId> = to_run
                 .iter()
                 .flat_map(|(id, _)| self.dag.nodes[*id].upstream_ids())
+                .filter(|&u| !self.unavailable(u))
                 .collect();
             needed.sort_unstable();
             needed.dedup();
@@ -446,7 +438,15 @@ impl<'a> Exec<'a> {
         let mut upstream_running = Vec::new();
         for (label, r) in &node.inputs {
             match r {
-                InputRef::Node(u) => {
+                InputRef::OptionalNode(u) if self.unavailable(*u) => {
+                    hashes.push(absent_hash());
+                    recorded.push(RecordedInput {
+                        label: label.clone(),
+                        source: self.dag.nodes[*u].identity(),
+                        hash: ABSENT.to_string(),
+                    });
+                }
+                InputRef::Node(u) | InputRef::OptionalNode(u) => {
                     let s = self.slot(*u);
                     let source = self.dag.nodes[*u].identity();
                     match &s.status {
@@ -609,6 +609,16 @@ impl<'a> Exec<'a> {
     /// recompute those whose artifact is gone or corrupt (after ensuring their own inputs). Returns the ids
     /// that could not be provided, with the reason.
     fn ensure_values(&self, ids: &[NodeId]) -> Vec<(NodeId, String)> {
+        self.ensure_values_keeping(ids, &HashSet::new())
+    }
+
+    /// [`Self::ensure_values`], never releasing the values in `keep` (those an enclosing call still needs:
+    /// in a diamond, a node can be both an input and an input's input of what is being recomputed).
+    fn ensure_values_keeping(
+        &self,
+        ids: &[NodeId],
+        keep: &HashSet<NodeId>,
+    ) -> Vec<(NodeId, String)> {
         let missing: Vec<NodeId> = ids
             .iter()
             .copied()
@@ -644,11 +654,19 @@ impl<'a> Exec<'a> {
         let mut upstream: Vec<NodeId> = recompute
             .iter()
             .flat_map(|&id| self.dag.nodes[id].upstream_ids())
+            .filter(|&u| !self.unavailable(u))
             .collect();
         upstream.sort_unstable();
         upstream.dedup();
-        let upstream_failures: HashMap<NodeId, String> =
-            self.ensure_values(&upstream).into_iter().collect();
+        let mut keep_upstream = keep.clone();
+        keep_upstream.extend(ids.iter().copied());
+        keep_upstream.extend(upstream.iter().copied());
+        let upstream_failures: HashMap<NodeId, String> = self
+            .ensure_values_keeping(&upstream, &keep_upstream)
+            .into_iter()
+            .collect();
+        // A node recomputed as an upstream of another one in this set is not run twice.
+        recompute.retain(|&id| self.slot(id).value.is_none());
         let results: Vec<(NodeId, Result<f64, String>)> = recompute
             .par_iter()
             .map(|&id| {
@@ -684,6 +702,9 @@ impl<'a> Exec<'a> {
         }
         // Release recomputed upstream values nobody will read again.
         for &u in &upstream {
+            if keep.contains(&u) || ids.contains(&u) {
+                continue;
+            }
             let mut s = self.slot(u);
             if s.consumers_left == 0 && !self.dag.nodes[u].requested {
                 s.value = None;
@@ -699,7 +720,11 @@ impl<'a> Exec<'a> {
         let mut hashes = Vec::with_capacity(node.inputs.len());
         for (_, r) in &node.inputs {
             match r {
-                InputRef::Node(u) => {
+                InputRef::OptionalNode(u) if self.unavailable(*u) => {
+                    values.push(InputValue::Absent);
+                    hashes.push(absent_hash());
+                }
+                InputRef::Node(u) | InputRef::OptionalNode(u) => {
                     let s = self.slot(*u);
                     match (&s.value, s.hash) {
                         (Some(v), Some(h)) => {

@@ -9,7 +9,7 @@
 //! b.add(ToyScale, "x", Default::default(), folder).unwrap(); // ToyScale reads a Handle<f64>
 //! ```
 
-use crate::dag::stage::StageError;
+use crate::dag::error::StageError;
 use crate::hashing::ContentHash;
 use std::any::Any;
 use std::marker::PhantomData;
@@ -71,7 +71,19 @@ pub struct RawFileValue {
 #[derive(Clone, Debug)]
 pub enum InputRef {
     Node(NodeId),
+    /// A node's output the consumer can do without (see [`Optional`]).
+    OptionalNode(NodeId),
     File(PathBuf),
+}
+
+impl InputRef {
+    /// The upstream node of this edge, if it is one.
+    pub fn node(&self) -> Option<NodeId> {
+        match self {
+            InputRef::Node(id) | InputRef::OptionalNode(id) => Some(*id),
+            InputRef::File(_) => None,
+        }
+    }
 }
 
 /// One input value, as the executor hands it over.
@@ -79,6 +91,57 @@ pub enum InputRef {
 pub enum InputValue {
     Node(Arc<dyn Any + Send + Sync>),
     File(RawFileValue),
+    /// An optional input whose node failed or was skipped.
+    Absent,
+}
+
+/// The input hash standing for an [`Optional`] input whose node failed or was skipped: a consumer that ran
+/// without it has a key of its own, and runs again once the input is produced.
+pub fn absent_hash() -> ContentHash {
+    ContentHash(
+        *blake3::hash(b"skytie: optional input absent (its node failed or was skipped)").as_bytes(),
+    )
+}
+
+/// An input the consumer can do without: when its node fails or is skipped, the consumer still runs and
+/// receives `None`. For aggregates over many items (the adjustment over every recording, a summary over all
+/// images), so that one bad item fails only its own nodes; the engine counts it as failed.
+pub struct Optional<T>(pub Handle<T>);
+
+impl<T> Clone for Optional<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T> Copy for Optional<T> {}
+
+impl<T> Handle<T> {
+    /// This handle as an [`Optional`] input.
+    pub fn optional(self) -> Optional<T> {
+        Optional(self)
+    }
+}
+
+/// Every handle of `handles` as an [`Optional`] input.
+pub fn optional_all<T>(handles: &[Handle<T>]) -> Vec<Optional<T>> {
+    handles.iter().map(|h| h.optional()).collect()
+}
+
+impl<T: Send + Sync + 'static> InputSet for Optional<T> {
+    type Values = Option<Arc<T>>;
+    fn collect_refs(&self, label: &str, out: &mut Vec<(String, InputRef)>) {
+        out.push((label.to_string(), InputRef::OptionalNode(self.0.id)));
+    }
+    fn take_values(
+        &self,
+        values: &mut std::slice::Iter<'_, InputValue>,
+    ) -> Result<Option<Arc<T>>, StageError> {
+        match values.next() {
+            Some(InputValue::Node(v)) => v.clone().downcast::<T>().map(Some).map_err(|_| missing()),
+            Some(InputValue::Absent) => Ok(None),
+            _ => Err(missing()),
+        }
+    }
 }
 
 /// A set of typed inputs. Implemented for `()`, `Handle<T>`, `RawFile`, `Vec<I>` and tuples (up to 6).

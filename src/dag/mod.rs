@@ -1,19 +1,25 @@
 //! The dataflow engine: typed stages and handles, graph building, keys, records and the executor.
 
 pub mod builder;
+pub mod error;
 pub mod executor;
+pub mod failures;
 pub mod inputs;
+pub mod json_diff;
 pub mod key;
 pub mod node;
+pub mod progress;
 pub mod record;
 pub mod stage;
+pub mod status;
 
 pub use builder::{BuildError, Dag, DagBuilder};
+pub use error::StageError;
 pub use executor::{execute, Env, Mode, NodeReport, NodeStatus, Outcome};
-pub use inputs::{Handle, InputSet, NodeId, RawFile, RawFileValue};
-pub use stage::{NodeCtx, Stage, StageError};
+pub use inputs::{optional_all, Handle, InputSet, NodeId, Optional, RawFile, RawFileValue};
+pub use stage::{NodeCtx, Stage};
 pub mod pipeline;
 pub mod session;
 
-pub use pipeline::{pipeline_by_name, Pipeline};
+pub use pipeline::Pipeline;
 pub use session::{Phase, PhaseValues, PipelineError, Session};

@@ -1,8 +1,9 @@
 //! A node of the DAG with its stage type erased, so nodes of many stage types live in one graph.
 
 use crate::codec::{Artifact, CodecError};
+use crate::dag::error::StageError;
 use crate::dag::inputs::{InputRef, InputSet, InputValue};
-use crate::dag::stage::{NodeCtx, Stage, StageError};
+use crate::dag::stage::{NodeCtx, Stage};
 use std::any::Any;
 use std::io::{self, Read, Write};
 use std::sync::Arc;
@@ -88,14 +89,7 @@ impl Node {
     }
     /// Ids of the nodes this node reads (each once, ascending).
     pub fn upstream_ids(&self) -> Vec<usize> {
-        let mut ids: Vec<usize> = self
-            .inputs
-            .iter()
-            .filter_map(|(_, r)| match r {
-                InputRef::Node(id) => Some(*id),
-                InputRef::File(_) => None,
-            })
-            .collect();
+        let mut ids: Vec<usize> = self.inputs.iter().filter_map(|(_, r)| r.node()).collect();
         ids.sort_unstable();
         ids.dedup();
         ids

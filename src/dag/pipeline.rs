@@ -1,5 +1,6 @@
 //! Pipelines: Rust functions that turn a workflow into DAG phases. A workflow names its pipeline
-//! (`pipeline = "skytie"` by default); the registry below maps names to implementations.
+//! (`pipeline = "skytie"` by default); the command line's registry (`pipelines::by_name`) maps names to
+//! implementations, so the engine knows none of them.
 
 use crate::dag::session::{PipelineError, Session};
 use crate::workflow::Workflow;
@@ -17,21 +18,4 @@ pub trait Pipeline: Sync {
     }
     /// Build each phase, execute it with `session.execute`, build the next from its values.
     fn run(&self, workflow: &Workflow, session: &mut Session<'_>) -> Result<(), PipelineError>;
-}
-
-/// The pipeline a workflow asks for.
-pub fn pipeline_by_name(name: &str) -> Result<&'static dyn Pipeline, String> {
-    match name {
-        "skytie" => Ok(&crate::pipelines::skytie::SkytiePipeline),
-        "toy" => Ok(&crate::testing::toy_pipeline::ToyPipeline),
-        other => Err(format!(
-            "unknown pipeline '{other}': this skytie knows: {} (set `pipeline = ...` in the workflow)",
-            known_pipelines().join(", ")
-        )),
-    }
-}
-
-/// Names of the registered pipelines.
-pub fn known_pipelines() -> Vec<&'static str> {
-    vec!["skytie", "toy"]
 }

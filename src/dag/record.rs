@@ -118,47 +118,6 @@ pub fn save_failure(store: &Store, failure: &FailureRecord) -> Result<(), String
         .map_err(|e| e.to_string())
 }
 
-/// Records every FAILED node of an executed (run-mode) phase under its first variant, as node records are
-/// (nodes skipped because an upstream failed are not failures of their own). Returns the number recorded, or
-/// the first error.
-pub fn save_failures(
-    store: &Store,
-    dag: &crate::dag::Dag,
-    reports: &[crate::dag::NodeReport],
-) -> Result<usize, String> {
-    let now = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.as_secs())
-        .unwrap_or(0);
-    let mut recorded = 0;
-    for report in reports {
-        let crate::dag::NodeStatus::Failed(error) = &report.status else {
-            continue;
-        };
-        let Some(node) = dag.nodes().get(report.id) else {
-            continue;
-        };
-        let failure = FailureRecord {
-            identity: report.identity.clone(),
-            variant: node
-                .variants
-                .first()
-                .cloned()
-                .unwrap_or_else(|| "default".to_string()),
-            key: report.key.map(|k| k.to_string()).unwrap_or_default(),
-            stage_version: node.version.to_string(),
-            params: node.params_json.clone(),
-            inputs: report.inputs.clone(),
-            error: error.clone(),
-            recorded_unix_s: now,
-            skytie_version: env!("CARGO_PKG_VERSION").to_string(),
-        };
-        save_failure(store, &failure)?;
-        recorded += 1;
-    }
-    Ok(recorded)
-}
-
 /// Why a node that FAILED last time will run: `failed last time: <error>`, then what changed since that
 /// attempt (nothing, when it is retried with the same ingredients). The error is cut to its first line.
 pub fn failure_reasons(
@@ -215,7 +174,7 @@ pub fn reasons(
         ));
     }
     let mut changes = Vec::new();
-    diff_json("", &prev.params, params, &mut changes);
+    crate::dag::json_diff::diff_json("", &prev.params, params, &mut changes);
     for c in changes {
         why.push(format!("param changed: {c}"));
     }
@@ -248,41 +207,6 @@ pub fn reasons(
     why
 }
 
-/// Dotted paths of the fields that differ between two JSON values, as `path: old -> new`.
-pub fn diff_json(
-    path: &str,
-    old: &serde_json::Value,
-    new: &serde_json::Value,
-    out: &mut Vec<String>,
-) {
-    use serde_json::Value;
-    match (old, new) {
-        (Value::Object(a), Value::Object(b)) => {
-            let mut keys: Vec<&String> = a.keys().chain(b.keys()).collect();
-            keys.sort();
-            keys.dedup();
-            for k in keys {
-                let p = if path.is_empty() {
-                    k.clone()
-                } else {
-                    format!("{path}.{k}")
-                };
-                match (a.get(k), b.get(k)) {
-                    (Some(x), Some(y)) => diff_json(&p, x, y, out),
-                    (None, Some(y)) => out.push(format!("{p}: (absent) -> {y}")),
-                    (Some(x), None) => out.push(format!("{p}: {x} -> (absent)")),
-                    (None, None) => {}
-                }
-            }
-        }
-        _ if old != new => {
-            let p = if path.is_empty() { "(params)" } else { path };
-            out.push(format!("{p}: {old} -> {new}"));
-        }
-        _ => {}
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -291,7 +215,7 @@ mod tests {
     #[test]
     fn diff_names_nested_changed_fields() {
         let mut out = Vec::new();
-        diff_json(
+        crate::dag::json_diff::diff_json(
             "",
             &json!({"a": 1, "b": {"c": 2, "d": 3}}),
             &json!({"a": 1, "b": {"c": 5, "d": 3}, "e": true}),

@@ -10,8 +10,8 @@ use crate::dag::builder::Dag;
 use crate::dag::executor::{execute, Env, Mode, NodeReport, Outcome};
 use crate::dag::inputs::{Handle, NodeId};
 use crate::dag::node::AnyValue;
+use crate::dag::progress::Progress;
 use crate::hashing::StatCache;
-use crate::progress::Progress;
 use crate::store::Store;
 use std::collections::HashMap;
 use std::fmt;
@@ -140,7 +140,7 @@ impl<'a> Session<'a> {
         } = execute(&dag, &env, self.mode);
         if self.mode == Mode::Run {
             // `plan` says "failed last time: <error>" for these until they succeed.
-            if let Err(e) = crate::dag::record::save_failures(self.store, &dag, &reports) {
+            if let Err(e) = crate::dag::failures::save_failures(self.store, &dag, &reports) {
                 self.progress
                     .warn(&format!("could not record the failed nodes: {e}"));
             }

@@ -5,11 +5,11 @@
 //! what the stage computes: that re-runs exactly this stage's nodes (and dependents whose inputs change).
 
 use crate::codec::Artifact;
+use crate::dag::error::StageError;
 use crate::dag::inputs::InputSet;
 use crate::hashing::NodeKey;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
-use std::fmt;
 use std::path::{Path, PathBuf};
 
 /// A typed DAG computation. See the module documentation.
@@ -38,34 +38,6 @@ pub trait Stage: Send + Sync + 'static {
     /// outside the store that is gone (e.g. a generated folder was deleted), and the node is recomputed.
     fn cached_output_ok(&self, _output: &Self::Output, _ctx: &NodeCtx) -> bool {
         true
-    }
-}
-
-/// Why a stage failed; the message should say what is wrong and what to do.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct StageError {
-    pub message: String,
-}
-
-impl StageError {
-    pub fn new(message: impl Into<String>) -> Self {
-        StageError {
-            message: message.into(),
-        }
-    }
-}
-
-impl fmt::Display for StageError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.message)
-    }
-}
-
-impl std::error::Error for StageError {}
-
-impl From<std::io::Error> for StageError {
-    fn from(e: std::io::Error) -> Self {
-        StageError::new(e.to_string())
     }
 }
 

@@ -1,48 +1,59 @@
-//! Parameter validation of stage parameter types defined in `skytie-stages` (which does not know the engine's
-//! [`StageParams`] trait): each implementation forwards to the type's own `validate`.
+//! The bridge between the stages' declared parameters and the engine: every parameter struct declared with
+//! `skytie_stages::params!` (which does not know the engine) is a workflow table the engine can read and check,
+//! its range and cross-field violations becoming the engine's [`ParamError`]s.
 
 use crate::workflow::{ParamError, StageParams};
-use skytie_stages::adjustment::verify::VerifyConfig;
-use skytie_stages::adjustment::AdjustConfig;
-use skytie_stages::nadir::baseline::BaselineParams;
-use skytie_stages::nadir::control_points::ControlParams;
-use skytie_stages::nadir::initial_transform::TransformParams;
-use skytie_stages::nadir::mm_matching::MmMatchParams;
-use skytie_stages::nadir::refine::RefineParams;
-use skytie_stages::nadir::OrthoParams;
-use skytie_stages::oblique::consensus::ConsensusParams;
-use skytie_stages::oblique::facades::FacadeParams;
-use skytie_stages::oblique::patch_registration::PatchParams;
-use skytie_stages::oblique::sparse_cloud::SparseCloudParams;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use skytie_stages::params::Params;
 
-fn convert(errs: Vec<(String, String)>) -> Vec<ParamError> {
-    errs.into_iter()
-        .map(|(field, message)| ParamError::new(field, message))
-        .collect()
+impl<P: Params + Serialize + DeserializeOwned> StageParams for P {
+    fn validate(&self) -> Result<(), Vec<ParamError>> {
+        Params::validate(self).map_err(|violations| {
+            violations
+                .into_iter()
+                .map(|v| ParamError::new(v.field, v.message))
+                .collect()
+        })
+    }
 }
 
-/// `impl StageParams for T` forwarding to `T::validate(&self) -> Result<(), Vec<(String, String)>>`.
-macro_rules! forward_validate {
-    ($($t:ty),+ $(,)?) => {$(
-        impl StageParams for $t {
-            fn validate(&self) -> Result<(), Vec<ParamError>> {
-                <$t>::validate(self).map_err(convert)
-            }
-        }
-    )+};
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nodes::campaign::aerial::SelectAerialParams;
+    use crate::nodes::campaign::load::{LoadCampaignParams, SelectRecordingParams};
+    use crate::nodes::campaign::summary::SummaryParams;
+    use crate::nodes::campaign::synth::SynthParams;
+    use crate::nodes::nadir::options::NadirOptions;
+    use crate::nodes::oblique::options::ObliqueOptions;
+    use skytie_stages::params::self_check::declaration_problems;
+    use std::fmt::Debug;
 
-forward_validate!(
-    OrthoParams,
-    MmMatchParams,
-    TransformParams,
-    RefineParams,
-    ControlParams,
-    BaselineParams,
-    AdjustConfig,
-    VerifyConfig,
-    SparseCloudParams,
-    FacadeParams,
-    PatchParams,
-    ConsensusParams,
-);
+    fn check<P: Params + Serialize + DeserializeOwned + PartialEq + Debug>() {
+        let problems = declaration_problems::<P>();
+        assert!(problems.is_empty(), "{}", problems.join("\n"));
+    }
+
+    #[test]
+    fn every_node_parameter_struct() {
+        check::<SynthParams>();
+        check::<LoadCampaignParams>();
+        check::<SelectRecordingParams>();
+        check::<SelectAerialParams>();
+        check::<SummaryParams>();
+        check::<NadirOptions>();
+        check::<ObliqueOptions>();
+    }
+
+    #[test]
+    fn violations_reach_the_engine_with_their_dotted_field() {
+        let mut o = ObliqueOptions::default();
+        o.consensus.threshold_m = -1.0;
+        o.plane_neighbours = 11;
+        let errs = StageParams::validate(&o).unwrap_err();
+        let fields: Vec<&str> = errs.iter().map(|e| e.field.as_str()).collect();
+        assert_eq!(fields, ["plane_neighbours", "consensus.threshold_m"]);
+        assert_eq!(errs[1].message, "must be in (0, 100] m, got -1");
+    }
+}

@@ -4,14 +4,15 @@
 
 use super::nadir::{NadirHandles, RecordingItem};
 use super::oblique::ObliqueHandles;
+use super::stage;
 use super::wf_err;
-use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
-use crate::nodes::adjust::{AdjustReport, AdjustStage};
-use crate::nodes::adjust_grade::{AdjustGrade, GradeAdjust};
-use crate::nodes::campaign::CampaignSnapshot;
-use crate::nodes::nadir_grade::TRUTH_RECORDINGS;
-use crate::nodes::summary::SummaryParams;
-use crate::nodes::verify::{verify_metrics, VerifyStage};
+use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
+use crate::nodes::adjust::adjustment::{AdjustReport, AdjustStage};
+use crate::nodes::adjust::grade::{AdjustGrade, GradeAdjust};
+use crate::nodes::adjust::verify::{verify_metrics, VerifyStage};
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::summary::SummaryParams;
+use crate::nodes::nadir::grade::TRUTH_RECORDINGS;
 use crate::workflow::Workflow;
 use skytie_stages::adjustment::verify::{Verification, VerifyConfig};
 use skytie_stages::adjustment::{AdjustConfig, Sources};
@@ -20,7 +21,10 @@ use std::path::Path;
 /// Handles of the adjustment outputs (for the exports written after the run).
 pub struct AdjustHandles {
     pub report: Option<Handle<AdjustReport>>,
+    /// The recorded trajectory verified against aerial control (without adjusting).
     pub verification: Option<Handle<Verification>>,
+    /// The adjusted trajectory verified the same way (when both `adjust` and `verify` run).
+    pub verification_adjusted: Option<Handle<Verification>>,
 }
 
 /// Add `adjust`, `grade_adjust` and `verify` when the workflow enables them.
@@ -39,8 +43,9 @@ pub fn add_adjust(
     let mut out = AdjustHandles {
         report: None,
         verification: None,
+        verification_adjusted: None,
     };
-    if !(on("adjust") || on("verify") || on("grade_adjust")) {
+    if !(on(stage::ADJUST) || on(stage::VERIFY) || on(stage::GRADE_ADJUST)) {
         return Ok(out);
     }
     let nadir = nadir.filter(|n| !n.control.is_empty() || !n.windows.is_empty());
@@ -54,8 +59,8 @@ pub fn add_adjust(
         )));
     }
     let panos: Vec<RawFile> = items.iter().map(|i| i.pano.clone()).collect();
-    if on("adjust") {
-        let config: AdjustConfig = wf.params("adjust", variant).map_err(wf_err)?;
+    if on(stage::ADJUST) {
+        let config: AdjustConfig = wf.params(stage::ADJUST, variant).map_err(wf_err)?;
         let use_nadir = matches!(config.sources, Sources::Nadir | Sources::Combined);
         let use_oblique = matches!(config.sources, Sources::Oblique | Sources::Combined);
         let missing = match (
@@ -88,16 +93,16 @@ pub fn add_adjust(
             (
                 snap,
                 panos.clone(),
-                windows,
-                control,
-                clouds,
-                oblique_result,
+                optional_all(&windows),
+                optional_all(&control),
+                optional_all(&clouds),
+                optional_all(&oblique_result),
             ),
         )?;
         b.metrics(report, "adjust", |r: &AdjustReport| r.metrics());
         out.report = Some(report);
         let truth = root.join(TRUTH_RECORDINGS);
-        if on("grade_adjust") && truth.is_file() {
+        if on(stage::GRADE_ADJUST) && truth.is_file() {
             let grade = b.add(
                 GradeAdjust,
                 "",
@@ -107,8 +112,8 @@ pub fn add_adjust(
             b.metrics(grade, "adjust", |g: &AdjustGrade| g.metrics());
         }
     }
-    if on("verify") {
-        let config: VerifyConfig = wf.params("verify", variant).map_err(wf_err)?;
+    if on(stage::VERIFY) {
+        let config: VerifyConfig = wf.params(stage::VERIFY, variant).map_err(wf_err)?;
         let Some(nadir) = nadir else {
             return Err(wf_err(format!(
                 "{}: 'verify' compares aerial nadir control points with the MM data: enable the nadir chain",
@@ -117,12 +122,27 @@ pub fn add_adjust(
         };
         let v = b.add(
             VerifyStage,
-            "",
-            config,
-            (snap, panos, nadir.control.clone()),
+            "recorded",
+            config.clone(),
+            (
+                snap,
+                panos.clone(),
+                optional_all(&nadir.control),
+                Vec::new(),
+            ),
         )?;
         b.metrics(v, "verify", verify_metrics);
         out.verification = Some(v);
+        if let Some(report) = out.report {
+            let v = b.add(
+                VerifyStage,
+                "adjusted",
+                config,
+                (snap, panos, optional_all(&nadir.control), vec![report]),
+            )?;
+            b.metrics(v, "verify_adjusted", verify_metrics);
+            out.verification_adjusted = Some(v);
+        }
     }
     Ok(out)
 }

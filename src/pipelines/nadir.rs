@@ -4,21 +4,21 @@
 //! aerial control points (`control`), then the global `nadir` summary and — on synthetic campaigns with
 //! `truth/` — the evaluation node `grade_nadir`.
 
-use super::{distance_m, missing_upstream, wf_err};
-use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
-use crate::nodes::aerial::{SelectAerial, SelectAerialParams};
-use crate::nodes::baseline::BaselineStage;
-use crate::nodes::campaign::CampaignSnapshot;
-use crate::nodes::control::ControlStage;
-use crate::nodes::mm_match::MmMatch;
-use crate::nodes::nadir_grade::{grade_metrics, GradeNadir, TRUTH_AERIAL_NADIR, TRUTH_RECORDINGS};
-use crate::nodes::nadir_options::{Matcher, NadirOptions};
-use crate::nodes::nadir_summary::SummarizeNadir;
-use crate::nodes::ortho_aerial::OrthoForAerial;
-use crate::nodes::refine::RefineStage;
-use crate::nodes::summary::SummaryParams;
-use crate::nodes::transform::InitialTransformStage;
-use crate::nodes::transform_agreement::TransformAgreementStage;
+use super::{distance_m, missing_upstream, stage, wf_err};
+use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
+use crate::nodes::campaign::aerial::{SelectAerial, SelectAerialParams};
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::summary::SummaryParams;
+use crate::nodes::nadir::baseline::BaselineStage;
+use crate::nodes::nadir::control::ControlStage;
+use crate::nodes::nadir::grade::{grade_metrics, GradeNadir, TRUTH_AERIAL_NADIR, TRUTH_RECORDINGS};
+use crate::nodes::nadir::mm_match::MmMatch;
+use crate::nodes::nadir::options::{Matcher, NadirOptions};
+use crate::nodes::nadir::ortho_aerial::OrthoForAerial;
+use crate::nodes::nadir::refine::RefineStage;
+use crate::nodes::nadir::summary::SummarizeNadir;
+use crate::nodes::nadir::transform::InitialTransformStage;
+use crate::nodes::nadir::transform_agreement::TransformAgreementStage;
 use crate::workflow::Workflow;
 use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
 use skytie_stages::nadir::aerial_overlap::overlapping_nadir;
@@ -37,13 +37,13 @@ use std::path::Path;
 
 /// The stages of the nadir chain, in dependency order.
 pub const NADIR_STAGES: [&str; 7] = [
-    "mm_match",
-    "ortho_aerial",
-    "transform",
-    "refine",
-    "control",
-    "nadir",
-    "grade_nadir",
+    stage::MM_MATCH,
+    stage::ORTHO_AERIAL,
+    stage::TRANSFORM,
+    stage::REFINE,
+    stage::CONTROL,
+    stage::NADIR,
+    stage::GRADE_NADIR,
 ];
 
 /// One recording's per-item handles, built by the main pipeline.
@@ -66,9 +66,9 @@ pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
     let on = |s: &str| wf.stages.iter().any(|x| x == s);
     let Some(last) = NADIR_STAGES
         .iter()
-        .rposition(|s| on(s) && *s != "grade_nadir")
+        .rposition(|s| on(s) && *s != stage::GRADE_NADIR)
     else {
-        if on("grade_nadir") {
+        if on(stage::GRADE_NADIR) {
             return Err(wf_err(format!(
                 "{}: stage 'grade_nadir' needs the nadir chain ({})",
                 wf.path.display(),
@@ -78,14 +78,14 @@ pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
         return Ok(false);
     };
     let mut needed: Vec<&str> = NADIR_STAGES[..=last].to_vec();
-    if !on("ortho") {
-        needed.insert(0, "ortho");
+    if !on(stage::ORTHO) {
+        needed.insert(0, stage::ORTHO);
     }
     let missing: Vec<&str> = needed.into_iter().filter(|s| !on(s)).collect();
     if !missing.is_empty() {
         return Err(missing_upstream(
             wf,
-            "nadir",
+            stage::NADIR,
             NADIR_STAGES[last],
             &missing,
             &format!("ortho, {}", NADIR_STAGES.join(", ")),
@@ -107,11 +107,11 @@ pub fn add_nadir(
     ortho_base: &OrthoParams,
 ) -> Result<NadirHandles, PipelineError> {
     let on = |s: &str| wf.stages.iter().any(|x| x == s);
-    let options: NadirOptions = wf.params("nadir", variant).map_err(wf_err)?;
-    let mm_params: MmMatchParams = wf.params("mm_match", variant).map_err(wf_err)?;
-    let transform_params: TransformParams = wf.params("transform", variant).map_err(wf_err)?;
-    let refine_params: RefineParams = wf.params("refine", variant).map_err(wf_err)?;
-    let control_params: ControlParams = wf.params("control", variant).map_err(wf_err)?;
+    let options: NadirOptions = wf.params(stage::NADIR, variant).map_err(wf_err)?;
+    let mm_params: MmMatchParams = wf.params(stage::MM_MATCH, variant).map_err(wf_err)?;
+    let transform_params: TransformParams = wf.params(stage::TRANSFORM, variant).map_err(wf_err)?;
+    let refine_params: RefineParams = wf.params(stage::REFINE, variant).map_err(wf_err)?;
+    let control_params: ControlParams = wf.params(stage::CONTROL, variant).map_err(wf_err)?;
     let window_len = if options.triples { 2 } else { 1 };
     let Some(orthos) = items.iter().map(|i| i.ortho).collect::<Option<Vec<_>>>() else {
         return Err(wf_err(format!(
@@ -151,7 +151,7 @@ pub fn add_nadir(
             ),
         )?;
         windows.push(window);
-        if !on("ortho_aerial") {
+        if !on(stage::ORTHO_AERIAL) {
             continue;
         }
         let mut rec_refinements = Vec::new();
@@ -188,7 +188,7 @@ pub fn add_nadir(
                 ortho_base.clone(),
                 (item.row, item.pano.clone(), aerial),
             )?;
-            if !on("transform") {
+            if !on(stage::TRANSFORM) {
                 continue;
             }
             let outcome = b.add(
@@ -216,7 +216,7 @@ pub fn add_nadir(
                 (outcome, outcomes.clone()),
             )?;
             transforms.push(outcome);
-            if !on("refine") {
+            if !on(stage::REFINE) {
                 continue;
             }
             let inputs = (ortho, aerial_file, aerial, outcome, window);
@@ -244,7 +244,7 @@ pub fn add_nadir(
                     )?
                 }
                 Matcher::Baseline => {
-                    let p: BaselineParams = wf.params("baseline", variant).map_err(wf_err)?;
+                    let p: BaselineParams = wf.params(stage::BASELINE, variant).map_err(wf_err)?;
                     b.add(BaselineStage, &pair, p, inputs)?
                 }
             };
@@ -252,32 +252,32 @@ pub fn add_nadir(
             rec_refinements.push(refined);
             rec_aerials.push(aerial);
         }
-        if on("control") {
+        if on(stage::CONTROL) {
             control.push(b.add(
                 ControlStage,
                 &label,
                 control_params.clone(),
-                (window, rec_refinements, rec_aerials),
+                (window, optional_all(&rec_refinements), rec_aerials),
             )?);
         }
     }
-    if on("nadir") {
+    if on(stage::NADIR) {
         let summary = b.add(
             SummarizeNadir,
             "",
             SummaryParams::default(),
             (
                 snap,
-                windows.clone(),
-                transforms,
-                refinements.clone(),
-                control.clone(),
+                optional_all(&windows),
+                optional_all(&transforms),
+                optional_all(&refinements),
+                optional_all(&control),
             ),
         )?;
         b.metrics(summary, "nadir", |s: &NadirSummary| s.metrics());
     }
     let truth = root.join(TRUTH_RECORDINGS);
-    if on("grade_nadir") && truth.is_file() {
+    if on(stage::GRADE_NADIR) && truth.is_file() {
         let mut truth_files = vec![RawFile(truth)];
         let truth_aerial = root.join(TRUTH_AERIAL_NADIR);
         if truth_aerial.is_file() {

@@ -8,19 +8,19 @@
 //! setting; `patches` once per distinct (façades, registration setting).
 
 use super::nadir::RecordingItem;
-use super::{distance_m, missing_upstream, wf_err};
-use crate::dag::{DagBuilder, Handle, PipelineError, RawFile};
-use crate::nodes::aerial::{SelectAerial, SelectAerialParams};
-use crate::nodes::campaign::CampaignSnapshot;
-use crate::nodes::consensus::{ConsensusStage, ObliqueOutput};
-use crate::nodes::facades::FacadesStage;
-use crate::nodes::oblique_grade::{
+use super::{distance_m, missing_upstream, stage, wf_err};
+use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
+use crate::nodes::campaign::aerial::{SelectAerial, SelectAerialParams};
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::summary::SummaryParams;
+use crate::nodes::oblique::consensus::{ConsensusStage, ObliqueOutput};
+use crate::nodes::oblique::facades::FacadesStage;
+use crate::nodes::oblique::grade::{
     GradeOblique, SCENE_TRUTH_FILE, TRUTH_AERIAL_OBLIQUE, TRUTH_RECORDINGS,
 };
-use crate::nodes::oblique_options::ObliqueOptions;
-use crate::nodes::patches::PatchesStage;
-use crate::nodes::sparse_cloud::SparseCloudStage;
-use crate::nodes::summary::SummaryParams;
+use crate::nodes::oblique::options::ObliqueOptions;
+use crate::nodes::oblique::patches::PatchesStage;
+use crate::nodes::oblique::sparse_cloud::SparseCloudStage;
 use crate::workflow::Workflow;
 use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
 use skytie_stages::oblique::candidates::candidate_oblique;
@@ -33,11 +33,11 @@ use std::path::Path;
 
 /// The stages of the oblique chain, in dependency order.
 pub const OBLIQUE_STAGES: [&str; 5] = [
-    "sparse_cloud",
-    "facades",
-    "patches",
-    "oblique",
-    "grade_oblique",
+    stage::SPARSE_CLOUD,
+    stage::FACADES,
+    stage::PATCHES,
+    stage::OBLIQUE,
+    stage::GRADE_OBLIQUE,
 ];
 
 /// What the oblique chain hands to later stages (the adjustment, the exports).
@@ -52,7 +52,7 @@ pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
     let Some(last) = OBLIQUE_STAGES.iter().rposition(|s| on(s)) else {
         return Ok(false);
     };
-    let last_needed = if OBLIQUE_STAGES[last] == "grade_oblique" {
+    let last_needed = if OBLIQUE_STAGES[last] == stage::GRADE_OBLIQUE {
         3
     } else {
         last
@@ -65,7 +65,7 @@ pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
     if !missing.is_empty() {
         return Err(missing_upstream(
             wf,
-            "oblique",
+            stage::OBLIQUE,
             OBLIQUE_STAGES[last],
             &missing,
             &OBLIQUE_STAGES.join(", "),
@@ -86,10 +86,11 @@ pub fn add_oblique(
     items: &[RecordingItem<'_>],
 ) -> Result<ObliqueHandles, PipelineError> {
     let on = |s: &str| wf.stages.iter().any(|x| x == s);
-    let options: ObliqueOptions = wf.params("oblique", variant).map_err(wf_err)?;
-    let cloud_params: SparseCloudParams = wf.params("sparse_cloud", variant).map_err(wf_err)?;
-    let facade_params: FacadeParams = wf.params("facades", variant).map_err(wf_err)?;
-    let patch_params: PatchParams = wf.params("patches", variant).map_err(wf_err)?;
+    let options: ObliqueOptions = wf.params(stage::OBLIQUE, variant).map_err(wf_err)?;
+    let cloud_params: SparseCloudParams =
+        wf.params(stage::SPARSE_CLOUD, variant).map_err(wf_err)?;
+    let facade_params: FacadeParams = wf.params(stage::FACADES, variant).map_err(wf_err)?;
+    let patch_params: PatchParams = wf.params(stage::PATCHES, variant).map_err(wf_err)?;
     let oblique_dir = root.join("aerial/oblique");
     let oblique_rows = &snapshot.campaign.oblique;
 
@@ -119,7 +120,7 @@ pub fn add_oblique(
     let clouds: Vec<Handle<SparseCloud>> = triplets.iter().map(|(_, c)| *c).collect();
     // Pass 2: per triplet its façades (fitted to its own and its neighbours' points) and patches.
     for (t, &(centre_idx, cloud)) in triplets.iter().enumerate() {
-        if !on("facades") {
+        if !on(stage::FACADES) {
             break;
         }
         let centre = &items[centre_idx];
@@ -182,7 +183,7 @@ pub fn add_oblique(
             ),
         )?;
         all_facades.push(facades);
-        if !on("patches") {
+        if !on(stage::PATCHES) {
             continue;
         }
         for (a, aerial) in aerials {
@@ -207,7 +208,7 @@ pub fn add_oblique(
         clouds: clouds.clone(),
         result: None,
     };
-    if !on("oblique") {
+    if !on(stage::OBLIQUE) {
         return Ok(out);
     }
     let panos: Vec<RawFile> = items.iter().map(|i| i.pano.clone()).collect();
@@ -215,12 +216,18 @@ pub fn add_oblique(
         ConsensusStage,
         "",
         options.consensus.clone(),
-        (snap, panos.clone(), clouds.clone(), all_facades, sets),
+        (
+            snap,
+            panos.clone(),
+            optional_all(&clouds),
+            optional_all(&all_facades),
+            optional_all(&sets),
+        ),
     )?;
     b.metrics(result, "oblique", |o: &ObliqueOutput| o.summary.metrics());
     out.result = Some(result);
     let truth = root.join(TRUTH_RECORDINGS);
-    if on("grade_oblique") && truth.is_file() {
+    if on(stage::GRADE_OBLIQUE) && truth.is_file() {
         let mut truth_files = vec![RawFile(truth)];
         let truth_aerial = root.join(TRUTH_AERIAL_OBLIQUE);
         if truth_aerial.is_file() {

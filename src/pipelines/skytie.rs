@@ -2,7 +2,7 @@
 //!
 //! Phases (each built from the values of the previous one — staged planning):
 //! 1. `campaign`: the synthetic generator node when the workflow says `campaign = "synth:<preset>"`;
-//! 2. `load`: read and validate the campaign; then `vehicle`: the recording vehicle found in a sample of the
+//! 2. `load`: read and validate the campaign (its images probed by content); then `vehicle`: the recording vehicle found in a sample of the
 //!    panoramas (`pipelines::vehicle`), which masks every ortho image;
 //! 3. `items`, per sweep variant: per recording `recording` → `ortho` (thesis 3.4.3), the nadir chain
 //!    (`pipelines::nadir`, thesis chapter 3), the oblique chain (`pipelines::oblique`, chapter 4), the
@@ -11,10 +11,11 @@
 //! After phase 3 the exports of every variant are written into `OUT` (`OUT/variants/<name>/` in a sweep).
 //! A stage name the pipeline does not know is refused with the list of available ones.
 
-use super::{adjust, nadir, oblique, vehicle, wf_err};
-use crate::dag::{DagBuilder, Pipeline, PipelineError, RawFile, Session};
-use crate::exports::{verification_table, write_exports, ExportInputs};
-use crate::nodes::campaign::{listing_hash, metadata_inputs};
+use super::validate::add_validated_snapshot;
+use super::{adjust, nadir, oblique, stage, vehicle, wf_err};
+use crate::dag::{optional_all, DagBuilder, Pipeline, PipelineError, RawFile, Session};
+use crate::exports::{write_exports, ExportInputs};
+use crate::nodes::campaign::load::{listing_hash, metadata_inputs};
 use crate::nodes::{
     CampaignSummary, LoadCampaign, LoadCampaignParams, OrthoProject, RenderCampaign,
     SelectRecording, SelectRecordingParams, SummarizeCampaign, SummaryParams, SynthCampaign,
@@ -28,28 +29,7 @@ use std::path::{Path, PathBuf};
 pub struct SkytiePipeline;
 
 /// Stage names a workflow may enable in `stages = [...]`.
-pub const STAGES: [&str; 20] = [
-    "synth",
-    "load",
-    "ortho",
-    "summary",
-    "mm_match",
-    "ortho_aerial",
-    "transform",
-    "refine",
-    "control",
-    "nadir",
-    "grade_nadir",
-    "adjust",
-    "grade_adjust",
-    "verify",
-    "baseline",
-    "sparse_cloud",
-    "facades",
-    "patches",
-    "oblique",
-    "grade_oblique",
-];
+pub const STAGES: [&str; 20] = stage::ALL;
 
 /// Absolute form of a campaign folder (keys must not depend on the working directory's spelling).
 fn absolute(p: &Path) -> PathBuf {
@@ -63,6 +43,10 @@ impl Pipeline for SkytiePipeline {
 
     fn stage_names(&self) -> Vec<&'static str> {
         STAGES.to_vec()
+    }
+
+    fn validate(&self, wf: &Workflow) -> Result<(), String> {
+        super::catalogue::validate(wf)
     }
 
     fn run(&self, wf: &Workflow, session: &mut Session<'_>) -> Result<(), PipelineError> {
@@ -79,10 +63,12 @@ impl Pipeline for SkytiePipeline {
         let root: PathBuf = match &wf.campaign {
             CampaignSource::Path(p) => absolute(p),
             CampaignSource::Synth { preset, seed } => {
-                let mut params: SynthParams = wf.params("synth", "default").map_err(wf_err)?;
+                let mut params: SynthParams = wf.params(stage::SYNTH, "default").map_err(wf_err)?;
                 params.preset = preset.clone();
                 params.seed = *seed;
-                let options = params.options().map_err(PipelineError::Workflow)?;
+                let options = params
+                    .options()
+                    .map_err(|v| wf_err(format!("[synth] {v}")))?;
                 let mut b = DagBuilder::new();
                 let rendered = b.add(RenderCampaign, preset, options.render_identity(), ())?;
                 let h = b.add(SynthCampaign, preset, params, rendered)?;
@@ -112,7 +98,13 @@ impl Pipeline for SkytiePipeline {
         let snap_h = b.add(LoadCampaign, "", load_params.clone(), inputs.clone())?;
         b.request(snap_h);
         let values = session.execute("load", b.build());
-        let snapshot = values.require(snap_h, "the campaign")?;
+        let loaded = values.require(snap_h, "the campaign")?;
+        // Phase 2b: its images, probed by content (the validation `skytie check` applies).
+        let mut b = DagBuilder::new();
+        let valid_h = add_validated_snapshot(&mut b, &root, &load_params, &inputs, &loaded)?;
+        b.request(valid_h);
+        let values = session.execute("validate", b.build());
+        let snapshot = values.require(valid_h, "the validated campaign")?;
         if !snapshot.problems.is_empty() {
             eprintln!(
                 "campaign {}: {} problem(s) in the input; affected items are skipped (run `skytie check {}` for the list)",
@@ -121,17 +113,24 @@ impl Pipeline for SkytiePipeline {
                 root.display()
             );
         }
-        // Phase 2b: the recording vehicle, found in the panoramas (masks every ortho image).
-        let vehicle = vehicle::detect(wf, session, &root, &snapshot, (&load_params, &inputs))?;
+        // Phase 2c: the recording vehicle, found in the panoramas (masks every ortho image).
+        let campaign = vehicle::LoadedCampaign {
+            root: &root,
+            load_params: &load_params,
+            inputs: &inputs,
+            loaded: &loaded,
+            validated: &snapshot,
+        };
+        let vehicle = vehicle::detect(wf, session, &campaign)?;
         // Phase 3: per-recording stages and the summary, for every variant.
-        let ortho_on = wf.stages.iter().any(|s| s == "ortho");
+        let ortho_on = wf.stages.iter().any(|s| s == stage::ORTHO);
         let nadir_on = nadir::enabled(wf)?;
         let oblique_on = oblique::enabled(wf)?;
         let mut b = DagBuilder::new();
         let mut exports = Vec::new();
         for variant in wf.variants() {
             b.set_variant(&variant);
-            let snap = b.add(LoadCampaign, "", load_params.clone(), inputs.clone())?;
+            let snap = add_validated_snapshot(&mut b, &root, &load_params, &inputs, &loaded)?;
             let ortho: OrthoParams = vehicle::ortho_params(wf, &variant, vehicle.as_ref())?;
             let mut orthos = Vec::new();
             let mut items = Vec::new();
@@ -202,7 +201,7 @@ impl Pipeline for SkytiePipeline {
                 SummarizeCampaign,
                 "",
                 SummaryParams::default(),
-                (snap, orthos),
+                (snap, optional_all(&orthos)),
             )?;
             b.metrics(summary, "campaign", |s: &CampaignSummary| s.metrics().0);
             b.metrics(summary, "ortho", |s: &CampaignSummary| s.metrics().1);
@@ -212,6 +211,7 @@ impl Pipeline for SkytiePipeline {
             for (variant, h, nadir_control, oblique_result) in &exports {
                 let report = h.report.and_then(|r| values.get(r));
                 let verification = h.verification.and_then(|v| values.get(v));
+                let verification_adjusted = h.verification_adjusted.and_then(|v| values.get(v));
                 let nadir_control: Vec<_> = nadir_control
                     .iter()
                     .filter_map(|c| values.get(*c))
@@ -233,14 +233,12 @@ impl Pipeline for SkytiePipeline {
                     snapshot: &snapshot,
                     report: report.as_deref(),
                     verification: verification.as_deref(),
+                    verification_adjusted: verification_adjusted.as_deref(),
                     nadir_control: &nadir_control,
                     oblique: oblique.as_deref(),
                 };
                 for problem in write_exports(&dir, &inputs) {
                     session.progress.warn(&problem);
-                }
-                if let (false, Some(v)) = (wf.is_sweep(), &verification) {
-                    session.progress.info(&verification_table(v));
                 }
             }
         }

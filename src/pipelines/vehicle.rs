@@ -1,32 +1,42 @@
 //! The `vehicle` phase of the `skytie` pipeline: before the per-recording stages, the recording vehicle is found
-//! in a sample of the campaign's panoramas (`nodes::vehicle`), and every ortho image masks the detected box
-//! instead of the `[ortho.vehicle]` values — unless `[ortho.vehicle] detect = false` makes those the mask.
+//! in a sample of the campaign's validated panoramas (`nodes::nadir::vehicle`), and every ortho image masks the
+//! detected box instead of the `[ortho.vehicle]` values — unless `[ortho.vehicle] detect = false` makes those
+//! the mask.
 
-use super::wf_err;
+use super::validate::add_validated_snapshot;
+use super::{stage, wf_err};
 use crate::dag::{DagBuilder, PipelineError, RawFile, Session};
-use crate::nodes::campaign::CampaignSnapshot;
-use crate::nodes::vehicle::{DetectVehicle, VehicleDetection, VehicleNodeParams};
-use crate::nodes::{LoadCampaign, LoadCampaignParams};
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::nadir::vehicle::{DetectVehicle, VehicleDetection, VehicleNodeParams};
+use crate::nodes::LoadCampaignParams;
 use crate::workflow::Workflow;
 use skytie_stages::nadir::vehicle_detect::{spread_indices, VehicleDetectParams};
 use skytie_stages::nadir::OrthoParams;
 use std::path::Path;
 
+/// The campaign as the pipeline has read it: its folder, the load node's parameters and inputs, the loaded
+/// snapshot (which images there are) and the validated one (which recordings are usable).
+pub struct LoadedCampaign<'a> {
+    pub root: &'a Path,
+    pub load_params: &'a LoadCampaignParams,
+    pub inputs: &'a [RawFile],
+    pub loaded: &'a CampaignSnapshot,
+    pub validated: &'a CampaignSnapshot,
+}
+
 /// Run the detection when the ortho images are made and asked to use it; `None` otherwise.
 pub fn detect(
     wf: &Workflow,
     session: &mut Session<'_>,
-    root: &Path,
-    snapshot: &CampaignSnapshot,
-    load: (&LoadCampaignParams, &[RawFile]),
+    c: &LoadedCampaign<'_>,
 ) -> Result<Option<VehicleDetection>, PipelineError> {
-    let ortho_on = wf.stages.iter().any(|s| s == "ortho");
-    let base: OrthoParams = wf.params("ortho", "default").map_err(wf_err)?;
+    let ortho_on = wf.stages.iter().any(|s| s == stage::ORTHO);
+    let base: OrthoParams = wf.params(stage::ORTHO, "default").map_err(wf_err)?;
     if !ortho_on || !base.vehicle.detect || !base.vehicle.enabled {
         return Ok(None);
     }
     let detect = VehicleDetectParams::default();
-    let recs = &snapshot.campaign.recordings;
+    let recs = &c.validated.campaign.recordings;
     let picks = spread_indices(recs.len(), detect.max_recordings);
     let params = VehicleNodeParams {
         detect,
@@ -34,10 +44,10 @@ pub fn detect(
     };
     let panos: Vec<RawFile> = picks
         .iter()
-        .map(|&i| RawFile(root.join("mm/panoramas").join(&recs[i].file)))
+        .map(|&i| RawFile(c.root.join("mm/panoramas").join(&recs[i].file)))
         .collect();
     let mut b = DagBuilder::new();
-    let snap = b.add(LoadCampaign, "", load.0.clone(), load.1.to_vec())?;
+    let snap = add_validated_snapshot(&mut b, c.root, c.load_params, c.inputs, c.loaded)?;
     let h = b.add(DetectVehicle, "", params, (snap, panos))?;
     b.request(h);
     b.metrics(h, "vehicle", |d: &VehicleDetection| d.metrics());
@@ -55,7 +65,7 @@ pub fn ortho_params(
     variant: &str,
     detection: Option<&VehicleDetection>,
 ) -> Result<OrthoParams, PipelineError> {
-    let mut p: OrthoParams = wf.params("ortho", variant).map_err(wf_err)?;
+    let mut p: OrthoParams = wf.params(stage::ORTHO, variant).map_err(wf_err)?;
     if let Some(d) = detection {
         p.vehicle = d.mask_or(&p.vehicle);
     }

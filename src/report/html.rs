@@ -31,7 +31,16 @@ table.thesis th{background:#fde9c9}span.origin{font-weight:normal;font-style:ita
 table.thesis span.origin{color:#a05a00}p.note{font-size:0.9em;color:#555;margin-top:0}\
 figure{margin:1em 0}figcaption{font-size:0.9em;color:#444}img{max-width:100%;border:1px solid #ddd}\
 .pair{display:flex;gap:12px;flex-wrap:wrap}.pair figure{margin:0}.fail{color:#b00;font-weight:bold}\
-.ok{color:#070;font-weight:bold}nav a{margin-right:1em}";
+.ok{color:#070;font-weight:bold}nav a{margin-right:1em}\
+.headline{font-size:1.1em;border-left:6px solid #0072B2;padding:0.4em 1em;background:#f4f8fb}\
+.headline.warn{border-color:#D55E00;background:#fdf1ea}.headline li{margin:0.25em 0}\
+.headline .status{font-weight:bold;font-size:1.15em}.convention{font-size:0.9em;color:#444}\
+.mapwrap{display:flex;gap:12px;flex-wrap:wrap}.skymap{height:560px;flex:3 1 600px;border:1px solid #bbb}\
+.mappanel{flex:1 1 280px;max-height:560px;overflow:auto;font-size:0.9em}.mappanel img{max-width:100%}\
+.mappanel th{text-align:left;background:none;font-weight:normal;color:#555}\
+.skytie-vector-scale{background:rgba(255,255,255,0.85);padding:2px 6px;font-size:11px}\
+.skytie-vector-scale .bar{height:5px;background:#333;margin-bottom:2px}\
+.skytie-toggles{background:rgba(255,255,255,0.9);padding:4px 8px;font-size:12px;line-height:1.5}";
 
 const SIZE_SCRIPT: &str = "window.addEventListener('load',function(){var n=0;\
 document.querySelectorAll('img').forEach(function(i){i.setAttribute('data-natural-width',i.naturalWidth);\
@@ -42,6 +51,8 @@ document.body.setAttribute('data-images-loaded',n);});";
 pub struct Page {
     title: String,
     nav: Vec<(String, String)>,
+    /// Extra `<head>` lines (style sheets and scripts of the interactive map).
+    head: String,
     body: String,
 }
 
@@ -50,8 +61,22 @@ impl Page {
         Self {
             title: title.to_string(),
             nav: Vec::new(),
+            head: String::new(),
             body: String::new(),
         }
+    }
+
+    /// Adds lines to `<head>` (once: the same lines again are ignored).
+    pub fn head(&mut self, html: &str) {
+        if !self.head.contains(html) {
+            self.head.push_str(html);
+        }
+    }
+
+    /// Appends another page's body and head lines (sections assembled out of order).
+    pub fn append(&mut self, other: Page) {
+        self.head(&other.head);
+        self.body.push_str(&other.body);
     }
 
     /// A link in the navigation bar (href relative to the page).
@@ -89,8 +114,9 @@ impl Page {
         let _ = write!(
             s,
             "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n\
-             <style>{STYLE}</style>\n<script>{SIZE_SCRIPT}</script>\n</head>\n<body>\n<h1>{}</h1>\n",
+             <style>{STYLE}</style>\n<script>{SIZE_SCRIPT}</script>\n{}</head>\n<body>\n<h1>{}</h1>\n",
             escape(&self.title),
+            self.head,
             escape(&self.title)
         );
         if !self.nav.is_empty() {

@@ -10,11 +10,16 @@
 //! finished — go to `OUT/report/run-log/` instead, so that re-running a workflow reproduces `tables/`
 //! byte-identically (a warm rerun executes nothing and takes less time, which is all that changes).
 
+pub mod headline;
+pub mod headline_section;
 pub mod html;
 pub mod image_cache;
 pub mod inputs;
+pub mod interactive_map;
+pub mod map_background;
 pub mod map_data;
 pub mod plots;
+pub mod reasons;
 pub mod registration;
 pub mod results;
 pub mod summary;
@@ -25,7 +30,7 @@ pub mod thesis_values;
 use html::Page;
 use inputs::RunOutputs;
 use rayon::prelude::*;
-use skytie_stages::fsutil::atomic_write;
+use skytie_util::fsutil::atomic_write;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use tables::Table;
@@ -81,6 +86,8 @@ pub struct Builder {
     pub images: std::sync::Arc<image_cache::ImageCache>,
     /// The registration views' campaign, truth and drawn views, shared with the variants' builders.
     pub views: std::sync::Arc<registration::SharedViews>,
+    /// Registration views of the current result set per recording id: (href, caption), for the map's panel.
+    pub recording_views: std::collections::HashMap<String, Vec<(String, String)>>,
 }
 
 /// Folder names inside `OUT/report/`.
@@ -139,6 +146,7 @@ impl Builder {
             notes: Vec::new(),
             images: std::sync::Arc::clone(&self.images),
             views: std::sync::Arc::clone(&self.views),
+            recording_views: Default::default(),
         }
     }
 
@@ -211,7 +219,9 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
         notes: Vec::new(),
         images: Default::default(),
         views: Default::default(),
+        recording_views: Default::default(),
     };
+    interactive_map::write_assets(&report_dir)?;
     if b.campaign.is_none() {
         b.notes.push(
             "campaign folder not found (give --campaign DIR): no true positions, no registration views"
@@ -228,7 +238,6 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
                 .and_then(|s| inputs::str_at(&s.metrics, "campaign.name")))
             .unwrap_or("run")
     ));
-    summary::summary_section(&mut b, &mut index, &run);
     if run.is_sweep {
         sweep::sweep_section(&mut b, &mut index, &run)?;
         index.heading("variants", "Variants");
@@ -262,6 +271,8 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
     } else if let Some(set) = run.sets.first() {
         results::results_sections(&mut b, &mut index, set, &run)?;
     }
+    // Diagnostics last: the run, rejected items with their reasons, engine counters and stage timings.
+    summary::summary_section(&mut b, &mut index, &run);
     if !b.notes.is_empty() {
         index.heading("notes", "Notes on this report");
         let mut ul = String::from("<ul>\n");

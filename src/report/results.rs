@@ -3,6 +3,7 @@
 //! before/after, Tables 5-2/5-4/5-9's structure), the check-point residual histogram, verification
 //! (Table 5-13's structure) and the registration views.
 
+use super::headline_section::headline_section;
 use super::html::Page;
 use super::inputs::{num_at, obj_at, read_csv_opt, ResultSet, RunOutputs};
 use super::map_data::{read_map_data, AREA_GAP_M};
@@ -10,7 +11,7 @@ use super::plots::histogram::{histogram, HistSeries};
 use super::plots::trajectory::{trajectory_map, trim};
 use super::plots::{GREY, VERMILLION};
 use super::tables::{fmt_count, fmt_num, fmt_percent, Origin, Table};
-use super::{registration, slug, thesis_values, Builder};
+use super::{interactive_map, registration, slug, thesis_values, Builder};
 use serde_json::Value;
 
 /// Appends the sections of `set` to `page`.
@@ -30,11 +31,19 @@ pub fn results_sections(
     } else {
         format!(" ({})", set.name)
     };
-    map_section(b, page, set, &prefix, &title_suffix)?;
-    nadir_section(b, page, &set.metrics, &prefix);
-    accuracy_section(b, page, set, &prefix, &title_suffix)?;
-    verification_section(b, page, set, &prefix)?;
-    registration::registration_section(b, page, set, &prefix)?;
+    // Answer first, then the map, accuracy, registration; the map is built last (it links the registration
+    // views) but shown second.
+    headline_section(b, page, set, &prefix)?;
+    let mut rest = Page::new("");
+    accuracy_section(b, &mut rest, set, &prefix, &title_suffix)?;
+    super::headline_section::adjusted_verification_table(b, &mut rest, set, &prefix)?;
+    verification_section(b, &mut rest, set, &prefix)?;
+    nadir_section(b, &mut rest, &set.metrics, &prefix);
+    registration::registration_section(b, &mut rest, set, &prefix)?;
+    map_section(b, &mut rest, set, &prefix, &title_suffix)?;
+    let views = std::mem::take(&mut b.recording_views);
+    interactive_map::map_section(b, page, set, &prefix, &views)?;
+    page.append(rest);
     Ok(())
 }
 
@@ -45,7 +54,10 @@ fn map_section(
     prefix: &str,
     title_suffix: &str,
 ) -> Result<(), String> {
-    page.heading(&format!("{prefix}map"), "Trajectory map");
+    page.heading(
+        &format!("{prefix}static-map"),
+        "Trajectory map (static figure)",
+    );
     let campaign = b.campaign.clone();
     let Some(data) = read_map_data(&set.dir, campaign.as_deref())? else {
         b.note(
@@ -394,7 +406,7 @@ fn verification_section(
     }
     page.heading(
         &format!("{prefix}verification"),
-        "Verification (Table 5-13)",
+        "Verification of the recorded trajectory (Table 5-13)",
     );
     if let Some(passed) = m
         .get("verify")
@@ -415,7 +427,7 @@ fn verification_section(
     if let Some(v) = csv {
         let mut t = Table::new(
             &format!("{prefix}verification"),
-            "Per segment: aerial minus MM control-point offsets [m] and flags",
+            "Per segment, recorded poses: MM − aerial control-point offsets [m] and verdicts",
             Origin::Skytie,
             &[
                 "segment",

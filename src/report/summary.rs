@@ -1,7 +1,7 @@
-//! The report's summary section: campaign and workflow, what ran and what was served from the cache, time
-//! per stage, failed / skipped nodes (with reasons when `metrics.json` records them under
+//! The report's diagnostics section (last on the page): campaign and workflow, failed / skipped nodes (with reasons when `metrics.json` records them under
 //! `engine.failures` / `engine.skipped_nodes`), rejected items with their reasons (`nadir.transforms_rejected`,
-//! the verification's skipped points, the adjustment's rejected observations) and input problems.
+//! the verification's skipped points, the adjustment's rejected observations, in words) and input problems,
+//! then what ran and what was served from the cache and the time per stage.
 
 use super::html::Page;
 use super::inputs::{num_at, obj_at, str_at, RunOutputs};
@@ -14,7 +14,7 @@ pub fn summary_section(b: &mut Builder, page: &mut Page, run: &RunOutputs) {
     // For sweeps the campaign section lives in the variants' metrics.
     let first = run.sets.first().map(|s| &s.metrics).unwrap_or(m);
     let prov = run.provenance.as_ref();
-    page.heading("summary", "Summary");
+    page.heading("summary", "Diagnostics");
     let mut t = Table::new("summary-run", "Run", Origin::Skytie, &["item", "value"]);
     let mut kv = |k: &str, v: String| t.push(vec![k.to_string(), v]);
     let campaign_name = str_at(first, "campaign.name").unwrap_or("n/a");
@@ -70,6 +70,7 @@ pub fn summary_section(b: &mut Builder, page: &mut Page, run: &RunOutputs) {
         kv("variants", fmt_count(Some(run.sets.len() as f64)));
     }
     b.table(page, t);
+    problems(b, page, run);
 
     // What this particular run did: differs between runs of one workflow (a warm rerun executes nothing).
     let mut t = Table::new(
@@ -134,7 +135,6 @@ pub fn summary_section(b: &mut Builder, page: &mut Page, run: &RunOutputs) {
         }
         b.run_log_table(page, t);
     }
-    problems(b, page, run);
 }
 
 /// Failed / skipped nodes and rejected items with their reasons.
@@ -204,8 +204,8 @@ fn problems(b: &mut Builder, page: &mut Page, run: &RunOutputs) {
             for (reason, v) in rej {
                 r.push(vec![
                     name.to_string(),
-                    "nadir initial transform rejected".into(),
-                    reason.clone(),
+                    "nadir initial transform (recording × aerial image) rejected".into(),
+                    super::reasons::transform_rejection(reason),
                     fmt_count(v.as_f64()),
                 ]);
             }
@@ -239,7 +239,7 @@ fn problems(b: &mut Builder, page: &mut Page, run: &RunOutputs) {
                             r.push(vec![
                                 name.to_string(),
                                 format!("adjustment {config}: observation rejected"),
-                                format!("{kind} residual too large"),
+                                super::reasons::rejected_observation(kind),
                                 fmt_count(v.as_f64()),
                             ]);
                         }

@@ -208,7 +208,8 @@ pub fn table_5_12() -> Table {
 pub fn table_5_13() -> Table {
     table(
         "thesis-table-5-13",
-        "Table 5-13: verification, aerial minus MM differences in object space [m]",
+        "Table 5-13 as published: verification, differences aerial − MM in object space [m] (the opposite \
+         sign of skytie's MM − aerial)",
         &["", "X", "Y", "Z", "3D distance"],
         &[
             &["mean difference", "0.58", "1.26", "0.02", "1.42"],

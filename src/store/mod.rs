@@ -265,7 +265,7 @@ impl Store {
         let placeholder = entry::encode_header(key, &meta_block, 0, &ContentHash::default());
         let path = self.object_path(key);
         let mut content_hash = ContentHash::default();
-        skytie_stages::fsutil::atomic_write_with(&path, |w| {
+        skytie_util::fsutil::atomic_write_with(&path, |w| {
             w.write_all(&placeholder)?;
             let mut sink = HashingWriter::new(&mut *w);
             encode(&mut sink)?;

@@ -47,7 +47,7 @@ pub(crate) fn put(
     out.extend_from_slice(&(bytes.len() as u64).to_le_bytes());
     out.extend_from_slice(hash_bytes(bytes).as_bytes());
     out.extend_from_slice(bytes);
-    skytie_stages::fsutil::atomic_write(&path, &out).map_err(StoreError::io("write record", &path))
+    skytie_util::fsutil::atomic_write(&path, &out).map_err(StoreError::io("write record", &path))
 }
 
 fn parse<'a>(file: &'a [u8], name: &str) -> Option<&'a [u8]> {

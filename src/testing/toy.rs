@@ -230,7 +230,7 @@ impl Stage for ToyGen {
 /// Write one toy item file (atomically).
 pub fn write_item(dir: &Path, name: &str, value: f64) -> std::io::Result<PathBuf> {
     let p = dir.join(name);
-    skytie_stages::fsutil::atomic_write(&p, format!("{value}\n").as_bytes())?;
+    skytie_util::fsutil::atomic_write(&p, format!("{value}\n").as_bytes())?;
     Ok(p)
 }
 

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use super::campaign_source::CampaignSource;
 use super::error::WorkflowError;
-use super::file::load_document;
+use super::file::{load_document, WorkflowFiles, BUILT_IN_DIR};
 use super::source::{describe_position, error_at, SourceFile};
 use super::suggest::did_you_mean;
 use super::sweep::{parse_sweep, Sweep};
@@ -78,7 +78,43 @@ impl Workflow {
     /// Checks a workflow given as text; `path` is where it lives (names it in messages, and relative `include`
     /// and campaign paths are resolved against its folder).
     pub fn parse(text: &str, path: &Path) -> Result<Workflow, WorkflowError> {
-        let loaded = load_document(text, path)?;
+        Workflow::parse_from(text, path, WorkflowFiles::Disk)
+    }
+
+    /// A workflow built into the program: `name` (`default` or `default.toml`) among `files` (file name,
+    /// text); its includes name other files of the set. Messages show `<built-in>/NAME.toml`.
+    pub fn built_in(
+        name: &str,
+        files: &'static [(&'static str, &'static str)],
+    ) -> Result<Workflow, WorkflowError> {
+        let file = if name.ends_with(".toml") {
+            name.to_string()
+        } else {
+            format!("{name}.toml")
+        };
+        let path = Path::new(BUILT_IN_DIR).join(&file);
+        let Some((_, text)) = files.iter().find(|(n, _)| *n == file) else {
+            return Err(WorkflowError::in_file(
+                &path,
+                format!(
+                    "no built-in workflow '{name}' (built in: {})",
+                    files
+                        .iter()
+                        .map(|(n, _)| n.trim_end_matches(".toml"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ));
+        };
+        Workflow::parse_from(text, &path, WorkflowFiles::BuiltIn(files))
+    }
+
+    fn parse_from(
+        text: &str,
+        path: &Path,
+        source: WorkflowFiles,
+    ) -> Result<Workflow, WorkflowError> {
+        let loaded = load_document(text, path, source)?;
         let mut files = loaded.sources;
         let file_hash = hash_sources(&files);
         for f in &mut files {

@@ -21,14 +21,87 @@ pub(crate) struct Loaded {
     pub document: Table,
 }
 
-/// Loads the workflow whose text is `text` and which lives at `path` (includes are read from disk).
-pub(crate) fn load_document(text: &str, path: &Path) -> Result<Loaded, WorkflowError> {
+/// Where a workflow's files are read from: the file system, or a set of files built into the program.
+#[derive(Clone, Copy, Debug)]
+pub enum WorkflowFiles {
+    /// Files on disk; includes are resolved against the including file's folder.
+    Disk,
+    /// Files built into the program: (file name, text). Their paths are shown as `<built-in>/NAME`; an
+    /// include names another built-in file.
+    BuiltIn(&'static [(&'static str, &'static str)]),
+}
+
+/// The folder that built-in workflow files appear to live in (messages show `<built-in>/default.toml`).
+pub const BUILT_IN_DIR: &str = "<built-in>";
+
+impl WorkflowFiles {
+    /// The canonical form of `path` (for cycle and diamond detection), or why it cannot be read.
+    fn canonical(self, path: &Path) -> std::io::Result<PathBuf> {
+        match self {
+            WorkflowFiles::Disk => std::fs::canonicalize(path),
+            WorkflowFiles::BuiltIn(files) => {
+                let name = built_in_name(path);
+                match files.iter().find(|(n, _)| Some(*n) == name.as_deref()) {
+                    Some((n, _)) => Ok(Path::new(BUILT_IN_DIR).join(n)),
+                    None => Err(std::io::Error::new(
+                        std::io::ErrorKind::NotFound,
+                        format!(
+                            "no built-in workflow file of that name (built in: {})",
+                            files.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+                        ),
+                    )),
+                }
+            }
+        }
+    }
+
+    /// The bytes of a file given by its canonical path.
+    fn read(self, canonical: &Path) -> std::io::Result<Vec<u8>> {
+        match self {
+            WorkflowFiles::Disk => std::fs::read(canonical),
+            WorkflowFiles::BuiltIn(files) => {
+                let name = built_in_name(canonical);
+                files
+                    .iter()
+                    .find(|(n, _)| Some(*n) == name.as_deref())
+                    .map(|(_, text)| text.as_bytes().to_vec())
+                    .ok_or_else(|| std::io::Error::from(std::io::ErrorKind::NotFound))
+            }
+        }
+    }
+}
+
+/// The file name of a path below [`BUILT_IN_DIR`] (`.` and `..` resolved), if it stays there.
+fn built_in_name(path: &Path) -> Option<String> {
+    let mut parts: Vec<String> = Vec::new();
+    for c in path.components() {
+        match c {
+            std::path::Component::Normal(s) => parts.push(s.to_string_lossy().into_owned()),
+            std::path::Component::ParentDir => {
+                parts.pop()?;
+            }
+            _ => {}
+        }
+    }
+    match parts.as_slice() {
+        [dir, name] if dir == BUILT_IN_DIR => Some(name.clone()),
+        _ => None,
+    }
+}
+
+/// Loads the workflow whose text is `text` and which lives at `path`, reading its includes from `files`.
+pub(crate) fn load_document(
+    text: &str,
+    path: &Path,
+    files: WorkflowFiles,
+) -> Result<Loaded, WorkflowError> {
     let mut loader = Loader {
         sources: Vec::new(),
         stack: Vec::new(),
         seen: Vec::new(),
+        files,
     };
-    let canonical = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    let canonical = files.canonical(path).unwrap_or_else(|_| path.to_path_buf());
     let document = loader.load(text, path, canonical)?;
     Ok(Loaded {
         sources: loader.sources,
@@ -42,6 +115,7 @@ struct Loader {
     stack: Vec<(PathBuf, PathBuf)>,
     /// Canonical paths of all files read so far: a file reached twice (diamond includes) is merged once.
     seen: Vec<PathBuf>,
+    files: WorkflowFiles,
 }
 
 impl Loader {
@@ -82,7 +156,7 @@ impl Loader {
     ) -> Result<Table, WorkflowError> {
         let error = |message: String| WorkflowError::at(from, at.line, at.column, message);
         let shown = from.parent().unwrap_or(Path::new("")).join(include);
-        let canonical = std::fs::canonicalize(&shown).map_err(|e| {
+        let canonical = self.files.canonical(&shown).map_err(|e| {
             error(format!(
                 "cannot read included file '{include}' (looked for {}): {e}",
                 shown.display()
@@ -107,7 +181,7 @@ impl Loader {
                 "includes nested deeper than {MAX_INCLUDE_DEPTH} files"
             )));
         }
-        let bytes = std::fs::read(&canonical).map_err(|e| {
+        let bytes = self.files.read(&canonical).map_err(|e| {
             error(format!(
                 "cannot read included file '{include}' ({}): {e}",
                 shown.display()

@@ -8,13 +8,20 @@
 pub mod adjustment;
 pub mod campaign;
 pub mod correspondence;
+pub mod crs;
 pub mod estimators;
 pub mod export;
 pub mod features;
-pub mod fsutil;
+pub mod formats;
 pub mod geometry;
 pub mod imaging;
+pub mod import;
 pub mod matching;
 pub mod nadir;
 pub mod oblique;
+pub mod params;
+pub mod rng;
 pub mod synth;
+
+/// Atomic file replacement (from `skytie-util`, shared with the engine).
+pub use skytie_util::fsutil;

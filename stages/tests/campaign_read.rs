@@ -58,6 +58,10 @@ fn aerial(id: &str, file: &str) -> AerialImage {
         k2: 0.0,
         p1: 0.0,
         p2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
+        b1: 0.0,
+        b2: 0.0,
         sigma_px: 0.5,
     }
 }
@@ -411,14 +415,13 @@ n5,n5.png,255030,463000,300,0,0,0,100,40,30,80,60\r\n";
     );
     let shown =
         |file: &str, row: usize, field: &str| find(&report.problems, file, row, field).to_string();
-    assert!(
-        shown("mm/recordings.csv", 15, "file").contains("mm/panoramas/trunc.jpg does not decode")
-    );
+    assert!(shown("mm/recordings.csv", 15, "file")
+        .contains("mm/panoramas/trunc.jpg is a truncated JPEG file"));
     assert!(shown("mm/recordings.csv", 16, "file").contains("64×64 px, not 2:1"));
     assert!(shown("aerial/nadir/cameras.csv", 6, "file")
         .contains("is 80×60 px but its row says width 100, height 60"));
     assert!(shown("aerial/nadir/cameras.csv", 7, "image_id")
-        .contains("'n5' sees none of the 4 recording positions"));
+        .contains("'n5' sees none of the 2 recording positions"));
     assert!(shown("control/observations.csv", 4, "u").contains("u must be < 64"));
     assert_eq!(
         (
@@ -427,7 +430,9 @@ n5,n5.png,255030,463000,300,0,0,0,100,40,30,80,60\r\n";
             report.checkpoints,
             report.observations
         ),
-        (4, 3, 1, 2)
+        // The truncated and the 1:1 panorama, the wrongly sized nadir frame and the observation outside its
+        // panorama are not usable.
+        (2, 2, 1, 1)
     );
     assert!(!report.is_clean());
     let rendered = report.render();
@@ -440,7 +445,7 @@ n5,n5.png,255030,463000,300,0,0,0,100,40,30,80,60\r\n";
         "{rendered}"
     );
     assert!(rendered.ends_with(
-        "19 errors, 2 warnings: 4 recordings, 3 nadir and 0 oblique images, 1 check points, 2 observations usable\n"
+        "19 errors, 2 warnings: 2 recordings, 2 nadir and 0 oblique images, 1 check points, 1 observations usable\n"
     ));
 }
 
@@ -672,7 +677,8 @@ fn check_is_deterministic() {
     std::fs::write(dir.path().join("mm/panoramas/sub/pano_1.png"), b"not a png").unwrap();
     std::fs::write(dir.path().join("aerial/nadir/n0.png"), b"").unwrap();
     let first = check_campaign(dir.path());
-    assert_eq!(first.error_count(), 2, "{}", first.render());
+    // The unusable pano_1 also takes its observation (control/observations.csv row 3) with it.
+    assert_eq!(first.error_count(), 3, "{}", first.render());
     for _ in 0..3 {
         assert_eq!(check_campaign(dir.path()), first);
     }

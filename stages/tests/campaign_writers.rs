@@ -180,6 +180,10 @@ fn other_tables_and_toml_have_documented_columns() {
         k2: 0.0,
         p1: 0.0,
         p2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
+        b1: 0.0,
+        b2: 0.0,
         sigma_px: 0.5,
     };
     write_aerial_cameras_csv(&d.join("nadir.csv"), &[a.clone()]).unwrap();

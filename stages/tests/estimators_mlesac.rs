@@ -5,6 +5,7 @@ use skytie_stages::estimators::mlesac::{
     axis_angle_deg, fit_plane_mlesac, plane_from_three, PlaneFitParams,
 };
 use skytie_stages::estimators::{required_iterations, SplitMix64};
+use skytie_stages::params::Params;
 
 /// `n_in` points on the plane x = `x0` over 10 × 8 m (y, z) with Gaussian noise `noise_m` along x, then
 /// `n_out` uniform outliers in the 20 m cube centred at the origin. Returns the points and the inlier count.
@@ -220,8 +221,8 @@ fn deterministic_for_a_seed_and_invalid_params_give_none() {
         ..Default::default()
     };
     let errs = bad.validate().unwrap_err();
-    assert!(errs.iter().any(|(f, _)| f == "sigma_m"));
-    assert!(errs.iter().any(|(f, _)| f == "confidence"));
+    assert!(errs.iter().any(|v| v.field == "sigma_m"));
+    assert!(errs.iter().any(|v| v.field == "confidence"));
     assert!(fit_plane_mlesac(&pts, &bad).is_none());
     assert!(fit_plane_mlesac(&pts[..2], &p).is_none());
     let mut nan = pts.clone();

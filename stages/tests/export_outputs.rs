@@ -9,10 +9,11 @@ use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, Synthetic
 use skytie_stages::adjustment::{
     run, AdjustConfig, AdjustInputs, AdjustmentRun, SyntheticBlockSpec, ViewSelection,
 };
-use skytie_stages::campaign::read_recordings_csv;
+use skytie_stages::campaign::{read_recordings_csv, write_recordings_csv};
 use skytie_stages::export::{
     checkpoint_rows, write_adjusted_trajectory, write_checkpoint_errors_csv, write_colmap_model,
-    write_run_geojson, write_tie_points_ply, CHECKPOINTS_CSV_HEADER, PLY_SOURCE_RECORDING,
+    write_run_geojson, write_tie_points_ply, CorrectionSeries, CHECKPOINTS_CSV_HEADER,
+    PLY_SOURCE_RECORDING,
 };
 use skytie_stages::geometry::FrameCamera;
 use std::collections::HashMap;
@@ -60,7 +61,11 @@ fn trajectory_csv_geojson_and_ply_round_trip() {
     let (c, r) = setup();
     let dir = temp_dir("traj");
     let path = dir.join("trajectory_adjusted.csv");
-    write_adjusted_trajectory(&path, &c.recordings, &r).unwrap();
+    let input = dir.join("recordings.csv");
+    write_recordings_csv(&input, &c.recordings).unwrap();
+    let series = CorrectionSeries::from_run(&c.recordings, &r).unwrap();
+    let counts = write_adjusted_trajectory(&path, &input, &series, &r).unwrap();
+    assert_eq!((counts.adjusted, counts.not_read), (c.recordings.len(), 0));
     let (back, problems) = read_recordings_csv(&path);
     assert!(problems.is_empty(), "{problems:?}");
     assert_eq!(back.len(), c.recordings.len());

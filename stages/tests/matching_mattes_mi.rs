@@ -7,6 +7,7 @@ use skytie_stages::imaging::GrayImage;
 use skytie_stages::matching::mattes_mi::{
     apply_mask, bspline3, register_translation, MattesMi, MiError,
 };
+use skytie_stages::params::Params;
 
 /// A smooth random texture (sum of Gaussian blobs, σ 2.5–7 px), as a function of continuous position, scaled to
 /// roughly [0, 255].

@@ -11,6 +11,7 @@ use skytie_stages::nadir::baseline::{
     baseline_matches, isolated_aerial_keypoints, BaselineParams, KdTree2,
 };
 use skytie_stages::nadir::{InitialTransform, MmWindowMatch, OrthoGeoref, OrthoImage, OrthoParams};
+use skytie_stages::params::Params;
 
 /// Bright axis-aligned squares (world metres) on a grey road with smooth (blurred) edges.
 struct Markings {
@@ -165,6 +166,10 @@ fn scene() -> Scene {
         k2: 0.0,
         p1: 0.0,
         p2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
+        b1: 0.0,
+        b2: 0.0,
         sigma_px: 0.5,
     };
     Scene {
@@ -303,7 +308,7 @@ fn baseline_params_validate_and_reject_unknown_keys() {
         search_px: 10,
         ..BaselineParams::default()
     };
-    assert_eq!(bad.validate().unwrap_err()[0].0, "search_px");
+    assert_eq!(bad.validate().unwrap_err()[0].field, "search_px");
     assert!(toml::from_str::<BaselineParams>("template = 16").is_err());
     let p: BaselineParams = toml::from_str("min_ncc = 0.8").unwrap();
     assert_eq!(p.min_ncc, 0.8);

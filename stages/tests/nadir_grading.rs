@@ -53,6 +53,10 @@ fn nadir_camera(id: &str, x: f64) -> AerialImage {
         k2: 0.0,
         p1: 0.0,
         p2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
+        b1: 0.0,
+        b2: 0.0,
         sigma_px: 0.5,
     }
 }

@@ -27,6 +27,7 @@ use skytie_stages::nadir::initial_transform::{
 use skytie_stages::nadir::refine::RefineParams;
 use skytie_stages::nadir::transform_agreement::check_agreement;
 use skytie_stages::nadir::{ortho_project, OrthoGeoref, OrthoImage, OrthoParams, TransformOutcome};
+use skytie_stages::params::Params;
 use skytie_stages::synth::{generate, Preset, SynthOptions};
 use std::collections::HashMap;
 use std::path::Path;
@@ -87,6 +88,10 @@ fn aerial_row(kappa_deg: f64, omega_deg: f64, phi_deg: f64) -> AerialImage {
         k2: 0.0,
         p1: 0.0,
         p2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
+        b1: 0.0,
+        b2: 0.0,
         sigma_px: 0.5,
     }
 }
@@ -354,7 +359,7 @@ fn blank_or_mismatched_aerial_is_rejected_with_a_reason() {
         ..p.clone()
     };
     let errs = bad.validate().unwrap_err();
-    assert_eq!(errs[0].0, "max_localisation_error_m");
+    assert_eq!(errs[0].field, "max_localisation_error_m");
     let parsed: Result<TransformParams, _> = toml::from_str("max_localisation_error = 2.0");
     assert!(parsed.is_err(), "unknown fields are refused");
     let parsed: TransformParams = toml::from_str("max_localisation_error_m = 2.0").unwrap();

@@ -5,7 +5,6 @@
 use nalgebra::{Matrix3, Vector2, Vector3};
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::correspondence::{AerialObservation, MmTiePoint, PanoObservation};
-use skytie_stages::estimators::rng::SplitMix64;
 use skytie_stages::geometry::{FrameCamera, PanoramaCamera, PointPair, Similarity2};
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::control_points::{aerial_control_points, ControlParams};
@@ -14,6 +13,8 @@ use skytie_stages::nadir::{
     AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch, OrthoGeoref, OrthoImage,
     OrthoParams,
 };
+use skytie_stages::params::Params;
+use skytie_stages::rng::SplitMix64;
 
 // ---------------------------------------------------------------------------------------------------------
 // Helpers
@@ -78,6 +79,10 @@ fn aerial_row(id: &str, w: u32, h: u32) -> AerialImage {
         k2: 0.0,
         p1: 0.0,
         p2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
+        b1: 0.0,
+        b2: 0.0,
         sigma_px: 0.5,
     }
 }
@@ -454,7 +459,7 @@ fn refine_params_validate_and_reject_unknown_keys() {
         ..RefineParams::default()
     };
     let errs = bad.validate().unwrap_err();
-    let fields: Vec<&str> = errs.iter().map(|(f, _)| f.as_str()).collect();
+    let fields: Vec<&str> = errs.iter().map(|v| v.field.as_str()).collect();
     assert_eq!(fields, ["template_px", "min_peak"]);
     let parsed: RefineParams = toml::from_str("template_px = 64\nwindow = \"blackman\"").unwrap();
     assert_eq!(parsed.template_px, 64);

@@ -4,7 +4,6 @@
 use nalgebra::{Matrix3, Vector3};
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::correspondence::{MmTiePoint, PanoObservation};
-use skytie_stages::estimators::rng::SplitMix64;
 use skytie_stages::geometry::{matrix_to_opk, FrameCamera};
 use skytie_stages::oblique::consensus::{
     consensus, consensus_with_diagnostics, ConsensusParams, SmallSetPolicy,
@@ -13,6 +12,8 @@ use skytie_stages::oblique::{
     PatchMatch, PatchRegistrationSet, PatchStats, SparseCloud, SparseCloudStats, SparsePoint,
     StreetSide,
 };
+use skytie_stages::params::Params;
+use skytie_stages::rng::SplitMix64;
 
 const E0: f64 = 500_000.0;
 const N0: f64 = 5_400_000.0;
@@ -60,6 +61,10 @@ fn oblique_image(id: &str, centre: Vector3<f64>, target: Vector3<f64>) -> Aerial
         k2: 0.0,
         p1: 0.0,
         p2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
+        b1: 0.0,
+        b2: 0.0,
         sigma_px: 0.5,
     }
 }
@@ -367,7 +372,7 @@ fn invalid_params_are_reported() {
         ..ConsensusParams::default()
     };
     let e = p.validate().unwrap_err();
-    let fields: Vec<&str> = e.iter().map(|(f, _)| f.as_str()).collect();
+    let fields: Vec<&str> = e.iter().map(|v| v.field.as_str()).collect();
     assert_eq!(fields, vec!["threshold_m", "min_set_size"]);
     assert!(ConsensusParams::default().validate().is_ok());
 }

@@ -18,6 +18,7 @@ use skytie_stages::oblique::facades::visibility::{
 };
 use skytie_stages::oblique::facades::{find_facades, FacadeParams, ThinningSplit};
 use skytie_stages::oblique::{SparseCloud, SparseCloudStats, SparsePoint, StreetSide};
+use skytie_stages::params::Params;
 
 const X0: f64 = 92_000.0;
 const Y0: f64 = 437_000.0;
@@ -164,6 +165,10 @@ fn oblique_north(id: &str, x: f64, y_aim: f64, focal_px: f64) -> AerialImage {
         k2: 0.0,
         p1: 0.0,
         p2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
+        b1: 0.0,
+        b2: 0.0,
         sigma_px: 0.5,
     }
 }
@@ -583,6 +588,10 @@ fn camera_looking_at(
         k2: 0.0,
         p1: 0.0,
         p2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
+        b1: 0.0,
+        b2: 0.0,
         sigma_px: 0.5,
     })
 }

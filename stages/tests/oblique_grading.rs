@@ -64,6 +64,10 @@ fn oblique_image(id: &str, centre: Vector3<f64>, target: Vector3<f64>) -> Aerial
         k2: 0.0,
         p1: 0.0,
         p2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
+        b1: 0.0,
+        b2: 0.0,
         sigma_px: 0.5,
     }
 }

@@ -17,6 +17,7 @@ use skytie_stages::oblique::types::{
     FacadePlane, FacadeStats, ObliqueView, SparseCloud, SparseCloudStats, SparsePoint, StreetSide,
     TripletFacades,
 };
+use skytie_stages::params::Params;
 use std::sync::OnceLock;
 
 /// The façade: the plane y = FACADE_Y (normal −y towards the street), x ∈ [X0 − 40, X0 + 40], z ∈ [0, 25].
@@ -104,6 +105,10 @@ fn oblique_image() -> AerialImage {
         k2: 0.0,
         p1: 0.0,
         p2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
+        b1: 0.0,
+        b2: 0.0,
         sigma_px: 0.5,
     }
 }

@@ -12,6 +12,7 @@ use skytie_stages::imaging::io::load_gray;
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::oblique::sparse_cloud::{sparse_cloud, SparseCloudParams};
 use skytie_stages::oblique::{SparseCloud, StreetSide};
+use skytie_stages::params::Params;
 use skytie_stages::synth::generate::plan_campaign;
 use skytie_stages::synth::scene::{Epoch, Scene};
 use skytie_stages::synth::{generate, Preset, SynthOptions};

@@ -285,7 +285,13 @@ fn distorted_oblique_markers_land_where_project_world_says() {
     let target = Vector3::new(ORIGIN[0] + 20.0, ORIGIN[1] - 10.0, GROUND_Z);
     let c = Vector3::new(target.x - 450.0, target.y, GROUND_Z + 450.0);
     let [k1, k2, p1, p2] = small_distortion(focal, w, h, 4.0);
-    let dist = BrownDistortion { k1, k2, p1, p2 };
+    let dist = BrownDistortion {
+        k1,
+        k2,
+        p1,
+        p2,
+        ..BrownDistortion::NONE
+    };
     let r =
         skytie_stages::geometry::rot_z(-90f64.to_radians()) * skytie_stages::geometry::rot_x(tilt);
     let (omega, phi, kappa) = skytie_stages::geometry::matrix_to_opk(&r);

@@ -22,9 +22,26 @@ pub fn run_ok(cmd: &mut Command) -> String {
     text
 }
 
-/// `skytie run WORKFLOW --cache CACHE --out OUT --quiet`, which must succeed.
-pub fn run_workflow(wf: &Path, cache: &Path, out: &Path) {
-    run_ok(
+/// Runs `cmd`, which must finish with exit 0 or 3 (a flagged result, see `skytie run --help`); returns stdout +
+/// stderr.
+pub fn run_finished(cmd: &mut Command) -> String {
+    let out = cmd.output().expect("start skytie");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        matches!(out.status.code(), Some(0 | 3)),
+        "{cmd:?} failed: {text}"
+    );
+    text
+}
+
+/// `skytie run WORKFLOW --cache CACHE --out OUT --quiet`, which must finish: exit 0, or 3 when the result is
+/// flagged (e.g. a tiny campaign with too little to register: "NOT CORRECTED"); returns stdout + stderr.
+pub fn run_workflow(wf: &Path, cache: &Path, out: &Path) -> String {
+    run_finished(
         skytie()
             .arg("run")
             .arg(wf)
@@ -33,5 +50,5 @@ pub fn run_workflow(wf: &Path, cache: &Path, out: &Path) {
             .arg("--out")
             .arg(out)
             .arg("--quiet"),
-    );
+    )
 }

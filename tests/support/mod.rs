@@ -1,9 +1,9 @@
 //! Shared helpers of the engine tests: toy campaigns in temp folders, a toy DAG builder, one-call runs.
 #![allow(dead_code)]
 
+use skytie::dag::progress::{Progress, ProgressMode};
 use skytie::dag::{execute, Dag, DagBuilder, Env, Handle, Mode, Outcome, RawFile};
 use skytie::hashing::StatCache;
-use skytie::progress::{Progress, ProgressMode};
 use skytie::store::Store;
 use skytie::testing::toy::{
     write_item, ToyParse, ToyParseParams, ToyScale, ToyScaleParams, ToyScaleV2, ToySum,
@@ -78,3 +78,4 @@ pub fn executed(o: &Outcome) -> (usize, usize, usize) {
         o.executed_of("toy_sum"),
     )
 }
+pub mod module_graph;

@@ -84,15 +84,34 @@ fn headless(chromium: &Path, profile: &Path) -> Command {
         .arg("--disable-extensions")
         .arg("--allow-file-access-from-files")
         .arg(format!("--user-data-dir={}", profile.display()))
+        .arg("--disable-background-networking")
+        .arg("--disable-component-update")
+        .arg("--disable-sync")
         .arg("--virtual-time-budget=8000");
     c
 }
 
+/// The value of attribute `attr` on the element with `id="{id}"` in a dumped DOM.
+pub fn element_attr(dom: &str, id: &str, attr: &str) -> Option<String> {
+    let start = dom.find(&format!("id=\"{id}\""))?;
+    let open = dom[..start].rfind('<')?;
+    let end = start + dom[start..].find('>')?;
+    attr_values(&dom[open..end], attr).into_iter().next()
+}
+
 /// The DOM of `page` after loading (scripts run), as Chromium dumps it.
 pub fn dump_dom(chromium: &Path, page: &Path, profile: &Path) -> String {
+    dump_dom_fragment(chromium, page, "", profile)
+}
+
+/// Like [`dump_dom`] with a fragment (`#…`) appended to the page's address.
+pub fn dump_dom_fragment(chromium: &Path, page: &Path, fragment: &str, profile: &Path) -> String {
     let out = headless(chromium, profile)
         .arg("--dump-dom")
-        .arg(format!("file://{}", page.canonicalize().unwrap().display()))
+        .arg(format!(
+            "file://{}{fragment}",
+            page.canonicalize().unwrap().display()
+        ))
         .output()
         .expect("start chromium");
     assert!(
@@ -126,11 +145,15 @@ pub fn screenshot(
     );
 }
 
-/// Per `<img>` of a dumped DOM: (src, natural width, natural height) as recorded by the page's script.
+/// Per `<img>` of a dumped DOM: (src, natural width, natural height) as recorded by the page's script. The
+/// map's own tiles (Leaflet image overlays, created by the map script) are not counted.
 pub fn image_sizes(dom: &str) -> Vec<(String, u32, u32)> {
     let mut out = Vec::new();
     for tag in dom.split("<img").skip(1) {
         let tag = &tag[..tag.find('>').unwrap_or(tag.len())];
+        if tag.contains("leaflet-image-layer") {
+            continue;
+        }
         let get = |a: &str| attr_values(tag, a).into_iter().next();
         let num = |a: &str| get(a).and_then(|v| v.parse::<u32>().ok()).unwrap_or(0);
         out.push((

@@ -10,7 +10,8 @@ use clap::Subcommand;
 use nadir::*;
 use oblique::*;
 use skytie_stages::campaign::{read_campaign, Recording};
-use skytie_stages::fsutil::atomic_write;
+use skytie_stages::params::Violation;
+use skytie_util::fsutil::atomic_write;
 use std::path::{Path, PathBuf};
 
 /// The tools.
@@ -94,14 +95,14 @@ pub(crate) fn campaign_recording(
 
 /// `(field, message)` range errors of a parameter struct as one line naming the command-line options: a field
 /// listed in `options` as `(field, option)` is reported as `--option`, any other as `--field` with `-` for `_`.
-pub(crate) fn option_errors(errs: &[(String, String)], options: &[(&str, &str)]) -> String {
+pub(crate) fn option_errors(errs: &[Violation], options: &[(&str, &str)]) -> String {
     errs.iter()
-        .map(|(f, m)| {
+        .map(|v| {
             let opt = options
                 .iter()
-                .find(|(field, _)| field == f)
-                .map_or_else(|| f.replace('_', "-"), |(_, o)| (*o).to_string());
-            format!("--{opt}: {m}")
+                .find(|(field, _)| *field == v.field)
+                .map_or_else(|| v.field.replace('_', "-"), |(_, o)| (*o).to_string());
+            format!("--{opt}: {}", v.message)
         })
         .collect::<Vec<_>>()
         .join("; ")

@@ -10,6 +10,7 @@ use skytie_stages::imaging::wallis::{wallis_filter, WallisParams};
 use skytie_stages::matching::ncc::match_template;
 use skytie_stages::matching::phase_correlation::{phase_correlate, PhaseCorrelationParams};
 use skytie_stages::nadir::{ortho_project, OrthoParams};
+use skytie_stages::params::Params;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -91,7 +92,7 @@ pub fn ortho(a: &OrthoArgs) -> Result<(), String> {
         ..OrthoParams::default()
     };
     params.vehicle.enabled = !a.no_mask;
-    params.validate().map_err(|errs| {
+    Params::validate(&params).map_err(|errs| {
         option_errors(&errs, &[("gsd_m", "gsd"), ("rotation_deg", "rotate-deg")])
     })?;
     let ortho = ortho_project(&pano, &rec, &params);

@@ -12,6 +12,7 @@ use skytie_stages::geometry::PanoramaCamera;
 use skytie_stages::imaging::io::{load_gray, load_rgb, save_rgb};
 use skytie_stages::matching::mattes_mi::MiError;
 use skytie_stages::oblique::patch_registration::search::mi_search;
+use skytie_stages::params::Params;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

@@ -29,7 +29,7 @@ pub const DARK: RGBColor = RGBColor(40, 40, 40);
 
 /// Writes an SVG document atomically.
 pub fn write_svg(path: &Path, svg: &str) -> Result<(), String> {
-    skytie_stages::fsutil::atomic_write(path, svg.as_bytes())
+    skytie_util::fsutil::atomic_write(path, svg.as_bytes())
         .map_err(|e| format!("{}: cannot write: {e}", path.display()))
 }
 

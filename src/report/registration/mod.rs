@@ -368,23 +368,28 @@ pub fn registration_section(
             };
             match made {
                 Ok((aerial_id, c)) => {
+                    let caption = format!(
+                        "{rec_id} ({}) and {source} image {aerial_id}: {} correct (green), {} wrong (red), \
+                         {} non-matchable (blue), {} ungraded (yellow).",
+                        if source == "nadir" {
+                            "MM ortho image, 3 cm, north up"
+                        } else {
+                            "panorama crop"
+                        },
+                        c.correct,
+                        c.wrong,
+                        c.non_matchable,
+                        c.ungraded
+                    );
                     page.figure(
                         &href,
                         &format!("{source} registration of {rec_id}"),
-                        &format!(
-                            "{rec_id} ({}) and {source} image {aerial_id}: {} correct (green), {} wrong (red), \
-                             {} non-matchable (blue), {} ungraded (yellow).",
-                            if source == "nadir" {
-                                "MM ortho image, 3 cm, north up"
-                            } else {
-                                "panorama crop"
-                            },
-                            c.correct,
-                            c.wrong,
-                            c.non_matchable,
-                            c.ungraded
-                        ),
+                        &caption,
                     );
+                    b.recording_views
+                        .entry(rec_id.to_string())
+                        .or_default()
+                        .push((href.clone(), caption));
                     let n = c.correct + c.wrong + c.non_matchable + c.ungraded;
                     t.push(vec![
                         source.to_string(),

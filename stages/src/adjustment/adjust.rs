@@ -11,8 +11,9 @@
 //! full inverse). Priors and relative constraints are never rejected.
 
 use super::covariance::recording_covariances;
+use super::error::AdjustError;
 use super::prepared::{Prepared, Rejected};
-use super::problem::{AdjustError, AdjustOptions, Block};
+use super::problem::{AdjustOptions, Block};
 use super::residuals::{pano_residual, State};
 use super::solver::{solve, SolveReport, Termination};
 use crate::geometry::LocalOrigin;

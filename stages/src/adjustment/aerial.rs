@@ -98,6 +98,7 @@ mod tests {
                 k2: 0.02,
                 p1: 0.0007,
                 p2: -0.0004,
+                ..BrownDistortion::NONE
             },
         )
     }

@@ -1,11 +1,11 @@
-//! The parameters of one adjustment configuration as the adjust node receives them (issue 6 "Configurations";
-//! thesis 5.4.3, 5.5.1–5.5.3, 5.7): which correspondence sources (a label: the node passes the chosen sets),
-//! horizontal-only or full 3-D, residual weighting method 1–4, control weighting (σ = 0.10 m, 5.4.3, or the
-//! aerial triangulation covariance), aerial pixel observations directly in the bundle (issue 6 (a)), robust
-//! loss and rejection (issue 6 (b)), prior σ overrides, relative constraints and yaw estimation.
+//! The parameters of one adjustment configuration as the adjust node receives them (thesis 5.4.3, 5.5.1–5.5.3,
+//! 5.7): which correspondence sources (a label: the node passes the chosen sets), horizontal-only or full 3-D,
+//! residual weighting method 1–4, control weighting (σ = 0.10 m, 5.4.3, or the aerial triangulation
+//! covariance), aerial pixel observations directly in the bundle, robust loss and rejection, prior σ
+//! overrides, relative constraints and yaw estimation.
 //!
-//! Serde with `deny_unknown_fields` and defaults for every field, so a workflow TOML names only what differs;
-//! [`AdjustConfig::validate`] names every bad field at once.
+//! Declared with [`crate::params!`]: a workflow TOML names only what differs from the defaults, unknown keys
+//! are rejected and [`Params::validate`](crate::params::Params::validate) names every bad field at once.
 
 use super::problem::{AdjustOptions, LmOptions, DEFAULT_CONTROL_SIGMA_M};
 use super::robust::RobustLoss;
@@ -71,172 +71,62 @@ pub enum LossKind {
     Cauchy,
 }
 
-/// One adjustment configuration (the adjust node's params).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct AdjustConfig {
-    /// Label of the correspondence sources (`nadir`, `oblique`, `combined`).
-    pub sources: Sources,
-    /// `horizontal` or `full` (thesis 5.7).
-    pub dimensions: Dimensions,
-    /// Residual weighting method of thesis 5.7: 1 unweighted, 2 near-weighted, 3 far-weighted, 4 GSD-weighted.
-    pub weighting_method: u8,
-    /// Maximum correspondence distance l of methods 2 and 3, metres (thesis: 15 m).
-    pub weighting_max_distance_m: f64,
-    /// Angular resolution α of method 4, degrees; absent = 360° / panorama width.
-    pub weighting_alpha_deg: Option<f64>,
-    /// σ of a panorama observation, pixels.
-    pub pano_sigma_px: f64,
-    /// `fixed` (σ = `control_sigma_m`, thesis 5.4.3) or `covariance` (aerial triangulation covariance).
-    pub control_weighting: ControlWeighting,
-    /// σ of an aerial control point per axis with `control_weighting = "fixed"`, metres (thesis: 0.10 m).
-    pub control_sigma_m: f64,
-    /// Issue 6 (a): put the aerial pixel observations into the bundle (aerial orientation fixed) instead of
-    /// aerial-triangulated control points, so points seen in a single aerial image count too.
-    pub aerial_observations: bool,
-    /// `none`, `huber` or `cauchy`.
-    pub loss: LossKind,
-    /// Huber threshold / Cauchy scale, in σ units.
-    pub loss_scale: f64,
-    /// Reject observations whose |normalised residual| exceeds this many σ and re-solve (absent = never).
-    pub rejection_threshold: Option<f64>,
-    /// Largest number of rejection rounds.
-    pub max_rejection_rounds: usize,
-    /// Prior σ of recorded X and Y for every recording, metres (overrides `sigma_xy` of recordings.csv).
-    pub prior_sigma_xy_m: Option<f64>,
-    /// Prior σ of recorded Z for every recording, metres (overrides `sigma_z` of recordings.csv).
-    pub prior_sigma_z_m: Option<f64>,
-    /// Prior σ of X and Y for recordings without a `sigma_xy` value and no override, metres.
-    pub default_prior_sigma_xy_m: f64,
-    /// Prior σ of Z for recordings without a `sigma_z` value and no override, metres.
-    pub default_prior_sigma_z_m: f64,
-    /// Keep the recorded differences between consecutive recordings (thesis 3.4.2) with σ `relative_sigma_m`.
-    pub relative_constraints: bool,
-    /// σ of a relative constraint per axis, metres.
-    pub relative_sigma_m: f64,
-    /// Consecutive recordings farther apart than this are not linked (a gap in the trajectory), metres.
-    pub relative_max_gap_m: f64,
-    /// Estimate a yaw correction per recording.
-    pub estimate_yaw: bool,
-    /// σ of the zero prior on each yaw correction, degrees.
-    pub yaw_prior_sigma_deg: f64,
-    /// Largest number of LM iterations per solve.
-    pub max_iterations: usize,
-}
-
-impl Default for AdjustConfig {
-    fn default() -> Self {
-        Self {
-            sources: Sources::Combined,
-            dimensions: Dimensions::Full,
-            weighting_method: 1,
-            weighting_max_distance_m: 15.0,
-            weighting_alpha_deg: None,
-            pano_sigma_px: 1.0,
-            control_weighting: ControlWeighting::Fixed,
-            control_sigma_m: DEFAULT_CONTROL_SIGMA_M,
-            aerial_observations: false,
-            loss: LossKind::None,
-            loss_scale: 2.0,
-            rejection_threshold: None,
-            max_rejection_rounds: 10,
-            prior_sigma_xy_m: None,
-            prior_sigma_z_m: None,
-            default_prior_sigma_xy_m: DEFAULT_PRIOR_SIGMA_XY_M,
-            default_prior_sigma_z_m: DEFAULT_PRIOR_SIGMA_Z_M,
-            relative_constraints: false,
-            relative_sigma_m: 0.02,
-            relative_max_gap_m: 15.0,
-            estimate_yaw: false,
-            yaw_prior_sigma_deg: 1.0,
-            max_iterations: 100,
-        }
+crate::params! {
+    /// One adjustment configuration (the adjust node's params).
+    pub struct AdjustConfig {
+        /// Label of the correspondence sources (`nadir`, `oblique`, `combined`).
+        sources: Sources = Sources::Combined;
+        /// `horizontal` or `full` (thesis 5.7).
+        dimensions: Dimensions = Dimensions::Full;
+        /// Residual weighting method of thesis 5.7: 1 unweighted, 2 near-weighted, 3 far-weighted,
+        /// 4 GSD-weighted.
+        weighting_method: u8 = 1, min 1, max 4;
+        /// Maximum correspondence distance l of methods 2 and 3 (thesis: 15 m).
+        weighting_max_distance_m: f64 = 15.0, unit "m", above 0.0;
+        /// Angular resolution α of method 4 (thesis: 0.075°); absent = 360° / panorama width.
+        weighting_alpha_deg: Option<f64> = None, unit "deg", above 0.0;
+        /// σ of a panorama observation.
+        pano_sigma_px: f64 = 1.0, unit "px", above 0.0;
+        /// `fixed` (σ = `control_sigma_m`, thesis 5.4.3) or `covariance` (aerial triangulation covariance).
+        control_weighting: ControlWeighting = ControlWeighting::Fixed;
+        /// σ of an aerial control point per axis with `control_weighting = "fixed"` (thesis: 0.10 m).
+        control_sigma_m: f64 = DEFAULT_CONTROL_SIGMA_M, unit "m", above 0.0;
+        /// Put the aerial pixel observations into the bundle (aerial orientation fixed) instead of
+        /// aerial-triangulated control points, so points seen in a single aerial image count too.
+        aerial_observations: bool = false;
+        /// Robust loss on the observations: `none`, `huber` or `cauchy`.
+        loss: LossKind = LossKind::None;
+        /// Huber threshold / Cauchy scale, in σ units.
+        loss_scale: f64 = 2.0, above 0.0;
+        /// Reject observations whose |normalised residual| exceeds this many σ and re-solve; absent = never.
+        rejection_threshold: Option<f64> = None, above 0.0;
+        /// Largest number of rejection rounds.
+        max_rejection_rounds: usize = 10;
+        /// Prior σ of recorded X and Y for every recording (overrides `sigma_xy` of recordings.csv).
+        prior_sigma_xy_m: Option<f64> = None, unit "m", above 0.0;
+        /// Prior σ of recorded Z for every recording (overrides `sigma_z` of recordings.csv).
+        prior_sigma_z_m: Option<f64> = None, unit "m", above 0.0;
+        /// Prior σ of X and Y for recordings without a `sigma_xy` value and no override.
+        default_prior_sigma_xy_m: f64 = DEFAULT_PRIOR_SIGMA_XY_M, unit "m", above 0.0;
+        /// Prior σ of Z for recordings without a `sigma_z` value and no override.
+        default_prior_sigma_z_m: f64 = DEFAULT_PRIOR_SIGMA_Z_M, unit "m", above 0.0;
+        /// Keep the recorded differences between consecutive recordings (thesis 3.4.2) with σ
+        /// `relative_sigma_m`.
+        relative_constraints: bool = false;
+        /// σ of a relative constraint per axis.
+        relative_sigma_m: f64 = 0.02, unit "m", above 0.0;
+        /// Consecutive recordings farther apart than this are not linked (a gap in the trajectory).
+        relative_max_gap_m: f64 = 15.0, unit "m", above 0.0;
+        /// Estimate a yaw correction per recording.
+        estimate_yaw: bool = false;
+        /// σ of the zero prior on each yaw correction.
+        yaw_prior_sigma_deg: f64 = 1.0, unit "deg", above 0.0;
+        /// Largest number of Levenberg–Marquardt iterations per solve.
+        max_iterations: usize = 100, min 1;
     }
-}
-
-fn positive_finite(x: f64) -> bool {
-    x.is_finite() && x > 0.0
 }
 
 impl AdjustConfig {
-    /// Every invalid field as (field name, what is wrong and what to use); empty = valid.
-    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
-        let mut problems = Vec::new();
-        let mut positive = |field: &str, value: f64, hint: &str| {
-            if !positive_finite(value) {
-                problems.push((
-                    field.to_string(),
-                    format!("{value} must be finite and > 0 ({hint})"),
-                ));
-            }
-        };
-        positive(
-            "weighting_max_distance_m",
-            self.weighting_max_distance_m,
-            "thesis: 15",
-        );
-        if let Some(a) = self.weighting_alpha_deg {
-            positive("weighting_alpha_deg", a, "thesis: 0.075, or leave it out");
-        }
-        positive("pano_sigma_px", self.pano_sigma_px, "e.g. 1");
-        positive("control_sigma_m", self.control_sigma_m, "thesis: 0.10");
-        positive("loss_scale", self.loss_scale, "in sigma units, e.g. 2");
-        if let Some(k) = self.rejection_threshold {
-            positive("rejection_threshold", k, "in sigma units, e.g. 3");
-        }
-        if let Some(s) = self.prior_sigma_xy_m {
-            positive("prior_sigma_xy_m", s, "metres, or leave it out");
-        }
-        if let Some(s) = self.prior_sigma_z_m {
-            positive("prior_sigma_z_m", s, "metres, or leave it out");
-        }
-        positive(
-            "default_prior_sigma_xy_m",
-            self.default_prior_sigma_xy_m,
-            "metres",
-        );
-        positive(
-            "default_prior_sigma_z_m",
-            self.default_prior_sigma_z_m,
-            "metres",
-        );
-        positive(
-            "relative_sigma_m",
-            self.relative_sigma_m,
-            "metres, e.g. 0.02",
-        );
-        positive(
-            "relative_max_gap_m",
-            self.relative_max_gap_m,
-            "metres, e.g. 15",
-        );
-        positive(
-            "yaw_prior_sigma_deg",
-            self.yaw_prior_sigma_deg,
-            "degrees, e.g. 1",
-        );
-        if !(1..=4).contains(&self.weighting_method) {
-            problems.push((
-                "weighting_method".to_string(),
-                format!(
-                    "{} is not a thesis 5.7 method; use 1 (unweighted), 2 (near), 3 (far) or 4 (GSD)",
-                    self.weighting_method
-                ),
-            ));
-        }
-        if self.max_iterations == 0 {
-            problems.push((
-                "max_iterations".to_string(),
-                "0 would not iterate; use e.g. 100".to_string(),
-            ));
-        }
-        if problems.is_empty() {
-            Ok(())
-        } else {
-            Err(problems)
-        }
-    }
-
     /// The residual weighting method.
     pub fn weighting(&self) -> ResidualWeighting {
         ResidualWeighting {
@@ -289,6 +179,7 @@ impl AdjustConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::Params;
 
     #[test]
     fn toml_with_defaults_and_errors_naming_fields() {
@@ -309,11 +200,11 @@ mod tests {
             .validate()
             .unwrap_err()
             .into_iter()
-            .map(|p| p.0)
+            .map(|p| p.field)
             .collect();
         assert_eq!(
             fields,
-            ["control_sigma_m", "rejection_threshold", "weighting_method"]
+            ["weighting_method", "control_sigma_m", "rejection_threshold"]
         );
         assert!(AdjustConfig::default().validate().is_ok());
         let robust = AdjustConfig {

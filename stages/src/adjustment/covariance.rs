@@ -5,15 +5,17 @@
 //! normal matrix), evaluated undamped at the solution with the final robust weights. Because all residuals
 //! are whitened by their a-priori σ, `S⁻¹` is the **a-priori** covariance (σ0 = 1); the **a-posteriori**
 //! covariance is `σ̂0²·S⁻¹` with the variance factor `σ̂0² = Σr² / (n − u)` (n residual components, u
-//! unknowns). Only the 3 × 3/4 × 4 diagonal blocks of S⁻¹ are computed (one solve per parameter with the
-//! envelope factor, recordings in parallel with an ordered collect).
+//! unknowns). Only the blocks of S⁻¹ on the structure of the sparse Cholesky factor are computed, by
+//! selected inversion ([`super::sparse::selected_inverse`]), never the dense inverse: the diagonal 4 × 4 block
+//! of each recording is read from them.
 
+use super::error::AdjustError;
+use super::linearization::linearize;
 use super::prepared::Prepared;
-use super::problem::AdjustError;
 use super::residuals::State;
-use super::solver::factorized_reduced_matrix;
+use super::schur::{ReduceError, ReducedSystem};
+use super::sparse::SelectedInverse;
 use nalgebra::Matrix4;
-use rayon::prelude::*;
 
 /// A-priori covariance blocks over (x [m], y [m], z [m], ψ [rad]) per recording (rows/columns of fixed
 /// parameters are zero), and the variance factor σ̂0² (`None` without redundancy).
@@ -30,27 +32,36 @@ pub fn recording_covariances(
     prep: &Prepared,
     state: &State,
 ) -> Result<RecordingCovariances, AdjustError> {
-    let factor = factorized_reduced_matrix(prep, state)?;
+    let lin = linearize(prep, state);
+    let mut system = ReducedSystem::new(prep);
+    system.reduce(prep, &lin, 0.0).map_err(|e| match e {
+        ReduceError::Pivot(p) => AdjustError::Singular {
+            recording: p.block,
+            parameter: p.component,
+        },
+        ReduceError::Point(_) => AdjustError::Singular {
+            recording: 0,
+            parameter: 0,
+        },
+    })?;
+    drop(lin);
+    let symbolic = &prep.structure.symbolic;
+    let inverse = SelectedInverse::new(symbolic, &system.factor);
     let active = &prep.parameterization.active;
-    let k = active.len();
-    let n = factor.dim();
     let n_rec = prep.recorded_local.len();
     let a_priori: Vec<Matrix4<f64>> = (0..n_rec)
-        .into_par_iter()
         .map(|c| {
-            let mut block = Matrix4::zeros();
-            let mut column = vec![0.0; n];
-            for (s1, &f1) in active.iter().enumerate() {
-                column.iter_mut().for_each(|v| *v = 0.0);
-                column[c * k + s1] = 1.0;
-                factor.solve_in_place(&mut column);
-                for (s2, &f2) in active.iter().enumerate() {
-                    block[(f2, f1)] = column[c * k + s2];
+            let z = inverse.diagonal(symbolic, c);
+            Matrix4::from_fn(|i, j| {
+                if active.contains(&i) && active.contains(&j) {
+                    z[(i, j)]
+                } else {
+                    0.0
                 }
-            }
-            block
+            })
         })
         .collect();
+    let n = n_rec * active.len();
     let (sum_sq, components) = prep.plain_sum_of_squares(state);
     let unknowns = n + 3 * prep.point_active.iter().filter(|&&a| a).count();
     let redundancy = components as i64 - unknowns as i64;

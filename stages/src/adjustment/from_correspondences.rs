@@ -11,16 +11,25 @@
 
 use super::adjust::{adjust, ObservationCounts};
 use super::config::{AdjustConfig, ControlWeighting};
+use super::error::AdjustError;
 use super::problem::{
-    AdjustError, AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint,
-    PanoObservation, RelativeConstraint,
+    AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, PanoObservation,
+    RelativeConstraint,
 };
 use crate::campaign::{AerialImage, AerialKind, Recording};
 use crate::correspondence::{AerialControlPoint, MmTiePoint};
 use crate::geometry::{triangulate_rays, FrameCamera, PanoramaCamera};
+use crate::params::{describe, Params, StageId};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "adjust",
+    version: "3",
+};
 
 /// The inputs of one adjustment.
 #[derive(Clone, Copy, Debug)]
@@ -108,6 +117,8 @@ pub struct RunRecording {
     pub yaw_correction_deg: f64,
     /// Posterior σ of x, y, z, metres: a posteriori (scaled by σ̂0) when there is redundancy, else a priori.
     pub sigma_m: [f64; 3],
+    /// σ of the yaw correction, degrees, scaled like `sigma_m` (0 when yaw is not estimated).
+    pub sigma_yaw_deg: f64,
     pub sigma_is_a_posteriori: bool,
 }
 
@@ -151,10 +162,9 @@ pub fn build_block(
     config: &AdjustConfig,
 ) -> Result<BlockBuild, AdjustError> {
     if let Err(problems) = config.validate() {
-        let (field, problem) = problems[0].clone();
         return Err(AdjustError::InvalidInput {
-            item: format!("adjust parameter {field}"),
-            problem,
+            item: "adjust parameters".to_string(),
+            problem: describe(&problems),
         });
     }
     let n_rec = inputs.recordings.len();
@@ -461,12 +471,17 @@ pub fn run(inputs: &AdjustInputs, config: &AdjustConfig) -> Result<AdjustmentRun
                 Some(s) => (s, true),
                 None => (a.sigma_a_priori_m, false),
             };
+            let yaw_scale = match (posterior, adj.variance_factor) {
+                (true, Some(f)) => f.sqrt(),
+                _ => 1.0,
+            };
             RunRecording {
                 image_id: id.clone(),
                 recorded_world: rec.camera.center_world.into(),
                 adjusted_world: a.position_world.into(),
                 yaw_correction_deg: a.yaw_correction_deg,
                 sigma_m: sigma.into(),
+                sigma_yaw_deg: a.sigma_yaw_a_priori_deg * yaw_scale,
                 sigma_is_a_posteriori: posterior,
             }
         })

@@ -2,38 +2,51 @@
 //! optionally, a yaw correction per recording) from panorama observations of tie points, aerial control
 //! points, weak priors on the recorded positions and optional relative constraints along the trajectory.
 //!
-//! Layers: [`problem`] (the block and the options), [`aerial`] (aerial image observations with the aerial
-//! orientation fixed, issue 6 (a)), [`weighting`] (residual weighting methods 1–4 of thesis
-//! 5.7), [`robust`] (Huber/Cauchy losses), [`residuals`] (residuals and analytic Jacobians), [`skyline`]
-//! (envelope Cholesky of the reduced camera matrix), [`solver`] (Levenberg–Marquardt with the points
-//! eliminated by a Schur complement), [`covariance`] (posterior σ per recording), [`adjust`] (solve, reject
-//! by normalised residuals, re-solve), [`evaluate`] (check-point triangulation and RMSE), [`synthetic_block`]
+//! Layers, bottom up: [`error`] (what can go wrong, naming the item), [`weighting`] (residual weighting
+//! methods 1–4 of thesis 5.7), [`robust`] (Huber/Cauchy losses), [`problem`] (the block and the options),
+//! [`aerial`] (aerial image observations with the aerial orientation fixed, issue 6 (a)), [`residuals`]
+//! (residuals and analytic Jacobians), [`parallel`] (thread-count-independent parallel loops), [`sparse`]
+//! (block sparse Cholesky with a fill-reducing ordering, and selected inversion), [`layout`] (observations
+//! by point and recording, structure of the reduced camera matrix), [`prepared`] (one solve's setup and
+//! cost), [`linearization`] (normal-equation blocks), [`schur`] (the reduced camera system), [`solver`]
+//! (Levenberg–Marquardt), [`covariance`] (posterior σ per recording), [`adjust`] (solve, reject by
+//! normalised residuals, re-solve), [`evaluate`] (check-point triangulation and RMSE), [`synthetic_block`]
 //! (known-answer test blocks). On top: [`config`] (the adjust node's params), [`from_correspondences`]
 //! (correspondences → block → [`AdjustmentRun`]), [`verify`] (thesis Table 5-13 verification per trajectory
 //! segment) and [`synthetic_campaign`] (a synthetic block as campaign rows and correspondences, with aerial
 //! images, for known-answer tests).
+//!
+//! Scale: memory and time grow linearly with the observations for a trajectory (a chain of recordings) and
+//! with the fill of the sparse factor for street networks with crossings and repeated passes.
 
 pub mod adjust;
 pub mod aerial;
 pub mod campaign_checkpoints;
 pub mod config;
 pub mod covariance;
+pub mod error;
 pub mod evaluate;
 pub mod from_correspondences;
+pub mod layout;
+pub mod linearization;
+pub mod parallel;
 pub mod prepared;
 pub mod problem;
 pub mod residuals;
 pub mod robust;
-pub mod skyline;
+pub mod schur;
 pub mod solver;
+pub mod sparse;
 pub mod synthetic_block;
 pub mod synthetic_campaign;
+pub mod synthetic_streets;
 pub mod trajectory_errors;
 pub mod verify;
 pub mod weighting;
 
 pub use adjust::{adjust, AdjustedRecording, Adjustment, ObservationCounts, RoundReport};
 pub use config::{AdjustConfig, ControlWeighting, Dimensions, LossKind, Sources};
+pub use error::AdjustError;
 pub use evaluate::{
     evaluate_checkpoints, CheckObservation, CheckPointError, CheckPointEvaluation, RmseSummary,
     ViewSelection,
@@ -43,8 +56,8 @@ pub use from_correspondences::{
     RunPoint, RunRecording,
 };
 pub use problem::{
-    AdjustError, AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint,
-    LmOptions, PanoObservation, RelativeConstraint,
+    AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, LmOptions,
+    PanoObservation, RelativeConstraint,
 };
 pub use robust::RobustLoss;
 pub use solver::Termination;

@@ -1,5 +1,5 @@
 //! One solve's fixed setup (local frame, active observations, weights, whitening) and the evaluation of its
-//! cost and its linearisation (thesis 5.4: the adjustment model; 5.7: residual weighting).
+//! cost (thesis 5.4: the adjustment model; 5.7: residual weighting).
 //!
 //! Whitening: every residual is divided by its a-priori standard deviation, so the cost is
 //! `½·Σ ρ(‖r_obs‖²)` over panorama, aerial-image and control-point observations (robust loss ρ) plus `½·Σ ‖r‖²` over the
@@ -7,13 +7,14 @@
 //! factor, fixed per solve from the distances at the start of the solve.
 
 use super::aerial::FixedFrameCamera;
-use super::problem::{AdjustError, AdjustOptions, Block};
+use super::error::AdjustError;
+use super::layout::{ObservationLayout, ReducedStructure};
+use super::parallel::ordered_sum;
+use super::problem::{AdjustOptions, Block};
 use super::residuals::{observed_angles_rad, pano_residual, Parameterization, State};
 use super::robust::RobustLoss;
-use nalgebra::{Matrix3, Matrix4, SMatrix, Vector3, Vector4};
-
-/// 4 × 3 coupling block Jᵀ_camera·J_point of one panorama observation.
-pub type Coupling = SMatrix<f64, 4, 3>;
+use nalgebra::{Matrix3, Vector3};
+use rayon::prelude::*;
 
 /// A panorama observation ready for evaluation.
 #[derive(Clone, Copy, Debug)]
@@ -72,27 +73,10 @@ pub struct Prepared {
     pub relative: Vec<(usize, usize, f64)>,
     /// Points with enough active observations to be determined.
     pub point_active: Vec<bool>,
-    /// Active panorama observations per point.
-    pub point_observations: Vec<Vec<usize>>,
-    /// Envelope of the reduced camera matrix: first coupled recording per recording.
-    pub first_recording: Vec<usize>,
-}
-
-/// Gradient and Gauss–Newton blocks at one state (robust weights included).
-#[derive(Clone, Debug)]
-pub struct Linearization {
-    /// Per recording: Jᵀ·J over (x, y, z, ψ).
-    pub camera_diag: Vec<Matrix4<f64>>,
-    /// (row recording, column recording < row, block) from relative constraints.
-    pub camera_off: Vec<(usize, usize, Matrix4<f64>)>,
-    /// Per recording: −Jᵀ·r.
-    pub camera_rhs: Vec<Vector4<f64>>,
-    /// Per point: Jᵀ·J.
-    pub point_diag: Vec<Matrix3<f64>>,
-    /// Per point: −Jᵀ·r.
-    pub point_rhs: Vec<Vector3<f64>>,
-    /// Per panorama observation: Jᵀ_camera·J_point (zero when inactive).
-    pub couplings: Vec<Coupling>,
+    /// Active panorama observations by point and by recording.
+    pub layout: ObservationLayout,
+    /// Block structure of the reduced camera matrix and its symbolic factorisation.
+    pub structure: ReducedStructure,
 }
 
 impl Prepared {
@@ -220,28 +204,22 @@ impl Prepared {
         for o in aerial.iter_mut() {
             o.active &= point_active[o.point];
         }
-        let mut point_observations = vec![Vec::new(); n_pts];
-        for (i, o) in pano.iter().enumerate().filter(|(_, o)| o.active) {
-            point_observations[o.point].push(i);
-        }
+        let layout = ObservationLayout::new(
+            n_rec,
+            n_pts,
+            pano.iter()
+                .enumerate()
+                .filter(|(_, o)| o.active)
+                .map(|(i, o)| (i, o.point)),
+            |i| pano[i].recording,
+        );
         let relative: Vec<(usize, usize, f64)> = block
             .relative_constraints
             .iter()
             .map(|r| (r.from, r.to, r.sigma_m))
             .collect();
-        let mut first_recording: Vec<usize> = (0..n_rec).collect();
-        for obs in &point_observations {
-            if let Some(min) = obs.iter().map(|&i| pano[i].recording).min() {
-                for &i in obs {
-                    let r = pano[i].recording;
-                    first_recording[r] = first_recording[r].min(min);
-                }
-            }
-        }
-        for &(a, b, _) in &relative {
-            let (lo, hi) = (a.min(b), a.max(b));
-            first_recording[hi] = first_recording[hi].min(lo);
-        }
+        let pairs: Vec<(usize, usize)> = relative.iter().map(|&(a, b, _)| (a, b)).collect();
+        let structure = ReducedStructure::new(&layout, &pairs);
         Ok(Self {
             parameterization: Parameterization::from_options(options),
             loss: options.loss,
@@ -264,13 +242,13 @@ impl Prepared {
             aerial,
             relative,
             point_active,
-            point_observations,
-            first_recording,
+            layout,
+            structure,
         })
     }
 
     /// Number of axes (of x, y, z) that are free: 2 horizontal-only, else 3.
-    fn position_axes(&self) -> usize {
+    pub(super) fn position_axes(&self) -> usize {
         if self.horizontal_only {
             2
         } else {
@@ -321,7 +299,7 @@ impl Prepared {
     }
 
     /// Whitened prior residuals of recording `c`: (axis, residual, 1/σ) for each prior axis.
-    fn prior_terms(&self, c: usize, state: &State) -> [(usize, f64, f64); 3] {
+    pub(super) fn prior_terms(&self, c: usize, state: &State) -> [(usize, f64, f64); 3] {
         let d = state.centers_local[c] - self.recorded_local[c];
         let mut out = [(0, 0.0, 0.0); 3];
         if let Some(s) = self.prior_sigma_xy_m[c] {
@@ -335,7 +313,7 @@ impl Prepared {
     }
 
     /// Relative-constraint residual (whitened) of constraint `i`, per free axis.
-    fn relative_residual(&self, i: usize, state: &State) -> Vector3<f64> {
+    pub(super) fn relative_residual(&self, i: usize, state: &State) -> Vector3<f64> {
         let (a, b, sigma) = self.relative[i];
         let kept = self.recorded_local[b] - self.recorded_local[a];
         let mut r = (state.centers_local[b] - state.centers_local[a] - kept) / sigma;
@@ -347,15 +325,17 @@ impl Prepared {
 
     /// The cost ½·Σρ at `state`; +∞ if some observation is geometrically degenerate there.
     pub fn cost(&self, state: &State) -> f64 {
-        let mut total = 0.0;
-        for (i, o) in self.pano.iter().enumerate() {
-            if !o.active {
-                continue;
+        let mut total = ordered_sum(self.pano.len(), |i| {
+            if !self.pano[i].active {
+                return 0.0;
             }
             match self.pano_whitened(i, state) {
-                Some((r, _, _)) => total += self.loss.rho(r.norm_squared()),
-                None => return f64::INFINITY,
+                Some((r, _, _)) => self.loss.rho(r.norm_squared()),
+                None => f64::INFINITY,
             }
+        });
+        if total == f64::INFINITY {
+            return total;
         }
         for (i, c) in self.control.iter().enumerate() {
             if c.active {
@@ -394,100 +374,23 @@ impl Prepared {
         total
     }
 
-    /// Normal-equation blocks at `state`; degenerate observations (rare, only far from the solution)
-    /// contribute nothing.
-    pub fn linearize(&self, state: &State) -> Linearization {
-        let n_rec = self.recorded_local.len();
-        let n_pts = self.point_active.len();
-        let mut lin = Linearization {
-            camera_diag: vec![Matrix4::zeros(); n_rec],
-            camera_off: Vec::with_capacity(self.relative.len()),
-            camera_rhs: vec![Vector4::zeros(); n_rec],
-            point_diag: vec![Matrix3::zeros(); n_pts],
-            point_rhs: vec![Vector3::zeros(); n_pts],
-            couplings: vec![Coupling::zeros(); self.pano.len()],
-        };
-        for (i, o) in self.pano.iter().enumerate() {
-            if !o.active {
-                continue;
-            }
-            let Some((r, jc, jp)) = self.pano_whitened(i, state) else {
-                continue;
-            };
-            let w = self.loss.weight(r.norm_squared());
-            lin.camera_diag[o.recording] += w * jc.transpose() * jc;
-            lin.camera_rhs[o.recording] -= w * jc.transpose() * r;
-            lin.point_diag[o.point] += w * jp.transpose() * jp;
-            lin.point_rhs[o.point] -= w * jp.transpose() * r;
-            lin.couplings[i] = w * jc.transpose() * jp;
-        }
-        for (i, c) in self.control.iter().enumerate() {
-            if !c.active {
-                continue;
-            }
-            let r = self.control_whitened(i, state);
-            let w = self.loss.weight(r.norm_squared());
-            let j = c.whitening;
-            lin.point_diag[c.point] += w * j.transpose() * j;
-            lin.point_rhs[c.point] -= w * j.transpose() * r;
-        }
-        // Aerial observations touch only their point (the camera is fixed): no coupling with the recordings,
-        // so they enter the Schur complement through V alone.
-        for (i, o) in self.aerial.iter().enumerate() {
-            if !o.active {
-                continue;
-            }
-            let Some((r, j)) = self.aerial_whitened(i, state) else {
-                continue;
-            };
-            let w = self.loss.weight(r.norm_squared());
-            lin.point_diag[o.point] += w * j.transpose() * j;
-            lin.point_rhs[o.point] -= w * j.transpose() * r;
-        }
-        for c in 0..n_rec {
-            for (axis, r, inv_sigma) in self.prior_terms(c, state) {
-                if inv_sigma > 0.0 {
-                    lin.camera_diag[c][(axis, axis)] += inv_sigma * inv_sigma;
-                    lin.camera_rhs[c][axis] -= inv_sigma * r;
-                }
-            }
-            if let Some(s) = self.yaw_prior_sigma_rad {
-                lin.camera_diag[c][(3, 3)] += 1.0 / (s * s);
-                lin.camera_rhs[c][3] -= state.yaw_correction_rad[c] / (s * s);
-            }
-        }
-        for i in 0..self.relative.len() {
-            let (a, b, sigma) = self.relative[i];
-            let r = self.relative_residual(i, state);
-            let inv2 = 1.0 / (sigma * sigma);
-            let mut block = Matrix4::zeros();
-            for axis in 0..self.position_axes() {
-                lin.camera_diag[a][(axis, axis)] += inv2;
-                lin.camera_diag[b][(axis, axis)] += inv2;
-                block[(axis, axis)] = -inv2;
-                // J_a = −I/σ, J_b = I/σ.
-                lin.camera_rhs[a][axis] += r[axis] / sigma;
-                lin.camera_rhs[b][axis] -= r[axis] / sigma;
-            }
-            let (row, col) = if a > b { (a, b) } else { (b, a) };
-            lin.camera_off.push((row, col, block));
-        }
-        lin
-    }
-
     /// Squared-residual sum Σ‖r‖² of the active observations without robust loss (for σ̂0²), and the number of
     /// residual components.
     pub fn plain_sum_of_squares(&self, state: &State) -> (f64, usize) {
         let mut total = self.gaussian_terms(state);
         let mut count = 0usize;
-        for (i, o) in self.pano.iter().enumerate() {
-            if o.active {
-                if let Some((r, _, _)) = self.pano_whitened(i, state) {
-                    total += r.norm_squared();
-                    count += 2;
-                }
-            }
-        }
+        total += ordered_sum(self.pano.len(), |i| {
+            let r = self.pano[i]
+                .active
+                .then(|| self.pano_whitened(i, state))
+                .flatten();
+            r.map_or(0.0, |(r, _, _)| r.norm_squared())
+        });
+        count += 2
+            * (0..self.pano.len())
+                .into_par_iter()
+                .filter(|&i| self.pano[i].active && self.pano_whitened(i, state).is_some())
+                .count();
         for (i, c) in self.control.iter().enumerate() {
             if c.active {
                 total += self.control_whitened(i, state).norm_squared();

@@ -5,6 +5,7 @@
 //! frame shifted to the mean recording centre. Pixel coordinates follow campaign-format.md (continuous, first
 //! pixel centre at 0.5). Angles carry their unit in the name.
 
+use super::error::AdjustError;
 use super::robust::RobustLoss;
 use super::weighting::ResidualWeighting;
 use crate::geometry::{FrameCamera, PanoramaCamera};
@@ -162,45 +163,6 @@ impl AdjustOptions {
             ..Self::default()
         }
     }
-}
-
-/// Why an adjustment could not be set up or solved.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum AdjustError {
-    #[error("the block has no recordings; add at least one recording")]
-    NoRecordings,
-    #[error("recording {index}: {field} = {value} is not valid ({hint})")]
-    InvalidRecording {
-        index: usize,
-        field: &'static str,
-        value: f64,
-        hint: &'static str,
-    },
-    #[error(
-        "tie point {index}: initial coordinates are not finite; triangulate it first or drop it"
-    )]
-    InvalidPoint { index: usize },
-    #[error("panorama observation {index}: {problem}")]
-    InvalidPanoObservation { index: usize, problem: String },
-    #[error("control point {index}: {problem}")]
-    InvalidControlPoint { index: usize, problem: String },
-    #[error("aerial observation {index}: {problem}")]
-    InvalidAerialObservation { index: usize, problem: String },
-    #[error("{item}: {problem}")]
-    InvalidInput { item: String, problem: String },
-    #[error("relative constraint {index}: {problem}")]
-    InvalidRelativeConstraint { index: usize, problem: String },
-    #[error("option {field} = {value} is not valid ({hint})")]
-    InvalidOption {
-        field: &'static str,
-        value: f64,
-        hint: &'static str,
-    },
-    #[error(
-        "the reduced normal matrix is singular at recording {recording} (parameter {parameter}): the block does \
-         not determine it; add priors (sigma_xy/sigma_z), control points or observations of that recording"
-    )]
-    Singular { recording: usize, parameter: usize },
 }
 
 fn positive_finite(x: f64) -> bool {

@@ -15,7 +15,7 @@
 
 use super::problem::AdjustOptions;
 use crate::geometry::{rot_z, LocalOrigin};
-use nalgebra::{Matrix2x3, Matrix3, SMatrix, Vector2, Vector3};
+use nalgebra::{Matrix2x3, Matrix3, SMatrix, Vector2, Vector3, Vector4};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// Number of recording parameters before masking: x, y, z, ψ.
@@ -63,25 +63,18 @@ pub struct State {
 }
 
 impl State {
-    /// Adds an update of the free camera parameters (`camera_step`, `per_recording` values per recording in
-    /// `parameterization.active` order) and of the points (3 per point; unconstrained points get zero).
-    pub fn apply(
-        &self,
-        parameterization: &Parameterization,
-        camera_step: &[f64],
-        point_step: &[Vector3<f64>],
-    ) -> State {
-        let k = parameterization.per_recording();
+    /// Adds an update of the camera parameters (per recording over (x, y, z, ψ); fixed ones are zero) and of
+    /// the points (3 per point; undetermined points get zero).
+    pub fn apply(&self, camera_step: &[Vector4<f64>], point_step: &[Vector3<f64>]) -> State {
         let mut next = self.clone();
-        for (c, center) in next.centers_local.iter_mut().enumerate() {
-            for (slot, &full) in parameterization.active.iter().enumerate() {
-                let delta = camera_step[c * k + slot];
-                if full < 3 {
-                    center[full] += delta;
-                } else {
-                    next.yaw_correction_rad[c] += delta;
-                }
-            }
+        for ((center, yaw), step) in next
+            .centers_local
+            .iter_mut()
+            .zip(next.yaw_correction_rad.iter_mut())
+            .zip(camera_step)
+        {
+            *center += step.xyz();
+            *yaw += step.w;
         }
         for (p, step) in next.points_local.iter_mut().zip(point_step) {
             *p += step;

@@ -3,7 +3,7 @@
 //! `s = ‖r‖²` of its whitened residual vector, minimised by iteratively re-weighted least squares inside LM
 //! (residual and Jacobian scaled by √ρ'(s), the Triggs/ceres first-order correction).
 
-use super::problem::AdjustError;
+use super::error::AdjustError;
 
 /// The loss ρ(s) of one observation, s = squared norm of its whitened residual (units of σ²).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]

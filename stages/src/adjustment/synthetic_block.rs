@@ -9,8 +9,8 @@
 
 use super::evaluate::CheckObservation;
 use super::problem::{Block, BlockRecording, ControlPoint, PanoObservation};
-use crate::estimators::rng::SplitMix64;
 use crate::geometry::{triangulate_rays, PanoramaCamera};
+use crate::rng::SplitMix64;
 use nalgebra::Vector3;
 use std::f64::consts::TAU;
 

@@ -10,8 +10,8 @@ use crate::campaign::{AerialImage, AerialKind, CheckPoint, Observation, Recordin
 use crate::correspondence::{
     AerialControlPoint, AerialObservation, MmTiePoint, PanoObservation as CorrPanoObservation,
 };
-use crate::estimators::rng::SplitMix64;
 use crate::geometry::{matrix_to_opk, opk_to_matrix, triangulate_rays, FrameCamera};
+use crate::rng::SplitMix64;
 use nalgebra::Vector3;
 
 /// Parameters of the aerial part of a synthetic campaign.
@@ -189,6 +189,10 @@ impl SyntheticCampaignSpec {
                 k2: 0.0,
                 p1,
                 p2: 0.0,
+                k3: 0.0,
+                k4: 0.0,
+                b1: 0.0,
+                b2: 0.0,
                 sigma_px: self.aerial_sigma_px,
             };
             cameras.push(FrameCamera::from_aerial(&row));

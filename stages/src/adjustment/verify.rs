@@ -1,4 +1,4 @@
-//! Verification without adjustment (thesis 5.7, Table 5-13; issue 6 "Verification"): are a campaign's recorded
+//! Verification without adjustment (thesis 5.7, Table 5-13): are a campaign's recorded
 //! positions good enough? Each aerial control point triangulated from ≥ 2 aerial images is compared with the
 //! same point triangulated from its MM observations alone with the RECORDED poses; the offset `MM − aerial`
 //! estimates the local trajectory error. Per trajectory segment (a number of recordings or an along-track
@@ -18,87 +18,42 @@ use crate::campaign::Recording;
 use crate::correspondence::AerialControlPoint;
 use crate::fsutil::atomic_write_with;
 use crate::geometry::{triangulate_rays, PanoramaCamera};
+use crate::params::{describe, Params, StageId};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::io::{self, Write};
 use std::path::Path;
 
-/// Parameters of a verification (the verify node's params).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct VerifyConfig {
-    /// Segment length in recordings (used when `segment_length_m` is absent).
-    pub segment_recordings: usize,
-    /// Segment length along the recorded trajectory, metres (overrides `segment_recordings`).
-    pub segment_length_m: Option<f64>,
-    /// Largest acceptable mean horizontal offset, metres.
-    pub tolerance_xy_m: f64,
-    /// Largest acceptable |mean vertical offset|, metres (with `check_height`).
-    pub tolerance_z_m: f64,
-    /// Also fail a segment on its mean vertical offset. Off by default: heights triangulated from nadir images
-    /// at ≈ 4.5 km are metres off (thesis 3.5.1.1), and centimetre errors of the aerial orientations make them
-    /// worse still, so a height test flags good trajectories (measured: the `aerial` error profile, demo seed 1,
-    /// segment mean Z +3.9 m with the recorded positions exact).
-    pub check_height: bool,
-    /// Fewer points in a segment give status `insufficient`.
-    pub min_points: usize,
-    /// A segment fails only when an offset exceeds its tolerance by more than this many σ of the mean.
-    pub confidence_k: f64,
-    /// σ of a panorama observation, pixels (weights the MM triangulation).
-    pub pano_sigma_px: f64,
-}
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "verify",
+    version: "4",
+};
 
-impl Default for VerifyConfig {
-    fn default() -> Self {
-        Self {
-            segment_recordings: 20,
-            segment_length_m: None,
-            tolerance_xy_m: 0.20,
-            tolerance_z_m: 0.30,
-            check_height: false,
-            min_points: 3,
-            confidence_k: 2.0,
-            pano_sigma_px: 1.0,
-        }
-    }
-}
-
-impl VerifyConfig {
-    /// Every invalid field as (field, problem); empty = valid.
-    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
-        let mut problems = Vec::new();
-        let mut positive = |field: &str, v: f64| {
-            if !(v.is_finite() && v > 0.0) {
-                problems.push((field.to_string(), format!("{v} must be finite and > 0")));
-            }
-        };
-        positive("tolerance_xy_m", self.tolerance_xy_m);
-        positive("tolerance_z_m", self.tolerance_z_m);
-        positive("pano_sigma_px", self.pano_sigma_px);
-        if let Some(l) = self.segment_length_m {
-            positive("segment_length_m", l);
-        }
-        if self.segment_recordings == 0 {
-            problems.push((
-                "segment_recordings".to_string(),
-                "0 recordings per segment; use e.g. 20".to_string(),
-            ));
-        }
-        if !(self.confidence_k.is_finite() && self.confidence_k >= 0.0) {
-            problems.push((
-                "confidence_k".to_string(),
-                format!("{} must be finite and ≥ 0 (e.g. 2)", self.confidence_k),
-            ));
-        }
-        if self.min_points == 0 {
-            problems.push(("min_points".to_string(), "must be ≥ 1 (e.g. 3)".to_string()));
-        }
-        if problems.is_empty() {
-            Ok(())
-        } else {
-            Err(problems)
-        }
+crate::params! {
+    /// Parameters of a verification (the verify node's params).
+    pub struct VerifyConfig {
+        /// Segment length in recordings (used when `segment_length_m` is absent).
+        segment_recordings: usize = 20, min 1;
+        /// Segment length along the recorded trajectory (overrides `segment_recordings`).
+        segment_length_m: Option<f64> = None, unit "m", above 0.0;
+        /// Largest acceptable mean horizontal offset.
+        tolerance_xy_m: f64 = 0.20, unit "m", above 0.0;
+        /// Largest acceptable |mean vertical offset| (with `check_height`).
+        tolerance_z_m: f64 = 0.30, unit "m", above 0.0;
+        /// Also fail a segment on its mean vertical offset. Off by default: heights triangulated from nadir
+        /// images at ≈ 4.5 km are metres off (thesis 3.5.1.1), and centimetre errors of the aerial orientations
+        /// make them worse still, so a height test flags good trajectories (measured: the `aerial` error
+        /// profile, demo seed 1, segment mean Z +3.9 m with the recorded positions exact).
+        check_height: bool = false;
+        /// Fewer points in a segment give status `insufficient`.
+        min_points: usize = 3, min 1;
+        /// A segment fails only when an offset exceeds its tolerance by more than this many σ of the mean.
+        confidence_k: f64 = 2.0, min 0.0;
+        /// σ of a panorama observation (weights the MM triangulation).
+        pano_sigma_px: f64 = 1.0, unit "px", above 0.0;
     }
 }
 
@@ -208,10 +163,7 @@ pub fn verify(
     config: &VerifyConfig,
 ) -> Result<Verification, String> {
     if let Err(problems) = config.validate() {
-        return Err(format!(
-            "verify parameter {}: {}",
-            problems[0].0, problems[0].1
-        ));
+        return Err(format!("verify parameters: {}", describe(&problems)));
     }
     if pano_size_px.len() != recordings.len() {
         return Err(format!(

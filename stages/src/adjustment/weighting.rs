@@ -13,7 +13,7 @@
 //! The factor multiplies the whitened residual (pixel residual / σ_px); it is evaluated once per solve from the
 //! initial distances and then held fixed, so each solve is an ordinary weighted least-squares problem.
 
-use super::problem::AdjustError;
+use super::error::AdjustError;
 use std::f64::consts::PI;
 
 /// Which of the thesis' four residual weightings (5.7) to apply.

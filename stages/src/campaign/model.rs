@@ -58,6 +58,17 @@ pub struct AerialImage {
     pub k2: f64,
     pub p1: f64,
     pub p2: f64,
+    /// Higher radial terms r⁶, r⁸ (optional columns `k3`, `k4`, default 0).
+    #[serde(default)]
+    pub k3: f64,
+    #[serde(default)]
+    pub k4: f64,
+    /// Affinity and non-orthogonality of the pixel axes, pixels (optional columns `b1`, `b2`, default 0):
+    /// `u = cx + (focal_px + b1)·x_d + b2·y_d`, `v = cy − focal_px·y_d`.
+    #[serde(default)]
+    pub b1: f64,
+    #[serde(default)]
+    pub b2: f64,
     /// Image measurement precision, pixels (optional, default 0.5).
     pub sigma_px: f64,
 }

@@ -14,6 +14,70 @@ pub enum Severity {
     Warning,
 }
 
+/// What sort of problem it is (counted per kind in `metrics.json`, `campaign.input_errors_by_kind`).
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    PartialOrd,
+    Ord,
+    Hash,
+    serde::Serialize,
+    serde::Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum ProblemKind {
+    /// A required file or column is missing, or a file cannot be read.
+    Missing,
+    /// Not valid CSV/TOML/UTF-8, or a row with the wrong number of cells.
+    Syntax,
+    /// A cell that is empty, not a number, not finite or outside its defined range.
+    #[default]
+    Value,
+    /// A value that is valid on its own but implausible (position jumps, far outside the campaign, absurd σ,
+    /// focal length or size).
+    Implausible,
+    /// An id or image used by more than one row.
+    Duplicate,
+    /// An id that refers to nothing usable.
+    Reference,
+    /// A file path that leaves the campaign folder.
+    Path,
+    /// An image file that is missing.
+    ImageMissing,
+    /// An image that is not JPEG/PNG/TIFF, or of a kind the decoders do not read.
+    ImageFormat,
+    /// An image file that is cut off or structurally damaged.
+    ImageDamaged,
+    /// An image whose size is wrong (not 2:1, not what its row says, or absurd).
+    ImageSize,
+    /// An image that does not decode (`skytie check --deep` and the run).
+    ImageDecode,
+}
+
+impl ProblemKind {
+    /// The snake_case name used in metrics.
+    pub fn name(self) -> &'static str {
+        match self {
+            ProblemKind::Missing => "missing",
+            ProblemKind::Syntax => "syntax",
+            ProblemKind::Value => "value",
+            ProblemKind::Implausible => "implausible",
+            ProblemKind::Duplicate => "duplicate",
+            ProblemKind::Reference => "reference",
+            ProblemKind::Path => "path",
+            ProblemKind::ImageMissing => "image_missing",
+            ProblemKind::ImageFormat => "image_format",
+            ProblemKind::ImageDamaged => "image_damaged",
+            ProblemKind::ImageSize => "image_size",
+            ProblemKind::ImageDecode => "image_decode",
+        }
+    }
+}
+
 /// One finding, e.g. `mm/recordings.csv:14: field 'x': 'abc' is not a number — write a decimal number with
 /// '.' as decimal mark`.
 #[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -29,6 +93,9 @@ pub struct Problem {
     pub message: String,
     /// What to do about it.
     pub hint: String,
+    /// What sort of problem (default: a bad value).
+    #[serde(default)]
+    pub kind: ProblemKind,
 }
 
 impl Problem {
@@ -83,7 +150,14 @@ impl Problem {
             field: field.map(str::to_string),
             message,
             hint,
+            kind: ProblemKind::Value,
         }
+    }
+
+    /// The same problem, of sort `kind`.
+    pub fn with_kind(mut self, kind: ProblemKind) -> Self {
+        self.kind = kind;
+        self
     }
 
     pub fn is_error(&self) -> bool {

@@ -2,14 +2,23 @@
 //! [`Problem`] naming file, row and field, the rest is returned. Images are not decoded (see `check`), only
 //! their existence is checked.
 
-use super::model::{AerialImage, Campaign, Observation, Recording};
-use super::problem::Problem;
+use super::model::{AerialImage, Campaign, Recording};
+use super::plausibility::{check_checkpoints, check_trajectory, shared_images, ImageUse};
+use super::problem::{Problem, ProblemKind};
 use super::read_aerial::read_aerial_rows;
 use super::read_control::{read_checkpoint_rows, read_observation_rows};
 use super::read_recordings::{read_recording_rows, sort_by_time};
 use super::unique::{keep_unique, Sourced};
+use crate::params::StageId;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "load",
+    version: "2",
+};
 
 /// The folder holds nothing usable as a campaign.
 #[derive(Debug, thiserror::Error)]
@@ -31,14 +40,21 @@ pub(crate) const OBLIQUE: &str = "aerial/oblique/cameras.csv";
 pub(crate) const CHECKPOINTS: &str = "control/checkpoints.csv";
 pub(crate) const OBSERVATIONS: &str = "control/observations.csv";
 
+/// The 1-based row (editor line) each item of a [`Campaign`] came from, parallel to its vectors.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SourceRows {
+    pub recordings: Vec<usize>,
+    pub nadir: Vec<usize>,
+    pub oblique: Vec<usize>,
+    pub checkpoints: Vec<usize>,
+    pub observations: Vec<usize>,
+}
+
 /// The campaign plus the row each item came from (for checks that report on rows later).
-pub(crate) struct SourcedCampaign {
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SourcedCampaign {
     pub campaign: Campaign,
-    /// Parallel to `campaign.recordings`, `.nadir`, `.oblique`, `.observations`.
-    pub recording_rows: Vec<usize>,
-    pub nadir_rows: Vec<usize>,
-    pub oblique_rows: Vec<usize>,
-    pub observation_rows: Vec<usize>,
+    pub rows: SourceRows,
 }
 
 /// Read and validate the campaign in `root`. `Err` only when nothing usable exists; otherwise the valid rows
@@ -47,7 +63,9 @@ pub fn read_campaign(root: &Path) -> Result<(Campaign, Vec<Problem>), CampaignEr
     read_sourced(root).map(|(s, problems)| (s.campaign, problems))
 }
 
-pub(crate) fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>), CampaignError> {
+/// [`read_campaign`] keeping each item's row: the first step of the one validation `skytie check` and the
+/// run share (the images are checked by [`super::images`]).
+pub fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>), CampaignError> {
     std::fs::read_dir(root).map_err(|source| CampaignError::Unreadable {
         path: root.to_path_buf(),
         source,
@@ -66,16 +84,20 @@ pub(crate) fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>
             &mut problems,
         )
     } else {
-        problems.push(Problem::error(
-            RECORDINGS,
-            None,
-            None,
-            "does not exist",
-            "put one row per panorama into mm/recordings.csv",
-        ));
+        problems.push(
+            Problem::error(
+                RECORDINGS,
+                None,
+                None,
+                "does not exist",
+                "put one row per panorama into mm/recordings.csv",
+            )
+            .with_kind(ProblemKind::Missing),
+        );
         Vec::new()
     };
     sort_by_time(&mut recordings);
+    let recordings = check_trajectory(recordings, &mut problems);
 
     let mut aerial = Vec::new();
     for rel in [NADIR, OBLIQUE] {
@@ -87,13 +109,16 @@ pub(crate) fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>
                     .map(|r| (rel, r)),
             );
         } else if root.join(folder).is_dir() {
-            problems.push(Problem::error(
-                rel,
-                None,
-                None,
-                format!("does not exist although {}/ does", folder.display()),
-                "add cameras.csv describing the images, or remove the folder",
-            ));
+            problems.push(
+                Problem::error(
+                    rel,
+                    None,
+                    None,
+                    format!("does not exist although {}/ does", folder.display()),
+                    "add cameras.csv describing the images, or remove the folder",
+                )
+                .with_kind(ProblemKind::Missing),
+            );
         }
     }
     // Image ids must be unique across nadir and oblique (stages address aerial images by id).
@@ -126,6 +151,8 @@ pub(crate) fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>
             row: r.row,
         });
     }
+    let (recordings, nadir, oblique) =
+        without_shared_images(root, recordings, nadir, oblique, &mut problems);
     let panorama_ids: HashSet<&str> = recordings
         .iter()
         .map(|r| r.item.image_id.as_str())
@@ -146,7 +173,8 @@ pub(crate) fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>
     }
 
     let checkpoints = if root.join(CHECKPOINTS).is_file() {
-        read_checkpoint_rows(root, Path::new(CHECKPOINTS), &mut problems)
+        let points = read_checkpoint_rows(root, Path::new(CHECKPOINTS), &mut problems);
+        check_checkpoints(&recordings, points, &mut problems)
     } else {
         Vec::new()
     };
@@ -164,28 +192,30 @@ pub(crate) fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>
                 &mut problems,
             )
         } else {
-            problems.push(Problem::error(
-                CHECKPOINTS,
-                None,
-                None,
-                "does not exist, so control/observations.csv cannot be used",
-                "add the surveyed points to control/checkpoints.csv",
-            ));
+            problems.push(
+                Problem::error(
+                    CHECKPOINTS,
+                    None,
+                    None,
+                    "does not exist, so control/observations.csv cannot be used",
+                    "add the surveyed points to control/checkpoints.csv",
+                )
+                .with_kind(ProblemKind::Missing),
+            );
             Vec::new()
         }
     } else {
         Vec::new()
     };
 
-    let split = |rows: Vec<Sourced<AerialImage>>| -> (Vec<AerialImage>, Vec<usize>) {
+    fn split<T>(rows: Vec<Sourced<T>>) -> (Vec<T>, Vec<usize>) {
         rows.into_iter().map(|r| (r.item, r.row)).unzip()
-    };
-    let (recordings, recording_rows): (Vec<Recording>, Vec<usize>) =
-        recordings.into_iter().map(|r| (r.item, r.row)).unzip();
+    }
+    let (recordings, recording_rows) = split(recordings);
     let (nadir, nadir_rows) = split(nadir);
     let (oblique, oblique_rows) = split(oblique);
-    let (observations, observation_rows): (Vec<Observation>, Vec<usize>) =
-        observations.into_iter().map(|r| (r.item, r.row)).unzip();
+    let (checkpoints, checkpoint_rows) = split(checkpoints);
+    let (observations, observation_rows) = split(observations);
     let campaign = Campaign {
         root: root.to_path_buf(),
         name,
@@ -193,22 +223,66 @@ pub(crate) fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>
         recordings,
         nadir,
         oblique,
-        checkpoints: checkpoints.into_iter().map(|r| r.item).collect(),
+        checkpoints,
         observations,
     };
     sort_problems(&mut problems);
     let sourced = SourcedCampaign {
         campaign,
-        recording_rows,
-        nadir_rows,
-        oblique_rows,
-        observation_rows,
+        rows: SourceRows {
+            recordings: recording_rows,
+            nadir: nadir_rows,
+            oblique: oblique_rows,
+            checkpoints: checkpoint_rows,
+            observations: observation_rows,
+        },
     };
     Ok((sourced, problems))
 }
 
+type Aerials = Vec<Sourced<AerialImage>>;
+
+/// Drop every row whose image file is also another row's image (see `plausibility::shared_images`).
+fn without_shared_images(
+    root: &Path,
+    recordings: Vec<Sourced<Recording>>,
+    nadir: Aerials,
+    oblique: Aerials,
+    problems: &mut Vec<Problem>,
+) -> (Vec<Sourced<Recording>>, Aerials, Aerials) {
+    let mut uses: Vec<ImageUse> = recordings
+        .iter()
+        .map(|r| ImageUse {
+            file: r.file.clone(),
+            row: r.row,
+            path: root.join(PANORAMAS).join(&r.item.file),
+        })
+        .collect();
+    for (csv, rows) in [(NADIR, &nadir), (OBLIQUE, &oblique)] {
+        let dir = root.join(Path::new(csv).parent().unwrap_or(Path::new("")));
+        uses.extend(rows.iter().map(|r| ImageUse {
+            file: r.file.clone(),
+            row: r.row,
+            path: dir.join(&r.item.file),
+        }));
+    }
+    let shared: HashSet<(PathBuf, usize)> = shared_images(&uses, problems).into_iter().collect();
+    let keep = |file: &Path, row: usize| !shared.contains(&(file.to_path_buf(), row));
+    (
+        recordings
+            .into_iter()
+            .filter(|r| keep(&r.file, r.row))
+            .collect(),
+        nadir.into_iter().filter(|r| keep(&r.file, r.row)).collect(),
+        oblique
+            .into_iter()
+            .filter(|r| keep(&r.file, r.row))
+            .collect(),
+    )
+}
+
 /// Order problems by file (in reading order) and row, keeping the order of problems on the same row.
-pub(crate) fn sort_problems(problems: &mut [Problem]) {
+pub fn sort_problems(problems: &mut [Problem]) {
     const ORDER: [&str; 6] = [TOML, RECORDINGS, NADIR, OBLIQUE, CHECKPOINTS, OBSERVATIONS];
     problems.sort_by_key(|p| {
         let rank = ORDER
@@ -225,7 +299,10 @@ fn read_toml(root: &Path, problems: &mut Vec<Problem>) -> (String, String) {
     let text = match std::fs::read_to_string(root.join(TOML)) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            problems.push(Problem::error(TOML, None, None, "does not exist", HINT));
+            problems.push(
+                Problem::error(TOML, None, None, "does not exist", HINT)
+                    .with_kind(ProblemKind::Missing),
+            );
             return (String::new(), String::new());
         }
         Err(e) => {

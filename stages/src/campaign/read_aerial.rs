@@ -3,6 +3,7 @@
 
 use super::model::AerialImage;
 use super::problem::Problem;
+use super::ranges;
 use super::read_recordings::check_file_exists;
 use super::table::read_table;
 use super::unique::Sourced;
@@ -42,6 +43,12 @@ pub(crate) fn read_aerial_rows(
             f.number_or("p1", 0.0),
             f.number_or("p2", 0.0),
         );
+        let (k3, k4, b1, b2) = (
+            f.number_or("k3", 0.0),
+            f.number_or("k4", 0.0),
+            f.number_or("b1", 0.0),
+            f.number_or("b2", 0.0),
+        );
         let sigma_px = f.number_or("sigma_px", 0.5);
         // campaign-format.md: ω and φ tilt the view axis away from the nadir; beyond ±90° it looks up.
         for (column, angle) in [("omega", omega_deg), ("phi", phi_deg)] {
@@ -53,25 +60,15 @@ pub(crate) fn read_aerial_rows(
                 );
             }
         }
-        if focal_px <= 0.0 {
-            f.error(
-                "focal_px",
-                format!("{focal_px} is not a principal distance"),
-                "give the principal distance in pixels, > 0",
-            );
-        }
+        ranges::coordinates(&mut f, x, y, z);
+        ranges::angle(&mut f, "kappa", kappa_deg, -360.0, 360.0);
+        ranges::frame_camera(&mut f, focal_px, width_px, height_px);
         for (column, c, size) in [("cx", cx_px, width_px), ("cy", cy_px, height_px)] {
             if size > 0 && !(0.0..=f64::from(size)).contains(&c) {
                 f.error(column, format!("principal point {c} px lies outside the image (0..{size} px)"), "give the principal point in continuous pixel coordinates of this image (centre = size/2)");
             }
         }
-        if sigma_px <= 0.0 {
-            f.error(
-                "sigma_px",
-                format!("{sigma_px} is not a standard deviation"),
-                "write a value > 0 px, or leave the cell empty for the default 0.5",
-            );
-        }
+        ranges::sigma_px(&mut f, sigma_px);
         if check_files && !file.is_empty() {
             check_file_exists(&mut f, root, dir, &file);
         }
@@ -94,6 +91,10 @@ pub(crate) fn read_aerial_rows(
                 k2,
                 p1,
                 p2,
+                k3,
+                k4,
+                b1,
+                b2,
                 sigma_px,
             };
             rows.push(Sourced {

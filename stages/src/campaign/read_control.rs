@@ -2,7 +2,8 @@
 //! "Control"): check points are for evaluation only; observations must name a known point and panorama.
 
 use super::model::{CheckPoint, Observation};
-use super::problem::Problem;
+use super::problem::{Problem, ProblemKind};
+use super::ranges;
 use super::table::read_table;
 use super::unique::{keep_unique, Sourced};
 use std::collections::HashSet;
@@ -24,15 +25,9 @@ pub(crate) fn read_checkpoint_rows(
         let (x, y, z) = (f.number("x"), f.number("y"), f.number("z"));
         let sigma_xy_m = f.optional_number("sigma_xy");
         let sigma_z_m = f.optional_number("sigma_z");
-        for (column, sigma) in [("sigma_xy", sigma_xy_m), ("sigma_z", sigma_z_m)] {
-            if let Some(s) = sigma.filter(|s| *s <= 0.0) {
-                f.error(
-                    column,
-                    format!("{s} is not a standard deviation"),
-                    "write a value > 0 m, or leave the cell empty",
-                );
-            }
-        }
+        ranges::coordinates(&mut f, x, y, z);
+        ranges::sigma_m(&mut f, "sigma_xy", sigma_xy_m);
+        ranges::sigma_m(&mut f, "sigma_z", sigma_z_m);
         if f.ok {
             let item = CheckPoint {
                 point_id,
@@ -78,10 +73,11 @@ pub(crate) fn read_observation_rows(
         let image_id = f.text("image_id");
         let (u_px, v_px) = (f.number("u"), f.number("v"));
         if !point_id.is_empty() && !points.contains(point_id.as_str()) {
-            f.error("point_id", format!("'{point_id}' is not a usable point of control/checkpoints.csv"), "add the point to control/checkpoints.csv (or fix its row there), or correct the id");
+            f.error_of(ProblemKind::Reference, "point_id", format!("'{point_id}' is not a usable point of control/checkpoints.csv"), "add the point to control/checkpoints.csv (or fix its row there), or correct the id");
         }
         if !image_id.is_empty() && !images.contains(image_id.as_str()) {
-            f.error(
+            f.error_of(
+                ProblemKind::Reference,
                 "image_id",
                 format!("'{image_id}' is not a usable panorama of mm/recordings.csv"),
                 "use the image_id of a panorama in mm/recordings.csv (or fix its row there)",

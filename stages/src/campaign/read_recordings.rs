@@ -2,7 +2,8 @@
 //! `trajectory_adjusted.csv`) row by row with validation (campaign-format.md, "Panoramas").
 
 use super::model::Recording;
-use super::problem::Problem;
+use super::problem::{Problem, ProblemKind};
+use super::ranges;
 use super::table::read_table;
 use super::time::parse_time_s;
 use super::unique::{keep_unique, Sourced};
@@ -73,15 +74,11 @@ pub(crate) fn read_recording_rows(
                 "check the column and its unit (metres)",
             );
         }
-        for (column, sigma) in [("sigma_xy", sigma_xy_m), ("sigma_z", sigma_z_m)] {
-            if let Some(s) = sigma.filter(|s| *s <= 0.0) {
-                f.error(
-                    column,
-                    format!("{s} is not a standard deviation"),
-                    "write a value > 0 m, or leave the cell empty for the default",
-                );
-            }
-        }
+        ranges::coordinates(&mut f, x, y, z);
+        ranges::angle(&mut f, "heading", heading_deg, -180.0, 360.0);
+        ranges::angle(&mut f, "yaw", yaw_deg, -360.0, 360.0);
+        ranges::sigma_m(&mut f, "sigma_xy", sigma_xy_m);
+        ranges::sigma_m(&mut f, "sigma_z", sigma_z_m);
         for (column, angle) in [("pitch", pitch_deg), ("roll", roll_deg)] {
             if angle.abs() > 90.0 {
                 f.error(column, format!("{angle}° is beyond ±90°"), "the residual tilt of a levelled panorama is a few degrees; check the column and its unit (degrees)");
@@ -141,7 +138,8 @@ pub(crate) fn read_recording_rows(
     rows
 }
 
-/// `file` (relative to `root/dir`) must be an existing file.
+/// `file` (relative to `root/dir`) must be an existing file inside the campaign folder: no absolute path, no
+/// `..`, no symbolic link that leads out of `root`.
 pub(crate) fn check_file_exists(
     f: &mut super::table::Fields<'_>,
     root: &Path,
@@ -149,20 +147,44 @@ pub(crate) fn check_file_exists(
     file: &str,
 ) {
     let rel = Path::new(file);
-    if rel.is_absolute() {
-        f.error(
+    let shown = dir.display();
+    let leaves = rel
+        .components()
+        .any(|c| matches!(c, std::path::Component::ParentDir));
+    if rel.is_absolute() || leaves {
+        let what = if leaves {
+            "leads out of its folder with '..'"
+        } else {
+            "is an absolute path"
+        };
+        f.error_of(
+            ProblemKind::Path,
             "file",
-            format!("'{file}' is an absolute path"),
-            format!("write the path relative to {}/", dir.display()),
+            format!("'{file}' {what}; images must lie inside the campaign folder"),
+            format!("copy the image into {shown}/ and write its path relative to {shown}/"),
         );
-    } else if !root.join(dir).join(rel).is_file() {
-        f.error(
+        return;
+    }
+    let path = root.join(dir).join(rel);
+    if !path.is_file() {
+        f.error_of(
+            ProblemKind::ImageMissing,
             "file",
-            format!("{}/{file} does not exist", dir.display()),
-            format!(
-                "put the image into {}/ or correct the file name",
-                dir.display()
-            ),
+            format!("{shown}/{file} does not exist"),
+            format!("put the image into {shown}/ or correct the file name"),
+        );
+        return;
+    }
+    let inside = match (std::fs::canonicalize(root), std::fs::canonicalize(&path)) {
+        (Ok(r), Ok(p)) => p.starts_with(r),
+        _ => true,
+    };
+    if !inside {
+        f.error_of(
+            ProblemKind::Path,
+            "file",
+            format!("{shown}/{file} is a link to a file outside the campaign folder"),
+            "copy the image itself into the campaign folder (a campaign must be complete on its own)",
         );
     }
 }

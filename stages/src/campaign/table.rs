@@ -7,7 +7,7 @@
 //! typed values, recording a [`Problem`] naming file, row and field for every bad cell (all of them, not
 //! just the first), so a caller can skip the row and still report everything at once.
 
-use super::problem::Problem;
+use super::problem::{Problem, ProblemKind};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -40,13 +40,16 @@ pub(crate) fn read_table(
     let bytes = match std::fs::read(root.join(rel)) {
         Ok(b) => b,
         Err(e) => {
-            problems.push(Problem::error(
-                rel,
-                None,
-                None,
-                format!("cannot be read ({e})"),
-                "check that the file exists and is readable",
-            ));
+            problems.push(
+                Problem::error(
+                    rel,
+                    None,
+                    None,
+                    format!("cannot be read ({e})"),
+                    "check that the file exists and is readable",
+                )
+                .with_kind(ProblemKind::Missing),
+            );
             return None;
         }
     };
@@ -85,13 +88,16 @@ pub(crate) fn read_table(
             Ok(true) => {}
             Err(e) => {
                 let row = e.position().map(|p| row_at(p.byte()));
-                problems.push(Problem::error(
-                    rel,
-                    row,
-                    None,
-                    format!("is not valid CSV ({e})"),
-                    "fix the quoting of this row",
-                ));
+                problems.push(
+                    Problem::error(
+                        rel,
+                        row,
+                        None,
+                        format!("is not valid CSV ({e})"),
+                        "fix the quoting of this row",
+                    )
+                    .with_kind(ProblemKind::Syntax),
+                );
                 return None;
             }
         }
@@ -101,13 +107,16 @@ pub(crate) fn read_table(
             .map(|c| std::str::from_utf8(c).map(str::to_string))
             .collect();
         let Ok(cells) = cells else {
-            problems.push(Problem::error(
-                rel,
-                Some(row),
-                None,
-                "is not valid UTF-8",
-                "save the file as UTF-8",
-            ));
+            problems.push(
+                Problem::error(
+                    rel,
+                    Some(row),
+                    None,
+                    "is not valid UTF-8",
+                    "save the file as UTF-8",
+                )
+                .with_kind(ProblemKind::Syntax),
+            );
             if header.is_none() {
                 return None;
             }
@@ -123,7 +132,7 @@ pub(crate) fn read_table(
                         None,
                         format!("has {} cells but the header has {} columns; row skipped", cells.len(), names.len()),
                         "give every row one cell per header column; quote values that contain commas",
-                    ));
+                    ).with_kind(ProblemKind::Syntax));
                     continue;
                 }
                 records.push(Record { row, fields: cells });
@@ -131,16 +140,19 @@ pub(crate) fn read_table(
         }
     }
     let Some((header_row, names)) = header else {
-        problems.push(Problem::error(
-            rel,
-            None,
-            None,
-            "is empty (no header row)",
-            format!(
-                "write a header row with the columns {}",
-                required.join(", ")
-            ),
-        ));
+        problems.push(
+            Problem::error(
+                rel,
+                None,
+                None,
+                "is empty (no header row)",
+                format!(
+                    "write a header row with the columns {}",
+                    required.join(", ")
+                ),
+            )
+            .with_kind(ProblemKind::Syntax),
+        );
         return None;
     };
     let mut columns = HashMap::new();
@@ -149,17 +161,20 @@ pub(crate) fn read_table(
         let key = name.to_ascii_lowercase();
         if let Some(first) = columns.insert(key.clone(), i) {
             if is_known(&key, required) {
-                problems.push(Problem::error(
-                    rel,
-                    Some(header_row),
-                    Some(&key),
-                    format!(
-                        "column appears twice (columns {} and {}); file skipped",
-                        first + 1,
-                        i + 1
-                    ),
-                    "keep one column of each name",
-                ));
+                problems.push(
+                    Problem::error(
+                        rel,
+                        Some(header_row),
+                        Some(&key),
+                        format!(
+                            "column appears twice (columns {} and {}); file skipped",
+                            first + 1,
+                            i + 1
+                        ),
+                        "keep one column of each name",
+                    )
+                    .with_kind(ProblemKind::Duplicate),
+                );
                 usable = false;
             }
         }
@@ -172,7 +187,7 @@ pub(crate) fn read_table(
                 Some(col),
                 "required column is missing; file skipped",
                 format!("add a '{col}' column to the header (row {header_row}) and a value to every row"),
-            ));
+            ).with_kind(ProblemKind::Missing));
             usable = false;
         }
     }
@@ -253,6 +268,20 @@ impl Fields<'_> {
             hint,
         ));
         self.ok = false;
+    }
+
+    /// Reject the row because of `column`, with a problem of sort `kind`.
+    pub fn error_of(
+        &mut self,
+        kind: ProblemKind,
+        column: &str,
+        message: impl Into<String>,
+        hint: impl Into<String>,
+    ) {
+        self.error(column, message, hint);
+        if let Some(p) = self.problems.last_mut() {
+            p.kind = kind;
+        }
     }
 
     /// Keep the row but report something suspicious in `column`.

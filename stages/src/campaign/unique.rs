@@ -1,7 +1,7 @@
 //! Rejecting rows whose id is not unique: every row sharing the id is skipped (which one is right cannot be
 //! known), each repeat reported with the row of the first occurrence.
 
-use super::problem::Problem;
+use super::problem::{Problem, ProblemKind};
 use std::collections::HashMap;
 use std::path::PathBuf;
 
@@ -36,13 +36,16 @@ pub(crate) fn keep_unique<T>(
                 } else {
                     format!("{}:{}", f.file.to_string_lossy().replace('\\', "/"), f.row)
                 };
-                problems.push(Problem::error(
-                    &r.file,
-                    Some(r.row),
-                    Some(column),
-                    format!("'{key}' is also used on {place}; both rows skipped"),
-                    hint,
-                ));
+                problems.push(
+                    Problem::error(
+                        &r.file,
+                        Some(r.row),
+                        Some(column),
+                        format!("'{key}' is also used on {place}; both rows skipped"),
+                        hint,
+                    )
+                    .with_kind(ProblemKind::Duplicate),
+                );
             }
             None => {
                 first.insert(key, i);

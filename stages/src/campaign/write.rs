@@ -151,12 +151,18 @@ fn write_recording_rows(path: &Path, rows: &[(&Recording, Option<[f64; 3]>)]) ->
     })
 }
 
-/// `aerial/{nadir,oblique}/cameras.csv`. Distortion columns appear only if some coefficient is non-zero,
-/// `sigma_px` only if some row differs from the default 0.5.
+/// `aerial/{nadir,oblique}/cameras.csv`. Distortion columns appear only if some coefficient is non-zero (the
+/// extended ones `k3, k4, b1, b2` only if one of them is), `sigma_px` only if some row differs from the default
+/// 0.5.
 pub fn write_aerial_cameras_csv(path: &Path, rows: &[AerialImage]) -> io::Result<()> {
-    let has_distortion = rows
+    let has_distortion = rows.iter().any(|a| {
+        [a.k1, a.k2, a.p1, a.p2, a.k3, a.k4, a.b1, a.b2]
+            .iter()
+            .any(|&c| c != 0.0)
+    });
+    let has_extended = rows
         .iter()
-        .any(|a| a.k1 != 0.0 || a.k2 != 0.0 || a.p1 != 0.0 || a.p2 != 0.0);
+        .any(|a| a.k3 != 0.0 || a.k4 != 0.0 || a.b1 != 0.0 || a.b2 != 0.0);
     let has_sigma = rows.iter().any(|a| a.sigma_px != 0.5);
     let mut header = vec![
         "image_id", "file", "x", "y", "z", "omega", "phi", "kappa", "focal_px", "cx", "cy",
@@ -164,6 +170,9 @@ pub fn write_aerial_cameras_csv(path: &Path, rows: &[AerialImage]) -> io::Result
     ];
     if has_distortion {
         header.extend(["k1", "k2", "p1", "p2"]);
+    }
+    if has_extended {
+        header.extend(["k3", "k4", "b1", "b2"]);
     }
     if has_sigma {
         header.push("sigma_px");
@@ -191,6 +200,9 @@ pub fn write_aerial_cameras_csv(path: &Path, rows: &[AerialImage]) -> io::Result
             cells.extend([a.width_px.to_string(), a.height_px.to_string()]);
             if has_distortion {
                 cells.extend([a.k1, a.k2, a.p1, a.p2].map(num));
+            }
+            if has_extended {
+                cells.extend([a.k3, a.k4, a.b1, a.b2].map(num));
             }
             if has_sigma {
                 cells.push(num(a.sigma_px));

@@ -81,7 +81,7 @@ pub fn median_consensus<const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::estimators::rng::SplitMix64;
+    use crate::rng::SplitMix64;
 
     #[test]
     fn empty_input_gives_none() {

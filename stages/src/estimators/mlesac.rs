@@ -18,109 +18,42 @@
 //! world coordinates are ≈ 10⁵ m). Deterministic for a given `seed`.
 
 use super::ransac::required_iterations;
-use super::rng::SplitMix64;
+use crate::params::Params;
+use crate::rng::SplitMix64;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use serde::{Deserialize, Serialize};
 
-/// Everything MLESAC plane fitting can be told.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct PlaneFitParams {
-    /// Points with |n·p + d| ≤ this are inliers of the final plane, metres (default 0.5 m: façade relief,
-    /// thesis 4.4.2).
-    pub inlier_band_m: f64,
-    /// σ of the Gaussian inlier error of the likelihood, metres (default band / 2 = 0.25 m: the band is ≈ 2σ).
-    pub sigma_m: f64,
-    /// Hard cap on the 3-point samples drawn (default 10 000, as PCL).
-    pub max_trials: usize,
-    /// Probability of drawing at least one all-inlier sample (default 0.99).
-    pub confidence: f64,
-    /// EM iterations for the mixing weight γ per hypothesis (default 3, as PCL).
-    pub em_iterations: usize,
-    /// If set, the plane normal must lie within `max_angle_deg` of this vector (sign-free: n and −n are the
-    /// same plane). Need not be unit length; must be nonzero.
-    pub reference_normal: Option<[f64; 3]>,
-    /// Maximum angle between the normal and `±reference_normal`, degrees (default 5°, thesis 4.4.2). The
-    /// constraint is a cone around the reference, i.e. it bounds yaw and pitch together.
-    pub max_angle_deg: f64,
-    /// Seed of the sampling RNG.
-    pub seed: u64,
-}
-
-impl Default for PlaneFitParams {
-    fn default() -> Self {
-        Self {
-            inlier_band_m: 0.5,
-            sigma_m: 0.25,
-            max_trials: 10_000,
-            confidence: 0.99,
-            em_iterations: 3,
-            reference_normal: None,
-            max_angle_deg: 5.0,
-            seed: 0,
-        }
+crate::params! {
+    /// Everything MLESAC plane fitting can be told.
+    pub struct PlaneFitParams {
+        /// Points with |n·p + d| at most this are inliers of the final plane (façade relief, thesis 4.4.2).
+        inlier_band_m: f64 = 0.5, unit "m", above 0.0;
+        /// σ of the Gaussian inlier error of the likelihood (the band is about 2σ).
+        sigma_m: f64 = 0.25, unit "m", above 0.0;
+        /// Hard cap on the 3-point samples drawn (as PCL).
+        max_trials: usize = 10_000, min 1;
+        /// Probability of drawing at least one all-inlier sample.
+        confidence: f64 = 0.99, above 0.0, below 1.0;
+        /// EM iterations for the mixing weight γ per hypothesis (as PCL).
+        em_iterations: usize = 3, min 1, max 100;
+        /// If set, the plane normal must lie within `max_angle_deg` of this vector (sign-free: n and −n are the
+        /// same plane). Need not be unit length; must be finite and nonzero.
+        reference_normal: Option<[f64; 3]> = None;
+        /// Maximum angle between the normal and `±reference_normal` (thesis 4.4.2): a cone around the
+        /// reference, so it bounds yaw and pitch together.
+        max_angle_deg: f64 = 5.0, unit "deg", above 0.0, max 90.0;
+        /// Seed of the sampling RNG.
+        seed: u64 = 0;
     }
-}
-
-impl PlaneFitParams {
-    /// Range checks: (field, what is wrong and what to do) for every bad field.
-    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
-        let mut errs = Vec::new();
-        let mut check = |ok: bool, field: &str, msg: String| {
-            if !ok {
-                errs.push((field.to_string(), msg));
-            }
-        };
-        check(
-            self.inlier_band_m.is_finite() && self.inlier_band_m > 0.0,
-            "inlier_band_m",
-            format!("must be finite and > 0 m, got {}", self.inlier_band_m),
-        );
-        check(
-            self.sigma_m.is_finite() && self.sigma_m > 0.0,
-            "sigma_m",
-            format!(
-                "must be finite and > 0 m (about half the inlier band), got {}",
-                self.sigma_m
-            ),
-        );
-        check(
-            self.max_trials >= 1,
-            "max_trials",
-            "must be ≥ 1 (10000 is the usual cap)".to_string(),
-        );
-        check(
-            self.confidence > 0.0 && self.confidence < 1.0,
-            "confidence",
-            format!("must be in (0, 1), e.g. 0.99, got {}", self.confidence),
-        );
-        check(
-            (1..=100).contains(&self.em_iterations),
-            "em_iterations",
-            format!(
-                "must be in [1, 100] (3 is usual), got {}",
-                self.em_iterations
-            ),
-        );
-        if let Some(r) = self.reference_normal {
+    check(p, v) {
+        if let Some(r) = p.reference_normal {
             let norm = Vector3::from(r).norm();
-            check(
-                norm.is_finite() && norm > 0.0,
-                "reference_normal",
-                format!("must be a finite nonzero vector or absent, got {r:?}"),
-            );
-        }
-        check(
-            self.max_angle_deg.is_finite()
-                && self.max_angle_deg > 0.0
-                && self.max_angle_deg <= 90.0,
-            "max_angle_deg",
-            format!("must be in (0, 90] degrees, got {}", self.max_angle_deg),
-        );
-        if errs.is_empty() {
-            Ok(())
-        } else {
-            Err(errs)
+            if !(norm.is_finite() && norm > 0.0) {
+                v.push(crate::params::Violation::new(
+                    "reference_normal",
+                    format!("must be a finite nonzero vector or absent, got {r:?}"),
+                ));
+            }
         }
     }
 }

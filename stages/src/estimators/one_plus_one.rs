@@ -9,90 +9,36 @@
 //! child counts as a failure. The normal deviates come from a [`SplitMix64`] seeded by the params, so a run is
 //! reproducible bit for bit.
 
-use super::rng::SplitMix64;
-use serde::{Deserialize, Serialize};
+use crate::rng::SplitMix64;
 
-/// Settings of the (1+1)-ES (ITK class defaults).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct OnePlusOneParams {
-    /// Iteration limit (ITK: 100).
-    pub max_iterations: usize,
-    /// Stop when the Frobenius norm of the search matrix falls to this (ITK: 1.5e-4), parameter units.
-    pub epsilon: f64,
-    /// Initial search radius r0 (ITK: 1.01), parameter units (divided by the scales).
-    pub initial_radius: f64,
-    /// Search-matrix factor after a success (ITK: 1.05).
-    pub growth_factor: f64,
-    /// Search-matrix factor after a failure (ITK: 1.05^(−1/4) ≈ 0.98788).
-    pub shrink_factor: f64,
-    /// Seed of the normal generator.
-    pub seed: u64,
-    /// Record every iteration's parent vector and value in [`OnePlusOneResult::trace`].
-    pub record_trace: bool,
-}
-
-impl Default for OnePlusOneParams {
-    fn default() -> Self {
-        Self {
-            max_iterations: 100,
-            epsilon: 1.5e-4,
-            initial_radius: 1.01,
-            growth_factor: 1.05,
-            shrink_factor: 1.05f64.powf(-0.25),
-            seed: 0,
-            record_trace: false,
-        }
+crate::params! {
+    /// Settings of the (1+1)-ES (ITK class defaults).
+    pub struct OnePlusOneParams {
+        /// Iteration limit (ITK: 100).
+        max_iterations: usize = 100, min 1, max 10_000_000;
+        /// Stop when the Frobenius norm of the search matrix falls to this (ITK: 1.5e-4), in parameter units.
+        epsilon: f64 = 1.5e-4, above 0.0;
+        /// Initial search radius r0 (ITK: 1.01), in parameter units (divided by the scales); larger than
+        /// `epsilon`.
+        initial_radius: f64 = 1.01;
+        /// Search-matrix factor after a success (ITK: 1.05).
+        growth_factor: f64 = 1.05, above 1.0;
+        /// Search-matrix factor after a failure (ITK: 1.05^(−1/4) ≈ 0.98788).
+        shrink_factor: f64 = 1.05f64.powf(-0.25), above 0.0, below 1.0;
+        /// Seed of the normal generator.
+        seed: u64 = 0;
+        /// Record every iteration's parent vector and value in [`OnePlusOneResult::trace`].
+        record_trace: bool = false;
     }
-}
-
-impl OnePlusOneParams {
-    /// Check ranges; each error is (field, message with the allowed range).
-    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
-        let mut errs = Vec::new();
-        let mut check = |ok: bool, field: &str, msg: String| {
-            if !ok {
-                errs.push((field.to_string(), msg));
-            }
-        };
-        check(
-            (1..=10_000_000).contains(&self.max_iterations),
-            "max_iterations",
-            format!("must be in [1, 10000000], got {}", self.max_iterations),
-        );
-        check(
-            self.epsilon.is_finite() && self.epsilon > 0.0,
-            "epsilon",
-            format!("must be finite and > 0, got {}", self.epsilon),
-        );
-        check(
-            self.initial_radius.is_finite() && self.initial_radius > self.epsilon,
-            "initial_radius",
-            format!(
-                "must be finite and > epsilon ({}), got {}",
-                self.epsilon, self.initial_radius
-            ),
-        );
-        check(
-            self.growth_factor.is_finite() && self.growth_factor > 1.0,
-            "growth_factor",
-            format!(
-                "must be finite and > 1 (ITK 1.05), got {}",
-                self.growth_factor
-            ),
-        );
-        check(
-            self.shrink_factor > 0.0 && self.shrink_factor < 1.0,
-            "shrink_factor",
-            format!(
-                "must be in (0, 1) (ITK 1.05^(-1/4)), got {}",
-                self.shrink_factor
-            ),
-        );
-        if errs.is_empty() {
-            Ok(())
-        } else {
-            Err(errs)
+    check(p, v) {
+        if !(p.initial_radius.is_finite() && p.initial_radius > p.epsilon) {
+            v.push(crate::params::Violation::new(
+                "initial_radius",
+                format!(
+                    "must be a finite number > epsilon ({}), got {}",
+                    p.epsilon, p.initial_radius
+                ),
+            ));
         }
     }
 }

@@ -6,7 +6,8 @@
 //! Ties in the inlier count are broken by the smaller sum of squared inlier residuals (MSAC-like), so the
 //! result depends only on the data, the parameters and the seed.
 
-use super::rng::SplitMix64;
+use crate::params::Params;
+use crate::rng::SplitMix64;
 
 /// A model RANSAC can estimate: fitted from `MIN_SAMPLES` data (minimal sample) or more (least squares).
 pub trait Model: Sized {
@@ -21,17 +22,20 @@ pub trait Model: Sized {
     fn residual(&self, d: &Self::Datum) -> f64;
 }
 
-/// RANSAC settings.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct RansacParams {
-    /// A datum is an inlier when its residual is ≤ this (model units, e.g. destination pixels).
-    pub threshold: f64,
-    /// Probability of drawing at least one all-inlier sample, in (0, 1) (e.g. 0.99).
-    pub confidence: f64,
-    /// Upper bound on the number of samples drawn (≥ 1).
-    pub max_iterations: usize,
-    /// Seed of the sampling RNG.
-    pub seed: u64,
+crate::params! {
+    /// RANSAC settings.
+    #[derive(Copy)]
+    pub struct RansacParams {
+        /// A datum is an inlier when its residual is at most this, in the model's units (e.g. destination
+        /// pixels); callers set it for their model.
+        threshold: f64 = 1.0, above 0.0;
+        /// Probability of drawing at least one all-inlier sample.
+        confidence: f64 = 0.99, above 0.0, below 1.0;
+        /// Upper bound on the number of samples drawn.
+        max_iterations: usize = 2000, min 1;
+        /// Seed of the sampling RNG.
+        seed: u64 = 0;
+    }
 }
 
 impl RansacParams {
@@ -39,30 +43,9 @@ impl RansacParams {
     pub fn new(threshold: f64, seed: u64) -> Self {
         Self {
             threshold,
-            confidence: 0.99,
-            max_iterations: 2000,
             seed,
+            ..Self::default()
         }
-    }
-
-    /// Checks the parameters; the error says which one is wrong and what is allowed.
-    pub fn validate(&self) -> Result<(), String> {
-        if !(self.threshold > 0.0 && self.threshold.is_finite()) {
-            return Err(format!(
-                "RANSAC threshold {} must be finite and > 0",
-                self.threshold
-            ));
-        }
-        if !(self.confidence > 0.0 && self.confidence < 1.0) {
-            return Err(format!(
-                "RANSAC confidence {} must lie strictly between 0 and 1",
-                self.confidence
-            ));
-        }
-        if self.max_iterations == 0 {
-            return Err("RANSAC max_iterations must be at least 1".to_string());
-        }
-        Ok(())
     }
 }
 
@@ -99,7 +82,7 @@ pub fn required_iterations(confidence: f64, inlier_fraction: f64, sample_size: u
 /// Maximum number of least-squares refits on the growing consensus set.
 const MAX_REFITS: usize = 10;
 
-/// Robustly fits `M` to `data`; `None` if the parameters are invalid ([`RansacParams::validate`]), there are
+/// Robustly fits `M` to `data`; `None` if the parameters are invalid ([`Params::validate`]), there are
 /// fewer than `M::MIN_SAMPLES` data, or no non-degenerate sample was found.
 pub fn ransac<M: Model>(data: &[M::Datum], p: &RansacParams) -> Option<RansacResult<M>> {
     ransac_filtered(data, p, |_: &M| true)

@@ -127,24 +127,32 @@ pub fn write_colmap_model(
         let cam = FrameCamera::from_aerial(row);
         let id = camera_lines.len() + 1;
         let d = cam.distortion;
+        if d.k4 != 0.0 || d.a2 != 0.0 {
+            return Err(invalid(format!(
+                "aerial image '{}' has k4 or b2, which no COLMAP camera model carries; export without them",
+                a.image_id
+            )));
+        }
+        // b1 scales the u axis only: fx = f + b1 (COLMAP's y points down, hence −p1).
+        let fx = cam.focal_px * (1.0 + d.a1);
+        let (w, h, f, cx, cy) = (
+            cam.width_px,
+            cam.height_px,
+            cam.focal_px,
+            cam.cx_px,
+            cam.cy_px,
+        );
         camera_lines.push(if d.is_zero() {
+            format!("{id} PINHOLE {w} {h} {f} {f} {cx} {cy}")
+        } else if d.k3 == 0.0 {
             format!(
-                "{id} PINHOLE {} {} {} {} {} {}",
-                cam.width_px, cam.height_px, cam.focal_px, cam.focal_px, cam.cx_px, cam.cy_px
+                "{id} OPENCV {w} {h} {fx} {f} {cx} {cy} {} {} {} {}",
+                d.k1, d.k2, -d.p1, d.p2
             )
         } else {
             format!(
-                "{id} OPENCV {} {} {} {} {} {} {} {} {} {}",
-                cam.width_px,
-                cam.height_px,
-                cam.focal_px,
-                cam.focal_px,
-                cam.cx_px,
-                cam.cy_px,
-                d.k1,
-                d.k2,
-                -d.p1,
-                d.p2
+                "{id} FULL_OPENCV {w} {h} {fx} {f} {cx} {cy} {} {} {} {} {} 0 0 0",
+                d.k1, d.k2, -d.p1, d.p2, d.k3
             )
         });
         aerial_camera_id.push(id);

@@ -1,27 +1,41 @@
-//! Run outputs for users (issue 6 "Outputs"; campaign-format.md "Outputs of a run"), one file each, all written
-//! atomically ([`crate::fsutil`]) and deterministically:
-//! [`trajectory`] `trajectory_adjusted.csv`, [`geojson`] `trajectory.geojson` (QGIS), [`ply`] `tie_points.ply`
+//! Run outputs for users (campaign-format.md "Outputs of a run"; every file is described in `docs/outputs.md`),
+//! one file each, all written atomically ([`crate::fsutil`]) and deterministically:
+//! [`trajectory`] `trajectory_adjusted.csv` (the input recordings file with adjusted values),
+//! [`corrections_csv`] `corrections.csv` (the correction time series of [`corrections`], each value with what
+//! supports it, [`support`]), [`geojson`] `trajectory.geojson` (QGIS), [`ply`] `tie_points.ply`
 //! (CloudCompare), [`checkpoints`] `checkpoints.csv` (per-point errors before/after), [`correspondences`]
-//! `correspondences.csv` (every control point's observations), [`colmap`] a COLMAP text
+//! `correspondences.csv` (every control point's observations), [`gcp`] ground control for OpenSfM /
+//! OpenDroneMap, Metashape and as a plain list, [`gpkg`] `skytie.gpkg` (GeoPackage layers for GIS), [`colmap`] a COLMAP text
 //! model (`cameras.txt`, `images.txt`, `points3D.txt`) with COLMAP's EQUIRECTANGULAR model for the panoramas.
 //! The CSV/GeoJSON/PLY encoders are the campaign writers ([`crate::campaign::write`]); this module maps an
 //! [`crate::adjustment::AdjustmentRun`] onto them.
 
 pub mod checkpoints;
 pub mod colmap;
+pub mod corrections;
+pub mod corrections_csv;
 pub mod correspondences;
+#[cfg(test)]
+mod fixture;
+pub mod gcp;
 pub mod geojson;
+pub mod gpkg;
 pub mod ply;
+pub mod support;
 pub mod trajectory;
 
 pub use checkpoints::{
     checkpoint_rows, write_checkpoint_errors_csv, CheckPointRow, CHECKPOINTS_CSV_HEADER,
 };
 pub use colmap::{write_colmap_model, ColmapExport};
+pub use corrections::{Correction, CorrectionSeries, SampleKind};
+pub use corrections_csv::{write_corrections_csv, CORRECTIONS_CSV_HEADER, CORRECTION_STEP_S};
 pub use correspondences::{write_correspondences_csv, CORRESPONDENCES_CSV_HEADER};
+pub use gcp::{opensfm_projection, write_ground_control, GcpExport};
 pub use geojson::write_run_geojson;
 pub use ply::{
     write_tie_points_ply, PLY_SOURCE_CONTROL, PLY_SOURCE_RECORDING, PLY_SOURCE_SINGLE_AERIAL,
     PLY_SOURCE_TIE,
 };
-pub use trajectory::{adjusted_recordings, write_adjusted_trajectory};
+pub use support::{recording_support, RecordingSupport, Support};
+pub use trajectory::{adjusted_recordings, write_adjusted_trajectory, TrajectoryExportCounts};

@@ -54,53 +54,16 @@ const CIRCLE: [(isize, isize); 16] = [
     (-1, -3),
 ];
 
-/// Detector parameters (OpenCV `AgastFeatureDetector::create` defaults).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct AgastParams {
-    /// Segment-test threshold in 0..255 grey levels, compared against 255·value of the 0..1 image (default 10,
-    /// OpenCV's default).
-    pub threshold: f32,
-    /// 3×3 non-maximum suppression on the score (default true).
-    pub nonmax_suppression: bool,
-    /// Keep only the strongest corners (after suppression); None keeps all (default None).
-    pub max_corners: Option<usize>,
-}
-
-impl Default for AgastParams {
-    fn default() -> Self {
-        Self {
-            threshold: 10.0,
-            nonmax_suppression: true,
-            max_corners: None,
-        }
-    }
-}
-
-impl AgastParams {
-    /// Range checks: (field, what is wrong and what to do).
-    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
-        let mut errs = Vec::new();
-        if !(self.threshold.is_finite() && (0.0..=255.0).contains(&self.threshold)) {
-            errs.push((
-                "threshold".to_string(),
-                format!(
-                    "must be in [0, 255] grey levels (OpenCV scale; default 10), got {}",
-                    self.threshold
-                ),
-            ));
-        }
-        if self.max_corners == Some(0) {
-            errs.push((
-                "max_corners".to_string(),
-                "must be ≥ 1 or absent (absent keeps every corner), got 0".to_string(),
-            ));
-        }
-        if errs.is_empty() {
-            Ok(())
-        } else {
-            Err(errs)
-        }
+crate::params! {
+    /// Detector parameters (OpenCV `AgastFeatureDetector::create` defaults).
+    pub struct AgastParams {
+        /// Segment-test threshold in 0..255 grey levels, compared against 255·value of the 0..1 image
+        /// (OpenCV's scale and default).
+        threshold: f32 = 10.0, min 0.0, max 255.0;
+        /// 3×3 non-maximum suppression on the score.
+        nonmax_suppression: bool = true;
+        /// Keep only the strongest corners (after suppression); absent keeps all.
+        max_corners: Option<usize> = None, min 1;
     }
 }
 
@@ -284,6 +247,7 @@ fn is_local_max(keys: &[(f32, f32)], w: usize, col: usize, row: usize, k: (f32, 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::Params;
 
     /// Brute-force FAST-9 test at threshold t on 0..255 values (no rejection, no score).
     fn brute_force_corner(g: &[f32], w: usize, col: usize, row: usize, t: f32) -> bool {
@@ -408,7 +372,7 @@ mod tests {
         };
         let e = bad.validate().unwrap_err();
         assert_eq!(e.len(), 2);
-        assert_eq!(e[0].0, "threshold");
-        assert_eq!(e[1].0, "max_corners");
+        assert_eq!(e[0].field, "threshold");
+        assert_eq!(e[1].field, "max_corners");
     }
 }

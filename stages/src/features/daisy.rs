@@ -46,73 +46,24 @@ pub enum DaisyNormalization {
     Sift,
 }
 
-/// Descriptor parameters (OpenCV `DAISY::create` defaults except the normalisation: Partial, see the module doc).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct DaisyParams {
-    /// Radius of the outermost ring, pixels (default 15).
-    pub radius_px: f64,
-    /// Number of rings Q (default 3).
-    pub rings: usize,
-    /// Histograms per ring T (default 8).
-    pub histograms: usize,
-    /// Orientation bins per histogram H (default 8).
-    pub orientations: usize,
-    /// Normalisation (default Partial).
-    pub normalization: DaisyNormalization,
-}
-
-impl Default for DaisyParams {
-    fn default() -> Self {
-        Self {
-            radius_px: 15.0,
-            rings: 3,
-            histograms: 8,
-            orientations: 8,
-            normalization: DaisyNormalization::Partial,
-        }
+crate::params! {
+    /// Descriptor parameters (OpenCV `DAISY::create` defaults except the normalisation: Partial, see the module
+    /// doc).
+    pub struct DaisyParams {
+        /// Radius of the outermost ring.
+        radius_px: f64 = 15.0, unit "px", min 1.0, max 200.0;
+        /// Number of rings Q.
+        rings: usize = 3, min 1, max 16;
+        /// Histograms per ring T.
+        histograms: usize = 8, min 1, max 64;
+        /// Orientation bins per histogram H.
+        orientations: usize = 8, min 1, max 64;
+        /// Normalisation of the descriptor.
+        normalization: DaisyNormalization = DaisyNormalization::Partial;
     }
 }
 
 impl DaisyParams {
-    /// Range checks: (field, what is wrong and what to do).
-    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
-        let mut errs = Vec::new();
-        let mut check = |ok: bool, field: &str, msg: String| {
-            if !ok {
-                errs.push((field.to_string(), msg));
-            }
-        };
-        check(
-            self.radius_px.is_finite() && self.radius_px >= 1.0 && self.radius_px <= 200.0,
-            "radius_px",
-            format!(
-                "must be in [1, 200] px (default 15), got {}",
-                self.radius_px
-            ),
-        );
-        check(
-            (1..=16).contains(&self.rings),
-            "rings",
-            format!("must be in [1, 16] (default 3), got {}", self.rings),
-        );
-        check(
-            (1..=64).contains(&self.histograms),
-            "histograms",
-            format!("must be in [1, 64] (default 8), got {}", self.histograms),
-        );
-        check(
-            (1..=64).contains(&self.orientations),
-            "orientations",
-            format!("must be in [1, 64] (default 8), got {}", self.orientations),
-        );
-        if errs.is_empty() {
-            Ok(())
-        } else {
-            Err(errs)
-        }
-    }
-
     /// The parameters brought into the valid ranges (used by [`DaisyExtractor::new`], which cannot fail).
     fn clamped(&self) -> Self {
         Self {
@@ -337,6 +288,7 @@ fn normalise(d: &mut [f32], hn: usize, mode: DaisyNormalization) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::Params;
 
     fn ramp(w: usize, h: usize, gx: f32, gy: f32) -> GrayImage {
         let data = (0..w * h)
@@ -416,7 +368,7 @@ mod tests {
             .validate()
             .unwrap_err()
             .into_iter()
-            .map(|e| e.0)
+            .map(|e| e.field)
             .collect();
         assert_eq!(fields, ["radius_px", "rings", "orientations"]);
     }

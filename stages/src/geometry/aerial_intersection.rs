@@ -161,6 +161,7 @@ mod tests {
                 k2: 0.001,
                 p1: 1e-5,
                 p2: -1e-5,
+                ..BrownDistortion::NONE
             },
         );
         cam.rotation_cam_to_world = r;

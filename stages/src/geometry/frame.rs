@@ -6,7 +6,6 @@
 pub use super::distortion::BrownDistortion;
 use super::ray::Ray;
 use super::rotation::opk_to_matrix;
-use crate::campaign::AerialImage;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -28,27 +27,6 @@ pub struct FrameCamera {
 }
 
 impl FrameCamera {
-    /// The camera of one `aerial/*/cameras.csv` row.
-    pub fn from_aerial(img: &AerialImage) -> Self {
-        Self::from_opk(
-            Vector3::new(img.x, img.y, img.z),
-            img.omega_deg,
-            img.phi_deg,
-            img.kappa_deg,
-            img.focal_px,
-            img.cx_px,
-            img.cy_px,
-            img.width_px,
-            img.height_px,
-            BrownDistortion {
-                k1: img.k1,
-                k2: img.k2,
-                p1: img.p1,
-                p2: img.p2,
-            },
-        )
-    }
-
     /// A camera from its centre, ω-φ-κ attitude (degrees) and interior orientation.
     #[allow(clippy::too_many_arguments)]
     pub fn from_opk(

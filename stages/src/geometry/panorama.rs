@@ -9,7 +9,6 @@
 use super::atan2_poly::atan2_poly;
 use super::ray::Ray;
 use super::rotation::panorama_rotation;
-use crate::campaign::Recording;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -41,18 +40,6 @@ impl PanoramaCamera {
             center_world,
             rotation_pano_to_world: panorama_rotation(yaw_deg, pitch_deg, roll_deg),
         }
-    }
-
-    /// The camera of one `mm/recordings.csv` row (its recorded pose) for an image of the given size.
-    pub fn from_recording(rec: &Recording, width_px: u32, height_px: u32) -> Self {
-        Self::new(
-            width_px,
-            height_px,
-            Vector3::new(rec.x, rec.y, rec.z),
-            rec.yaw_deg,
-            rec.pitch_deg,
-            rec.roll_deg,
-        )
     }
 
     /// Angular size of one pixel, radians (2π/W; equal in both directions when W = 2H).

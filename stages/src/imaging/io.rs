@@ -22,7 +22,10 @@ fn err(path: &Path, message: impl Into<String>) -> ImageIoError {
     }
 }
 
+/// Decode `path` by its content after [`probe`](super::probe::probe) found it complete: a truncated file (which
+/// the decoders would fill with grey) or an absurd header is an error before anything is allocated.
 fn open(path: &Path) -> Result<image::DynamicImage, ImageIoError> {
+    super::probe::probe(path).map_err(|e| err(path, format!("{e}; {}", e.hint())))?;
     let reader = image::ImageReader::open(path)
         .map_err(|e| {
             err(

@@ -3,9 +3,11 @@
 //! Pixel convention everywhere (campaign-format.md): continuous coordinates, the image's top-left corner is
 //! (0, 0), u grows right, v down, the centre of the first pixel is (0.5, 0.5).
 
-pub mod huge_pages;
+/// Huge-page advice for large image buffers (from `skytie-util`, shared with the engine).
+pub use skytie_util::huge_pages;
 pub mod image;
 pub mod io;
+pub mod probe;
 
 pub mod bilinear_many;
 pub mod border;

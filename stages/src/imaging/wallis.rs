@@ -12,32 +12,26 @@ use thiserror::Error;
 
 use super::border::reflect_index;
 use super::image::GrayImage;
+use crate::params::{describe, Params};
 
-/// Wallis parameters; intensities in the image's own units (0..1 for loaded 8-bit images).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct WallisParams {
-    /// Target mean m_f.
-    pub target_mean: f32,
-    /// Target standard deviation s_f (> 0).
-    pub target_std: f32,
-    /// Contrast expansion constant c ∈ [0, 1] (1 forces the target std; maximum gain c/(1 − c)).
-    pub contrast_c: f32,
-    /// Brightness forcing constant b ∈ [0, 1] (1 forces the target mean, 0 keeps the local mean).
-    pub brightness_b: f32,
-    /// Side of the square statistics window in pixels; odd (an even value is rounded up to the next odd one).
-    pub window_px: usize,
-}
-
-impl Default for WallisParams {
-    /// 127/40 of 255, c = 0.94, b = 1, 21 px window (ALGORITHMS.md §3 table), scaled to 0..1 intensities.
-    fn default() -> Self {
-        Self {
-            target_mean: 127.0 / 255.0,
-            target_std: 40.0 / 255.0,
-            contrast_c: 0.94,
-            brightness_b: 1.0,
-            window_px: 21,
-        }
+crate::params! {
+    /// Wallis parameters; intensities in the image's own units (0..1 for loaded 8-bit images). Defaults: 127/40
+    /// of 255, c = 0.94, b = 1, 21 px window, scaled to 0..1 intensities.
+    #[derive(Copy)]
+    pub struct WallisParams {
+        /// Target mean m_f.
+        target_mean: f32 = 127.0 / 255.0;
+        /// Target standard deviation s_f.
+        target_std: f32 = 40.0 / 255.0, above 0.0;
+        /// Contrast expansion constant c (1 forces the target std; maximum gain c/(1 − c)).
+        contrast_c: f32 = 0.94, min 0.0, max 1.0;
+        /// Brightness forcing constant b (1 forces the target mean, 0 keeps the local mean).
+        brightness_b: f32 = 1.0, min 0.0, max 1.0;
+        /// Side of the square statistics window; odd (an even value is rounded up to the next odd one).
+        window_px: usize = 21, unit "px", min 1;
+    }
+    check(p, v) {
+        crate::params::check_finite("target_mean", &p.target_mean, v);
     }
 }
 
@@ -52,41 +46,18 @@ impl WallisParams {
         self
     }
 
-    fn validate(&self) -> Result<(), WallisError> {
-        let bad = |field: &'static str, value: f32, expected: &'static str| {
-            Err(WallisError::InvalidParameter {
-                field,
-                value,
-                expected,
-            })
-        };
-        if !(0.0..=1.0).contains(&self.contrast_c) {
-            return bad("contrast_c", self.contrast_c, "a value in [0, 1]");
-        }
-        if !(0.0..=1.0).contains(&self.brightness_b) {
-            return bad("brightness_b", self.brightness_b, "a value in [0, 1]");
-        }
-        if !(self.target_std.is_finite() && self.target_std > 0.0) {
-            return bad("target_std", self.target_std, "a finite value > 0");
-        }
-        if !self.target_mean.is_finite() {
-            return bad("target_mean", self.target_mean, "a finite value");
-        }
-        if self.window_px == 0 {
-            return bad("window_px", 0.0, "a window of at least 1 pixel");
-        }
-        Ok(())
+    /// The range checks of [`Params::validate`] as a [`WallisError`].
+    fn checked(&self) -> Result<(), WallisError> {
+        self.validate().map_err(|v| WallisError::InvalidParameters {
+            problems: describe(&v),
+        })
     }
 }
 
 #[derive(Debug, Error, PartialEq)]
 pub enum WallisError {
-    #[error("Wallis parameter `{field}` = {value} is invalid: expected {expected}")]
-    InvalidParameter {
-        field: &'static str,
-        value: f32,
-        expected: &'static str,
-    },
+    #[error("invalid Wallis parameters: {problems}")]
+    InvalidParameters { problems: String },
     #[error("Wallis statistics images are {got_w}×{got_h} but the image is {want_w}×{want_h}")]
     SizeMismatch {
         got_w: usize,
@@ -172,7 +143,7 @@ pub fn wallis_apply(
     local_std: &GrayImage,
     p: &WallisParams,
 ) -> Result<GrayImage, WallisError> {
-    p.validate()?;
+    p.checked()?;
     for s in [local_mean, local_std] {
         if s.width != img.width || s.height != img.height {
             return Err(WallisError::SizeMismatch {
@@ -202,7 +173,7 @@ pub fn wallis_apply(
 
 /// Wallis filter with local statistics over `p.window_px` (thesis 3.4.5.2: applied to MM and aerial patches).
 pub fn wallis_filter(img: &GrayImage, p: &WallisParams) -> Result<GrayImage, WallisError> {
-    p.validate()?;
+    p.checked()?;
     let (m, s) = local_mean_std(img, p.window_px);
     wallis_apply(img, &m, &s, p)
 }

@@ -11,7 +11,15 @@
 use super::ortho::{OrthoGeoref, OrthoParams};
 use crate::geometry::FrameCamera;
 use crate::imaging::GrayImage;
+use crate::params::StageId;
 use nalgebra::Vector3;
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "ortho_aerial",
+    version: "3",
+};
 
 /// Step of the finite differences of the projection Jacobian, metres on the ground.
 const JACOBIAN_STEP_M: f64 = 1.0;

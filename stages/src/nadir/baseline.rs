@@ -24,7 +24,6 @@ mod kdtree;
 pub use kdtree::KdTree2;
 
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
 use super::ortho::OrthoImage;
 use super::refine::{cut_ortho_template, grey_std, sample_aerial_on_ortho_grid};
@@ -36,140 +35,58 @@ use crate::geometry::FrameCamera;
 use crate::imaging::gaussian::gaussian_blur;
 use crate::imaging::GrayImage;
 use crate::matching::ncc::match_template;
+use crate::params::{Params, StageId};
 use nalgebra::{Vector2, Vector3};
 
-/// Parameters of [`baseline_matches`]; thesis 2.2.3 values as defaults.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct BaselineParams {
-    /// Förstner σ of the derivative-of-Gaussian gradient, aerial px.
-    pub forstner_sigma_gradient_px: f32,
-    /// Förstner σ of the tensor's integration window, aerial px.
-    pub forstner_sigma_integration_px: f32,
-    /// Förstner minimum roundness q.
-    pub forstner_min_roundness: f32,
-    /// Förstner minimum weight relative to the patch's mean weight.
-    pub forstner_min_weight_rel: f32,
-    /// Side of the square neighbourhood of the isolation test, m (thesis: 6 × 6 m).
-    pub isolation_box_m: f64,
-    /// A keypoint is isolated with at most this many other keypoints in the box (thesis: 7).
-    pub max_neighbours: usize,
-    /// σ of the Gaussian blur of the MM ortho image, px (0 = none).
-    pub mm_blur_sigma_px: f32,
-    /// Template side, px (thesis: 16).
-    pub template_px: usize,
-    /// Search window side, px (thesis: 40).
-    pub search_px: usize,
-    /// Smallest accepted NCC peak.
-    pub min_ncc: f64,
-    /// Largest distance from the NCC peak to the isolated aerial keypoint that becomes the observation, px.
-    pub snap_px: f64,
-    /// Smallest grey-value standard deviation of a template (0..1 scale).
-    pub min_template_std: f64,
-}
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "baseline",
+    version: "3",
+};
 
-impl Default for BaselineParams {
-    fn default() -> Self {
-        Self {
-            forstner_sigma_gradient_px: 0.7,
-            forstner_sigma_integration_px: 2.0,
-            forstner_min_roundness: 0.5,
-            forstner_min_weight_rel: 1.0,
-            isolation_box_m: 6.0,
-            max_neighbours: 7,
-            mm_blur_sigma_px: 1.0,
-            template_px: 16,
-            search_px: 40,
-            min_ncc: 0.7,
-            snap_px: 1.5,
-            min_template_std: 0.01,
+crate::params! {
+    /// Parameters of [`baseline_matches`]; thesis 2.2.3 values as defaults.
+    pub struct BaselineParams {
+        /// Förstner σ of the derivative-of-Gaussian gradient, in aerial pixels.
+        forstner_sigma_gradient_px: f32 = 0.7, unit "px", above 0.0, max 20.0;
+        /// Förstner σ of the tensor's integration window, in aerial pixels.
+        forstner_sigma_integration_px: f32 = 2.0, unit "px", above 0.0, max 20.0;
+        /// Förstner minimum roundness q.
+        forstner_min_roundness: f32 = 0.5, min 0.0, max 1.0;
+        /// Förstner minimum weight relative to the patch's mean weight.
+        forstner_min_weight_rel: f32 = 1.0, min 0.0;
+        /// Side of the square neighbourhood of the isolation test (thesis: 6 × 6 m).
+        isolation_box_m: f64 = 6.0, unit "m", above 0.0, max 100.0;
+        /// A keypoint is isolated with at most this many other keypoints in the box (thesis: 7).
+        max_neighbours: usize = 7;
+        /// σ of the Gaussian blur of the MM ortho image; 0 = none.
+        mm_blur_sigma_px: f32 = 1.0, unit "px", min 0.0, max 10.0;
+        /// Template side (thesis: 16).
+        template_px: usize = 16, unit "px", min 4, max 128;
+        /// Search window side (thesis: 40); larger than `template_px`.
+        search_px: usize = 40, unit "px", max 512;
+        /// Smallest accepted NCC peak.
+        min_ncc: f64 = 0.7, min -1.0, max 1.0;
+        /// Largest distance from the NCC peak to the isolated aerial keypoint that becomes the observation.
+        snap_px: f64 = 1.5, unit "px", above 0.0, max 20.0;
+        /// Smallest grey-value standard deviation of a template (0..1 scale).
+        min_template_std: f64 = 0.01, min 0.0;
+    }
+    check(p, v) {
+        if p.search_px <= p.template_px {
+            v.push(crate::params::Violation::new(
+                "search_px",
+                format!(
+                    "must be larger than template_px ({}), got {}",
+                    p.template_px, p.search_px
+                ),
+            ));
         }
     }
 }
 
 impl BaselineParams {
-    /// Check ranges; each error is (field, message with the allowed range).
-    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
-        let mut errs: Vec<(String, String)> = Vec::new();
-        let mut check = |ok: bool, field: &str, msg: String| {
-            if !ok {
-                errs.push((field.into(), msg));
-            }
-        };
-        let s = |v: f32| v.is_finite() && v > 0.0 && v <= 20.0;
-        check(
-            s(self.forstner_sigma_gradient_px),
-            "forstner_sigma_gradient_px",
-            format!(
-                "must be in (0, 20] px, got {}",
-                self.forstner_sigma_gradient_px
-            ),
-        );
-        check(
-            s(self.forstner_sigma_integration_px),
-            "forstner_sigma_integration_px",
-            format!(
-                "must be in (0, 20] px, got {}",
-                self.forstner_sigma_integration_px
-            ),
-        );
-        check(
-            (0.0..=1.0).contains(&self.forstner_min_roundness),
-            "forstner_min_roundness",
-            format!("must be in [0, 1], got {}", self.forstner_min_roundness),
-        );
-        check(
-            self.forstner_min_weight_rel.is_finite() && self.forstner_min_weight_rel >= 0.0,
-            "forstner_min_weight_rel",
-            format!("must be ≥ 0, got {}", self.forstner_min_weight_rel),
-        );
-        check(
-            self.isolation_box_m.is_finite()
-                && self.isolation_box_m > 0.0
-                && self.isolation_box_m <= 100.0,
-            "isolation_box_m",
-            format!("must be in (0, 100] m, got {}", self.isolation_box_m),
-        );
-        check(
-            self.mm_blur_sigma_px.is_finite() && (0.0..=10.0).contains(&self.mm_blur_sigma_px),
-            "mm_blur_sigma_px",
-            format!("must be in [0, 10] px, got {}", self.mm_blur_sigma_px),
-        );
-        check(
-            (4..=128).contains(&self.template_px),
-            "template_px",
-            format!("must be in [4, 128] px, got {}", self.template_px),
-        );
-        check(
-            self.search_px > self.template_px && self.search_px <= 512,
-            "search_px",
-            format!(
-                "must be larger than template_px ({}) and ≤ 512 px, got {}",
-                self.template_px, self.search_px
-            ),
-        );
-        check(
-            self.min_ncc.is_finite() && (-1.0..=1.0).contains(&self.min_ncc),
-            "min_ncc",
-            format!("must be in [−1, 1], got {}", self.min_ncc),
-        );
-        check(
-            self.snap_px.is_finite() && self.snap_px > 0.0 && self.snap_px <= 20.0,
-            "snap_px",
-            format!("must be in (0, 20] px, got {}", self.snap_px),
-        );
-        check(
-            self.min_template_std.is_finite() && self.min_template_std >= 0.0,
-            "min_template_std",
-            format!("must be ≥ 0, got {}", self.min_template_std),
-        );
-        if errs.is_empty() {
-            Ok(())
-        } else {
-            Err(errs)
-        }
-    }
-
     fn forstner(&self) -> ForstnerParams {
         ForstnerParams {
             sigma_gradient_px: self.forstner_sigma_gradient_px,

@@ -22,65 +22,34 @@
 
 use std::collections::HashMap;
 
-use serde::{Deserialize, Serialize};
-
 use super::registration::{AerialRefinement, MmWindowMatch};
 use crate::campaign::AerialImage;
 use crate::correspondence::{AerialControlPoint, AerialObservation};
 use crate::geometry::{
     intersect_ray_plane, triangulate_rays, FrameCamera, Plane, Ray, Triangulation,
 };
+use crate::params::{Params, StageId};
 use nalgebra::{Vector2, Vector3};
 
-/// Parameters of [`aerial_control_points`].
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct ControlParams {
-    /// Rejection threshold in standard deviations (ground-point agreement and reprojection residuals).
-    pub k_sigma: f64,
-    /// Standard deviation of the MM tie point's height used by the ground-plane check, m.
-    pub mm_height_sigma_m: f64,
-    /// Observations with a matching score below this are ignored.
-    pub min_score: f64,
-}
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "control",
+    version: "1",
+};
 
-impl Default for ControlParams {
-    fn default() -> Self {
-        Self {
-            k_sigma: 3.0,
-            mm_height_sigma_m: 1.0,
-            min_score: 0.0,
-        }
+crate::params! {
+    /// Parameters of [`aerial_control_points`].
+    pub struct ControlParams {
+        /// Rejection threshold in standard deviations (ground-point agreement and reprojection residuals).
+        k_sigma: f64 = 3.0, min 1.0, max 100.0;
+        /// Standard deviation of the MM tie point's height used by the ground-plane check.
+        mm_height_sigma_m: f64 = 1.0, unit "m", min 0.0, max 1000.0;
+        /// Observations with a matching score below this are ignored.
+        min_score: f64 = 0.0;
     }
-}
-
-impl ControlParams {
-    /// Check ranges; each error is (field, message with the allowed range).
-    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
-        let mut errs = Vec::new();
-        if !(self.k_sigma.is_finite() && self.k_sigma >= 1.0 && self.k_sigma <= 100.0) {
-            errs.push((
-                "k_sigma".into(),
-                format!("must be in [1, 100], got {}", self.k_sigma),
-            ));
-        }
-        if !(self.mm_height_sigma_m.is_finite()
-            && self.mm_height_sigma_m >= 0.0
-            && self.mm_height_sigma_m <= 1000.0)
-        {
-            errs.push((
-                "mm_height_sigma_m".into(),
-                format!("must be in [0, 1000] m, got {}", self.mm_height_sigma_m),
-            ));
-        }
-        if !self.min_score.is_finite() {
-            errs.push(("min_score".into(), "must be a finite number".into()));
-        }
-        if errs.is_empty() {
-            Ok(())
-        } else {
-            Err(errs)
-        }
+    check(p, v) {
+        crate::params::check_finite("min_score", &p.min_score, v);
     }
 }
 

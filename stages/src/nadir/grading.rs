@@ -13,9 +13,17 @@ use crate::correspondence::{AerialControlPoint, MmTiePoint, PanoObservation};
 use crate::estimators::median_consensus::median_in_place;
 use crate::geometry::{triangulate_rays, FrameCamera, PanoramaCamera, Ray};
 use crate::nadir::registration::AerialRefinement;
+use crate::params::StageId;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "grade_nadir",
+    version: "3",
+};
 
 /// A correspondence is correct within this distance, aerial pixels.
 pub const CORRECT_TOLERANCE_PX: f64 = 1.0;

@@ -31,251 +31,99 @@ use crate::geometry::{intersect_ray_plane, FrameCamera, Plane, PointPair, Simila
 use crate::imaging::wallis::{wallis_filter, WallisParams};
 use crate::imaging::GrayImage;
 use crate::matching::descriptor_match::match_windowed;
+use crate::params::{describe, Params, StageId};
 use nalgebra::{Vector2, Vector3};
-use serde::{Deserialize, Serialize};
 
-/// Parameters of the initial MM→aerial transform (thesis 3.4.5.2). Intensities are 0..1.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct TransformParams {
-    /// Expected maximum localisation error of the MM platform, metres: enlarges the aerial patch, sets the
-    /// matching window (± this, in aerial pixels) and the plausibility limit of the centre offset.
-    pub max_localisation_error_m: f64,
-    /// Wallis target mean m_f (0..1 intensities).
-    pub wallis_target_mean: f32,
-    /// Wallis target standard deviation s_f.
-    pub wallis_target_std: f32,
-    /// Wallis contrast expansion constant c ∈ [0, 1].
-    pub wallis_contrast_c: f32,
-    /// Wallis brightness forcing constant b ∈ [0, 1].
-    pub wallis_brightness_b: f32,
-    /// Wallis statistics window side, pixels (odd; even values are rounded up).
-    pub wallis_window_px: usize,
-    /// KAZE detector threshold (det Hessian) of the MM instance.
-    pub kaze_threshold_mm: f32,
-    /// KAZE detector threshold of the aerial instance.
-    pub kaze_threshold_aerial: f32,
-    /// KAZE octaves (thesis: one, the images share a similar scale).
-    pub kaze_octaves: usize,
-    /// KAZE sub-levels per octave.
-    pub kaze_sublevels: usize,
-    /// 128-value descriptor (thesis: extended).
-    pub descriptor_extended: bool,
-    /// No rotation invariance (thesis: upright).
-    pub upright: bool,
-    /// Ratio test between the nearest and second-nearest aerial descriptor inside the window (d1 < ratio·d2;
-    /// values > 1 keep every nearest neighbour).
-    pub match_ratio: f32,
-    /// MM keypoints with a masked (vehicle) pixel within this radius, ortho pixels, are not used.
-    pub mask_clearance_px: f64,
-    /// RANSAC inlier threshold, aerial pixels.
-    pub ransac_threshold_px: f64,
-    /// RANSAC confidence in (0, 1).
-    pub ransac_confidence: f64,
-    /// RANSAC maximum number of samples.
-    pub ransac_max_iterations: usize,
-    /// Fewer RANSAC inliers than this reject the transform.
-    pub min_inliers: usize,
-    /// Largest relative difference between a hypothesis' scale and the recorded-pose scale (ortho px → aerial px).
-    pub max_scale_deviation: f64,
-    /// Largest difference between a hypothesis' rotation and the recorded-pose rotation, degrees.
-    pub max_rotation_deg: f64,
-    /// Seed of RANSAC; each (recording, aerial image) pair derives its own stream from it.
-    pub seed: u64,
-    /// Estimate scale and rotation too (2-point RANSAC similarity within `max_scale_deviation` /
-    /// `max_rotation_deg`). Default `false`: the ortho image is made at the aerial GSD and orientation, so
-    /// scale and rotation are the recorded-pose ones and only the translation is estimated (exhaustive 1-point
-    /// consensus, [`super::translation_consensus`]) — far less prone to a random consensus and, with few or
-    /// clustered inliers, to extrapolation errors at the ortho border.
-    pub estimate_shape: bool,
-    /// Fewer inliers than this fraction of the descriptor matches reject the transform (a consensus that
-    /// explains only a small part of the matches is likely random).
-    pub min_inlier_ratio: f64,
-    /// The winning translation must have at least this many times the support of the best competing one
-    /// (> 2 × `ransac_threshold_px` away); ambiguous (repetitive) content is rejected. Translation mode only.
-    pub min_consensus_margin: f64,
-    /// Agreement across the recording's nadir images (`nadir::transform_agreement`): a transform whose implied
-    /// recording offset lies farther than this from the median of the offsets implied by ≥ 2 other accepted
-    /// transforms of the same recording is rejected, m (0 = no check). Default 1.2 m: the `refine` search
-    /// margin (12 px) at the 10 cm aerial GSD — a transform farther off than that from its siblings cannot be
-    /// corrected by the refinement, which then confirms whatever repeats there. Measured on demo seeds 1–3:
-    /// implied offsets of one recording differ by 0.07 m (median), 0.5 m (p90); the aliased ones by 1.6–2.2 m.
-    pub max_offset_disagreement_m: f64,
-    /// A-contrario test of the translation consensus (translation mode): reject it when random matches would
-    /// give a consensus as large this often or more (expected number of false alarms,
-    /// [`super::translation_consensus::false_alarms`]). 0.1: with ±15 px windows and a 2 px threshold a
-    /// consensus of 7 among 105 matches (NFA 0.40, what chance gives) is rejected, 6 among 60 (NFA 0.09) and
-    /// 6 among 8 (NFA < 10⁻⁶) are kept.
-    pub max_false_alarms: f64,
-}
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "transform",
+    version: "4",
+};
 
-impl Default for TransformParams {
-    fn default() -> Self {
-        let wallis = WallisParams::default();
-        Self {
-            max_localisation_error_m: 1.5,
-            wallis_target_mean: wallis.target_mean,
-            wallis_target_std: wallis.target_std,
-            wallis_contrast_c: wallis.contrast_c,
-            wallis_brightness_b: wallis.brightness_b,
-            wallis_window_px: wallis.window_px,
-            // Measured on the tiny synthetic campaign: 0.001 finds ~16 MM keypoints per ortho (too few), 1e-4 ~280.
-            kaze_threshold_mm: 0.0001,
-            kaze_threshold_aerial: 0.0001,
-            kaze_octaves: 1,
-            kaze_sublevels: 4,
-            descriptor_extended: true,
-            upright: true,
-            match_ratio: 0.9,
-            mask_clearance_px: 3.0,
-            ransac_threshold_px: 2.0,
-            ransac_confidence: 0.999,
-            ransac_max_iterations: 2000,
-            min_inliers: 6,
-            max_scale_deviation: 0.1,
-            max_rotation_deg: 5.0,
-            seed: 1,
-            estimate_shape: false,
-            min_inlier_ratio: 0.0,
-            min_consensus_margin: 1.0,
-            max_offset_disagreement_m: 1.2,
-            max_false_alarms: 0.1,
+crate::params! {
+    /// Parameters of the initial MM→aerial transform (thesis 3.4.5.2). Intensities are 0..1.
+    pub struct TransformParams {
+        /// Expected maximum localisation error of the MM platform: enlarges the aerial patch, sets the matching
+        /// window (± this, in aerial pixels) and the plausibility limit of the centre offset.
+        max_localisation_error_m: f64 = 1.5, unit "m", above 0.0, max 50.0;
+        /// Wallis target mean m_f.
+        wallis_target_mean: f32 = WallisParams::default().target_mean;
+        /// Wallis target standard deviation s_f.
+        wallis_target_std: f32 = WallisParams::default().target_std, above 0.0;
+        /// Wallis contrast expansion constant c.
+        wallis_contrast_c: f32 = WallisParams::default().contrast_c, min 0.0, max 1.0;
+        /// Wallis brightness forcing constant b.
+        wallis_brightness_b: f32 = WallisParams::default().brightness_b, min 0.0, max 1.0;
+        /// Wallis statistics window side (odd; even values are rounded up).
+        wallis_window_px: usize = WallisParams::default().window_px, unit "px", min 3, max 501;
+        /// KAZE detector threshold (det Hessian) of the MM instance.
+        kaze_threshold_mm: f32 = 0.0001, above 0.0;
+        /// KAZE detector threshold of the aerial instance.
+        kaze_threshold_aerial: f32 = 0.0001, above 0.0;
+        /// KAZE octaves (thesis: one, the images share a similar scale).
+        kaze_octaves: usize = 1, min 1, max 8;
+        /// KAZE sub-levels per octave; octaves × sub-levels must give at least 3 levels.
+        kaze_sublevels: usize = 4, min 1, max 16;
+        /// 128-value descriptor (thesis: extended).
+        descriptor_extended: bool = true;
+        /// No rotation invariance (thesis: upright).
+        upright: bool = true;
+        /// Ratio test between the nearest and second-nearest aerial descriptor inside the window
+        /// (d1 < ratio·d2); values above 1 keep every nearest neighbour.
+        match_ratio: f32 = 0.9, above 0.0;
+        /// MM keypoints with a masked (vehicle) pixel within this radius, in ortho pixels, are not used.
+        mask_clearance_px: f64 = 3.0, unit "px", min 0.0, max 100.0;
+        /// RANSAC inlier threshold, in aerial pixels.
+        ransac_threshold_px: f64 = 2.0, unit "px", above 0.0;
+        /// RANSAC confidence.
+        ransac_confidence: f64 = 0.999, above 0.0, below 1.0;
+        /// RANSAC maximum number of samples.
+        ransac_max_iterations: usize = 2000, min 1;
+        /// Fewer RANSAC inliers than this reject the transform (a similarity needs 2).
+        min_inliers: usize = 6, min 2;
+        /// Largest relative difference between a hypothesis' scale and the recorded-pose scale (ortho px →
+        /// aerial px).
+        max_scale_deviation: f64 = 0.1, above 0.0, below 1.0;
+        /// Largest difference between a hypothesis' rotation and the recorded-pose rotation.
+        max_rotation_deg: f64 = 5.0, unit "deg", above 0.0, max 180.0;
+        /// Seed of RANSAC; each (recording, aerial image) pair derives its own stream from it.
+        seed: u64 = 1;
+        /// Estimate scale and rotation too (2-point RANSAC similarity within `max_scale_deviation` and
+        /// `max_rotation_deg`) instead of the translation alone (exhaustive 1-point consensus,
+        /// [`super::translation_consensus`]).
+        estimate_shape: bool = false;
+        /// Fewer inliers than this fraction of the descriptor matches reject the transform.
+        min_inlier_ratio: f64 = 0.0, min 0.0, max 1.0;
+        /// The winning translation must have at least this many times the support of the best competing one
+        /// (more than 2 × `ransac_threshold_px` away), else the content is ambiguous. Translation mode only.
+        min_consensus_margin: f64 = 1.0, min 1.0;
+        /// Agreement across the recording's nadir images (`nadir::transform_agreement`): a transform whose
+        /// implied recording offset lies farther than this from the median offset implied by ≥ 2 other accepted
+        /// transforms of the same recording is rejected; 0 = no check.
+        max_offset_disagreement_m: f64 = 1.2, unit "m", min 0.0;
+        /// A-contrario test of the translation consensus (translation mode): reject it when random matches would
+        /// give a consensus as large this often or more (expected number of false alarms,
+        /// [`super::translation_consensus::false_alarms`]). 0.1: with ±15 px windows and a 2 px threshold a
+        /// consensus of 7 among 105 matches (NFA 0.40, what chance gives) is rejected, 6 among 60 (NFA 0.09) and
+        /// 6 among 8 (NFA < 10⁻⁶) are kept.
+        max_false_alarms: f64 = 0.1, above 0.0;
+    }
+    check(p, v) {
+        crate::params::check_finite("wallis_target_mean", &p.wallis_target_mean, v);
+        if p.kaze_octaves.saturating_mul(p.kaze_sublevels) < 3 {
+            v.push(crate::params::Violation::new(
+                "kaze_sublevels",
+                format!(
+                    "kaze_octaves × kaze_sublevels must give at least 3 levels, got {} × {}",
+                    p.kaze_octaves, p.kaze_sublevels
+                ),
+            ));
         }
     }
 }
 
 impl TransformParams {
-    /// Check ranges; each error is (field, message with the allowed range).
-    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
-        let mut errs: Vec<(String, String)> = Vec::new();
-        let mut need = |ok: bool, field: &str, msg: String| {
-            if !ok {
-                errs.push((field.to_string(), msg));
-            }
-        };
-        let d = self.max_offset_disagreement_m;
-        need(
-            d.is_finite() && d >= 0.0,
-            "max_offset_disagreement_m",
-            format!("must be ≥ 0 m (0 = no check), got {d}"),
-        );
-        let e = self.max_localisation_error_m;
-        need(
-            e.is_finite() && e > 0.0 && e <= 50.0,
-            "max_localisation_error_m",
-            format!("must be in (0, 50] m, got {e}"),
-        );
-        need(
-            self.wallis_target_mean.is_finite(),
-            "wallis_target_mean",
-            format!("must be finite, got {}", self.wallis_target_mean),
-        );
-        need(
-            self.wallis_target_std.is_finite() && self.wallis_target_std > 0.0,
-            "wallis_target_std",
-            format!("must be finite and > 0, got {}", self.wallis_target_std),
-        );
-        need(
-            (0.0..=1.0).contains(&self.wallis_contrast_c),
-            "wallis_contrast_c",
-            format!("must be in [0, 1], got {}", self.wallis_contrast_c),
-        );
-        need(
-            (0.0..=1.0).contains(&self.wallis_brightness_b),
-            "wallis_brightness_b",
-            format!("must be in [0, 1], got {}", self.wallis_brightness_b),
-        );
-        need(
-            (3..=501).contains(&self.wallis_window_px),
-            "wallis_window_px",
-            format!("must be in [3, 501] px, got {}", self.wallis_window_px),
-        );
-        for (field, t) in [
-            ("kaze_threshold_mm", self.kaze_threshold_mm),
-            ("kaze_threshold_aerial", self.kaze_threshold_aerial),
-        ] {
-            need(
-                t.is_finite() && t > 0.0,
-                field,
-                format!("must be finite and > 0 (e.g. 0.001), got {t}"),
-            );
-        }
-        need(
-            (1..=8).contains(&self.kaze_octaves),
-            "kaze_octaves",
-            format!("must be in [1, 8], got {}", self.kaze_octaves),
-        );
-        need(
-            (1..=16).contains(&self.kaze_sublevels) && self.kaze_octaves * self.kaze_sublevels >= 3,
-            "kaze_sublevels",
-            format!(
-                "must be in [1, 16] with kaze_octaves × kaze_sublevels ≥ 3 levels, got {}",
-                self.kaze_sublevels
-            ),
-        );
-        need(
-            self.match_ratio.is_finite() && self.match_ratio > 0.0,
-            "match_ratio",
-            format!(
-                "must be finite and > 0 (e.g. 0.9), got {}",
-                self.match_ratio
-            ),
-        );
-        need(
-            self.mask_clearance_px.is_finite() && (0.0..=100.0).contains(&self.mask_clearance_px),
-            "mask_clearance_px",
-            format!("must be in [0, 100] px, got {}", self.mask_clearance_px),
-        );
-        if let Err(msg) = self.ransac().validate() {
-            need(false, "ransac_threshold_px", msg);
-        }
-        need(
-            self.min_inliers >= 2,
-            "min_inliers",
-            format!(
-                "must be at least 2 (a similarity needs 2 points), got {}",
-                self.min_inliers
-            ),
-        );
-        need(
-            self.max_scale_deviation.is_finite()
-                && self.max_scale_deviation > 0.0
-                && self.max_scale_deviation < 1.0,
-            "max_scale_deviation",
-            format!("must be in (0, 1), got {}", self.max_scale_deviation),
-        );
-        need(
-            self.max_rotation_deg.is_finite()
-                && self.max_rotation_deg > 0.0
-                && self.max_rotation_deg <= 180.0,
-            "max_rotation_deg",
-            format!("must be in (0, 180] degrees, got {}", self.max_rotation_deg),
-        );
-        need(
-            self.min_inlier_ratio.is_finite() && (0.0..=1.0).contains(&self.min_inlier_ratio),
-            "min_inlier_ratio",
-            format!("must be in [0, 1], got {}", self.min_inlier_ratio),
-        );
-        need(
-            self.max_false_alarms.is_finite() && self.max_false_alarms > 0.0,
-            "max_false_alarms",
-            format!(
-                "must be > 0 (expected chance consensus; large = no test), got {}",
-                self.max_false_alarms
-            ),
-        );
-        need(
-            self.min_consensus_margin.is_finite() && self.min_consensus_margin >= 1.0,
-            "min_consensus_margin",
-            format!("must be ≥ 1, got {}", self.min_consensus_margin),
-        );
-        if errs.is_empty() {
-            Ok(())
-        } else {
-            Err(errs)
-        }
-    }
-
     /// The Wallis filter settings.
     pub fn wallis(&self) -> WallisParams {
         WallisParams {
@@ -447,9 +295,8 @@ pub fn initial_transform(
         inliers,
     };
     if let Err(errs) = p.validate() {
-        let list: Vec<String> = errs.iter().map(|(f, m)| format!("{f}: {m}")).collect();
         return reject(
-            format!("invalid transform parameters: {}", list.join("; ")),
+            format!("invalid transform parameters: {}", describe(&errs)),
             0,
             0,
         );

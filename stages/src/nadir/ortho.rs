@@ -18,73 +18,36 @@ use crate::imaging::bilinear_many::sample_bilinear_many;
 use crate::imaging::border::Border;
 use crate::imaging::sample::{floor_fast, sample_bilinear};
 use crate::imaging::GrayImage;
+use crate::params::StageId;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// Parameters of one ortho-projection.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct OrthoParams {
-    /// Pixel spacing on the ground, m.
-    pub gsd_m: f64,
-    /// Diagonal of the square ground plane, m (thesis: 30 m).
-    pub diagonal_m: f64,
-    /// Azimuth (degrees clockwise from grid north) that the image's "up" direction points at.
-    pub rotation_deg: f64,
-    /// The recording vehicle's body, masked out.
-    pub vehicle: VehicleMask,
-}
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "ortho",
+    version: "3",
+};
 
-impl Default for OrthoParams {
-    fn default() -> Self {
-        Self {
-            gsd_m: 0.03,
-            diagonal_m: 30.0,
-            rotation_deg: 0.0,
-            vehicle: VehicleMask::default(),
-        }
+crate::params! {
+    /// Parameters of one ortho-projection.
+    pub struct OrthoParams {
+        /// Pixel spacing on the ground.
+        gsd_m: f64 = 0.03, unit "m", min 0.001, max 1.0;
+        /// Diagonal of the square ground plane (thesis: 30 m).
+        diagonal_m: f64 = 30.0, unit "m", min 1.0, max 200.0;
+        /// Azimuth (clockwise from grid north) that the image's "up" direction points at.
+        rotation_deg: f64 = 0.0, unit "deg", min -360.0, max 360.0;
+        /// The recording vehicle's body, masked out.
+        vehicle: VehicleMask = VehicleMask::default(), section;
     }
-}
-
-impl OrthoParams {
-    /// Check ranges; each error is (field, message with the allowed range).
-    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
-        let mut errs = Vec::new();
-        if !(self.gsd_m.is_finite() && self.gsd_m >= 0.001 && self.gsd_m <= 1.0) {
-            errs.push((
-                "gsd_m".into(),
-                format!("must be in [0.001, 1] m, got {}", self.gsd_m),
+    check(p, v) {
+        if p.diagonal_m / p.gsd_m > 20_000.0 {
+            v.push(crate::params::Violation::new(
+                "gsd_m",
+                "diagonal_m / gsd_m exceeds 20000 px: the ortho image would be too large",
             ));
-        }
-        if !(self.diagonal_m.is_finite() && self.diagonal_m >= 1.0 && self.diagonal_m <= 200.0) {
-            errs.push((
-                "diagonal_m".into(),
-                format!("must be in [1, 200] m, got {}", self.diagonal_m),
-            ));
-        }
-        if !self.rotation_deg.is_finite() {
-            errs.push((
-                "rotation_deg".into(),
-                "must be a finite angle in degrees".into(),
-            ));
-        }
-        if self.gsd_m.is_finite()
-            && self.diagonal_m.is_finite()
-            && self.diagonal_m / self.gsd_m > 20_000.0
-        {
-            errs.push((
-                "gsd_m".into(),
-                "diagonal_m / gsd_m exceeds 20000 px: the ortho image would be too large".into(),
-            ));
-        }
-        if let Err(v) = self.vehicle.validate() {
-            errs.extend(v.into_iter().map(|(f, m)| (format!("vehicle.{f}"), m)));
-        }
-        if errs.is_empty() {
-            Ok(())
-        } else {
-            Err(errs)
         }
     }
 }

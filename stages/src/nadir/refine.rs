@@ -40,7 +40,15 @@ use crate::imaging::window::WindowKind;
 use crate::imaging::GrayImage;
 use crate::matching::phase_correlation::{locate_template, PhaseCorrelationParams};
 use crate::matching::subpixel::PeakFit;
+use crate::params::{Params, StageId};
 use nalgebra::{Vector2, Vector3};
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "refine",
+    version: "6",
+};
 
 /// Taper applied before the Fourier transform (serialisable mirror of [`WindowKind`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -61,150 +69,38 @@ impl TaperWindow {
     }
 }
 
-/// Parameters of [`refine_in_aerial`]; lengths in MM ortho pixels (≈ aerial pixels).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct RefineParams {
-    /// Side of the square MM template, px (32 px = 3.2 m at 10 cm GSD; FFT-friendly sizes are fastest).
-    pub template_px: usize,
-    /// The aerial window extends the template by this many px on each side: the largest correction of the
-    /// initial transform that can be found (larger shifts are rejected).
-    pub search_margin_px: usize,
-    /// Taper of template and window before the FFT.
-    pub window: TaperWindow,
-    /// σ of the Gaussian low-pass on the cross-power spectrum, px (0 = none; see `PhaseCorrelationParams`).
-    /// 1.5 px: at 1.0 px a 32-px template of broadband texture occasionally locks onto a wrong peak (measured
-    /// ~10 px errors on noise-free synthetic texture); 1.5–2 px removes that at equal sub-pixel accuracy.
-    pub lowpass_sigma_px: f64,
-    /// Re-estimations with the window re-centred on the content found (removes the fixed-window bias).
-    pub refinements: usize,
-    /// Smallest accepted correlation peak (1 = identical images). Measured on the Tiny synthetic campaign with
-    /// a transform from the true poses (lowpass 1.5 px, 32 px): of the located observations, 44 % are within
-    /// 1 aerial px of the truth at peak ≥ 0.3, 75 % at ≥ 0.5, 90 % at ≥ 0.6, 95 % at ≥ 0.7. Through the whole
-    /// nadir chain on demo seed 1 (KAZE transform): inlier ratio 0.49 at 0.5, 0.89 at 0.7, 0.945 at 0.75,
-    /// 0.93 at 0.8 with 28 → 20 recordings matched — default 0.75.
-    pub min_peak: f64,
-    /// Smallest standard deviation of the template grey values (0..1 scale); flatter templates are skipped.
-    pub min_template_std: f64,
-    /// Parallax check (`nadir::parallax_check`): a corner is not located when a neighbouring recording that
-    /// saw it shows more than this share of the template's structure differently — content at another height
-    /// than the corner (kerbs) or hidden from one view. 1 = no check. Measured with `nadir.toml` on demo seeds
-    /// 1/2/3, inlier ratio (graded correspondences): 1 → 0.912 (136) / 0.964 (138) / 0.961 (128); 0.5 → 0.912 /
-    /// 0.962 / 0.961; 0.35 → 0.932 / 0.992 / 0.969; **0.25** → 0.945 (128) / 0.992 (128) / 0.969 (127); 0.15 →
-    /// 0.960 (124) / 0.992 (126) / 0.968 (124).
-    pub max_parallax_share: f64,
-    /// Fewest tie points that must be located in one aerial image for any of them to be kept (1 = keep lone
-    /// ones). A lone located template has nothing to confirm it: the pair's initial transform and its
-    /// refinement rest on one patch. Measured with `nadir.toml` on demo seeds 1/2/3 (parallax share 0.25):
-    /// correspondences located alone in their image are wrong in 5/19, 1/18, 2/26 cases, those located with
-    /// others in 1/80, 0/86, 1/64. Inlier ratio: 1 → 0.945 (128) / 0.992 (128) / 0.969 (127); **2** → 0.982
-    /// (109) / 1.000 (110) / 0.980 (101).
-    pub min_located: usize,
-    /// Shift consistency within one aerial image, px (0 = no check): every located tie point moved from where the
-    /// initial transform predicted it by its own correction; a tie point whose correction differs from the
-    /// median of the image's corrections by more than this is dropped (with two located, both are dropped when
-    /// they differ by more). A periodic template — a zebra crossing, one stripe (≈ 10 px) away — locks onto the
-    /// wrong stripe in every aerial image alike, where the multi-image check (3.4.5.4) cannot see it, but it
-    /// stands out against the other tie points of the same recording in each image. Measured with `nadir.toml`
-    /// (inlier ratio, graded correspondences): demo seeds 1/2/3, 0 → 0.973 (113) / 1.000 (107) / 0.971 (102);
-    /// 2 → 1.000 (100) / 1.000 (107) / 0.970 (99); 3 → 0.991 (110) / 1.000 / 0.970 (100); **5** → 0.991 (110) /
-    /// 1.000 (107) / 0.971 (102). `paper` campaign: 0 → 0.972 (1399/1440); 3 → 0.985 (1378/1399); **5** → 0.985
-    /// (1389/1410), every one-stripe (10 px) error gone, 82 recordings registered either way.
-    pub max_shift_spread_px: f64,
-}
-
-impl Default for RefineParams {
-    fn default() -> Self {
-        Self {
-            template_px: 32,
-            search_margin_px: 12,
-            window: TaperWindow::Hann,
-            lowpass_sigma_px: 1.5,
-            refinements: 3,
-            min_peak: 0.75,
-            min_template_std: 0.01,
-            max_parallax_share: 0.25,
-            min_located: 2,
-            max_shift_spread_px: 5.0,
-        }
+crate::params! {
+    /// Parameters of [`refine_in_aerial`]; lengths in MM ortho pixels (≈ aerial pixels).
+    pub struct RefineParams {
+        /// Side of the square MM template (FFT-friendly sizes are fastest).
+        template_px: usize = 32, unit "px", min 8, max 256;
+        /// The aerial window extends the template by this much on each side: the largest correction of the
+        /// initial transform that can be found (larger shifts are rejected).
+        search_margin_px: usize = 12, unit "px", min 1, max 128;
+        /// Taper of template and window before the FFT.
+        window: TaperWindow = TaperWindow::Hann;
+        /// σ of the Gaussian low-pass on the cross-power spectrum; 0 = none.
+        lowpass_sigma_px: f64 = 1.5, unit "px", min 0.0, max 10.0;
+        /// Re-estimations with the window re-centred on the content found (removes the fixed-window bias).
+        refinements: usize = 3, max 10;
+        /// Smallest accepted correlation peak (1 = identical images).
+        min_peak: f64 = 0.75, min 0.0, below 1.0;
+        /// Smallest standard deviation of the template grey values (0..1 scale); flatter templates are skipped.
+        min_template_std: f64 = 0.01, min 0.0;
+        /// Parallax check (`nadir::parallax_check`): a corner is not located when a neighbouring recording that
+        /// saw it shows more than this share of the template's structure differently. 1 = no check.
+        max_parallax_share: f64 = 0.25, min 0.0, max 1.0;
+        /// Fewest tie points that must be located in one aerial image for any of them to be kept (1 = keep lone
+        /// ones).
+        min_located: usize = 2, min 1, max 100;
+        /// Shift consistency within one aerial image: a tie point whose correction differs from the median of
+        /// the image's corrections by more than this is dropped (with two located, both are dropped when they
+        /// differ by more); 0 = no check.
+        max_shift_spread_px: f64 = 5.0, unit "px", min 0.0;
     }
 }
 
 impl RefineParams {
-    /// Check ranges; each error is (field, message with the allowed range).
-    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
-        let mut errs = Vec::new();
-        if !(8..=256).contains(&self.template_px) {
-            errs.push((
-                "template_px".into(),
-                format!("must be in [8, 256] px, got {}", self.template_px),
-            ));
-        }
-        if !(1..=128).contains(&self.search_margin_px) {
-            errs.push((
-                "search_margin_px".into(),
-                format!("must be in [1, 128] px, got {}", self.search_margin_px),
-            ));
-        }
-        if !(self.lowpass_sigma_px.is_finite() && (0.0..=10.0).contains(&self.lowpass_sigma_px)) {
-            errs.push((
-                "lowpass_sigma_px".into(),
-                format!("must be in [0, 10] px, got {}", self.lowpass_sigma_px),
-            ));
-        }
-        if self.refinements > 10 {
-            errs.push((
-                "refinements".into(),
-                format!("must be in [0, 10], got {}", self.refinements),
-            ));
-        }
-        if !(self.min_peak.is_finite() && (0.0..1.0).contains(&self.min_peak)) {
-            errs.push((
-                "min_peak".into(),
-                format!("must be in [0, 1), got {}", self.min_peak),
-            ));
-        }
-        if !(self.min_template_std.is_finite() && self.min_template_std >= 0.0) {
-            errs.push((
-                "min_template_std".into(),
-                format!("must be ≥ 0, got {}", self.min_template_std),
-            ));
-        }
-        if !(self.max_parallax_share.is_finite() && (0.0..=1.0).contains(&self.max_parallax_share))
-        {
-            errs.push((
-                "max_parallax_share".into(),
-                format!(
-                    "must be in [0, 1] (1 = no parallax check), got {}",
-                    self.max_parallax_share
-                ),
-            ));
-        }
-        if !(self.max_shift_spread_px.is_finite() && self.max_shift_spread_px >= 0.0) {
-            errs.push((
-                "max_shift_spread_px".into(),
-                format!(
-                    "must be ≥ 0 px (0 = no shift-consistency check), got {}",
-                    self.max_shift_spread_px
-                ),
-            ));
-        }
-        if !(1..=100).contains(&self.min_located) {
-            errs.push((
-                "min_located".into(),
-                format!(
-                    "must be in [1, 100] (1 = keep lone correspondences), got {}",
-                    self.min_located
-                ),
-            ));
-        }
-        if errs.is_empty() {
-            Ok(())
-        } else {
-            Err(errs)
-        }
-    }
-
     fn phase_params(&self) -> PhaseCorrelationParams {
         PhaseCorrelationParams {
             window: self.window.kind(),

@@ -5,8 +5,16 @@
 use super::registration::{
     AerialRefinement, MmWindowMatch, PairMethod, RecordingControl, TransformOutcome,
 };
+use crate::params::StageId;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "nadir",
+    version: "4",
+};
 
 /// See the module documentation. Counts, not grades.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]

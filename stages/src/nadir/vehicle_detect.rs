@@ -20,68 +20,43 @@ use crate::geometry::PanoramaCamera;
 use crate::imaging::border::Border;
 use crate::imaging::sample::sample_bilinear;
 use crate::imaging::GrayImage;
+use crate::params::{describe, Params, StageId, Violation};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// Parameters of [`detect_vehicle`].
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct VehicleDetectParams {
-    /// Use at most this many recordings, evenly spread over the campaign.
-    pub max_recordings: usize,
-    /// Fewer usable recordings than this: no detection.
-    pub min_recordings: usize,
-    /// Grid step in azimuth (relative to the driving direction), degrees.
-    pub azimuth_step_deg: f64,
-    /// Grid step in depression below the horizon, degrees.
-    pub depression_step_deg: f64,
-    /// The car is searched below this depression only, degrees (the horizon is never the car).
-    pub min_depression_deg: f64,
-    /// Relative enlargement of the fitted box (edges blurred by the grid and the images).
-    pub margin: f64,
-}
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "vehicle",
+    version: "1",
+};
 
-impl Default for VehicleDetectParams {
-    fn default() -> Self {
-        Self {
-            max_recordings: 24,
-            min_recordings: 5,
-            azimuth_step_deg: 2.0,
-            depression_step_deg: 1.0,
-            min_depression_deg: 10.0,
-            margin: 0.08,
-        }
+crate::params! {
+    /// Parameters of [`detect_vehicle`].
+    pub struct VehicleDetectParams {
+        /// Use at most this many recordings, evenly spread over the campaign.
+        max_recordings: usize = 24, min 3;
+        /// Fewer usable recordings than this: no detection.
+        min_recordings: usize = 5, min 3;
+        /// Grid step in azimuth (relative to the driving direction).
+        azimuth_step_deg: f64 = 2.0, unit "deg", min 0.25, max 20.0;
+        /// Grid step in depression below the horizon.
+        depression_step_deg: f64 = 1.0, unit "deg", min 0.1, max 10.0;
+        /// The car is searched below this depression only (the horizon is never the car).
+        min_depression_deg: f64 = 10.0, unit "deg", min 0.0, max 80.0;
+        /// Relative enlargement of the fitted box (edges blurred by the grid and the images).
+        margin: f64 = 0.08, min 0.0, max 1.0;
     }
-}
-
-impl VehicleDetectParams {
-    /// Every invalid field as (field, problem).
-    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
-        let mut errs = Vec::new();
-        if self.min_recordings < 3 || self.max_recordings < self.min_recordings {
-            errs.push((
-                "min_recordings".into(),
+    check(p, v) {
+        if p.max_recordings < p.min_recordings {
+            v.push(Violation::new(
+                "min_recordings",
                 format!(
-                    "needs 3 ≤ min_recordings ≤ max_recordings, got {} and {}",
-                    self.min_recordings, self.max_recordings
+                    "must be ≤ max_recordings, got {} and {}",
+                    p.min_recordings, p.max_recordings
                 ),
             ));
-        }
-        for (f, v, lo, hi) in [
-            ("azimuth_step_deg", self.azimuth_step_deg, 0.25, 20.0),
-            ("depression_step_deg", self.depression_step_deg, 0.1, 10.0),
-            ("min_depression_deg", self.min_depression_deg, 0.0, 80.0),
-            ("margin", self.margin, 0.0, 1.0),
-        ] {
-            if !(v.is_finite() && (lo..=hi).contains(&v)) {
-                errs.push((f.into(), format!("must be in [{lo}, {hi}], got {v}")));
-            }
-        }
-        if errs.is_empty() {
-            Ok(())
-        } else {
-            Err(errs)
         }
     }
 }
@@ -256,7 +231,10 @@ pub fn detect_vehicle(
     p: &VehicleDetectParams,
 ) -> Result<DetectedVehicle, String> {
     if let Err(e) = p.validate() {
-        return Err(format!("invalid vehicle detection parameters: {e:?}"));
+        return Err(format!(
+            "invalid vehicle detection parameters: {}",
+            describe(&e)
+        ));
     }
     if views.len() < p.min_recordings {
         return Err(format!(

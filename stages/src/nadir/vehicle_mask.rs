@@ -7,62 +7,28 @@
 //! projected onto the roof plane, plus a 5 cm margin) — set them for your vehicle.
 
 use nalgebra::Vector3;
-use serde::{Deserialize, Serialize};
 
-/// Box model of the recording vehicle in its own frame (x forward along `heading`, y to the left).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct VehicleMask {
-    /// Mask the vehicle at all.
-    pub enabled: bool,
-    /// Find the box in the panoramas (the `vehicle` stage) and use the values below only when that fails;
-    /// `false` = use the values below (an override for a known vehicle).
-    pub detect: bool,
-    /// Vertical distance from the projection centre down to the vehicle's top face, m.
-    pub roof_drop_m: f64,
-    /// Extent of the body ahead of the projection centre (bonnet), m.
-    pub front_m: f64,
-    /// Extent of the body behind the projection centre, m.
-    pub rear_m: f64,
-    /// Half the body width, m.
-    pub half_width_m: f64,
-}
-
-impl Default for VehicleMask {
-    fn default() -> Self {
-        Self {
-            enabled: true,
-            detect: true,
-            roof_drop_m: 0.4,
-            front_m: 0.75,
-            rear_m: 1.25,
-            half_width_m: 0.75,
-        }
+crate::params! {
+    /// Box model of the recording vehicle in its own frame (x forward along `heading`, y to the left).
+    #[derive(Copy)]
+    pub struct VehicleMask {
+        /// Mask the vehicle at all.
+        enabled: bool = true;
+        /// Find the box in the panoramas (the `vehicle` stage) and use the values below only when that fails;
+        /// `false` = use the values below (an override for a known vehicle).
+        detect: bool = true;
+        /// Vertical distance from the projection centre down to the vehicle's top face.
+        roof_drop_m: f64 = 0.4, unit "m", min 0.0, below 20.0;
+        /// Extent of the body ahead of the projection centre (bonnet).
+        front_m: f64 = 0.75, unit "m", min 0.0, below 20.0;
+        /// Extent of the body behind the projection centre.
+        rear_m: f64 = 1.25, unit "m", min 0.0, below 20.0;
+        /// Half the body width.
+        half_width_m: f64 = 0.75, unit "m", min 0.0, below 20.0;
     }
 }
 
 impl VehicleMask {
-    /// Check the parameters; messages name the field and the allowed range.
-    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
-        let mut errs = Vec::new();
-        let positive = [
-            ("roof_drop_m", self.roof_drop_m),
-            ("front_m", self.front_m),
-            ("rear_m", self.rear_m),
-            ("half_width_m", self.half_width_m),
-        ];
-        for (name, v) in positive {
-            if !(v.is_finite() && v >= 0.0 && v < 20.0) {
-                errs.push((name.to_string(), format!("must be in [0, 20) m, got {v}")));
-            }
-        }
-        if errs.is_empty() {
-            Ok(())
-        } else {
-            Err(errs)
-        }
-    }
-
     /// Whether the ray from the camera (at `camera_world`, vehicle heading `heading_deg` clockwise from grid north)
     /// towards `point_world` passes through the vehicle's top face, i.e. the point is hidden by the car.
     pub fn hides(

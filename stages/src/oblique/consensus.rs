@@ -39,6 +39,14 @@ use crate::geometry::aerial_intersection::{
     intersect_checked, IntersectionLimits, IntersectionRejection, PixelObservation,
 };
 use crate::geometry::FrameCamera;
+use crate::params::{Params, StageId};
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "oblique",
+    version: "1",
+};
 
 /// What happens to the matches of a set smaller than `min_set_size` (`"keep"` or `"drop"` in a workflow).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -50,92 +58,26 @@ pub enum SmallSetPolicy {
     Drop,
 }
 
-/// Parameters of [`consensus`].
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct ConsensusParams {
-    /// Largest distance of a translation from the median translation, m (thesis default 0.5; Table 4-8 also
-    /// 1.0 and 0.3).
-    pub threshold_m: f64,
-    /// Consensus tracking across adjacent panoramas sharing an oblique image (Table 4-8).
-    pub tracking: bool,
-    /// Smallest set (pooled set with tracking) for which a median is taken.
-    pub min_set_size: usize,
-    /// What happens to sets below `min_set_size`.
-    pub small_sets: SmallSetPolicy,
-    /// Panoramas on each side (along the trajectory) whose sets are pooled by tracking.
-    pub tracking_window: usize,
-    /// Oblique control points: smallest accepted intersection angle of the oblique rays, degrees.
-    pub min_intersection_angle_deg: f64,
-    /// Oblique control points: largest accepted reprojection error, in units of the image's σ_px.
-    pub max_reprojection_sigma: f64,
-    /// σ of an oblique observation, px, used when the image's `sigma_px` is missing or not > 0.
-    pub default_oblique_sigma_px: f64,
-}
-
-impl Default for ConsensusParams {
-    fn default() -> Self {
-        Self {
-            threshold_m: 0.5,
-            tracking: false,
-            min_set_size: 3,
-            small_sets: SmallSetPolicy::Keep,
-            tracking_window: 1,
-            min_intersection_angle_deg: 5.0,
-            max_reprojection_sigma: 10.0,
-            default_oblique_sigma_px: 1.0,
-        }
-    }
-}
-
-impl ConsensusParams {
-    /// Check ranges; each error is (field, what is wrong and what to do).
-    pub fn validate(&self) -> Result<(), Vec<(String, String)>> {
-        let mut e = Vec::new();
-        let mut check = |ok: bool, field: &str, msg: String| {
-            if !ok {
-                e.push((field.to_string(), msg));
-            }
-        };
-        check(
-            self.threshold_m.is_finite() && self.threshold_m > 0.0 && self.threshold_m <= 100.0,
-            "threshold_m",
-            format!("must be in (0, 100] m, got {}", self.threshold_m),
-        );
-        check(
-            (1..=1000).contains(&self.min_set_size),
-            "min_set_size",
-            format!("must be in [1, 1000], got {}", self.min_set_size),
-        );
-        check(
-            (1..=50).contains(&self.tracking_window),
-            "tracking_window",
-            format!("must be in [1, 50] panoramas, got {}", self.tracking_window),
-        );
-        check(
-            self.min_intersection_angle_deg.is_finite()
-                && (0.0..90.0).contains(&self.min_intersection_angle_deg),
-            "min_intersection_angle_deg",
-            format!(
-                "must be in [0, 90) degrees, got {}",
-                self.min_intersection_angle_deg
-            ),
-        );
-        check(
-            self.max_reprojection_sigma.is_finite() && self.max_reprojection_sigma > 0.0,
-            "max_reprojection_sigma",
-            format!("must be > 0, got {}", self.max_reprojection_sigma),
-        );
-        check(
-            self.default_oblique_sigma_px.is_finite() && self.default_oblique_sigma_px > 0.0,
-            "default_oblique_sigma_px",
-            format!("must be > 0 px, got {}", self.default_oblique_sigma_px),
-        );
-        if e.is_empty() {
-            Ok(())
-        } else {
-            Err(e)
-        }
+crate::params! {
+    /// Parameters of [`consensus`].
+    pub struct ConsensusParams {
+        /// Largest distance of a translation from the median translation (thesis 4.4.7; Table 4-8 also uses
+        /// 1.0 and 0.3 m).
+        threshold_m: f64 = 0.5, unit "m", above 0.0, max 100.0;
+        /// Consensus tracking across adjacent panoramas sharing an oblique image (Table 4-8).
+        tracking: bool = false;
+        /// Smallest set (pooled set with tracking) for which a median is taken.
+        min_set_size: usize = 3, min 1, max 1000;
+        /// What happens to sets below `min_set_size`.
+        small_sets: SmallSetPolicy = SmallSetPolicy::Keep;
+        /// Panoramas on each side (along the trajectory) whose sets are pooled by tracking.
+        tracking_window: usize = 1, min 1, max 50;
+        /// Oblique control points: smallest accepted intersection angle of the oblique rays.
+        min_intersection_angle_deg: f64 = 5.0, unit "deg", min 0.0, below 90.0;
+        /// Oblique control points: largest accepted reprojection error, in units of the image's σ_px.
+        max_reprojection_sigma: f64 = 10.0, above 0.0;
+        /// σ of an oblique observation, used when the image's `sigma_px` is missing or not > 0.
+        default_oblique_sigma_px: f64 = 1.0, unit "px", above 0.0;
     }
 }
 

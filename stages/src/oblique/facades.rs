@@ -38,11 +38,19 @@ use self::thinning::box_grid_thin;
 use self::trajectory::{check_collinearity, reference_normal};
 use self::visibility::{check_visibility, horizontal_axes};
 use crate::campaign::{AerialImage, Recording};
-use crate::estimators::rng::mix_seed;
 use crate::geometry::local_frame::LocalOrigin;
 use crate::geometry::FrameCamera;
 use crate::oblique::types::{FacadePlane, FacadeStats, SparseCloud, StreetSide, TripletFacades};
+use crate::params::{Params, StageId};
+use crate::rng::mix_seed;
 use nalgebra::Vector3;
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "facades",
+    version: "4",
+};
 
 /// FNV-1a hash of a string: a stable item id for seeding (independent of platform and run).
 fn stable_hash(s: &str) -> u64 {

@@ -42,7 +42,15 @@ use super::types::{ObliqueResult, PatchMatch, SparseCloud, StreetSide};
 use crate::correspondence::{MmTiePoint, PanoObservation};
 use crate::geometry::{closest_approach, FrameCamera, PanoramaCamera};
 pub use crate::nadir::grading::{ErrorStats, Truth};
+use crate::params::StageId;
 pub use crate::synth::scene_truth::SceneOracle;
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "grade_oblique",
+    version: "3",
+};
 
 /// Largest closest-approach distance of the panorama and oblique rays of a correct correspondence, m.
 pub const CLOSEST_APPROACH_TOLERANCE_M: f64 = 0.15;

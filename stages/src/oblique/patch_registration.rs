@@ -42,9 +42,17 @@ use crate::oblique::types::{
     FacadePlane, ObliqueView, PatchMatch, PatchRegistrationSet, PatchStats, SparseCloud,
     SparsePoint, TripletFacades,
 };
+use crate::params::StageId;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use search::{mi_search, ncc_search, Found};
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "patches",
+    version: "6",
+};
 
 /// Stable 64-bit FNV-1a hash of the strings (separated), for per-item seeds.
 fn stable_hash(parts: &[&str]) -> u64 {

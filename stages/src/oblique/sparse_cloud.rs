@@ -27,9 +27,17 @@ use crate::matching::descriptor_match::{
     match_ratio, match_restricted, DescriptorMatch, MatchError,
 };
 use crate::nadir::mm_matching::tie_point::{triangulate_track, TrackTriangulation};
+use crate::params::StageId;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use std::collections::HashMap;
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "sparse_cloud",
+    version: "1",
+};
 
 /// Corners of one view with their descriptors (row-major, `len` values each).
 struct ViewFeatures {

@@ -111,6 +111,10 @@ pub fn plan_nadir(
                 k2,
                 p1,
                 p2,
+                k3: 0.0,
+                k4: 0.0,
+                b1: 0.0,
+                b2: 0.0,
                 sigma_px: 0.5,
             });
         }
@@ -233,6 +237,10 @@ pub fn plan_oblique(
                 k2,
                 p1,
                 p2,
+                k3: 0.0,
+                k4: 0.0,
+                b1: 0.0,
+                b2: 0.0,
                 sigma_px: 0.5,
             });
         }
@@ -335,6 +343,7 @@ mod tests {
                 k2: a.k2,
                 p1: a.p1,
                 p2: a.p2,
+                ..BrownDistortion::NONE
             };
             let (x, y) = (500.0 / a.focal_px, 375.0 / a.focal_px);
             let (xd, yd) = dist.distort(x, y);

@@ -26,11 +26,26 @@ use crate::campaign::write as cw;
 use crate::campaign::{AerialImage, Recording};
 use crate::geometry::{FrameCamera, PanoramaCamera};
 use crate::imaging::io::save_rgb;
+use crate::params::StageId;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
+
+/// The identity of the generator stage (the rendered campaign with an error profile applied) in cache keys;
+/// bump the version whenever its output for the same inputs and parameters changes.
+pub const STAGE: StageId = StageId {
+    name: "synth",
+    version: "2",
+};
+
+/// The identity of the render stage (the error-free campaign of a [`RenderIdentity`]); bump the version
+/// whenever the generator renders differently (scenes, presets, cameras, looks).
+pub const RENDER_STAGE: StageId = StageId {
+    name: "render",
+    version: "3",
+};
 
 /// What was generated and how long it took.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -92,8 +92,8 @@ impl SynthOptions {
             option: option.into(),
             message,
         };
-        if let Some((field, problem)) = self.profile.problems().into_iter().next() {
-            return Err(bad(&format!("profile parameter {field}"), problem));
+        if let Some(v) = self.profile.problems().into_iter().next() {
+            return Err(bad(&format!("profile parameter {}", v.field), v.message));
         }
         if let Some(a) = self.nadir_altitude_m {
             if !(a.is_finite() && a > 10.0) {

@@ -2,8 +2,8 @@
 //! (`tests/support/tool_cli.rs`) — known content with texture at every scale above the blur, for detectors,
 //! matchers and samplers. Not part of the synthetic campaign's scene.
 
-use crate::estimators::rng::SplitMix64;
 use crate::imaging::{gaussian_blur, GrayImage};
+use crate::rng::SplitMix64;
 
 /// `width × height` uniform noise (24-bit values from the SplitMix64 stream of `seed`) blurred with a Gaussian of
 /// σ = `sigma_px` and stretched to [0, 1] (min → 0, max → 1). Deterministic for a given seed.

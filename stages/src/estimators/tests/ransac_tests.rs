@@ -1,6 +1,7 @@
 //! Generic RANSAC behaviour: trial counts, parameter validation, a 1-D model with a known answer.
 
 use crate::estimators::{ransac, required_iterations, Model, RansacParams};
+use crate::params::Params;
 
 #[test]
 fn trial_counts_match_the_formula() {

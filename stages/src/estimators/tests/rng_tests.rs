@@ -1,6 +1,6 @@
 //! SplitMix64: reference values, determinism, distributions.
 
-use crate::estimators::rng::{mix_seed, SplitMix64};
+use crate::rng::{mix_seed, SplitMix64};
 
 #[test]
 fn matches_reference_splitmix64_sequence() {

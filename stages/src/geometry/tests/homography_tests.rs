@@ -1,7 +1,7 @@
 //! Homography: normalised DLT recovery, degeneracy, inverse, normalisation invariance.
 
-use crate::estimators::SplitMix64;
 use crate::geometry::{Homography, PointPair};
+use crate::rng::SplitMix64;
 use nalgebra::{Matrix3, Vector2};
 
 pub(crate) fn truth() -> Homography {

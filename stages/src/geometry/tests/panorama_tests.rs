@@ -1,6 +1,5 @@
 //! Panorama camera: the documented pixel ↔ direction conventions and round trips.
 
-use crate::campaign::Recording;
 use crate::geometry::PanoramaCamera;
 use nalgebra::Vector3;
 
@@ -203,32 +202,6 @@ fn poles_map_back_to_the_pole_rows() {
             assert!((v - f64::from(H)).abs() < 1e-6, "nadir -> v = {v}");
         }
     }
-}
-
-#[test]
-fn from_recording_uses_pose_and_rotation() {
-    let rec = Recording {
-        image_id: "p1".into(),
-        file: "p1.jpg".into(),
-        time: "2019-06-14T10:31:07.250Z".into(),
-        time_s: 0.0,
-        x: 92_000.0,
-        y: 437_000.0,
-        z: 4.0,
-        heading_deg: 90.0,
-        camera_height_m: 2.5,
-        sigma_xy_m: None,
-        sigma_z_m: None,
-        yaw_deg: 1.0,
-        pitch_deg: 2.0,
-        roll_deg: 3.0,
-    };
-    let cam = PanoramaCamera::from_recording(&rec, W, H);
-    assert_eq!(
-        cam,
-        PanoramaCamera::new(W, H, Vector3::new(92_000.0, 437_000.0, 4.0), 1.0, 2.0, 3.0)
-    );
-    assert!((cam.pixel_angle_rad() - 0.075f64.to_radians()).abs() < 1e-15);
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! 2-D similarity: exact recovery, inverse/compose, Umeyama equivalence, normalisation invariance.
 
-use crate::estimators::SplitMix64;
 use crate::geometry::{PointPair, Similarity2};
+use crate::rng::SplitMix64;
 use nalgebra::{Matrix2, Vector2};
 
 fn truth() -> Similarity2 {

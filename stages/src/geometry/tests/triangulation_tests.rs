@@ -1,8 +1,8 @@
 //! Multi-view triangulation: exact rays, two-ray closed form, covariance behaviour, Monte Carlo check of the
 //! covariance, errors.
 
-use crate::estimators::SplitMix64;
 use crate::geometry::{triangulate_rays, Ray, TriangulationError};
+use crate::rng::SplitMix64;
 use nalgebra::{Matrix3, Vector3};
 
 fn rd_point() -> Vector3<f64> {
@@ -273,6 +273,7 @@ fn panorama_and_aerial_pixels_triangulate_a_ground_point() {
         k2: 0.01,
         p1: 1e-4,
         p2: -2e-4,
+        ..BrownDistortion::NONE
     };
     let aerial = [
         FrameCamera::from_opk(

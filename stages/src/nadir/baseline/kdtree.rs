@@ -36,7 +36,7 @@ impl KdTree2 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::estimators::rng::SplitMix64;
+    use crate::rng::SplitMix64;
 
     #[test]
     fn box_counts_equal_brute_force() {

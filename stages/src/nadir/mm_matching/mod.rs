@@ -30,8 +30,16 @@ use crate::correspondence::PanoObservation;
 use crate::estimators::mix_seed;
 use crate::geometry::PanoramaCamera;
 use crate::nadir::{MmWindowMatch, OrthoImage, PairMethod, PairReport, ViewGround};
+use crate::params::{describe, Params, StageId};
 use prepared::PreparedOrtho;
 use rayon::prelude::*;
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "mm_match",
+    version: "2",
+};
 
 /// One recording as the matcher sees it: its recorded pose, its 3 cm north-up ortho image, the panorama size.
 #[derive(Clone, Copy, Debug)]
@@ -85,7 +93,7 @@ fn invalid_window(detecting: &OrthoView, neighbours: &[OrthoView], reason: &str)
 /// triples: the next two recordings along the trajectory), refined by template matching, verified, tracked,
 /// mapped back to panorama pixels via the exact inverse and triangulated (2- or 3-view).
 ///
-/// Never panics on user data: invalid parameters (see [`MmMatchParams::validate`]; callers should validate
+/// Never panics on user data: invalid parameters (see [`Params::validate`]; callers should validate
 /// first) give a window without tie points whose pairs report the problem as their fallback reason; an empty
 /// panorama size gives no tie points.
 pub fn match_window(
@@ -94,11 +102,10 @@ pub fn match_window(
     p: &MmMatchParams,
 ) -> MmWindowMatch {
     if let Err(errs) = p.validate() {
-        let text: Vec<String> = errs.iter().map(|(f, m)| format!("{f}: {m}")).collect();
         return invalid_window(
             detecting,
             neighbours,
-            &format!("invalid parameters: {}", text.join("; ")),
+            &format!("invalid parameters: {}", describe(&errs)),
         );
     }
     let det_id = &detecting.recording.image_id;

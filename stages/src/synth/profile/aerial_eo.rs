@@ -10,40 +10,27 @@
 //! moved so that the camera turns about the ground point of its principal ray (that point keeps its pixel),
 //! then the whole frame is shifted by a block shift (one per block: nadir, oblique) plus N(0, σ) per frame.
 
-use super::{check_non_negative, Tables};
+use super::Tables;
 use crate::campaign::{AerialImage, Recording};
 use crate::geometry::{matrix_to_opk, opk_to_matrix, rot_x, rot_y, rot_z, FrameCamera};
 use crate::synth::rng::{hash_str, Stream};
 use nalgebra::Vector3;
-use serde::{Deserialize, Serialize};
 
-/// Parameters of the `aerial` component (`[synth.aerial]`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct AerialEoParams {
-    /// SD of the attitude error about each camera axis, millidegrees.
-    pub attitude_sigma_mdeg: f64,
-    /// SD of the shift of each frame per horizontal axis, m.
-    pub shift_sigma_m: f64,
-    /// SD of the vertical shift of each frame, m.
-    pub z_shift_sigma_m: f64,
-    /// SD of the shift shared by all frames of a block per axis, m.
-    pub block_shift_sigma_m: f64,
-    /// Turn each camera about the ground point of its principal ray (the correlation of an aerial
-    /// triangulation); `false` leaves the centre where it is (a tilt from 4.5 km then moves the ground by
-    /// decimetres).
-    pub correlated: bool,
-}
-
-impl Default for AerialEoParams {
-    fn default() -> Self {
-        Self {
-            attitude_sigma_mdeg: 3.0,
-            shift_sigma_m: 0.03,
-            z_shift_sigma_m: 0.05,
-            block_shift_sigma_m: 0.02,
-            correlated: true,
-        }
+crate::params! {
+    /// Parameters of the `aerial` component (`[synth.aerial]`).
+    pub struct AerialEoParams {
+        /// SD of the attitude error about each camera axis.
+        attitude_sigma_mdeg: f64 = 3.0, unit "mdeg", min 0.0;
+        /// SD of the shift of each frame per horizontal axis.
+        shift_sigma_m: f64 = 0.03, unit "m", min 0.0;
+        /// SD of the vertical shift of each frame.
+        z_shift_sigma_m: f64 = 0.05, unit "m", min 0.0;
+        /// SD of the shift shared by all frames of a block per axis.
+        block_shift_sigma_m: f64 = 0.02, unit "m", min 0.0;
+        /// Turn each camera about the ground point of its principal ray (the correlation of an aerial
+        /// triangulation); `false` leaves the centre where it is (a tilt from 4.5 km then moves the ground by
+        /// decimetres).
+        correlated: bool = true;
     }
 }
 
@@ -72,24 +59,6 @@ fn ground_z_below(img: &AerialImage, recordings: &[Recording], median_ground_z: 
 }
 
 impl AerialEoParams {
-    /// Every invalid field as (field, problem).
-    pub fn problems(&self) -> Vec<(String, String)> {
-        let mut p = Vec::new();
-        check_non_negative(
-            &mut p,
-            "aerial.attitude_sigma_mdeg",
-            self.attitude_sigma_mdeg,
-        );
-        check_non_negative(&mut p, "aerial.shift_sigma_m", self.shift_sigma_m);
-        check_non_negative(&mut p, "aerial.z_shift_sigma_m", self.z_shift_sigma_m);
-        check_non_negative(
-            &mut p,
-            "aerial.block_shift_sigma_m",
-            self.block_shift_sigma_m,
-        );
-        p
-    }
-
     /// The erroneous pose of one frame (true pose `img`, ground height `ground_z`, block shift `block`).
     fn perturb(
         &self,
@@ -200,6 +169,10 @@ mod tests {
             k2: 0.0,
             p1: 0.0,
             p2: 0.0,
+            k3: 0.0,
+            k4: 0.0,
+            b1: 0.0,
+            b2: 0.0,
             sigma_px: 0.5,
         }
     }

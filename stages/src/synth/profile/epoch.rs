@@ -5,66 +5,25 @@
 //! shadows in the mobile-mapping run; and exposure differing from image to image. Changes the rendered images,
 //! so campaigns with and without it are rendered separately.
 
-use super::check_non_negative;
-use serde::{Deserialize, Serialize};
-
-/// Parameters of the `epoch` component (`[synth.epoch]`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct EpochParams {
-    /// Fraction of the parked cars present in one epoch only (half in each), instead of the preset's.
-    pub moved_car_fraction: f64,
-    /// Fraction of the painted markings (lines, arrows, stop lines, zebras) present in one epoch only.
-    pub changed_marking_fraction: f64,
-    /// Roadworks per street: a patch of fresh asphalt with cones, in one epoch only.
-    pub roadworks_per_street: usize,
-    /// Tree crowns in the aerial epoch are larger by this radius, m.
-    pub crown_growth_m: f64,
-    /// Sun elevation of the mobile-mapping run, degrees (long shadows).
-    pub mm_sun_elevation_deg: f64,
-    /// SD of the natural logarithm of each image's exposure gain (per panorama and per aerial frame).
-    pub exposure_log_sigma: f64,
-}
-
-impl Default for EpochParams {
-    fn default() -> Self {
-        Self {
-            moved_car_fraction: 0.6,
-            changed_marking_fraction: 0.15,
-            roadworks_per_street: 1,
-            crown_growth_m: 1.0,
-            mm_sun_elevation_deg: 22.0,
-            exposure_log_sigma: 0.15,
-        }
+crate::params! {
+    /// Parameters of the `epoch` component (`[synth.epoch]`).
+    pub struct EpochParams {
+        /// Fraction of the parked cars present in one epoch only (half in each), instead of the preset's.
+        moved_car_fraction: f64 = 0.6, min 0.0, max 1.0;
+        /// Fraction of the painted markings (lines, arrows, stop lines, zebras) present in one epoch only.
+        changed_marking_fraction: f64 = 0.15, min 0.0, max 1.0;
+        /// Roadworks per street: a patch of fresh asphalt with cones, in one epoch only.
+        roadworks_per_street: usize = 1;
+        /// Tree crowns in the aerial epoch are larger by this radius.
+        crown_growth_m: f64 = 1.0, unit "m", min 0.0;
+        /// Sun elevation of the mobile-mapping run (long shadows).
+        mm_sun_elevation_deg: f64 = 22.0, unit "deg", above 0.0, below 90.0;
+        /// SD of the natural logarithm of each image's exposure gain (per panorama and per aerial frame).
+        exposure_log_sigma: f64 = 0.15, min 0.0;
     }
 }
 
 impl EpochParams {
-    /// Every invalid field as (field, problem).
-    pub fn problems(&self) -> Vec<(String, String)> {
-        let mut p = Vec::new();
-        for (field, v) in [
-            ("epoch.moved_car_fraction", self.moved_car_fraction),
-            (
-                "epoch.changed_marking_fraction",
-                self.changed_marking_fraction,
-            ),
-        ] {
-            if !(0.0..=1.0).contains(&v) {
-                p.push((field.into(), format!("{v} must be a fraction in [0, 1]")));
-            }
-        }
-        check_non_negative(&mut p, "epoch.crown_growth_m", self.crown_growth_m);
-        check_non_negative(&mut p, "epoch.exposure_log_sigma", self.exposure_log_sigma);
-        if !(self.mm_sun_elevation_deg > 0.0 && self.mm_sun_elevation_deg < 90.0) {
-            p.push((
-                "epoch.mm_sun_elevation_deg".into(),
-                format!("{} must be in (0, 90) degrees", self.mm_sun_elevation_deg),
-            ));
-        }
-        p
-    }
-
     /// README line.
     pub fn note(&self) -> Vec<String> {
         vec![format!(

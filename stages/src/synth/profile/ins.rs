@@ -5,50 +5,25 @@
 //! inertial unit) get the errors, exactly as a provider who north-aligns panoramas with a biased heading
 //! delivers them.
 
-use super::{check_non_negative, check_range, signed_draw, Routes, Tables};
+use super::{signed_draw, Routes, Tables};
 use crate::synth::rng::{hash_str, Stream};
-use serde::{Deserialize, Serialize};
 
-/// Parameters of the `ins` component (`[synth.ins]`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct InsParams {
-    /// Size of the heading bias per route, degrees: drawn uniformly from this range, with a random sign.
-    pub heading_bias_deg: [f64; 2],
-    /// SD of one random-walk step of the heading error per recording, degrees.
-    pub heading_walk_step_deg: f64,
-    /// SD of the white noise on pitch and on roll, degrees.
-    pub pitch_roll_sigma_deg: f64,
-}
-
-impl Default for InsParams {
-    fn default() -> Self {
-        Self {
-            heading_bias_deg: [0.1, 0.5],
-            heading_walk_step_deg: 0.01,
-            pitch_roll_sigma_deg: 0.02,
-        }
+crate::params! {
+    /// Parameters of the `ins` component (`[synth.ins]`).
+    pub struct InsParams {
+        /// Size of the heading bias per route: drawn uniformly from this range [low, high], with a random sign.
+        heading_bias_deg: [f64; 2] = [0.1, 0.5], unit "deg", min 0.0;
+        /// SD of one random-walk step of the heading error per recording.
+        heading_walk_step_deg: f64 = 0.01, unit "deg", min 0.0;
+        /// SD of the white noise on pitch and on roll.
+        pitch_roll_sigma_deg: f64 = 0.02, unit "deg", min 0.0;
+    }
+    check(p, v) {
+        super::check_ordered("heading_bias_deg", p.heading_bias_deg, v);
     }
 }
 
 impl InsParams {
-    /// Every invalid field as (field, problem).
-    pub fn problems(&self) -> Vec<(String, String)> {
-        let mut p = Vec::new();
-        check_range(&mut p, "ins.heading_bias_deg", self.heading_bias_deg);
-        check_non_negative(
-            &mut p,
-            "ins.heading_walk_step_deg",
-            self.heading_walk_step_deg,
-        );
-        check_non_negative(
-            &mut p,
-            "ins.pitch_roll_sigma_deg",
-            self.pitch_roll_sigma_deg,
-        );
-        p
-    }
-
     /// The signed heading bias of route `route`, degrees.
     pub fn bias_deg(&self, seed: u64, route: usize) -> f64 {
         signed_draw(

@@ -3,33 +3,17 @@
 //! coefficients (a calibrated camera), with `lens-unknown` they give zero for every aerial frame, nadir and
 //! oblique (a provider who delivers undistorted-image parameters for distorted images, or none at all).
 
-use super::{check_non_negative, Tables};
-use serde::{Deserialize, Serialize};
+use super::Tables;
 
-/// Parameters of the `lens` / `lens-unknown` components (`[synth.lens]`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct LensParams {
-    /// Radial displacement at the nadir frames' corners, pixels (sets k1; k2, p1, p2 are fractions of it).
-    pub nadir_corner_px: f64,
-}
-
-impl Default for LensParams {
-    fn default() -> Self {
-        Self {
-            nadir_corner_px: 3.0,
-        }
+crate::params! {
+    /// Parameters of the `lens` / `lens-unknown` components (`[synth.lens]`).
+    pub struct LensParams {
+        /// Radial displacement at the nadir frames' corners (sets k1; k2, p1, p2 are fractions of it).
+        nadir_corner_px: f64 = 3.0, unit "px", min 0.0;
     }
 }
 
 impl LensParams {
-    /// Every invalid field as (field, problem).
-    pub fn problems(&self) -> Vec<(String, String)> {
-        let mut p = Vec::new();
-        check_non_negative(&mut p, "lens.nadir_corner_px", self.nadir_corner_px);
-        p
-    }
-
     /// README line of `lens` (the tables keep the true coefficients).
     pub fn given_note(&self) -> Vec<String> {
         vec![format!(
@@ -46,6 +30,10 @@ impl LensParams {
             img.k2 = 0.0;
             img.p1 = 0.0;
             img.p2 = 0.0;
+            img.k3 = 0.0;
+            img.k4 = 0.0;
+            img.b1 = 0.0;
+            img.b2 = 0.0;
         }
         vec![format!(
             "`lens-unknown`: the nadir frames are rendered through a Brown distortion of about {:.1} px at the \

@@ -36,6 +36,7 @@ pub use vertical::VerticalParams;
 use super::rng::Stream;
 use super::SynthError;
 use crate::campaign::{AerialImage, Recording};
+use crate::params::{Params, Violation};
 use serde::{Deserialize, Serialize};
 
 /// One named error component.
@@ -113,31 +114,24 @@ impl Component {
     }
 }
 
-/// The parameters of every component (the `[synth.<component>]` tables); only those of the profile's
-/// components are used.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct ComponentParams {
-    pub thesis: ThesisParams,
-    pub outage: OutageParams,
-    pub ins: InsParams,
-    pub vertical: VerticalParams,
-    pub aerial: AerialEoParams,
-    pub lens: LensParams,
-    pub epoch: EpochParams,
-}
-
-impl ComponentParams {
-    /// Every invalid field as (dotted field, problem).
-    pub fn problems(&self) -> Vec<(String, String)> {
-        let mut p = self.thesis.problems();
-        p.extend(self.outage.problems());
-        p.extend(self.ins.problems());
-        p.extend(self.vertical.problems());
-        p.extend(self.aerial.problems());
-        p.extend(self.lens.problems());
-        p.extend(self.epoch.problems());
-        p
+crate::params! {
+    /// The parameters of every component (the `[synth.<component>]` tables); only those of the profile's
+    /// components are used.
+    pub struct ComponentParams {
+        /// `[synth.thesis]`: constant offset + noise.
+        thesis: ThesisParams = ThesisParams::default(), section;
+        /// `[synth.outage]`: GNSS outage drift.
+        outage: OutageParams = OutageParams::default(), section;
+        /// `[synth.ins]`: inertial heading, pitch and roll errors.
+        ins: InsParams = InsParams::default(), section;
+        /// `[synth.vertical]`: height and camera-height errors.
+        vertical: VerticalParams = VerticalParams::default(), section;
+        /// `[synth.aerial]`: aerial orientation errors.
+        aerial: AerialEoParams = AerialEoParams::default(), section;
+        /// `[synth.lens]`: nadir lens distortion.
+        lens: LensParams = LensParams::default(), section;
+        /// `[synth.epoch]`: aerial vs mobile-mapping epoch differences.
+        epoch: EpochParams = EpochParams::default(), section;
     }
 }
 
@@ -255,9 +249,9 @@ impl Profile {
         self.components.contains(&c)
     }
 
-    /// Every invalid parameter as (dotted field, problem); empty = valid.
-    pub fn problems(&self) -> Vec<(String, String)> {
-        self.params.problems()
+    /// Every invalid parameter (dotted field and problem); empty = valid.
+    pub fn problems(&self) -> Vec<Violation> {
+        self.params.violations()
     }
 
     /// A profile whose images are rendered as `r` says (only image-changing components; its tables are left
@@ -317,20 +311,14 @@ impl Profile {
     }
 }
 
-/// Push a problem unless `v` is finite and ≥ 0.
-pub(crate) fn check_non_negative(p: &mut Vec<(String, String)>, field: &str, v: f64) {
-    if !(v.is_finite() && v >= 0.0) {
-        p.push((field.into(), format!("{v} must be finite and ≥ 0")));
-    }
-}
-
-/// Push a problem unless `r` is a finite range `[lo, hi]` with 0 ≤ lo ≤ hi.
-pub(crate) fn check_range(p: &mut Vec<(String, String)>, field: &str, r: [f64; 2]) {
-    if !(r[0].is_finite() && r[1].is_finite() && 0.0 <= r[0] && r[0] <= r[1]) {
-        p.push((
-            field.into(),
+/// Push a violation unless the range `[low, high]` has low ≤ high (the bounds themselves are checked by the
+/// declaration).
+pub(crate) fn check_ordered(field: &str, r: [f64; 2], out: &mut Vec<Violation>) {
+    if r[0] > r[1] {
+        out.push(Violation::new(
+            field,
             format!(
-                "[{}, {}] must be a range [low, high] with 0 ≤ low ≤ high",
+                "must be a range [low, high] with low ≤ high, got [{}, {}]",
                 r[0], r[1]
             ),
         ));

@@ -5,37 +5,28 @@
 //! the vehicle frame (an along- and cross-track drift), so its direction in the world turns with the vehicle
 //! through a bend, and a random walk is added on top. Outside the outages positions keep centimetre noise.
 
-use super::{check_non_negative, check_range, Routes, Tables};
+use super::{Routes, Tables};
 use crate::synth::rng::{hash_str, Stream};
-use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
-/// Parameters of the `outage` component (`[synth.outage]`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct OutageParams {
-    /// Length of the outage along the route, m: drawn uniformly from this range (and cut to
-    /// `max_route_fraction` of a shorter route).
-    pub length_m: [f64; 2],
-    /// Largest error (middle of the outage), m: drawn uniformly from this range.
-    pub peak_m: [f64; 2],
-    /// Longest outage as a fraction of its route's length.
-    pub max_route_fraction: f64,
-    /// SD of one step of the random walk (per recording inside the outage, per horizontal axis), m.
-    pub random_walk_step_m: f64,
-    /// SD of the white noise of every recording (a healthy fix), per horizontal axis, m.
-    pub fix_sigma_m: f64,
-}
-
-impl Default for OutageParams {
-    fn default() -> Self {
-        Self {
-            length_m: [80.0, 150.0],
-            peak_m: [1.5, 2.0],
-            max_route_fraction: 0.8,
-            random_walk_step_m: 0.04,
-            fix_sigma_m: 0.02,
-        }
+crate::params! {
+    /// Parameters of the `outage` component (`[synth.outage]`).
+    pub struct OutageParams {
+        /// Length of the outage along the route: drawn uniformly from this range [low, high] (and cut to
+        /// `max_route_fraction` of a shorter route).
+        length_m: [f64; 2] = [80.0, 150.0], unit "m", min 0.0;
+        /// Largest error (middle of the outage): drawn uniformly from this range [low, high].
+        peak_m: [f64; 2] = [1.5, 2.0], unit "m", min 0.0;
+        /// Longest outage as a fraction of its route's length.
+        max_route_fraction: f64 = 0.8, above 0.0, max 1.0;
+        /// SD of one step of the random walk (per recording inside the outage, per horizontal axis).
+        random_walk_step_m: f64 = 0.04, unit "m", min 0.0;
+        /// SD of the white noise of every recording (a healthy fix), per horizontal axis.
+        fix_sigma_m: f64 = 0.02, unit "m", min 0.0;
+    }
+    check(p, v) {
+        super::check_ordered("length_m", p.length_m, v);
+        super::check_ordered("peak_m", p.peak_m, v);
     }
 }
 
@@ -65,22 +56,6 @@ impl Outage {
 }
 
 impl OutageParams {
-    /// Every invalid field as (field, problem).
-    pub fn problems(&self) -> Vec<(String, String)> {
-        let mut p = Vec::new();
-        check_range(&mut p, "outage.length_m", self.length_m);
-        check_range(&mut p, "outage.peak_m", self.peak_m);
-        check_non_negative(&mut p, "outage.random_walk_step_m", self.random_walk_step_m);
-        check_non_negative(&mut p, "outage.fix_sigma_m", self.fix_sigma_m);
-        if !(self.max_route_fraction > 0.0 && self.max_route_fraction <= 1.0) {
-            p.push((
-                "outage.max_route_fraction".into(),
-                format!("{} must be in (0, 1]", self.max_route_fraction),
-            ));
-        }
-        p
-    }
-
     /// The outage of route `route` (of length `route_length_m`) for `seed`.
     pub fn draw(&self, seed: u64, route: usize, route_length_m: f64) -> Outage {
         let mut s = Stream::new(&[seed, hash_str("outage"), route as u64]);

@@ -2,50 +2,25 @@
 //! (same for the whole campaign, towards an azimuth drawn from the seed) plus independent normal noise per
 //! horizontal axis and recording; heights untouched. The simulated GNSS problem of the thesis' experiments.
 
-use super::{check_non_negative, Tables};
+use super::Tables;
 use crate::synth::rng::{hash_str, Stream};
-use serde::{Deserialize, Serialize};
 
-/// Parameters of the `thesis` component (`[synth.thesis]`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct ThesisParams {
-    /// Length of the systematic horizontal offset, m (thesis: 0.80).
-    pub offset_m: f64,
-    /// SD of the random part per horizontal axis and recording, m (thesis: 0.10).
-    pub sigma_m: f64,
-    /// Direction of the offset, degrees clockwise from grid north; absent = drawn from the seed (rounded to
-    /// 0.1°).
-    pub azimuth_deg: Option<f64>,
-}
-
-impl Default for ThesisParams {
-    fn default() -> Self {
-        Self {
-            offset_m: 0.80,
-            sigma_m: 0.10,
-            azimuth_deg: None,
-        }
+crate::params! {
+    /// Parameters of the `thesis` component (`[synth.thesis]`).
+    pub struct ThesisParams {
+        /// Length of the systematic horizontal offset (thesis: 0.80).
+        offset_m: f64 = 0.80, unit "m", min 0.0;
+        /// SD of the random part per horizontal axis and recording (thesis: 0.10).
+        sigma_m: f64 = 0.10, unit "m", min 0.0;
+        /// Direction of the offset, clockwise from grid north; absent = drawn from the seed (rounded to 0.1°).
+        azimuth_deg: Option<f64> = None, unit "deg";
+    }
+    check(p, v) {
+        crate::params::check_finite("azimuth_deg", &p.azimuth_deg, v);
     }
 }
 
 impl ThesisParams {
-    /// Every invalid field as (field, problem).
-    pub fn problems(&self) -> Vec<(String, String)> {
-        let mut p = Vec::new();
-        check_non_negative(&mut p, "thesis.offset_m", self.offset_m);
-        check_non_negative(&mut p, "thesis.sigma_m", self.sigma_m);
-        if let Some(a) = self.azimuth_deg {
-            if !a.is_finite() {
-                p.push((
-                    "thesis.azimuth_deg".into(),
-                    format!("{a} is not a number of degrees"),
-                ));
-            }
-        }
-        p
-    }
-
     /// The offset's azimuth for `seed`.
     pub fn azimuth_for(&self, seed: u64) -> f64 {
         self.azimuth_deg.unwrap_or_else(|| {

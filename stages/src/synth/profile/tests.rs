@@ -54,6 +54,10 @@ fn truth() -> Tables {
         k2: 0.0,
         p1: 0.0,
         p2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
+        b1: 0.0,
+        b2: 0.0,
         sigma_px: 0.5,
     }];
     Tables {
@@ -106,7 +110,7 @@ fn names_parse_combine_and_are_refused_with_the_list() {
     let mut bad = Profile::parse("outage").unwrap();
     bad.params.outage.peak_m = [2.0, 1.0];
     bad.params.ins.pitch_roll_sigma_deg = f64::NAN;
-    let fields: Vec<String> = bad.problems().into_iter().map(|(f, _)| f).collect();
+    let fields: Vec<String> = bad.problems().into_iter().map(|v| v.field).collect();
     assert_eq!(fields, ["outage.peak_m", "ins.pitch_roll_sigma_deg"]);
 }
 

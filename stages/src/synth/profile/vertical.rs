@@ -3,54 +3,29 @@
 //! the road (a mis-measured mounting, the suspension): a constant per campaign plus a little noise. The camera
 //! height sets the scale of every ortho image, so its error reaches the nadir registration directly.
 
-use super::{check_non_negative, check_range, signed_draw, Routes, Tables};
+use super::{signed_draw, Routes, Tables};
 use crate::synth::rng::{hash_str, Stream};
-use serde::{Deserialize, Serialize};
 
-/// Parameters of the `vertical` component (`[synth.vertical]`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct VerticalParams {
-    /// Size of the height bias per route, m: drawn uniformly from this range, with a random sign.
-    pub z_bias_m: [f64; 2],
-    /// SD of the height noise per recording, m.
-    pub z_sigma_m: f64,
-    /// Size of the camera-height error of the campaign, m: drawn uniformly, with a random sign.
-    pub camera_height_bias_m: [f64; 2],
-    /// SD of the camera-height noise per recording, m.
-    pub camera_height_sigma_m: f64,
-}
-
-impl Default for VerticalParams {
-    fn default() -> Self {
-        Self {
-            z_bias_m: [0.10, 0.30],
-            z_sigma_m: 0.05,
-            camera_height_bias_m: [0.02, 0.05],
-            camera_height_sigma_m: 0.01,
-        }
+crate::params! {
+    /// Parameters of the `vertical` component (`[synth.vertical]`).
+    pub struct VerticalParams {
+        /// Size of the height bias per route: drawn uniformly from this range [low, high], with a random sign.
+        z_bias_m: [f64; 2] = [0.10, 0.30], unit "m", min 0.0;
+        /// SD of the height noise per recording.
+        z_sigma_m: f64 = 0.05, unit "m", min 0.0;
+        /// Size of the camera-height error of the campaign: drawn uniformly from [low, high], with a random
+        /// sign.
+        camera_height_bias_m: [f64; 2] = [0.02, 0.05], unit "m", min 0.0;
+        /// SD of the camera-height noise per recording.
+        camera_height_sigma_m: f64 = 0.01, unit "m", min 0.0;
+    }
+    check(p, v) {
+        super::check_ordered("z_bias_m", p.z_bias_m, v);
+        super::check_ordered("camera_height_bias_m", p.camera_height_bias_m, v);
     }
 }
 
 impl VerticalParams {
-    /// Every invalid field as (field, problem).
-    pub fn problems(&self) -> Vec<(String, String)> {
-        let mut p = Vec::new();
-        check_range(&mut p, "vertical.z_bias_m", self.z_bias_m);
-        check_non_negative(&mut p, "vertical.z_sigma_m", self.z_sigma_m);
-        check_range(
-            &mut p,
-            "vertical.camera_height_bias_m",
-            self.camera_height_bias_m,
-        );
-        check_non_negative(
-            &mut p,
-            "vertical.camera_height_sigma_m",
-            self.camera_height_sigma_m,
-        );
-        p
-    }
-
     /// Add the height and camera-height errors; returns the README lines.
     pub fn apply(
         &self,

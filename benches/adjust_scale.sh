@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# City-scale adjustment benchmark: time and peak memory of the adjustment on image-free street-network blocks
+# of 10^4, 10^5 (and with --million 10^6) recordings, once as the pipeline builds them (ties between
+# consecutive recordings only) and once with road-marking ties between the passes at every crossing.
+# Usage: benches/adjust_scale.sh [--million]    (from the repository root; needs /usr/bin/time)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --release -q -p skytie-stages --bench adjust_scale
+bin=$(cargo bench -q -p skytie-stages --bench adjust_scale --no-run 2>&1 | sed -n 's/.*(\(.*adjust_scale-[0-9a-f]*\)).*/\1/p' | tail -1)
+if [[ -z "$bin" ]]; then
+  bin=$(ls -t "${CARGO_TARGET_DIR:-target}"/release/deps/adjust_scale-* | grep -v '\.d$' | head -1)
+fi
+sizes=(10000 100000)
+if [[ "${1:-}" == "--million" ]]; then sizes+=(1000000); fi
+for n in "${sizes[@]}"; do
+  for crossings in 0 4; do
+    echo "== $n recordings, $crossings crossing ties per crossing"
+    /usr/bin/time -f "wall %e s, max RSS %M KiB" "$bin" "$n" "--crossing-points=$crossings" --structure
+  done
+done

@@ -1,0 +1,292 @@
+//! `adjust`: one global node per adjustment configuration (thesis 3.5.3, ch. 5): the MM tie points and aerial
+//! control points of the registration stages → corrected recording positions
+//! (`skytie_stages::adjustment::from_correspondences::run`), and the independent check-point evaluation
+//! before/after (thesis 3.5.3: check points triangulated from their panorama observations with the recorded
+//! and the adjusted poses, two-view and multi-view). Check points are never used as control.
+
+use crate::dag::{Handle, NodeCtx, Optional, RawFile, RawFileValue, Stage, StageError};
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::panorama_sizes::pano_sizes;
+use crate::nodes::oblique::consensus::ObliqueOutput;
+use serde::{Deserialize, Serialize};
+use skytie_stages::adjustment::campaign_checkpoints::{compare_checkpoints, CheckPointComparison};
+use skytie_stages::adjustment::config::AdjustConfig;
+use skytie_stages::adjustment::evaluate::MULTI_VIEW_RADIUS_M;
+use skytie_stages::adjustment::from_correspondences::{run, AdjustInputs, AdjustmentRun};
+use skytie_stages::adjustment::{RmseSummary, ViewSelection};
+use skytie_stages::correspondence::{AerialControlPoint, MmTiePoint};
+use skytie_stages::export::{checkpoint_rows, recording_support, CheckPointRow, Support};
+use skytie_stages::nadir::{MmWindowMatch, RecordingControl};
+use skytie_stages::oblique::SparseCloud;
+use std::sync::Arc;
+
+/// σ of a check-point observation in the panorama, pixels (the synthetic campaigns add N(0, 0.5 px)).
+pub const CHECKPOINT_SIGMA_PX: f64 = 0.5;
+
+/// Root-mean-square check-point errors, metres (thesis Tables 3-3…3-5, 5-2…5-9).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Rmse {
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+    pub d2: f64,
+    pub d3: f64,
+    pub count: usize,
+}
+
+impl From<&RmseSummary> for Rmse {
+    fn from(r: &RmseSummary) -> Self {
+        Rmse {
+            x: r.x,
+            y: r.y,
+            z: r.z,
+            d2: r.d2,
+            d3: r.d3,
+            count: r.count,
+        }
+    }
+}
+
+/// Check-point errors before/after with one view selection (thesis 3.5.3).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CheckPointSummary {
+    pub before: Rmse,
+    pub after: Rmse,
+    /// Per point (the rows of `checkpoints.csv`).
+    pub rows: Vec<CheckPointRow>,
+    /// Observations naming an unknown check point or panorama.
+    pub skipped_observations: usize,
+}
+
+impl CheckPointSummary {
+    fn of(c: &CheckPointComparison) -> Self {
+        CheckPointSummary {
+            before: Rmse::from(&c.before.rmse),
+            after: Rmse::from(&c.after.rmse),
+            rows: checkpoint_rows(c),
+            skipped_observations: c.skipped_observations,
+        }
+    }
+}
+
+/// The adjust node's output: the adjustment and the check-point evaluation before/after.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AdjustReport {
+    pub run: AdjustmentRun,
+    /// All recordings within 15 m of a check point (thesis' multi-view evaluation).
+    pub multi_view: CheckPointSummary,
+    /// The two nearest recordings (two-view evaluation).
+    pub two_view: CheckPointSummary,
+}
+crate::serde_artifact!(AdjustReport);
+
+fn rmse_json(r: &Rmse) -> serde_json::Value {
+    serde_json::json!({"x": r.x, "y": r.y, "z": r.z, "2d": r.d2, "3d": r.d3, "count": r.count})
+}
+
+impl AdjustReport {
+    /// The `adjust.<config>` metrics (issue 6): check points before/after, iterations, observations, rejected,
+    /// cost. Recording errors vs truth come from the `grade_adjust` node.
+    pub fn metrics(&self) -> serde_json::Value {
+        let r = &self.run;
+        serde_json::json!({ r.config.sources.label(): {
+            "checkpoints": {
+                "before": rmse_json(&self.multi_view.before),
+                "after": rmse_json(&self.multi_view.after),
+            },
+            "checkpoints_two_view": {
+                "before": rmse_json(&self.two_view.before),
+                "after": rmse_json(&self.two_view.after),
+            },
+            "iterations": r.iterations,
+            "termination": r.termination,
+            "observations": r.observations,
+            "rejected": r.rejected_total,
+            "rejected_by_kind": r.rejected,
+            "cost": r.final_cost,
+            "variance_factor": r.variance_factor,
+            "redundancy": r.redundancy,
+            "build": r.build,
+            "trajectory": recording_metrics(r),
+            "verdict": self.verdict().label(),
+        }})
+    }
+}
+
+/// How far the adjustment moved the recordings and how well it determined them: counts, horizontal shift
+/// (adjusted − recorded) and horizontal σ (√(σx² + σy²)) as median / 95th percentile / maximum, metres. A
+/// recording "with control" observes at least one aerial control point itself; the others are carried by tie
+/// points and relative constraints.
+fn recording_metrics(r: &AdjustmentRun) -> serde_json::Value {
+    let with_control = observes_control(r);
+    let moved: Vec<f64> = r
+        .recordings
+        .iter()
+        .map(|rec| {
+            (rec.adjusted_world[0] - rec.recorded_world[0])
+                .hypot(rec.adjusted_world[1] - rec.recorded_world[1])
+        })
+        .collect();
+    let sigma: Vec<f64> = r
+        .recordings
+        .iter()
+        .map(|rec| rec.sigma_m[0].hypot(rec.sigma_m[1]))
+        .collect();
+    serde_json::json!({
+        "count": r.recordings.len(),
+        "with_control": with_control.iter().filter(|&&c| c).count(),
+        "moved_2d_m": spread(moved),
+        "sigma_2d_m": spread(sigma),
+    })
+}
+
+/// Per recording of the run: whether it observes aerial control itself (`export::Support::Controlled`: a
+/// control point used in the adjustment).
+pub fn observes_control(r: &AdjustmentRun) -> Vec<bool> {
+    recording_support(r)
+        .iter()
+        .map(|s| s.support == Support::Controlled)
+        .collect()
+}
+
+/// Whether an adjustment corrected the trajectory, as far as the run can tell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    /// Some recordings observe aerial control, and the check points (if any) did not get worse.
+    Corrected,
+    /// No recording observes aerial control: the adjustment only smoothed the recorded trajectory.
+    NothingCorrected,
+    /// The check points are farther off after the adjustment than before (by more than 1 mm RMSE 2D).
+    CheckpointsWorse,
+}
+
+impl Verdict {
+    /// The label written into metrics (`adjust.<sources>.verdict`).
+    pub fn label(self) -> &'static str {
+        match self {
+            Verdict::Corrected => "corrected",
+            Verdict::NothingCorrected => "nothing_corrected",
+            Verdict::CheckpointsWorse => "checkpoints_worse",
+        }
+    }
+}
+
+impl AdjustReport {
+    /// See [`Verdict`]. Only a [`Verdict::Corrected`] adjustment is delivered as the adjusted trajectory.
+    pub fn verdict(&self) -> Verdict {
+        let (before, after) = (&self.multi_view.before, &self.multi_view.after);
+        if !observes_control(&self.run).contains(&true) {
+            Verdict::NothingCorrected
+        } else if before.count > 0 && after.d2 > before.d2 + 0.001 {
+            Verdict::CheckpointsWorse
+        } else {
+            Verdict::Corrected
+        }
+    }
+}
+
+/// Median, 95th percentile (nearest rank) and maximum of finite values; nulls when there are none.
+fn spread(mut values: Vec<f64>) -> serde_json::Value {
+    values.retain(|v| v.is_finite());
+    values.sort_by(f64::total_cmp);
+    let at = |q: f64| {
+        (!values.is_empty())
+            .then(|| values[((q * values.len() as f64).ceil() as usize).clamp(1, values.len()) - 1])
+    };
+    serde_json::json!({"median": at(0.5), "p95": at(0.95), "max": values.last()})
+}
+
+/// The adjustment node. Inputs: snapshot, panorama files (snapshot order), the nadir windows' tie points and
+/// the recordings' aerial control points, the oblique chain's sparse clouds (MM tie points) and its consensus
+/// output (oblique control points) — empty lists for a source that is not used.
+pub struct AdjustStage;
+
+impl Stage for AdjustStage {
+    const NAME: &'static str = skytie_stages::adjustment::from_correspondences::STAGE.name;
+    const VERSION: &'static str = skytie_stages::adjustment::from_correspondences::STAGE.version;
+    type Params = AdjustConfig;
+    type Output = AdjustReport;
+    type Inputs = (
+        Handle<CampaignSnapshot>,
+        Vec<RawFile>,
+        Vec<Optional<MmWindowMatch>>,
+        Vec<Optional<RecordingControl>>,
+        Vec<Optional<SparseCloud>>,
+        Vec<Optional<ObliqueOutput>>,
+    );
+
+    fn run(
+        &self,
+        config: &AdjustConfig,
+        (snap, panos, windows, control, clouds, oblique): (
+            Arc<CampaignSnapshot>,
+            Vec<RawFileValue>,
+            Vec<Option<Arc<MmWindowMatch>>>,
+            Vec<Option<Arc<RecordingControl>>>,
+            Vec<Option<Arc<SparseCloud>>>,
+            Vec<Option<Arc<ObliqueOutput>>>,
+        ),
+        _: &NodeCtx,
+    ) -> Result<AdjustReport, StageError> {
+        // Items whose nodes failed are absent: the adjustment uses the rest (the failures are counted).
+        let (windows, control, clouds, oblique) =
+            (flat(windows), flat(control), flat(clouds), flat(oblique));
+        let c = &snap.campaign;
+        let sizes = pano_sizes(&panos)?;
+        let tie_points: Vec<MmTiePoint> = windows
+            .iter()
+            .flat_map(|w| w.tie_points.iter().cloned())
+            .chain(
+                clouds
+                    .iter()
+                    .flat_map(|c| c.points.iter().map(|p| p.tie.clone())),
+            )
+            .collect();
+        let control_points: Vec<AerialControlPoint> = control
+            .iter()
+            .flat_map(|r| r.points.iter().cloned())
+            .chain(
+                oblique
+                    .iter()
+                    .flat_map(|o| o.result.control.iter().cloned()),
+            )
+            .collect();
+        let inputs = AdjustInputs {
+            recordings: &c.recordings,
+            pano_size_px: &sizes,
+            tie_points: &tie_points,
+            control: &control_points,
+            nadir: &c.nadir,
+            oblique: &c.oblique,
+        };
+        let result =
+            run(&inputs, config).map_err(|e| StageError::new(format!("adjustment failed: {e}")))?;
+        let compare = |selection| {
+            compare_checkpoints(
+                &c.recordings,
+                &sizes,
+                &result,
+                &c.checkpoints,
+                &c.observations,
+                selection,
+                CHECKPOINT_SIGMA_PX,
+            )
+            .map(|cmp| CheckPointSummary::of(&cmp))
+            .map_err(|e| StageError::new(format!("check-point evaluation: {e}")))
+        };
+        let multi_view = compare(ViewSelection::WithinRadius {
+            radius_m: MULTI_VIEW_RADIUS_M,
+        })?;
+        let two_view = compare(ViewSelection::TwoNearest)?;
+        Ok(AdjustReport {
+            run: result,
+            multi_view,
+            two_view,
+        })
+    }
+}
+
+/// The present values of optional inputs, in order.
+fn flat<T>(values: Vec<Option<Arc<T>>>) -> Vec<Arc<T>> {
+    values.into_iter().flatten().collect()
+}

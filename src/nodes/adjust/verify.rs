@@ -1,0 +1,105 @@
+//! `verify`: how far off is a trajectory? Per trajectory segment, aerial control points vs the same points
+//! triangulated from the MM data alone (thesis Table 5-13; `skytie_stages::adjustment::verify`), with a
+//! pass/fail flag against a tolerance. The node verifies the recorded positions (no adjustment given: the
+//! thesis' verification without adjusting) or, given the adjustment's result, the adjusted ones.
+
+use crate::dag::{Handle, NodeCtx, Optional, RawFile, RawFileValue, Stage, StageError};
+use crate::nodes::adjust::adjustment::AdjustReport;
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::panorama_sizes::pano_sizes;
+use skytie_stages::adjustment::from_correspondences::RunRecording;
+use skytie_stages::adjustment::verify::{verify, Verification, VerifyConfig};
+use skytie_stages::campaign::Recording;
+use skytie_stages::correspondence::AerialControlPoint;
+use skytie_stages::nadir::RecordingControl;
+use std::collections::HashMap;
+use std::sync::Arc;
+
+crate::serde_artifact!(Verification);
+
+/// `verify` metrics: overall and per-segment offsets and the flag.
+pub fn verify_metrics(v: &Verification) -> serde_json::Value {
+    let seg = |s: &skytie_stages::adjustment::verify::VerificationSegment| {
+        serde_json::json!({
+            "points": s.points,
+            "mean_m": s.mean_m,
+            "sd_m": s.sd_m,
+            "sigma_mean_m": s.sigma_mean_m,
+            "offset_2d_m": s.offset_2d_m,
+            "status": s.status.label(),
+        })
+    };
+    serde_json::json!({
+        "passed": v.passed(),
+        "segments": v.segments.len(),
+        "segments_failed": v.segments.iter().filter(|s| s.status.label() == "fail").count(),
+        "segments_insufficient": v.segments.iter().filter(|s| s.status.label() == "insufficient").count(),
+        "overall": seg(&v.overall),
+        "skipped_single_aerial": v.skipped_single_aerial,
+        "skipped_mm": v.skipped_mm,
+    })
+}
+
+/// The verification node.
+pub struct VerifyStage;
+
+impl Stage for VerifyStage {
+    const NAME: &'static str = skytie_stages::adjustment::verify::STAGE.name;
+    const VERSION: &'static str = skytie_stages::adjustment::verify::STAGE.version;
+    type Params = VerifyConfig;
+    type Output = Verification;
+    /// The campaign, its panoramas, the aerial control points, and no or one adjustment whose poses replace the
+    /// recorded ones.
+    type Inputs = (
+        Handle<CampaignSnapshot>,
+        Vec<RawFile>,
+        Vec<Optional<RecordingControl>>,
+        Vec<Handle<AdjustReport>>,
+    );
+
+    fn run(
+        &self,
+        config: &VerifyConfig,
+        (snap, panos, control, adjusted): (
+            Arc<CampaignSnapshot>,
+            Vec<RawFileValue>,
+            Vec<Option<Arc<RecordingControl>>>,
+            Vec<Arc<AdjustReport>>,
+        ),
+        _: &NodeCtx,
+    ) -> Result<Verification, StageError> {
+        let sizes = pano_sizes(&panos)?;
+        let points: Vec<AerialControlPoint> = control
+            .iter()
+            .flatten()
+            .flat_map(|r| r.points.iter().cloned())
+            .collect();
+        let recordings = match adjusted.first() {
+            Some(report) => adjusted_recordings(&snap.campaign.recordings, report),
+            None => snap.campaign.recordings.clone(),
+        };
+        verify(&recordings, &sizes, &points, config).map_err(StageError::new)
+    }
+}
+
+/// The campaign's recordings at their adjusted poses (position, and yaw where the adjustment estimated it);
+/// recordings the adjustment did not contain keep their recorded pose.
+fn adjusted_recordings(recorded: &[Recording], report: &AdjustReport) -> Vec<Recording> {
+    let adjusted: HashMap<&str, &RunRecording> = report
+        .run
+        .recordings
+        .iter()
+        .map(|r| (r.image_id.as_str(), r))
+        .collect();
+    recorded
+        .iter()
+        .map(|rec| {
+            let mut rec = rec.clone();
+            if let Some(a) = adjusted.get(rec.image_id.as_str()) {
+                [rec.x, rec.y, rec.z] = a.adjusted_world;
+                rec.yaw_deg += a.yaw_correction_deg;
+            }
+            rec
+        })
+        .collect()
+}

@@ -1,0 +1,60 @@
+//! `aerial`: one aerial image's row (nadir or oblique) out of the campaign snapshot — the per-item entry point
+//! for stages that work per (recording × aerial image). Like `recording`, its unchanged output cuts off its
+//! dependents when other rows of the campaign change.
+
+use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::nodes::campaign::load::CampaignSnapshot;
+use skytie_stages::campaign::{AerialImage, AerialKind};
+use skytie_stages::params::StageId;
+use std::sync::Arc;
+
+crate::serde_artifact!(AerialImage);
+
+skytie_stages::params! {
+    /// Parameters of the aerial-row selector (set by the pipeline).
+    pub struct SelectAerialParams {
+        /// The aerial image's id.
+        image_id: String = String::new();
+        /// Nadir or oblique.
+        kind: AerialKind = AerialKind::Nadir;
+    }
+}
+
+/// The stage's identity in cache keys (the computation lives in this node); bump the version whenever its
+/// output for the same inputs and parameters changes.
+pub const STAGE: StageId = StageId {
+    name: "aerial",
+    version: "1",
+};
+
+/// One aerial image's row of the snapshot.
+pub struct SelectAerial;
+
+impl Stage for SelectAerial {
+    const NAME: &'static str = STAGE.name;
+    const VERSION: &'static str = STAGE.version;
+    type Params = SelectAerialParams;
+    type Output = AerialImage;
+    type Inputs = Handle<CampaignSnapshot>;
+
+    fn run(
+        &self,
+        p: &SelectAerialParams,
+        snap: Arc<CampaignSnapshot>,
+        _: &NodeCtx,
+    ) -> Result<AerialImage, StageError> {
+        let rows = match p.kind {
+            AerialKind::Nadir => &snap.campaign.nadir,
+            AerialKind::Oblique => &snap.campaign.oblique,
+        };
+        rows.iter()
+            .find(|r| r.image_id == p.image_id)
+            .cloned()
+            .ok_or_else(|| {
+                StageError::new(format!(
+                    "aerial image '{}' is not in the campaign any more",
+                    p.image_id
+                ))
+            })
+    }
+}

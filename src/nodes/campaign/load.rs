@@ -1,0 +1,152 @@
+//! `campaign`: read and validate a campaign folder (campaign-format.md) into a snapshot, and `recording`: pick
+//! one recording's row out of it — the per-item entry point of the pipeline.
+//!
+//! Keys: the load node hashes the campaign's CSV/TOML files by content (raw-file inputs) plus the listing of all
+//! file names (a parameter), so adding an image or editing a row re-reads the campaign. Every per-recording
+//! node then re-selects its row; rows that did not change produce identical output, so by early cutoff only the
+//! new or edited recordings' downstream nodes run again.
+
+use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use serde::{Deserialize, Serialize};
+use skytie_stages::campaign::{
+    read_sourced, Campaign, Problem, Recording, SourceRows, SourcedCampaign,
+};
+use skytie_stages::params::StageId;
+use std::path::Path;
+use std::sync::Arc;
+
+/// The campaign's metadata files, in a fixed order (only those that exist are inputs).
+pub const METADATA_FILES: [&str; 6] = [
+    "campaign.toml",
+    "mm/recordings.csv",
+    "aerial/nadir/cameras.csv",
+    "aerial/oblique/cameras.csv",
+    "control/checkpoints.csv",
+    "control/observations.csv",
+];
+
+skytie_stages::params! {
+    /// Parameters of the load node (set by the pipeline, not by users).
+    pub struct LoadCampaignParams {
+        /// The campaign folder (absolute).
+        root: String = String::new();
+        /// blake3 of the sorted list of every file name below the folder (so file presence is part of the key).
+        listing_hash: String = String::new();
+    }
+}
+
+/// A validated campaign and the problems found while reading it (bad rows were skipped, never guessed).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CampaignSnapshot {
+    pub campaign: Campaign,
+    /// The row each item came from (parallel to the campaign's vectors).
+    pub rows: SourceRows,
+    pub problems: Vec<Problem>,
+}
+
+impl CampaignSnapshot {
+    pub fn new(sourced: SourcedCampaign, problems: Vec<Problem>) -> Self {
+        CampaignSnapshot {
+            campaign: sourced.campaign,
+            rows: sourced.rows,
+            problems,
+        }
+    }
+
+    /// The campaign with its rows (a copy).
+    pub fn sourced(&self) -> SourcedCampaign {
+        SourcedCampaign {
+            campaign: self.campaign.clone(),
+            rows: self.rows.clone(),
+        }
+    }
+}
+crate::serde_artifact!(CampaignSnapshot, Recording);
+
+/// The raw-file inputs of the load node for the campaign in `root`.
+pub fn metadata_inputs(root: &Path) -> Vec<RawFile> {
+    METADATA_FILES
+        .iter()
+        .map(|f| root.join(f))
+        .filter(|p| p.is_file())
+        .map(RawFile)
+        .collect()
+}
+
+/// blake3 (hex) of the sorted relative names of every file below `root` (not their contents).
+pub fn listing_hash(root: &Path) -> std::io::Result<String> {
+    let files = crate::nodes::campaign::synth::list_files(root)?;
+    let mut h = blake3::Hasher::new();
+    for (name, _) in &files {
+        h.update(name.as_bytes());
+        h.update(&[0]);
+    }
+    Ok(h.finalize().to_hex().to_string())
+}
+
+/// Reads the campaign and validates its rows (the images are validated by `nodes::validate`).
+pub struct LoadCampaign;
+
+impl Stage for LoadCampaign {
+    const NAME: &'static str = skytie_stages::campaign::read::STAGE.name;
+    const VERSION: &'static str = skytie_stages::campaign::read::STAGE.version;
+    type Params = LoadCampaignParams;
+    type Output = CampaignSnapshot;
+    type Inputs = Vec<RawFile>;
+
+    fn run(
+        &self,
+        p: &LoadCampaignParams,
+        _files: Vec<RawFileValue>,
+        _: &NodeCtx,
+    ) -> Result<CampaignSnapshot, StageError> {
+        let (sourced, problems) = read_sourced(Path::new(&p.root))
+            .map_err(|e| StageError::new(format!("cannot read the campaign: {e}")))?;
+        Ok(CampaignSnapshot::new(sourced, problems))
+    }
+}
+
+skytie_stages::params! {
+    /// Parameters of the per-recording selector (set by the pipeline).
+    pub struct SelectRecordingParams {
+        /// The recording's `image_id`.
+        image_id: String = String::new();
+    }
+}
+
+/// The stage's identity in cache keys (the computation lives in this node); bump the version whenever its
+/// output for the same inputs and parameters changes.
+pub const RECORDING_STAGE: StageId = StageId {
+    name: "recording",
+    version: "1",
+};
+
+/// One recording's row of the snapshot.
+pub struct SelectRecording;
+
+impl Stage for SelectRecording {
+    const NAME: &'static str = RECORDING_STAGE.name;
+    const VERSION: &'static str = RECORDING_STAGE.version;
+    type Params = SelectRecordingParams;
+    type Output = Recording;
+    type Inputs = Handle<CampaignSnapshot>;
+
+    fn run(
+        &self,
+        p: &SelectRecordingParams,
+        snap: Arc<CampaignSnapshot>,
+        _: &NodeCtx,
+    ) -> Result<Recording, StageError> {
+        snap.campaign
+            .recordings
+            .iter()
+            .find(|r| r.image_id == p.image_id)
+            .cloned()
+            .ok_or_else(|| {
+                StageError::new(format!(
+                    "recording '{}' is not in the campaign any more",
+                    p.image_id
+                ))
+            })
+    }
+}

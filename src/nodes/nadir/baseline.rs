@@ -1,0 +1,44 @@
+//! `baseline`: the chapter-2 baseline matcher (thesis 2.2.3: isolated Förstner keypoints in the aerial image +
+//! NCC template matching, `skytie_stages::nadir::baseline`) in place of the phase-correlation `refine` node when
+//! `[nadir] matcher = "baseline"` — so thesis Table 2-10's comparison can be regenerated as a sweep.
+
+use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::nodes::nadir::refine::locate_with_accepted;
+use skytie_stages::campaign::AerialImage;
+use skytie_stages::nadir::baseline::{baseline_matches, BaselineParams};
+use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, OrthoImage, TransformOutcome};
+use std::sync::Arc;
+
+/// The baseline matching node (same inputs and output as `refine`).
+pub struct BaselineStage;
+
+impl Stage for BaselineStage {
+    const NAME: &'static str = skytie_stages::nadir::baseline::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::baseline::STAGE.version;
+    type Params = BaselineParams;
+    type Output = AerialRefinement;
+    type Inputs = (
+        Handle<OrthoImage>,
+        RawFile,
+        Handle<AerialImage>,
+        Handle<TransformOutcome>,
+        Handle<MmWindowMatch>,
+    );
+
+    fn run(
+        &self,
+        p: &BaselineParams,
+        (ortho, aerial_file, aerial, outcome, window): (
+            Arc<OrthoImage>,
+            RawFileValue,
+            Arc<AerialImage>,
+            Arc<TransformOutcome>,
+            Arc<MmWindowMatch>,
+        ),
+        _: &NodeCtx,
+    ) -> Result<AerialRefinement, StageError> {
+        locate_with_accepted(&outcome, &window, &aerial, &aerial_file, |t, image| {
+            baseline_matches(&ortho, image, &aerial, t, &window, p)
+        })
+    }
+}

@@ -1,0 +1,53 @@
+//! `control`: per recording, its window's tie points gathered across all overlapping nadir images, checked for
+//! consistency and triangulated from the aerial images → aerial control points (thesis 3.4.5.4,
+//! `skytie_stages::nadir::control_points`).
+
+use crate::dag::{Handle, NodeCtx, Optional, Stage, StageError};
+use skytie_stages::campaign::AerialImage;
+use skytie_stages::nadir::control_points::{aerial_control_points, ControlParams};
+use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, RecordingControl};
+use std::sync::Arc;
+
+crate::serde_artifact!(RecordingControl);
+
+/// The aerial-control-point node; refinements and aerial rows are parallel lists.
+pub struct ControlStage;
+
+impl Stage for ControlStage {
+    const NAME: &'static str = skytie_stages::nadir::control_points::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::control_points::STAGE.version;
+    type Params = ControlParams;
+    type Output = RecordingControl;
+    type Inputs = (
+        Handle<MmWindowMatch>,
+        Vec<Optional<AerialRefinement>>,
+        Vec<Handle<AerialImage>>,
+    );
+
+    fn run(
+        &self,
+        p: &ControlParams,
+        (window, refinements, aerials): (
+            Arc<MmWindowMatch>,
+            Vec<Option<Arc<AerialRefinement>>>,
+            Vec<Arc<AerialImage>>,
+        ),
+        _: &NodeCtx,
+    ) -> Result<RecordingControl, StageError> {
+        if refinements.len() != aerials.len() {
+            return Err(StageError::new(
+                "internal: control needs one aerial row per refinement",
+            ));
+        }
+        let pairs: Vec<(&AerialImage, &AerialRefinement)> = aerials
+            .iter()
+            .map(|a| a.as_ref())
+            .zip(&refinements)
+            .filter_map(|(a, r)| r.as_deref().map(|r| (a, r)))
+            .collect();
+        Ok(RecordingControl {
+            recording_id: window.recording_id.clone(),
+            points: aerial_control_points(&window, &pairs, p),
+        })
+    }
+}

@@ -1,0 +1,46 @@
+//! `ortho_aerial`: per (recording × nadir image), the panorama ortho-projected at the aerial image's ground
+//! sampling distance and rotated to its orientation (thesis 3.4.3 and 3.4.5.2: "the MM are ortho-projected again
+//! for this step, but with a resolution of 10 cm"), so that MM and aerial patches differ by about a translation.
+
+use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use skytie_stages::campaign::{AerialImage, Recording};
+use skytie_stages::geometry::FrameCamera;
+use skytie_stages::nadir::aerial_overlap::foot_point_world;
+use skytie_stages::nadir::aerial_patch::ortho_params_for_aerial;
+use skytie_stages::nadir::{ortho_project, OrthoImage, OrthoParams};
+use std::sync::Arc;
+
+/// The aerial-oriented ortho-projection node. Its params are the workflow's `[ortho]` table (diagonal,
+/// vehicle mask); `gsd_m` and `rotation_deg` are replaced by the aerial image's.
+pub struct OrthoForAerial;
+
+impl Stage for OrthoForAerial {
+    const NAME: &'static str = skytie_stages::nadir::aerial_patch::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::aerial_patch::STAGE.version;
+    type Params = OrthoParams;
+    type Output = OrthoImage;
+    type Inputs = (Handle<Recording>, RawFile, Handle<AerialImage>);
+
+    fn run(
+        &self,
+        base: &OrthoParams,
+        (rec, pano, aerial): (Arc<Recording>, RawFileValue, Arc<AerialImage>),
+        _: &NodeCtx,
+    ) -> Result<OrthoImage, StageError> {
+        // Shared with the recording's other ortho nodes (one decode per panorama while it stays in memory).
+        let image = crate::nodes::campaign::decoded_images::gray(&pano)?;
+        let cam = FrameCamera::from_aerial(&aerial);
+        let params = ortho_params_for_aerial(&cam, foot_point_world(&rec), base);
+        if let Err(errs) = skytie_stages::params::Params::validate(&params) {
+            return Err(StageError::new(format!(
+                "aerial image '{}': the ortho parameters derived from it are invalid ({})",
+                aerial.image_id,
+                errs.iter()
+                    .map(|v| format!("{}: {}", v.field, v.message))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            )));
+        }
+        Ok(ortho_project(&image, &rec, &params))
+    }
+}

@@ -1,0 +1,82 @@
+//! `refine`: per (recording × nadir image) with an accepted initial transform, every MM tie point of the
+//! recording's window located in the aerial image by phase correlation (thesis 3.4.5.3,
+//! `skytie_stages::nadir::refine`), each template first compared with the window's neighbouring recordings'
+//! views (their orthos for the same aerial image, `skytie_stages::nadir::parallax_check`). A rejected transform
+//! gives an empty refinement.
+
+use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::nodes::campaign::decoded_images;
+use skytie_stages::campaign::AerialImage;
+use skytie_stages::imaging::GrayImage;
+use skytie_stages::nadir::refine::{refine_in_aerial, NeighbourOrtho, RefineParams};
+use skytie_stages::nadir::{
+    AerialRefinement, InitialTransform, MmWindowMatch, OrthoImage, TransformOutcome,
+};
+use std::sync::Arc;
+
+crate::serde_artifact!(AerialRefinement);
+
+/// The phase-correlation refinement node.
+pub struct RefineStage;
+
+impl Stage for RefineStage {
+    const NAME: &'static str = skytie_stages::nadir::refine::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::refine::STAGE.version;
+    type Params = RefineParams;
+    type Output = AerialRefinement;
+    type Inputs = (
+        Handle<OrthoImage>,
+        RawFile,
+        Handle<AerialImage>,
+        Handle<TransformOutcome>,
+        Handle<MmWindowMatch>,
+        Vec<Handle<OrthoImage>>,
+    );
+
+    fn run(
+        &self,
+        p: &RefineParams,
+        (ortho, aerial_file, aerial, outcome, window, neighbour_orthos): (
+            Arc<OrthoImage>,
+            RawFileValue,
+            Arc<AerialImage>,
+            Arc<TransformOutcome>,
+            Arc<MmWindowMatch>,
+            Vec<Arc<OrthoImage>>,
+        ),
+        _: &NodeCtx,
+    ) -> Result<AerialRefinement, StageError> {
+        // The neighbours' orthos come in the window's neighbour order (`window.pairs`).
+        let neighbours: Vec<NeighbourOrtho> = window
+            .pairs
+            .iter()
+            .zip(&neighbour_orthos)
+            .map(|(pair, o)| NeighbourOrtho {
+                recording_id: &pair.to_id,
+                ortho: o,
+            })
+            .collect();
+        locate_with_accepted(&outcome, &window, &aerial, &aerial_file, |t, image| {
+            refine_in_aerial(&ortho, image, &aerial, t, &window, &neighbours, p)
+        })
+    }
+}
+
+/// Shared by `refine` and `baseline`: an empty refinement when the transform was rejected, else `locate` on
+/// the decoded aerial image.
+pub fn locate_with_accepted(
+    outcome: &TransformOutcome,
+    window: &MmWindowMatch,
+    aerial: &AerialImage,
+    aerial_file: &RawFileValue,
+    locate: impl FnOnce(&InitialTransform, &GrayImage) -> AerialRefinement,
+) -> Result<AerialRefinement, StageError> {
+    let TransformOutcome::Accepted(t) = outcome else {
+        return Ok(AerialRefinement::empty(
+            &window.recording_id,
+            &aerial.image_id,
+        ));
+    };
+    let image = decoded_images::gray(aerial_file)?;
+    Ok(locate(t, &image))
+}

@@ -1,0 +1,53 @@
+//! `nadir`: the global summary of the nadir pipeline — counts of MM pairs, tie points, transforms,
+//! correspondences and control points (`skytie_stages::nadir::summary`), contributed to metrics as `nadir`.
+
+use crate::dag::{Handle, NodeCtx, Optional, Stage, StageError};
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::summary::SummaryParams;
+use skytie_stages::nadir::summary::NadirSummary;
+use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, RecordingControl, TransformOutcome};
+use std::sync::Arc;
+
+crate::serde_artifact!(NadirSummary);
+
+/// The nadir summary node (no tunable parameters).
+pub struct SummarizeNadir;
+
+impl Stage for SummarizeNadir {
+    const NAME: &'static str = skytie_stages::nadir::summary::STAGE.name;
+    const VERSION: &'static str = skytie_stages::nadir::summary::STAGE.version;
+    type Params = SummaryParams;
+    type Output = NadirSummary;
+    type Inputs = (
+        Handle<CampaignSnapshot>,
+        Vec<Optional<MmWindowMatch>>,
+        Vec<Optional<TransformOutcome>>,
+        Vec<Optional<AerialRefinement>>,
+        Vec<Optional<RecordingControl>>,
+    );
+
+    fn run(
+        &self,
+        _: &SummaryParams,
+        (snap, windows, transforms, refinements, control): (
+            Arc<CampaignSnapshot>,
+            Vec<Option<Arc<MmWindowMatch>>>,
+            Vec<Option<Arc<TransformOutcome>>>,
+            Vec<Option<Arc<AerialRefinement>>>,
+            Vec<Option<Arc<RecordingControl>>>,
+        ),
+        _: &NodeCtx,
+    ) -> Result<NadirSummary, StageError> {
+        let w: Vec<&MmWindowMatch> = windows.iter().flatten().map(|x| x.as_ref()).collect();
+        let t: Vec<&TransformOutcome> = transforms.iter().flatten().map(|x| x.as_ref()).collect();
+        let r: Vec<&AerialRefinement> = refinements.iter().flatten().map(|x| x.as_ref()).collect();
+        let c: Vec<&RecordingControl> = control.iter().flatten().map(|x| x.as_ref()).collect();
+        Ok(NadirSummary::from_parts(
+            snap.campaign.recordings.len(),
+            &w,
+            &t,
+            &r,
+            &c,
+        ))
+    }
+}

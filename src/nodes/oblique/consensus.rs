@@ -1,0 +1,62 @@
+//! `oblique`: one global node per variant — the 3-D median consensus of every (panorama × oblique image)
+//! registration set, optional consensus tracking, and the oblique control points (thesis 4.4.7,
+//! `skytie_stages::oblique::consensus`), with the pipeline's own counts (`oblique.*` metrics that need no truth).
+
+use crate::dag::{Handle, NodeCtx, Optional, RawFile, RawFileValue, Stage, StageError};
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::panorama_sizes::pano_sizes;
+use serde::{Deserialize, Serialize};
+use skytie_stages::oblique::consensus::{consensus, ConsensusParams};
+use skytie_stages::oblique::summary::ObliqueSummary;
+use skytie_stages::oblique::{ObliqueResult, PatchRegistrationSet, SparseCloud, TripletFacades};
+use std::sync::Arc;
+
+/// The consensus node's output: the correspondences and control points, and the pipeline's counts.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ObliqueOutput {
+    pub result: ObliqueResult,
+    pub summary: ObliqueSummary,
+}
+crate::serde_artifact!(ObliqueOutput);
+
+/// The consensus node. Inputs: snapshot, panorama files (snapshot order), every triplet's sparse cloud and
+/// façades, every registration set.
+pub struct ConsensusStage;
+
+impl Stage for ConsensusStage {
+    const NAME: &'static str = skytie_stages::oblique::consensus::STAGE.name;
+    const VERSION: &'static str = skytie_stages::oblique::consensus::STAGE.version;
+    type Params = ConsensusParams;
+    type Output = ObliqueOutput;
+    type Inputs = (
+        Handle<CampaignSnapshot>,
+        Vec<RawFile>,
+        Vec<Optional<SparseCloud>>,
+        Vec<Optional<TripletFacades>>,
+        Vec<Optional<PatchRegistrationSet>>,
+    );
+
+    fn run(
+        &self,
+        p: &ConsensusParams,
+        (snap, panos, clouds, facades, sets): (
+            Arc<CampaignSnapshot>,
+            Vec<RawFileValue>,
+            Vec<Option<Arc<SparseCloud>>>,
+            Vec<Option<Arc<TripletFacades>>>,
+            Vec<Option<Arc<PatchRegistrationSet>>>,
+        ),
+        _: &NodeCtx,
+    ) -> Result<ObliqueOutput, StageError> {
+        let c = &snap.campaign;
+        let sizes = pano_sizes(&panos)?;
+        let clouds: Vec<SparseCloud> = clouds.iter().flatten().map(|x| (**x).clone()).collect();
+        let facades: Vec<TripletFacades> =
+            facades.iter().flatten().map(|x| (**x).clone()).collect();
+        let sets: Vec<PatchRegistrationSet> =
+            sets.iter().flatten().map(|x| (**x).clone()).collect();
+        let result = consensus(&sets, &clouds, &c.recordings, &c.oblique, &sizes, p);
+        let summary = ObliqueSummary::from_parts(&clouds, &facades, &sets, &result);
+        Ok(ObliqueOutput { result, summary })
+    }
+}

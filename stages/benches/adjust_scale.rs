@@ -1,0 +1,139 @@
+//! City-scale benchmark of the adjustment on image-free street-network blocks
+//! ([`skytie_stages::adjustment::synthetic_streets`]): N recordings (first argument, default 10⁴) on a grid of
+//! streets driven in both directions, 20 panorama observations and 0.375 control points per recording,
+//! relative constraints, recorded positions off by a slowly varying GNSS bias. Prints the generation and
+//! adjustment times, LM iterations, the peak resident memory (VmHWM) and the RMS horizontal error before and
+//! after. `--structure` also prints the size of the reduced camera matrix and of its sparse factor.
+//! Run through `benches/adjust_scale.sh` for the 10⁴ / 10⁵ / 10⁶ table.
+
+use skytie_stages::adjustment::layout::ReducedStructure;
+use skytie_stages::adjustment::prepared::{Prepared, Rejected};
+use skytie_stages::adjustment::residuals::State;
+use skytie_stages::adjustment::synthetic_streets::StreetBlockSpec;
+use skytie_stages::adjustment::{adjust, AdjustOptions, Block};
+use skytie_stages::geometry::LocalOrigin;
+use std::time::Instant;
+
+fn peak_rss_mib() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+        })
+        .map_or(f64::NAN, |kib| kib / 1024.0)
+}
+
+fn rms_xy(
+    positions: impl Iterator<Item = nalgebra::Vector3<f64>>,
+    truth: &[nalgebra::Vector3<f64>],
+) -> f64 {
+    let (sum, n) = positions.zip(truth).fold((0.0, 0usize), |(s, n), (p, t)| {
+        (s + (p - t).xy().norm_squared(), n + 1)
+    });
+    (sum / n.max(1) as f64).sqrt()
+}
+
+fn structure(block: &Block, options: &AdjustOptions) -> ReducedStructure {
+    let origin =
+        LocalOrigin::at_mean(block.recordings.iter().map(|r| &r.camera.center_world)).unwrap();
+    let state = State {
+        origin,
+        centers_local: block
+            .recordings
+            .iter()
+            .map(|r| origin.to_local(&r.camera.center_world))
+            .collect(),
+        yaw_correction_rad: vec![0.0; block.recordings.len()],
+        points_local: block
+            .points_initial_world
+            .iter()
+            .map(|p| origin.to_local(p))
+            .collect(),
+    };
+    Prepared::new(block, options, &state, &Rejected::none(block))
+        .unwrap()
+        .structure
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let n: usize = args
+        .iter()
+        .find(|a| !a.starts_with("--"))
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(10_000);
+    let crossing_points = args
+        .iter()
+        .find_map(|a| a.strip_prefix("--crossing-points="))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(StreetBlockSpec::default().crossing_points);
+    let spec = StreetBlockSpec {
+        recordings: n,
+        crossing_points,
+        seed: 42,
+        ..StreetBlockSpec::default()
+    };
+    let t0 = Instant::now();
+    let synth = spec.generate();
+    let t_gen = t0.elapsed().as_secs_f64();
+    let b = &synth.block;
+    let options = AdjustOptions::default();
+    let before = rms_xy(
+        b.recordings.iter().map(|r| r.camera.center_world),
+        &synth.true_centers_world,
+    );
+    if args.iter().any(|a| a == "--structure-only") {
+        print_structure(b, &options);
+        return;
+    }
+    let t1 = Instant::now();
+    let adj = adjust(b, &options).expect("adjustment");
+    let t_adjust = t1.elapsed().as_secs_f64();
+    let after = rms_xy(
+        adj.recordings.iter().map(|r| r.position_world),
+        &synth.true_centers_world,
+    );
+    let sigma_mean = adj
+        .recordings
+        .iter()
+        .map(|r| r.sigma_a_priori_m.xy().norm())
+        .sum::<f64>()
+        / adj.recordings.len() as f64;
+    println!(
+        "adjust_scale: {n} recordings, {} points ({} at crossings), {} pano obs, {} control, {} relative; \
+         generate {t_gen:.2} s; adjust {t_adjust:.2} s ({} iterations, {:?}); peak RSS {:.0} MiB; \
+         RMS horizontal error {before:.3} m -> {after:.4} m; mean a-priori sigma_xy {sigma_mean:.4} m",
+        b.points_initial_world.len(),
+        synth.crossing_points,
+        b.pano_observations.len(),
+        b.control_points.len(),
+        b.relative_constraints.len(),
+        adj.iterations,
+        adj.termination,
+        peak_rss_mib(),
+    );
+    if args.iter().any(|a| a == "--structure") {
+        drop(adj);
+        print_structure(b, &options);
+    }
+}
+
+fn print_structure(b: &Block, options: &AdjustOptions) {
+    let s = structure(b, options);
+    println!(
+        "structure: reduced matrix {} blocks (lower), factor {} blocks (lower, incl. diagonal); fill ratio {:.2}",
+        s.rows.len(),
+        s.symbolic.lower_blocks() + s.symbolic.dim(),
+        (s.symbolic.lower_blocks() + s.symbolic.dim()) as f64 / s.rows.len() as f64
+    );
+    let lens: Vec<usize> = (0..s.symbolic.dim())
+        .map(|j| s.symbolic.column(j).len())
+        .collect();
+    let updates: usize = lens.iter().map(|l| l * (l + 1) / 2).sum();
+    println!(
+        "factor: longest column {} blocks, {updates} block updates per factorisation",
+        lens.iter().max().unwrap_or(&0)
+    );
+}

@@ -1,0 +1,154 @@
+//! Pix4D exports: the calibrated internal camera parameters file (`*_pix4d_calibrated_internal_camera_
+//! parameters.cam`: `F`, `Px`, `Py` in millimetres "assuming a sensor width of W×H mm", radial `K1…K3`,
+//! tangential `T1`, `T2`) and, through [`super::opk_list::OpkListFormat::pix4d`], the calibrated external
+//! camera parameters list. Followed: Pix4D support articles "How are the internal and external camera
+//! parameters defined?" (perspective lens) and the output file descriptions of Pix4Dmapper 4.x.
+
+use super::camera_model::Pix4dInternals;
+use crate::campaign::Problem;
+use std::path::Path;
+
+/// The values of a `.cam` file.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Pix4dCamFile {
+    pub focal_mm: f64,
+    pub px_mm: f64,
+    pub py_mm: f64,
+    pub k1: f64,
+    pub k2: f64,
+    pub k3: f64,
+    pub t1: f64,
+    pub t2: f64,
+    /// From the comment "assuming a sensor width of W×H mm", if present.
+    pub sensor_width_mm: Option<f64>,
+    pub sensor_height_mm: Option<f64>,
+}
+
+impl Pix4dCamFile {
+    /// Internals for images of `width_px` × `height_px`; the pixel size is the sensor width over the image
+    /// width (`Err` when the file does not state the sensor width: the millimetres cannot be converted).
+    pub fn internals(
+        &self,
+        path: &Path,
+        width_px: u32,
+        height_px: u32,
+    ) -> Result<Pix4dInternals, Problem> {
+        let sensor = self.sensor_width_mm.ok_or_else(|| {
+            Problem::error(path, None, Some("F"), "the file does not state the sensor width its millimetres assume", "keep Pix4D's comment line '#Focal Length mm assuming a sensor width of W x H mm', or set sensor_width_mm in the import configuration")
+        })?;
+        Ok(Pix4dInternals {
+            focal_mm: self.focal_mm,
+            px_mm: self.px_mm,
+            py_mm: self.py_mm,
+            r1: self.k1,
+            r2: self.k2,
+            r3: self.k3,
+            t1: self.t1,
+            t2: self.t2,
+            pixel_size_mm: sensor / f64::from(width_px),
+            width_px,
+            height_px,
+        })
+    }
+}
+
+/// Read a `.cam` file; every key must appear once with a finite number (K1…K3, T1, T2 default to 0).
+pub fn read_pix4d_cam(path: &Path) -> Result<Pix4dCamFile, Vec<Problem>> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        vec![Problem::error(
+            path,
+            None,
+            None,
+            format!("cannot be read ({e})"),
+            "check the path in the import configuration",
+        )]
+    })?;
+    let mut cam = Pix4dCamFile::default();
+    let mut seen = [false; 3];
+    let mut problems = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let t = line.trim();
+        if let Some(comment) = t.strip_prefix('#') {
+            if let Some((w, h)) = sensor_size(comment) {
+                cam.sensor_width_mm = Some(w);
+                cam.sensor_height_mm = Some(h);
+            }
+            continue;
+        }
+        let mut parts = t.split_whitespace();
+        let (Some(key), Some(value), None) = (parts.next(), parts.next(), parts.next()) else {
+            continue; // the title line "Pix4D camera calibration file 0" and blank lines
+        };
+        let slot = match key {
+            "F" => &mut cam.focal_mm,
+            "Px" => &mut cam.px_mm,
+            "Py" => &mut cam.py_mm,
+            "K1" => &mut cam.k1,
+            "K2" => &mut cam.k2,
+            "K3" => &mut cam.k3,
+            "T1" => &mut cam.t1,
+            "T2" => &mut cam.t2,
+            _ => continue,
+        };
+        match value.parse::<f64>() {
+            Ok(v) if v.is_finite() => *slot = v,
+            _ => problems.push(Problem::error(
+                path,
+                Some(i + 1),
+                Some(key),
+                format!("'{value}' is not a finite number"),
+                "write a decimal number with '.' as decimal mark",
+            )),
+        }
+        if let Some(k) = ["F", "Px", "Py"].iter().position(|k| *k == key) {
+            seen[k] = true;
+        }
+    }
+    for (k, name) in ["F", "Px", "Py"].iter().enumerate() {
+        if !seen[k] {
+            problems.push(Problem::error(
+                path,
+                None,
+                Some(name),
+                "is missing",
+                "this is not a Pix4D internal camera parameters file (.cam) or it is truncated",
+            ));
+        }
+    }
+    if cam.focal_mm <= 0.0 && seen[0] {
+        problems.push(Problem::error(
+            path,
+            None,
+            Some("F"),
+            format!("{} mm is not a focal length", cam.focal_mm),
+            "give the focal length in mm, > 0",
+        ));
+    }
+    if problems.is_empty() {
+        Ok(cam)
+    } else {
+        Err(problems)
+    }
+}
+
+/// "Focal Length mm assuming a sensor width of 12.83x9.62mm" → (12.83, 9.62).
+fn sensor_size(comment: &str) -> Option<(f64, f64)> {
+    let rest = comment.split("sensor width of").nth(1)?.trim();
+    let rest = rest.trim_end_matches("mm").trim();
+    let (w, h) = rest.split_once(['x', 'X', '×'])?;
+    Some((
+        w.trim().parse().ok()?,
+        h.trim().trim_end_matches("mm").trim().parse().ok()?,
+    ))
+}
+
+/// Write a `.cam` file of `p` (sensor size = pixel size × image size).
+pub fn write_pix4d_cam(path: &Path, p: &Pix4dInternals) -> std::io::Result<()> {
+    let w = p.pixel_size_mm * f64::from(p.width_px);
+    let h = p.pixel_size_mm * f64::from(p.height_px);
+    let text = format!(
+        "Pix4D camera calibration file 0\n#Focal Length mm assuming a sensor width of {w}x{h}mm\nF {}\n#Principal Point mm\nPx {}\nPy {}\n#Symmetrical Lens Distortion Coeffs\nK1 {}\nK2 {}\nK3 {}\n#Tangential Lens Distortion Coeffs\nT1 {}\nT2 {}\n",
+        p.focal_mm, p.px_mm, p.py_mm, p.r1, p.r2, p.r3, p.t1, p.t2
+    );
+    crate::fsutil::atomic_write(path, text.as_bytes())
+}

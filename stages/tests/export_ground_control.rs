@@ -1,0 +1,223 @@
+//! Ground-control exports read back by readers that follow each tool's documented format: OpenSfM's
+//! `gcp_list.txt` rules (projection line `WGS84`, `WGS84 UTM <zone>`, a PROJ string or `EPSG:<code>`; then
+//! `x y z px py image [extras]`, `#` comments, pixel centres on integers), Metashape's reference CSV
+//! (`nxyzXYZ`) and projection list. The fixture lines are the documentation's own examples.
+
+use skytie_stages::campaign::{AerialImage, AerialKind, Campaign, Recording};
+use skytie_stages::correspondence::{AerialControlPoint, AerialObservation, PanoObservation};
+use skytie_stages::export::{opensfm_projection, write_ground_control};
+
+/// One parsed `gcp_list.txt` observation: x, y, z, px, py, image, extras.
+type GcpLine = (f64, f64, f64, f64, f64, String, Vec<String>);
+
+/// A reader of `gcp_list.txt` as OpenSfM documents it; Err names the line.
+fn read_gcp_list(text: &str) -> Result<(String, Vec<GcpLine>), String> {
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let (_, projection) = lines.next().ok_or("empty file")?;
+    let p = projection.trim();
+    let known = p == "WGS84"
+        || p.to_uppercase().starts_with("WGS84 UTM")
+        || p.contains("+proj")
+        || p.to_uppercase().starts_with("EPSG:");
+    if !known {
+        return Err(format!("line 1: unsupported projection '{p}'"));
+    }
+    let mut out = Vec::new();
+    for (i, l) in lines {
+        let words: Vec<&str> = l.split_whitespace().collect();
+        if words.len() < 6 {
+            return Err(format!("line {}: {} fields, need 6", i + 1, words.len()));
+        }
+        let n = |k: usize| {
+            words[k]
+                .parse::<f64>()
+                .map_err(|e| format!("line {}: field {}: {e}", i + 1, k + 1))
+        };
+        out.push((
+            n(0)?,
+            n(1)?,
+            n(2)?,
+            n(3)?,
+            n(4)?,
+            words[5].to_string(),
+            words[6..].iter().map(|s| s.to_string()).collect(),
+        ));
+    }
+    Ok((p.to_string(), out))
+}
+
+#[test]
+fn the_reader_accepts_the_documented_examples() {
+    // OpenDroneMap's documentation example (UTM 17N by EPSG code), and OpenSfM's UTM form.
+    let doc = "EPSG:32617\n\
+               # comment lines are allowed\n\
+               274914.738 4603349.014 400 3044 2622 IMG_0525.jpg gcp1\n";
+    let (p, lines) = read_gcp_list(doc).unwrap();
+    assert_eq!(p, "EPSG:32617");
+    assert_eq!(lines[0].5, "IMG_0525.jpg");
+    assert_eq!(lines[0].6, ["gcp1"]);
+    let (_, l) = read_gcp_list("WGS84 UTM 32N\n481367 5782936 100 10 20 a.jpg\n").unwrap();
+    assert_eq!(l.len(), 1);
+    assert!(read_gcp_list("RD New\n1 2 3 4 5 a.jpg\n").is_err());
+}
+
+fn campaign(crs: &str) -> Campaign {
+    let rec = |id: &str, file: &str| Recording {
+        image_id: id.into(),
+        file: file.into(),
+        time: "2020-01-01T00:00:00Z".into(),
+        time_s: 1_577_836_800.0,
+        x: 1.0,
+        y: 2.0,
+        z: 3.0,
+        heading_deg: 0.0,
+        camera_height_m: 2.5,
+        sigma_xy_m: None,
+        sigma_z_m: None,
+        yaw_deg: 0.0,
+        pitch_deg: 0.0,
+        roll_deg: 0.0,
+    };
+    let nadir = |id: &str, file: &str| AerialImage {
+        image_id: id.into(),
+        file: file.into(),
+        x: 0.0,
+        y: 0.0,
+        z: 4000.0,
+        omega_deg: 0.0,
+        phi_deg: 0.0,
+        kappa_deg: 0.0,
+        focal_px: 10000.0,
+        cx_px: 2000.0,
+        cy_px: 1500.0,
+        width_px: 4000,
+        height_px: 3000,
+        k1: 0.0,
+        k2: 0.0,
+        k3: 0.0,
+        k4: 0.0,
+        p1: 0.0,
+        p2: 0.0,
+        b1: 0.0,
+        b2: 0.0,
+        sigma_px: 0.5,
+    };
+    Campaign {
+        crs: crs.into(),
+        recordings: vec![rec("p1", "pano 1.jpg"), rec("p2", "sub/p2.jpg")],
+        nadir: vec![nadir("n1", "n1.tif"), nadir("n2", "n2.tif")],
+        ..Campaign::default()
+    }
+}
+
+fn control() -> Vec<AerialControlPoint> {
+    let aerial = |id: &str, u: f64, v: f64| AerialObservation {
+        image_id: id.into(),
+        kind: AerialKind::Nadir,
+        u_px: u,
+        v_px: v,
+        score: 0.9,
+    };
+    vec![
+        AerialControlPoint {
+            tie_point_id: "t 1".into(),
+            mm: vec![
+                PanoObservation {
+                    image_id: "p1".into(),
+                    u_px: 100.5,
+                    v_px: 200.25,
+                },
+                PanoObservation {
+                    image_id: "p2".into(),
+                    u_px: 110.0,
+                    v_px: 210.0,
+                },
+            ],
+            aerial: vec![aerial("n1", 1000.5, 800.5), aerial("n2", 900.0, 700.0)],
+            point_world: Some([85000.125, 445000.5, 1.25]),
+            covariance_m2: Some([[0.0004, 0.0, 0.0], [0.0, 0.0009, 0.0], [0.0, 0.0, 0.25]]),
+        },
+        AerialControlPoint {
+            tie_point_id: "t2".into(),
+            mm: vec![],
+            aerial: vec![aerial("n1", 1.0, 1.0)],
+            point_world: None,
+            covariance_m2: None,
+        },
+    ]
+}
+
+#[test]
+fn gcp_list_metashape_and_plain_list_read_back() {
+    let d = tempfile::tempdir().unwrap();
+    let c = campaign("EPSG:28992");
+    let pts = control();
+    let e = write_ground_control(d.path(), &c, &[("nadir", &pts)], None).unwrap();
+    assert_eq!(
+        (e.points, e.observations, e.skipped_single_aerial),
+        (1, 4, 1)
+    );
+    assert_eq!(e.gcp_list_skipped, None);
+
+    let text = std::fs::read_to_string(d.path().join("gcp_list.txt")).unwrap();
+    let (projection, lines) = read_gcp_list(&text).unwrap();
+    assert_eq!(projection, "EPSG:28992");
+    // A file name with a space cannot be a white-space separated field: that observation is left out, counted.
+    let images: Vec<&str> = lines.iter().map(|l| l.5.as_str()).collect();
+    assert_eq!(images, ["sub/p2.jpg", "n1.tif", "n2.tif"]);
+    assert_eq!(e.gcp_list_skipped_names, 1);
+    let n1 = &lines[1];
+    assert_eq!((n1.0, n1.1, n1.2), (85000.125, 445000.5, 1.25));
+    // OpenSfM pixel convention: the first pixel's centre is (0, 0).
+    assert_eq!((n1.3, n1.4), (1000.0, 800.0));
+    assert_eq!(n1.6, ["nadir_t_1"]);
+
+    let mut r = csv::Reader::from_path(d.path().join("metashape_reference.csv")).unwrap();
+    let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), 1);
+    assert_eq!(
+        rows[0].iter().collect::<Vec<_>>(),
+        [
+            "nadir_t_1",
+            "85000.125",
+            "445000.5",
+            "1.25",
+            "0.02",
+            "0.03",
+            "0.5"
+        ]
+    );
+    let mut r = csv::Reader::from_path(d.path().join("metashape_projections.csv")).unwrap();
+    let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), 4);
+    assert_eq!(
+        rows[0].iter().collect::<Vec<_>>(),
+        ["nadir_t_1", "pano 1", "pano 1.jpg", "100.5", "200.25"]
+    );
+    assert_eq!(&rows[1][1], "p2");
+
+    let mut r = csv::Reader::from_path(d.path().join("control_points.csv")).unwrap();
+    let h = r.headers().unwrap().clone();
+    let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), 1);
+    let col = |name: &str| h.iter().position(|x| x == name).unwrap();
+    assert_eq!(&rows[0][col("aerial_observations")], "2");
+    assert_eq!(&rows[0][col("panorama_observations")], "2");
+    assert_eq!(&rows[0][col("residual_x")], "", "no adjustment given");
+}
+
+#[test]
+fn an_unknown_crs_skips_gcp_list_with_a_reason() {
+    let d = tempfile::tempdir().unwrap();
+    let pts = control();
+    let e =
+        write_ground_control(d.path(), &campaign("local grid"), &[("nadir", &pts)], None).unwrap();
+    assert!(e.gcp_list_skipped.unwrap().contains("local grid"));
+    assert!(!d.path().join("gcp_list.txt").exists());
+    assert!(d.path().join("control_points.csv").exists());
+    assert_eq!(opensfm_projection("epsg:25832").unwrap(), "EPSG:25832");
+    assert!(opensfm_projection("+proj=utm +zone=32 +ellps=GRS80").is_ok());
+}
