@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 5 benchmark: the 18-variant oblique sweep (workflows/oblique-sweep.toml) against its default variant
+# Benchmark: the 18-variant oblique sweep (workflows/oblique-sweep.toml) against its default variant
 # alone (workflows/oblique.toml), each on a FRESH cache, on the same campaign folder, in one run of this script.
 # Prints both wall times, their ratio (target ≤ 4) and stages.sparse_cloud.executed of both (must be equal: the
 # sparse cloud does not depend on any swept parameter).

@@ -1,4 +1,4 @@
-//! The HTML report (issue 7): `workflows/tiny.toml` on the generated tiny campaign through the real binary
+//! The HTML report: `workflows/tiny.toml` on the generated tiny campaign through the real binary
 //! (the run writes `OUT/report/`), then `skytie report OUT` rebuilds it byte-identically in ≤ 10 s; every
 //! image and table file the page references exists and is non-empty; with `chromium` on PATH the page is
 //! rendered headless, every image must load with a non-zero natural size, and a screenshot is written.

@@ -73,8 +73,9 @@ fn run(wf: &Path, campaign: &Path, cache: &Path, out: &Path) -> (i32, String) {
     (o.status.code().unwrap_or(-1), text)
 }
 
-const EXPORTS: [&str; 5] = [
-    "trajectory_adjusted.csv",
+/// Written by every run that reached the adjustment (`trajectory_adjusted.csv` only when it corrected
+/// something: see [`assert_adjusted_trajectory_follows_the_verdict`]).
+const EXPORTS: [&str; 4] = [
     "checkpoints.csv",
     "verification.csv",
     "correspondences.csv",
@@ -160,6 +161,20 @@ fn bad_items_are_dropped_counted_and_the_run_finishes_partially() {
     for f in EXPORTS {
         assert!(out.join(f).is_file(), "{f} missing");
     }
+    assert_adjusted_trajectory_follows_the_verdict(&out, &m);
+}
+
+/// The adjusted trajectory is delivered exactly when the adjustment's verdict is "corrected".
+fn assert_adjusted_trajectory_follows_the_verdict(out: &Path, m: &serde_json::Value) {
+    let corrected = m["adjust"]
+        .to_string()
+        .contains("\"verdict\":\"corrected\"");
+    assert_eq!(
+        out.join("trajectory_adjusted.csv").is_file(),
+        corrected,
+        "trajectory_adjusted.csv must exist exactly when the verdict is 'corrected': {}",
+        m["adjust"]
+    );
 }
 
 #[test]

@@ -1,4 +1,4 @@
-//! The nadir `skytie tool`s (issue 4, thesis ch. 3) on the real binary with known answers: `ortho` shows a
+//! The nadir `skytie tool`s (thesis ch. 3) on the real binary with known answers: `ortho` shows a
 //! panorama's east stripe east of the foot point (and on top when the image is turned to face east), `kaze` finds
 //! the same keypoints on an integer-shifted copy, `forstner` locates a rectangle's corners, `wallis` brings two
 //! halves of very different contrast to the target statistics, `phasecorr` recovers a sub-pixel shift, `ncc`

@@ -1,4 +1,4 @@
-//! The HTML report of a run (issue 7): `skytie report OUT [--campaign DIR]`, also written at the end of
+//! The HTML report of a run: `skytie report OUT [--campaign DIR]`, also written at the end of
 //! `skytie run`. A pure function of the output folder OUT (plus, optionally, the campaign folder for images
 //! and `truth/`): it never runs the pipeline.
 //!

@@ -1,5 +1,5 @@
 //! AGAST and DAISY benchmark and peer-input writer for `benches/peers/daisy_agast.py` (OpenCV
-//! `AgastFeatureDetector` and `xfeatures2d.DAISY`; issue 5 "Benchmarks against peers on identical inputs").
+//! `AgastFeatureDetector` and `xfeatures2d.DAISY`).
 //! Plain `fn main`, no harness.
 //!
 //! Two 1024×1024 8-bit images (written as PNG and re-loaded, so both sides see IDENTICAL pixels): `noise`

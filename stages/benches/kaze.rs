@@ -1,5 +1,4 @@
-//! KAZE benchmark and peer-input writer for `benches/peers/kaze.py` (`cv2.xfeatures2d.KAZE_create`; issue 4
-//! "Benchmarks against peers"). Plain `fn main`, no harness.
+//! KAZE benchmark and peer-input writer for `benches/peers/kaze.py` (`cv2.xfeatures2d.KAZE_create`). Plain `fn main`, no harness.
 //!
 //! Image A is a 1000×1000 crop of band-limited noise (8-bit); image B is the crop of the same noise at
 //! (+SHIFT_X, +SHIFT_Y), i.e. A's content at p appears in B at p − shift (an integer shift: no resampling). Both

@@ -1,5 +1,5 @@
 //! Mattes MI translation registration benchmark and peer-input writer for `benches/peers/mi_sitk.py`
-//! (SimpleITK `ImageRegistrationMethod`; issue 5 "Benchmarks against peers on identical inputs"). Plain
+//! (SimpleITK `ImageRegistrationMethod`). Plain
 //! `fn main`, no harness.
 //!
 //! 20 pairs of 96×96 patches: a crop of a band-limited texture (fixed) and the same crop translated by a random

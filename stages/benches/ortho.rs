@@ -1,5 +1,5 @@
 //! Ortho-projection benchmark and peer-input writer for `benches/peers/remap.py` (`cv2.remap` with the SAME map;
-//! issue 4 "Benchmarks against peers"; thesis 3.4.3). Plain `fn main`, no harness.
+//! thesis 3.4.3). Plain `fn main`, no harness.
 //!
 //! A 4000×2000 band-limited texture panorama (8-bit, written as PNG and re-loaded, so both sides see identical
 //! pixels) is ortho-projected at 3 cm (707×707 px) and 10 cm (212×212 px) on a 30 m diagonal. Timed, per GSD,

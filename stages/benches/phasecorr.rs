@@ -1,5 +1,4 @@
-//! Phase-correlation benchmark and peer-input writer (plain `fn main`, no harness; issue 4 "Benchmarks against
-//! peers"). For 32², 64² and 128² it makes 20 pairs each: a crop of a band-limited texture and the same crop
+//! Phase-correlation benchmark and peer-input writer (plain `fn main`, no harness). For 32², 64² and 128² it makes 20 pairs each: a crop of a band-limited texture and the same crop
 //! translated by a random sub-pixel t ∈ [−4, 4)² px (exact Fourier shift, see `tests/imaging_support`), then
 //! gain 0.6, offset 0.25, gamma 0.7 and noise σ 0.01. The pairs are written as 8-bit PNGs and re-loaded, so the
 //! numbers below and `benches/peers/phasecorr.py` (OpenCV, scikit-image) see IDENTICAL inputs.

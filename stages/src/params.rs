@@ -393,9 +393,6 @@ macro_rules! params {
 }
 
 #[cfg(test)]
-mod declared_types;
-
-#[cfg(test)]
 mod tests {
     use super::*;
 

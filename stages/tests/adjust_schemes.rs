@@ -1,7 +1,7 @@
-//! Known-answer comparison of the control schemes on a synthetic block with nadir aerial images (issue 6,
-//! "Compare both against the thesis' scheme"): (a) the thesis scheme (control points triangulated from ≥ 2
+//! Known-answer comparison of the control schemes on a synthetic block with nadir aerial images,
+//! compared against the thesis' scheme: (a) the thesis scheme (control points triangulated from ≥ 2
 //! aerial images, σ = 0.10 m, 5.4.3), (b) aerial pixel observations in the bundle with the aerial orientation
-//! fixed (issue 6 (a)), (c) robust loss + rejection with injected gross outliers (issue 6 (b)). Built through
+//! fixed, (c) robust loss + rejection with injected gross outliers. Built through
 //! `build_block`/`run` from the correspondence types, so the plumbing is tested too.
 
 use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};

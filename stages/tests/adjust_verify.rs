@@ -1,4 +1,4 @@
-//! Known-answer tests of the verification (thesis Table 5-13, issue 6 "Verification"): with exact observations
+//! Known-answer tests of the verification (thesis Table 5-13): with exact observations
 //! and a purely systematic position error, every MM − aerial offset equals that error; a deteriorated campaign
 //! is flagged, an undeteriorated one passes; `verification.csv` parses back; segments by count and by length.
 

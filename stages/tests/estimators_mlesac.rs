@@ -1,4 +1,4 @@
-//! Known-answer tests of MLESAC plane fitting (ALGORITHMS.md §8; issue 5: 50 % outliers to < 1° / 1 cm).
+//! Known-answer tests of MLESAC plane fitting (ALGORITHMS.md §8; 50 % outliers to < 1° / 1 cm).
 
 use nalgebra::Vector3;
 use skytie_stages::estimators::mlesac::{
@@ -74,7 +74,7 @@ fn plane_with_30_percent_outliers_is_recovered() {
 
 #[test]
 fn plane_with_50_percent_outliers_to_one_degree_and_one_centimetre() {
-    // Issue 5: 400 inliers with 5 mm noise + 400 outliers in the 20 m cube.
+    // 400 inliers with 5 mm noise + 400 outliers in the 20 m cube.
     for seed in 0..5u64 {
         let pts = plane_x_with_outliers(3.0, 400, 0.005, 400, 100 + seed);
         let fit = fit_plane_mlesac(

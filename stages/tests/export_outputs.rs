@@ -1,4 +1,4 @@
-//! Round trips of the run outputs (issue 6 "Outputs"): `trajectory_adjusted.csv` reads back as recordings,
+//! Round trips of the run outputs: `trajectory_adjusted.csv` reads back as recordings,
 //! `trajectory.geojson` parses as a FeatureCollection with the expected layers, `tie_points.ply` decodes,
 //! `checkpoints.csv` parses back to the errors, and the COLMAP text model's poses reproject every track
 //! observation with COLMAP's own camera-model formulas (EQUIRECTANGULAR, PINHOLE/OPENCV).

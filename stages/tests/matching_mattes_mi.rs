@@ -1,4 +1,4 @@
-//! Known-answer tests of Mattes MI and the (1+1)-ES (ALGORITHMS.md §5 KATs; issue 5's sub-pixel shift under a
+//! Known-answer tests of Mattes MI and the (1+1)-ES (ALGORITHMS.md §5 KATs; the sub-pixel shift under a
 //! gamma change and noise).
 
 use skytie_stages::estimators::one_plus_one::{minimize, OnePlusOneParams};
@@ -159,7 +159,7 @@ fn es_recovers_a_translation_under_a_non_monotone_remap() {
 
 #[test]
 fn mi_registration_recovers_a_subpixel_shift_of_a_gamma_changed_noisy_copy() {
-    // Issue 5: ≤ 0.2 px.
+    // ≤ 0.2 px.
     for (seed, d) in [(4u64, [0.6, -0.3]), (5, [-0.35, 0.8]), (6, [1.25, 0.45])] {
         let tex = Texture::new(seed, 80.0);
         let fixed = tex.render(80, [0.0, 0.0], |v| v);

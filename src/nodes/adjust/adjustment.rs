@@ -85,7 +85,7 @@ fn rmse_json(r: &Rmse) -> serde_json::Value {
 }
 
 impl AdjustReport {
-    /// The `adjust.<config>` metrics (issue 6): check points before/after, iterations, observations, rejected,
+    /// The `adjust.<config>` metrics: check points before/after, iterations, observations, rejected,
     /// cost. Recording errors vs truth come from the `grade_adjust` node.
     pub fn metrics(&self) -> serde_json::Value {
         let r = &self.run;

@@ -1,5 +1,5 @@
 //! `grade_adjust`: evaluation only — recorded and adjusted recording positions vs a synthetic campaign's
-//! `truth/recordings.csv` (issue 6: `adjust.<config>.recordings.{before,after}.{rmse_2d,rmse_3d,max_2d}`).
+//! `truth/recordings.csv` (`adjust.<config>.recordings.{before,after}.{rmse_2d,rmse_3d,max_2d}`).
 //! Added only when `truth/recordings.csv` exists.
 
 use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};

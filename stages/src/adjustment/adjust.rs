@@ -1,4 +1,4 @@
-//! The adjustment driver (thesis 5.4, 5.7; issue 6 "robust estimation"): solve with LM, reject observations
+//! The adjustment driver (thesis 5.4, 5.7): solve with LM, reject observations
 //! whose |normalised residual| exceeds k (per tie
 //! point only the worst one per round), re-solve from the current estimate, repeat until nothing is
 //! rejected (or the round limit); then posterior σ per recording.
@@ -39,7 +39,7 @@ pub struct AdjustedRecording {
 pub struct ObservationCounts {
     pub pano: usize,
     pub control: usize,
-    /// Aerial image observations (issue 6 (a)).
+    /// Aerial image observations.
     pub aerial: usize,
     pub priors: usize,
     pub relative: usize,

@@ -1,4 +1,4 @@
-//! Aerial image observations in the bundle (issue 6 (a); thesis 5.4.3 names this "classical bundle adjustment
+//! Aerial image observations in the bundle (thesis 5.4.3 names this "classical bundle adjustment
 //! by locking the exterior orientation of the aerial cameras", 6.1 item 4): a tie point's pixel in a nadir or
 //! oblique aerial image whose orientation is held fixed, so a point seen in a single aerial image also
 //! constrains the block.

@@ -1,4 +1,4 @@
-//! Check-point evaluation on campaign rows (thesis 3.5.3; issue 6 "Evaluation"): the panorama cameras of the
+//! Check-point evaluation on campaign rows (thesis 3.5.3): the panorama cameras of the
 //! recorded and of the adjusted trajectory, and the check points (`control/checkpoints.csv`) triangulated from
 //! their observations (`control/observations.csv`) with both, for one view selection (two nearest, or all
 //! within 15 m). Check points are never control. Observations naming an unknown point or panorama are

@@ -1,4 +1,4 @@
-//! Posterior precision of the adjusted recordings (issue 6: per-recording posterior standard deviations).
+//! Posterior precision of the adjusted recordings (per-recording posterior standard deviations).
 //!
 //! The covariance of the recording parameters is the inverse of the reduced camera matrix
 //! `S = U − W·V⁻¹·Wᵀ` (the Schur complement is exactly the inverse of the camera block of the full inverse

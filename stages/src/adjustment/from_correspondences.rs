@@ -1,8 +1,8 @@
 //! From the registration stages' correspondences to an adjustment block and back to per-recording results
-//! (thesis 5.4.3; issue 6 "Adjustment"): MM tie points become tie-point unknowns with their panorama
+//! (thesis 5.4.3): MM tie points become tie-point unknowns with their panorama
 //! observations; aerial control points either tie their point to the aerial triangulation (thesis scheme:
 //! ≥ 2 aerial observations, σ = 0.10 m or the triangulation covariance) or, with `aerial_observations`, put
-//! their aerial pixels into the bundle with the aerial orientation fixed (issue 6 (a): single-aerial points
+//! their aerial pixels into the bundle with the aerial orientation fixed (single-aerial points
 //! count). Recorded positions are weak priors (σ from the config, else `sigma_xy`/`sigma_z`, else the
 //! documented defaults); consecutive recordings optionally keep their recorded differences (3.4.2).
 //!
@@ -84,7 +84,7 @@ pub struct BuildCounts {
     pub control_points: usize,
     /// Control points used as triangulated control (thesis scheme).
     pub control_as_gcp: usize,
-    /// Control points whose aerial pixels went into the bundle (issue 6 (a)).
+    /// Control points whose aerial pixels went into the bundle.
     pub control_as_aerial_observations: usize,
     /// Control points not used: a single aerial observation in the thesis scheme, or no usable point.
     pub control_unused: usize,
@@ -132,7 +132,7 @@ pub struct RunPoint {
     pub determined: bool,
 }
 
-/// Everything the adjust node reports (issue 6 metrics: iterations, observations, rejected, cost).
+/// Everything the adjust node reports (metrics: iterations, observations, rejected, cost).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AdjustmentRun {
     pub config: AdjustConfig,

@@ -4,7 +4,7 @@
 //!
 //! Layers, bottom up: [`error`] (what can go wrong, naming the item), [`weighting`] (residual weighting
 //! methods 1–4 of thesis 5.7), [`robust`] (Huber/Cauchy losses), [`problem`] (the block and the options),
-//! [`aerial`] (aerial image observations with the aerial orientation fixed, issue 6 (a)), [`residuals`]
+//! [`aerial`] (aerial image observations with the aerial orientation fixed), [`residuals`]
 //! (residuals and analytic Jacobians), [`parallel`] (thread-count-independent parallel loops), [`sparse`]
 //! (block sparse Cholesky with a fill-reducing ordering, and selected inversion), [`layout`] (observations
 //! by point and recording, structure of the reduced camera matrix), [`prepared`] (one solve's setup and

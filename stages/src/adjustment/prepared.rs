@@ -40,7 +40,7 @@ pub struct PreparedControl {
     pub active: bool,
 }
 
-/// An aerial image observation ready for evaluation (issue 6 (a): the aerial orientation is fixed).
+/// An aerial image observation ready for evaluation (the aerial orientation is fixed).
 #[derive(Clone, Copy, Debug)]
 pub struct PreparedAerial {
     pub camera: usize,

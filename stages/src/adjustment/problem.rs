@@ -59,7 +59,7 @@ impl ControlPoint {
 }
 
 /// An observation of tie point `point` in aerial image `camera` (an index into [`Block::aerial_cameras`],
-/// whose orientation is held fixed; issue 6 (a)): continuous pixel (u, v) of the original aerial image.
+/// whose orientation is held fixed): continuous pixel (u, v) of the original aerial image.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AerialImageObservation {
     pub camera: usize,
@@ -91,7 +91,7 @@ pub struct Block {
     pub relative_constraints: Vec<RelativeConstraint>,
     /// Fixed aerial cameras referenced by `aerial_observations`.
     pub aerial_cameras: Vec<FrameCamera>,
-    /// Observations of tie points in the fixed aerial images (issue 6 (a)).
+    /// Observations of tie points in the fixed aerial images.
     pub aerial_observations: Vec<AerialImageObservation>,
 }
 

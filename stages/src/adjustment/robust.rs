@@ -1,4 +1,4 @@
-//! Robust losses for the bundle (beyond the thesis, issue 6: the open question of 4.6 — let the bundle, not
+//! Robust losses for the bundle (beyond the thesis, the open question of 4.6 — let the bundle, not
 //! only pre-filtering, remove outliers): Huber and Cauchy losses applied per observation to the squared norm
 //! `s = ‖r‖²` of its whitened residual vector, minimised by iteratively re-weighted least squares inside LM
 //! (residual and Jacobian scaled by √ρ'(s), the Triggs/ceres first-order correction).

@@ -1,4 +1,4 @@
-//! The reduced camera system (thesis 5.4; issue 6 "Solver"): with the normal equations
+//! The reduced camera system (thesis 5.4): with the normal equations
 //! `[U W; Wᵀ V]·[δc; δp] = [b_c; b_p]` and V block-diagonal (3 × 3 per tie point), the points are eliminated
 //! by the Schur complement `S = U − W·V⁻¹·Wᵀ`, `S·δc = b_c − W·V⁻¹·b_p`, and recovered afterwards as
 //! `δp_j = V_j⁻¹·(b_p,j − W_jᵀ·δc)`. Marquardt damping scales the diagonals of U and V by 1 + λ.

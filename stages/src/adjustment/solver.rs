@@ -1,4 +1,4 @@
-//! Levenberg–Marquardt with the tie points eliminated by a Schur complement (thesis 5.4; issue 6 "Solver"):
+//! Levenberg–Marquardt with the tie points eliminated by a Schur complement (thesis 5.4):
 //! each step solves the damped normal equations through the sparse reduced camera system
 //! ([`super::schur`]).
 //!

@@ -1,4 +1,4 @@
-//! Recording positions against the truth (issue 6 "Evaluation", synthetic campaigns only: the pipeline never
+//! Recording positions against the truth (synthetic campaigns only: the pipeline never
 //! reads `truth/`, evaluation code passes the truth rows in): RMSE 2-D and 3-D and the largest 2-D error of
 //! the recorded and of the adjusted positions, for metrics `adjust.<config>.recordings.{before,after}`.
 

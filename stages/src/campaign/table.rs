@@ -81,6 +81,7 @@ pub(crate) fn read_table(
         .from_reader(data.as_slice());
     let mut header: Option<(usize, Vec<String>)> = None;
     let mut records = Vec::new();
+    let mut row_problems = Vec::new();
     let mut byte_record = csv::ByteRecord::new();
     loop {
         match reader.read_byte_record(&mut byte_record) {
@@ -126,7 +127,7 @@ pub(crate) fn read_table(
             None => header = Some((row, cells)),
             Some((_, names)) => {
                 if cells.len() != names.len() {
-                    problems.push(Problem::error(
+                    row_problems.push(Problem::error(
                         rel,
                         Some(row),
                         None,
@@ -190,6 +191,10 @@ pub(crate) fn read_table(
             ).with_kind(ProblemKind::Missing));
             usable = false;
         }
+    }
+    // A skipped file's rows are not reported one by one: the header error covers them.
+    if usable {
+        problems.extend(row_problems);
     }
     usable.then(|| Table {
         file: rel.to_path_buf(),

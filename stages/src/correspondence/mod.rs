@@ -48,7 +48,7 @@ pub struct MmTiePoint {
 /// An aerial control point (thesis 3.4.5.4): a point located in ≥ 1 aerial image(s) and linked to its MM
 /// observations. With ≥ 2 aerial observations it is triangulated from the aerial images alone, so its object
 /// coordinate is independent of the uncertain MM positions; with exactly one it can still enter a bundle that
-/// holds the aerial orientation fixed (issue 6 (a)) but has no `point_world`.
+/// holds the aerial orientation fixed but has no `point_world`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AerialControlPoint {
     /// The MM tie point it came from (`MmTiePoint::id`).

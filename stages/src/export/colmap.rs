@@ -1,5 +1,5 @@
 //! A COLMAP text model of the adjusted block (`cameras.txt`, `images.txt`, `points3D.txt`) so users can
-//! inspect it in COLMAP (issue 6 "Outputs").
+//! inspect it in COLMAP.
 //!
 //! Cameras: panoramas use COLMAP's `EQUIRECTANGULAR` model (parameters `w, h`; camera frame x right, y down,
 //! z forward; pixel `x = (θ/2π + ½)·w`, `y = (½ − φ/π)·h` with `θ = atan2(x_c, z_c)`, `φ = atan2(−y_c,

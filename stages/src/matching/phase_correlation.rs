@@ -20,7 +20,7 @@
 //! deterministic. The 2-D FFTs run on the half spectrum of the real images (`real_fft_2d`). Cost per call:
 //! three forward half-spectrum FFTs (reference, moving in pass 0 and in the refinement), one inverse, two
 //! cross-power normalisations and the 3 × 3 evaluation; measured against `cv2.phaseCorrelate` in
-//! `benches/README.md` (issue 4).
+//! `benches/README.md`.
 
 mod real_fft_2d;
 

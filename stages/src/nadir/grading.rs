@@ -1,4 +1,4 @@
-//! Grading the nadir pipeline against a synthetic campaign's `truth/` (issue 4's `nadir.*` truth metrics).
+//! Grading the nadir pipeline against a synthetic campaign's `truth/` (the `nadir.*` truth metrics).
 //! Evaluation only: the pipeline never calls this; the engine runs it as a separate node when `truth/` exists.
 //!
 //! The rule for a **correct** MM–aerial correspondence (one MM tie point located in one aerial image): the tie

@@ -7,7 +7,7 @@
 //! the viewpoint: for recordings 5 m apart and a 0.11 m kerb, about 0.25 m (2.5 px at 10 cm). The aerial image
 //! shows all of it in place, so phase correlation of such a template settles on a compromise and puts the
 //! corner 2–3 px off — in every aerial image alike, where no aerial-side check can see it (measured on the demo
-//! campaigns, session 7 of the issue notes).
+//! campaigns).
 //!
 //! The test: the neighbour's ortho image (same GSD and orientation) is sampled on the template grid, aligned at
 //! the corner as the neighbour saw it (MM-to-MM matching, 3.4.4). Both templates are smoothed (3 × 3 box) and

@@ -1,4 +1,4 @@
-//! Counts of one run of the nadir pipeline (issue 4's `nadir.*` metrics that need no truth): MM pairs and
+//! Counts of one run of the nadir pipeline (the `nadir.*` metrics that need no truth): MM pairs and
 //! how they were related, MM tie points, initial transforms accepted/rejected, MM–aerial correspondences,
 //! aerial control points. Truth-based grades live in `grading.rs`.
 

@@ -1,4 +1,4 @@
-//! Grading the oblique pipeline against a synthetic campaign's `truth/` (issue 5's `oblique.*` truth metrics).
+//! Grading the oblique pipeline against a synthetic campaign's `truth/` (the `oblique.*` truth metrics).
 //! Evaluation only: the pipeline never calls this. Uses the nadir grading's [`Truth`] and [`ErrorStats`].
 //!
 //! **Rule for a correct oblique correspondence** (one patch match: panorama observation `mm` ↔ oblique pixel
@@ -139,7 +139,7 @@ fn ratio(a: usize, n: usize) -> f64 {
 }
 
 impl ObliqueGrade {
-    /// The `oblique.*` truth metrics of issue 5 (to be put under the `oblique` namespace).
+    /// The `oblique.*` truth metrics (to be put under the `oblique` namespace).
     pub fn metrics(&self) -> serde_json::Value {
         let side = |s: &SideCounts| {
             json!({

@@ -1,4 +1,4 @@
-//! The oblique pipeline's own counts (issue 5's `oblique.*` metrics that need no truth): how many sparse
+//! The oblique pipeline's own counts (the `oblique.*` metrics that need no truth): how many sparse
 //! points, planes, patches, correspondences and control points each stage produced and what each dropped.
 
 use serde::{Deserialize, Serialize};
