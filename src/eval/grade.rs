@@ -34,7 +34,7 @@ pub const SEGMENT_OFF_M: f64 = 0.3;
 pub const SEGMENT_GOOD_M: f64 = 0.2;
 
 /// Every metric, in table order.
-pub const METRICS: [MetricDef; 15] = [
+pub const METRICS: [MetricDef; 16] = [
     MetricDef {
         key: "nadir_inlier",
         title: "nadir inlier",
@@ -58,6 +58,12 @@ pub const METRICS: [MetricDef; 15] = [
         title: "obl. inl. +nm",
         better: Better::Higher,
         floor: 0.01,
+    },
+    MetricDef {
+        key: "corrected",
+        title: "corrected",
+        better: Better::Higher,
+        floor: 0.001,
     },
     MetricDef {
         key: "rec_2d_before",
@@ -215,6 +221,12 @@ pub fn grade_cell(out: &Path) -> Result<CellMetrics, String> {
         num_at(m, "oblique.inlier_ratio_after_consensus_incl_non_matchable").filter(|_| oblique),
     );
     if let Some(a) = adjust_section(m) {
+        // 1 when the run delivered the adjusted trajectory (verdict `corrected`), 0 when it withheld it.
+        let verdict = a.get("verdict").and_then(Value::as_str);
+        put(
+            "corrected",
+            verdict.map(|v| f64::from(u8::from(v == "corrected"))),
+        );
         put("rec_2d_before", num_at(a, "recordings.before.rmse_2d"));
         put("rec_2d_after", num_at(a, "recordings.after.rmse_2d"));
         put("rec_3d_after", num_at(a, "recordings.after.rmse_3d"));

@@ -10,7 +10,8 @@ use std::process::Command;
 /// How a cell's run ended.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum CellRun {
-    /// `skytie run` exited 0; results in the folder.
+    /// `skytie run` finished (exit 0, or 3 for a flagged result such as an adjustment that corrected nothing —
+    /// graded like any other; the `corrected` column counts it); results in the folder.
     Done(PathBuf),
     /// It exited non-zero: what the log's last line says.
     Failed(String),
@@ -63,7 +64,7 @@ pub fn run_cell(exe: &Path, cell: &Cell, out_root: &Path, cache: &Path) -> Resul
     std::fs::write(&log_path, &log).map_err(|e| format!("{}: {e}", log_path.display()))?;
     let text = String::from_utf8_lossy(&output.stderr);
     match output.status.code() {
-        Some(0) => Ok(CellRun::Done(out)),
+        Some(0 | 3) => Ok(CellRun::Done(out)),
         Some(2) => Err(format!(
             "{}: skytie run refused the workflow: {} (see {})",
             cell.label(),

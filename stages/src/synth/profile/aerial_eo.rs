@@ -19,8 +19,8 @@ use nalgebra::Vector3;
 crate::params! {
     /// Parameters of the `aerial` component (`[synth.aerial]`).
     pub struct AerialEoParams {
-        /// SD of the attitude error about each camera axis.
-        attitude_sigma_mdeg: f64 = 3.0, unit "mdeg", min 0.0;
+        /// SD of the attitude error about each camera axis (0.003° = 3 millidegrees).
+        attitude_sigma_deg: f64 = 0.003, unit "deg", min 0.0;
         /// SD of the shift of each frame per horizontal axis.
         shift_sigma_m: f64 = 0.03, unit "m", min 0.0;
         /// SD of the vertical shift of each frame.
@@ -68,7 +68,7 @@ impl AerialEoParams {
         block: &Vector3<f64>,
     ) -> AerialImage {
         let mut s = Stream::new(&[seed, hash_str("aerial-eo"), hash_str(&img.image_id)]);
-        let a = (self.attitude_sigma_mdeg * 1e-3).to_radians();
+        let a = self.attitude_sigma_deg.to_radians();
         let tilt = rot_x(a * s.normal()) * rot_y(a * s.normal()) * rot_z(a * s.normal());
         let r_true = opk_to_matrix(img.omega_deg, img.phi_deg, img.kappa_deg);
         let r = r_true * tilt;
@@ -128,7 +128,7 @@ impl AerialEoParams {
                     "`aerial` {block}: every frame's attitude turned by N(0, {:.1} mdeg) about each camera axis{}, \
                      then shifted by the block shift ({:+.3}, {:+.3}, {:+.3}) m plus N(0, {:.3} m) per \
                      horizontal axis and N(0, {:.3} m) vertically; true poses in `truth/aerial_{block}.csv`;",
-                    self.attitude_sigma_mdeg,
+                    self.attitude_sigma_deg * 1e3,
                     if self.correlated {
                         " about the ground point of its principal ray (correlated as in an aerial triangulation)"
                     } else {
@@ -180,7 +180,7 @@ mod tests {
     #[test]
     fn a_correlated_tilt_keeps_the_ground_point_of_the_principal_ray() {
         let p = AerialEoParams {
-            attitude_sigma_mdeg: 20.0,
+            attitude_sigma_deg: 0.020,
             shift_sigma_m: 0.0,
             z_shift_sigma_m: 0.0,
             block_shift_sigma_m: 0.0,

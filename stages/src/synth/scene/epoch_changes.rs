@@ -3,9 +3,9 @@
 //! over one lane with traffic cones along it), and tree crowns grown by the time of the flight. Every choice is
 //! hashed from the scene seed and the element's index, so the rest of the scene is the same as without changes.
 
+use super::epoch_draw::{changed_epochs, draw};
 use super::markings::StreetAxis;
 use super::objects::{Material, Object, Shape, IN_AERIAL, IN_MM};
-use crate::synth::noise::{mix64, unit_f64};
 
 /// The knobs (a [`super::SceneSpec`] field; `None` = no such changes).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,22 +41,6 @@ const CONE_RADIUS_M: f64 = 0.16;
 const CONE_HEIGHT_M: f64 = 0.7;
 /// Spacing of the cones along the patch, m.
 const CONE_SPACING_M: f64 = 2.0;
-
-/// A uniform number in [0, 1) for (seed, what, index).
-pub fn draw(seed: u64, what: u64, index: u64) -> f64 {
-    unit_f64(mix64(seed ^ mix64(what ^ mix64(index))))
-}
-
-/// One-epoch presence of element `index`: `Some(IN_MM or IN_AERIAL)` with probability `fraction`.
-pub fn changed_epochs(seed: u64, what: u64, index: u64, fraction: f64) -> Option<u8> {
-    (draw(seed, what, index) < fraction).then(|| {
-        if draw(seed, what ^ 0x5EED, index) < 0.5 {
-            IN_MM
-        } else {
-            IN_AERIAL
-        }
-    })
-}
 
 /// Roadworks of one street marked along s in `s_range` with carriageway half width `half_width_m`: each
 /// 8–14 m long over the left-hand (oncoming) lane, so the recording car's lane stays free.

@@ -6,7 +6,7 @@
 //! a stop line across that lane, and a zebra crossing (0.5 m stripes, 1.0 m period: repetitive on purpose)
 //! across the whole carriageway. Manhole covers (r = 0.3 m) sit in the lanes at a fixed spacing.
 
-use super::epoch_changes::changed_epochs;
+use super::epoch_draw::changed_epochs;
 use super::objects::IN_BOTH;
 
 /// Maps street coordinates (s, q) to local XY and back. Main street: s = x, q = y.

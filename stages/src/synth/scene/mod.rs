@@ -11,6 +11,7 @@
 
 pub mod accel;
 pub mod epoch_changes;
+pub mod epoch_draw;
 pub mod frame;
 pub mod ground;
 pub mod layout;
