@@ -218,8 +218,8 @@ fn tiny_triplets_give_points_on_both_sides() {
     eprintln!("points per side (left, right): {per_side:?}");
     assert!(per_side[0] >= 3 && per_side[1] >= 3, "{per_side:?}");
     assert!(
-        per_side[0] + per_side[1] >= 4 * all.len(),
-        "{per_side:?} in {} triplets",
+        per_side[0] + per_side[1] >= 10,
+        "{per_side:?} in {} triplets: fewer than tens of points",
         all.len()
     );
 }
