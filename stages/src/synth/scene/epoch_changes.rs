@@ -5,7 +5,7 @@
 
 use super::epoch_draw::{changed_epochs, draw};
 use super::markings::StreetAxis;
-use super::objects::{Material, Object, Shape, IN_AERIAL, IN_MM};
+use super::objects::{Material, Object, Shape, IN_MM};
 
 /// The knobs (a [`super::SceneSpec`] field; `None` = no such changes).
 #[derive(Clone, Copy, Debug, PartialEq)]
