@@ -2,7 +2,7 @@
 //! one-file change.
 //!
 //! An encoded artifact starts with [`FORMAT_VERSION`] (one byte) and a 4-byte kind magic, then the body:
-//! - `SERD`: bincode 2 (serde, standard config) of the value — used by [`serde_artifact!`] types and the
+//! - `SERD`: bincode 2 (serde, standard config) of the value — used by [`serde_artifact!`](crate::serde_artifact!) types and the
 //!   built-in scalars/vectors;
 //! - rasters (kinds chosen by the type, e.g. `GRAY` / `RGB3` for the node layer's images): width and height
 //!   (u64 little-endian) followed by the raw `f32` samples as little-endian bytes (memcpy speed; a 4000×3000
@@ -201,13 +201,13 @@ pub fn encode_serde<T: Serialize + ?Sized>(value: &T) -> Result<Vec<u8>, CodecEr
     Ok(out)
 }
 
-/// Decodes an artifact produced by [`encode_serde`] (or by a [`serde_artifact!`] type's `encode`).
+/// Decodes an artifact produced by [`encode_serde`] (or by a [`serde_artifact!`](crate::serde_artifact!) type's `encode`).
 pub fn decode_serde<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, CodecError> {
     let body = open_frame(bytes, KIND_SERDE, std::any::type_name::<T>())?;
     decode_serde_exact(body)
 }
 
-/// Appends the artifact encoding of a serde value; used by [`serde_artifact!`].
+/// Appends the artifact encoding of a serde value; used by [`serde_artifact!`](crate::serde_artifact!).
 ///
 /// # Panics
 /// Only if the type itself cannot be represented by bincode (e.g. a serde impl with sequences of unknown

@@ -195,7 +195,7 @@ fn column_order(a: &str, b: &str) -> std::cmp::Ordering {
 }
 
 /// `sweep.csv`: one row per variant (in the given order); columns = `variant`, then every numeric leaf
-/// ([`numeric_leaves`]) of any variant's document as a dotted path, in [`column_order`] (the same order for
+/// ([`numeric_leaves`]) of any variant's document as a dotted path, in `column_order` (the same order for
 /// the same metrics, whichever variant has them). A variant lacking a metric has an empty cell. Values are
 /// written in Rust's shortest round-trip form (`3`, `0.25`, `1e-7`).
 pub fn sweep_csv(rows: &[(String, Value)]) -> String {

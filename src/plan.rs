@@ -1,6 +1,6 @@
 //! `skytie plan`: for each phase and stage, how many nodes are cached and how many will run, and WHY each
 //! node will run (new item, stage version bump, the param field that changed, the input that changed, or
-//! "failed last time: <error>" with what changed since that attempt).
+//! "failed last time: `<error>`" with what changed since that attempt).
 
 use crate::dag::record::{self, RecordedInput};
 use crate::dag::{NodeReport, NodeStatus, Phase, PipelineError, Session};

@@ -208,7 +208,7 @@ fn wallis_brings_low_and_high_contrast_halves_to_the_target_statistics() {
     tool_ok(&["wallis", s(&png), "--out", s(&out)]);
     let filtered = load_gray(&out).unwrap();
     assert_eq!((filtered.width, filtered.height), (160, 80));
-    // Defaults (ALGORITHMS.md §3): target mean m_f = 127/255, std s_f = 40/255, contrast constant c = 0.94,
+    // Defaults (Wallis 1976; Baltsavias 1991): target mean m_f = 127/255, std s_f = 40/255, contrast constant c = 0.94,
     // brightness b = 1. A region of std s_g comes out with std s_f·c·s_g / (c·s_g + (1 − c)·s_f) (the gain is
     // capped, so a very flat region stays below s_f) and the target mean. Measured away from the seam and border.
     let (m_f, s_f, c) = (127.0 / 255.0, 40.0 / 255.0, 0.94);

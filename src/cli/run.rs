@@ -36,7 +36,7 @@ pub struct RunArgs {
     pub campaign: Option<PathBuf>,
     #[command(flatten)]
     pub cache: CacheOpt,
-    /// Output folder (default: out/<workflow name>/).
+    /// Output folder (default: `out/<workflow name>/`).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     #[command(flatten)]

@@ -4,7 +4,7 @@
 //! `explain` prints the record as the node's provenance. A second record maps an output key to its content
 //! hash so an all-cached run need not read artifacts it does not use. A third one keeps a node's last
 //! failure (error message and ingredients) until the node next succeeds, so `plan` can say "failed last
-//! time: <error>" instead of calling the node new.
+//! time: `<error>`" instead of calling the node new.
 
 use crate::hashing::{ContentHash, NodeKey};
 use crate::store::Store;

@@ -266,7 +266,7 @@ pub fn prefixed(prefix: &str, violations: Vec<Violation>) -> impl Iterator<Item 
     })
 }
 
-/// Declares a stage's parameter struct; see the [module documentation](crate::params).
+/// Declares a stage's parameter struct; see the [module documentation](mod@crate::params).
 #[macro_export]
 macro_rules! params {
     (

@@ -186,7 +186,7 @@ fn other_tables_and_toml_have_documented_columns() {
         b2: 0.0,
         sigma_px: 0.5,
     };
-    write_aerial_cameras_csv(&d.join("nadir.csv"), &[a.clone()]).unwrap();
+    write_aerial_cameras_csv(&d.join("nadir.csv"), std::slice::from_ref(&a)).unwrap();
     assert_eq!(
         std::fs::read_to_string(d.join("nadir.csv")).unwrap(),
         "image_id,file,x,y,z,omega,phi,kappa,focal_px,cx,cy,width,height\n\"n,1\",n1.png,1.5,2.5,500,0,0,0,1000,50,40,100,80\n"

@@ -1,4 +1,4 @@
-//! Known-answer tests of MLESAC plane fitting (ALGORITHMS.md §8; 50 % outliers to < 1° / 1 cm).
+//! Known-answer tests of MLESAC plane fitting (Torr & Zisserman 2000; 50 % outliers to < 1° / 1 cm).
 
 use nalgebra::Vector3;
 use skytie_stages::estimators::mlesac::{

@@ -1,4 +1,4 @@
-//! Known-answer tests of AGAST corners and DAISY descriptors (ALGORITHMS.md §6) on synthetic images whose
+//! Known-answer tests of AGAST corners and DAISY descriptors (Mair et al. 2010; Tola, Lepetit & Fua 2010) on synthetic images whose
 //! corners and shifts are known exactly: squares on black, and a scene of random rectangles over a smooth
 //! sinusoidal texture that is rendered in world coordinates, so an integer-shifted copy is exact.
 

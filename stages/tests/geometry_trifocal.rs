@@ -1,4 +1,4 @@
-//! Known-answer tests of the trifocal tensor and point transfer (ALGORITHMS.md §7): random cameras K·R·[I | −C]
+//! Known-answer tests of the trifocal tensor and point transfer (Hartley & Zisserman 2004, ch. 15–16): random cameras K·R·[I | −C]
 //! with random points in front of all three; the thesis' perspective-view configuration (three panoramas 5 m
 //! apart, views at yaw deviations 300°/270°/240°, pitch 30°).
 

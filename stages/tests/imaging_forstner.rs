@@ -1,4 +1,4 @@
-//! Known-answer tests of the Förstner operator with Köthe's 2× structure tensor (ALGORITHMS.md §2).
+//! Known-answer tests of the Förstner operator with Köthe's 2× structure tensor (Förstner & Gülch 1987; Köthe 2003).
 //!
 //! Test images are rendered analytically: an ideal corner blurred by a Gaussian (σ_b) is the product of two
 //! normal CDFs along the edge normals; each pixel averages 4 × 4 sub-samples (anti-aliasing, pixel area).

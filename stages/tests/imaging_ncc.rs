@@ -1,4 +1,4 @@
-//! Known-answer tests of NCC template matching (ALGORITHMS.md §12, OpenCV TM_CCOEFF_NORMED semantics).
+//! Known-answer tests of NCC template matching (OpenCV TM_CCOEFF_NORMED, OpenCV TM_CCOEFF_NORMED semantics).
 
 mod imaging_support;
 

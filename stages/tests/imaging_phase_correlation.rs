@@ -1,4 +1,4 @@
-//! Known-answer tests of phase correlation (ALGORITHMS.md §4, thesis 3.4.5.3).
+//! Known-answer tests of phase correlation (Kuglin & Hines 1975; Reddy & Chatterji 1996, thesis 3.4.5.3).
 //!
 //! Shifted images are produced by exact Fourier shift: the test texture is a sum of sinusoids that are periodic
 //! over the texture size, evaluated analytically at the translated pixel centres (see `imaging_support`).
@@ -51,7 +51,7 @@ fn circular_fourier_shift_is_recovered() {
         (s.dx_px - 2.3).abs() < 0.02 && (s.dy_px + 1.7).abs() < 0.02,
         "{s:?}"
     );
-    // Plain quadratic on the unweighted spectrum (thesis' fit): the ALGORITHMS.md bound of 0.15 px.
+    // Plain quadratic on the unweighted spectrum (thesis' fit): the bound of 0.15 px.
     let p = PhaseCorrelationParams {
         window: WindowKind::Rectangular,
         lowpass_sigma_px: 0.0,

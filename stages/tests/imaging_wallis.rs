@@ -1,4 +1,4 @@
-//! Known-answer tests of the Wallis filter (ALGORITHMS.md §3).
+//! Known-answer tests of the Wallis filter (Wallis 1976; Baltsavias 1991).
 
 use skytie_stages::imaging::wallis::{local_mean_std, wallis_apply, wallis_filter, WallisParams};
 use skytie_stages::imaging::GrayImage;

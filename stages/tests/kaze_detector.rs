@@ -1,4 +1,4 @@
-//! Known-answer tests of the KAZE detector and descriptor (ALGORITHMS.md §1 KAT): Gaussian blob located
+//! Known-answer tests of the KAZE detector and descriptor (Alcantarilla, Bartoli & Davison 2012 KAT): Gaussian blob located
 //! within 0.2 px, integer translation moves keypoints exactly and keeps upright descriptors identical,
 //! ≥ 90 % repeatability on an integer-shifted crop of a texture, 90° rotation stability of non-upright
 //! descriptors, determinism.

@@ -1,4 +1,4 @@
-//! Known-answer tests of KAZE's scale-space numerics (ALGORITHMS.md §1 KAT): Thomas solver vs dense LU, AOS
+//! Known-answer tests of KAZE's scale-space numerics (Alcantarilla, Bartoli & Davison 2012 KAT): Thomas solver vs dense LU, AOS
 //! mean conservation and constant preservation, g ≡ 1 diffusion ≈ Gaussian blur (AOS and FED), FED step
 //! sizes, contrast factor on a ramp.
 

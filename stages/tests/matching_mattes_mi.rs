@@ -1,4 +1,4 @@
-//! Known-answer tests of Mattes MI and the (1+1)-ES (ALGORITHMS.md §5 KATs; the sub-pixel shift under a
+//! Known-answer tests of Mattes MI and the (1+1)-ES (Mattes et al. 2001; Styner et al. 2000 KATs; the sub-pixel shift under a
 //! gamma change and noise).
 
 use skytie_stages::estimators::one_plus_one::{minimize, OnePlusOneParams};

@@ -1,5 +1,5 @@
 //! Known-answer tests of the façade stage (thesis 4.4.2–4.4.4): trajectory criteria, local plane frame,
-//! occlusion, visibility hypothesis, box-grid thinning (ALGORITHMS.md §9) and `find_facades` on synthetic
+//! occlusion, visibility hypothesis, box-grid thinning (Pomerleau et al. 2013) and `find_facades` on synthetic
 //! sparse clouds with two façades and clutter.
 
 use nalgebra::Vector3;
@@ -642,7 +642,7 @@ fn visibility_hypothesis_pass_and_fail() {
 }
 
 // ---------------------------------------------------------------------------------------------------------
-// box-grid thinning (ALGORITHMS.md §9)
+// box-grid thinning (Pomerleau et al. 2013)
 
 fn uniform_cube(n: usize, size: f64, seed: u64) -> Vec<[f64; 3]> {
     let mut rng = SplitMix64::new(seed);

@@ -137,11 +137,14 @@ type Drawn = Result<(String, ViewCounts), String>;
 /// (every oblique variant the same nadir ones), so a view is named after what it shows and drawn once.
 /// Values are computed outside the locks (a rayon worker may pick up another page meanwhile); when two pages
 /// compute the same value at once, both results are identical and the first is kept.
+/// The oblique grading rule's truth (when the campaign has one) and its notes.
+type ObliqueRule = (Option<ObliqueTruth>, Vec<String>);
+
 #[derive(Default)]
 pub struct SharedViews {
     campaign: Mutex<Option<Arc<Result<CampaignViews, String>>>>,
     /// (truth, notes) of the oblique grading rule.
-    oblique: Mutex<Option<Arc<(Option<ObliqueTruth>, Vec<String>)>>>,
+    oblique: Mutex<Option<Arc<ObliqueRule>>>,
     drawn: Mutex<HashMap<String, Drawn>>,
 }
 

@@ -17,7 +17,7 @@ use super::schur::{ReduceError, ReducedSystem};
 use super::sparse::SelectedInverse;
 use nalgebra::Matrix4;
 
-/// A-priori covariance blocks over (x [m], y [m], z [m], ψ [rad]) per recording (rows/columns of fixed
+/// A-priori covariance blocks over (x in m, y in m, z in m, ψ in rad) per recording (rows/columns of fixed
 /// parameters are zero), and the variance factor σ̂0² (`None` without redundancy).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RecordingCovariances {

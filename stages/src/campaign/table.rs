@@ -118,9 +118,7 @@ pub(crate) fn read_table(
                 )
                 .with_kind(ProblemKind::Syntax),
             );
-            if header.is_none() {
-                return None;
-            }
+            header.as_ref()?;
             continue;
         };
         match &header {

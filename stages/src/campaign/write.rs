@@ -330,7 +330,7 @@ pub fn write_trajectory_geojson(path: &Path, layers: &[GeoJsonLayer]) -> io::Res
     let head = serde_json::to_string(&Value::Object(head)).map_err(io::Error::other)?;
     atomic_write_with(path, |w| {
         // `{"type":..,"crs":..}` opened up to append the features member.
-        w.write_all(head[..head.len() - 1].as_bytes())?;
+        w.write_all(&head.as_bytes()[..head.len() - 1])?;
         w.write_all(b",\"features\":[\n")?;
         for (i, f) in features.iter().enumerate() {
             w.write_all(f.as_bytes())?;

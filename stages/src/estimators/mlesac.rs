@@ -1,4 +1,4 @@
-//! MLESAC plane fitting (Torr & Zisserman 2000; ALGORITHMS.md §8), used to find façade planes in a triplet's
+//! MLESAC plane fitting (Torr & Zisserman 2000; Torr & Zisserman 2000), used to find façade planes in a triplet's
 //! sparse cloud (thesis 4.4.2).
 //!
 //! Hypotheses come from three random points; each is scored by the negative log-likelihood of a mixture of a
@@ -81,7 +81,7 @@ const MIN_SAMPLE_SINE: f64 = 1e-6;
 /// At most this many core refits (see the module documentation).
 const CORE_REFITS: usize = 10;
 
-/// EM stops when γ changes by less than this (ALGORITHMS.md §8).
+/// EM stops when γ changes by less than this (Torr & Zisserman 2000).
 const EM_TOLERANCE: f64 = 1e-4;
 
 /// Cap on the EM iterations for the final plane's reported γ.

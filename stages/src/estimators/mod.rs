@@ -1,4 +1,4 @@
-//! Robust estimation: the deterministic PRNG of [`crate::rng`], generic RANSAC ([`ransac`]) and the [`Model`]
+//! Robust estimation: the deterministic PRNG of [`crate::rng`], generic RANSAC ([`ransac`](mod@ransac)) and the [`Model`]
 //! implementations of the 2-D transforms of [`crate::geometry`] ([`models`]).
 
 // `!(x > t)` is used on purpose throughout: it also rejects NaN, which `x <= t` would let through.

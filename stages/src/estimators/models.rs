@@ -1,4 +1,4 @@
-//! [`Model`] implementations of the 2-D transforms for [`super::ransac`] (ALGORITHMS.md §11): the datum is a
+//! [`Model`] implementations of the 2-D transforms for [`super::ransac`](mod@super::ransac) (Hartley & Zisserman 2004, ch. 4): the datum is a
 //! [`PointPair`], the residual the one-way transfer error in the destination image.
 
 use super::ransac::Model;

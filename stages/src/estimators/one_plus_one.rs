@@ -1,5 +1,5 @@
-//! The (1+1) evolution strategy of ITK's `OnePlusOneEvolutionaryOptimizer` (Styner et al. 2000; ALGORITHMS.md
-//! §5), the optimiser of the fine MI patch registration (thesis 4.4.6, Droste et al. 2002).
+//! The (1+1) evolution strategy of ITK's `OnePlusOneEvolutionaryOptimizer` (Styner et al. 2000),
+//! the optimiser of the fine MI patch registration (thesis 4.4.6, Droste et al. 2002).
 //!
 //! Parameters `x ∈ Rⁿ` with scales `s_i`; the search matrix starts as `A = diag(r0 / s_i)`. Each iteration draws
 //! `z ~ N(0, I)`, evaluates the child `y = x + A·z`, keeps it if it improves (minimisation) and picks the

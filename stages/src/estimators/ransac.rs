@@ -1,4 +1,4 @@
-//! Generic, deterministic RANSAC (Fischler & Bolles 1981; ALGORITHMS.md §11; thesis 3.4.4 and 3.4.5.2):
+//! Generic, deterministic RANSAC (Fischler & Bolles 1981; Hartley & Zisserman 2004, ch. 4; thesis 3.4.4 and 3.4.5.2):
 //! minimal samples from a seeded [`SplitMix64`], degenerate samples rejected by the model's `fit`, adaptive
 //! trial count `N = ⌈ln(1 − p) / ln(1 − wˢ)⌉` from the best inlier fraction w so far (capped by
 //! `max_iterations`), and a least-squares refit on the inliers repeated while the consensus set grows.

@@ -7,7 +7,7 @@
 //! (posterior σ of z), so the file read as a recordings file is the adjusted trajectory with its precision.
 //! Appended: `sigma_x, sigma_y` (and `sigma_z` when the input has none), `yaw` when yaw was estimated and the
 //! input has no such column, then `dx_m, dy_m, dz_m` (adjusted − recorded, metres), `dyaw_deg`,
-//! `sigma_yaw_deg`, and `correction` — what supports the row's correction ([`Support`] label), or `not_read`
+//! `sigma_yaw_deg`, and `correction` — what supports the row's correction (`Support` label), or `not_read`
 //! for a row the campaign reader rejected (written unchanged; its problem was reported when the campaign was
 //! read). An appended name that the input already uses for another column gets the prefix `skytie_`.
 //! Comment lines of the input are not copied.

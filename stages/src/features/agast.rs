@@ -1,4 +1,4 @@
-//! AGAST corner detector, OAST 9-16 mask (Mair et al. 2010; ALGORITHMS.md §6): corners for matching perspective
+//! AGAST corner detector, OAST 9-16 mask (Mair et al. 2010; Mair et al. 2010; Tola, Lepetit & Fua 2010): corners for matching perspective
 //! views rendered from the panoramas (façade sparse cloud, thesis 4.4.1).
 //!
 //! Segment test: pixel p (intensity I_p) is a corner at threshold t when ≥ 9 contiguous pixels of the 16-pixel

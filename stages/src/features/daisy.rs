@@ -1,4 +1,4 @@
-//! DAISY local descriptor (Tola, Lepetit, Fua 2010; OpenCV xfeatures2d defaults; ALGORITHMS.md §6) for matching
+//! DAISY local descriptor (Tola, Lepetit, Fua 2010; OpenCV xfeatures2d defaults; Mair et al. 2010; Tola, Lepetit & Fua 2010) for matching
 //! AGAST corners between perspective views rendered from the panoramas (façade sparse cloud, thesis 4.4.1).
 //!
 //! 1. Gradient by central differences (intensity per pixel, x right, y down); H orientation maps
@@ -105,7 +105,7 @@ pub struct DaisyExtractor {
 
 impl DaisyExtractor {
     /// Compute the layers of `img` (the expensive part, parallel). Parameters outside the ranges of
-    /// [`DaisyParams::validate`] are clamped into them (validate first to report them).
+    /// [`Params::validate`](crate::params::Params::validate) are clamped into them (validate first to report them).
     pub fn new(img: &GrayImage, p: &DaisyParams) -> Self {
         let params = p.clamped();
         let (w, h) = (img.width, img.height);

@@ -1,5 +1,5 @@
 //! Förstner interest operator with Köthe's improved structure tensor: sub-pixel corner (junction) or circular
-//! points (thesis 2.2.3.2, 3.4.4.4, 3.4.5.3; ALGORITHMS.md §2; Förstner & Gülch 1987, Köthe 2003).
+//! points (thesis 2.2.3.2, 3.4.4.4, 3.4.5.3; Förstner & Gülch 1987; Köthe 2003; Förstner & Gülch 1987, Köthe 2003).
 //!
 //! 1. Köthe: the tensor products g·gᵀ have twice the bandwidth of g, so they are formed on a 2× up-sampled grid
 //!    (bicubic up-sampling, derivative-of-Gaussian gradient at 2σ_d fine pixels, Gaussian integration at 2σ_i).

@@ -1,4 +1,4 @@
-//! Closest approach of two lines (the two-ray triangulation in closed form, ALGORITHMS.md §10): used to judge
+//! Closest approach of two lines (the two-ray triangulation in closed form, Hartley & Zisserman 2004, ch. 12): used to judge
 //! correspondences by the distance at which their rays pass each other (campaign-format.md, "Truth").
 
 use super::ray::Ray;

@@ -1,5 +1,5 @@
 //! 2-D projective transform (homography) estimated by the normalised DLT (Hartley & Zisserman alg. 4.2,
-//! ALGORITHMS.md §11); used between adjacent MM ortho-images (thesis 3.4.4).
+//! Hartley & Zisserman 2004, ch. 4); used between adjacent MM ortho-images (thesis 3.4.4).
 
 use super::point_pair::PointPair;
 use super::similarity2::Similarity2;

@@ -1,5 +1,5 @@
 //! Geometric refinement of a homography: Levenberg–Marquardt on the one-way transfer error
-//! Σ‖x'_i − π(H x_i)‖² (ALGORITHMS.md §11: OpenCV's `findHomography` likewise LM-refines the DLT result on the
+//! Σ‖x'_i − π(H x_i)‖² (Hartley & Zisserman 2004, ch. 4: OpenCV's `findHomography` likewise LM-refines the DLT result on the
 //! inliers). The DLT minimises an algebraic error; with noisy points this refinement gives the
 //! maximum-likelihood estimate for Gaussian noise in the destination image.
 //!

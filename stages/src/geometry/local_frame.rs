@@ -1,5 +1,5 @@
 //! A local origin for numerically stable solvers: world coordinates are ≈ 10⁵ m, so every normal equation,
-//! SVD or least-squares problem first subtracts a nearby origin (ALGORITHMS.md, global conventions).
+//! SVD or least-squares problem first subtracts a nearby origin (a local origin keeps the normal equations well conditioned).
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};

@@ -1,5 +1,5 @@
 //! The equirectangular panorama camera of the campaign contract (campaign-format.md, "Panorama geometry";
-//! ALGORITHMS.md §10; thesis 3.4.4.5).
+//! Hartley & Zisserman 2004, ch. 12; thesis 3.4.4.5).
 //!
 //! For an image of W × H pixels (W = 2H) a continuous pixel (u, v) has azimuth `A = 360°·u/W − 180°`
 //! (clockwise from grid north), elevation `E = 90° − 180°·v/H` and panorama-frame direction
@@ -48,7 +48,7 @@ impl PanoramaCamera {
     }
 
     /// Angular standard deviation (radians) of a pixel measurement with standard deviation `sigma_px`
-    /// (ALGORITHMS.md §10: σ_θ = σ_px·2π/W), e.g. for [`super::triangulate_rays`].
+    /// (Hartley & Zisserman 2004, ch. 12: σ_θ = σ_px·2π/W), e.g. for [`super::triangulate_rays`].
     pub fn angular_sigma_rad(&self, sigma_px: f64) -> f64 {
         sigma_px * self.pixel_angle_rad()
     }

@@ -1,4 +1,4 @@
-//! 2-D similarity transform (4 DoF: uniform scale, rotation, translation), ALGORITHMS.md §11; used to register
+//! 2-D similarity transform (4 DoF: uniform scale, rotation, translation), Hartley & Zisserman 2004, ch. 4; used to register
 //! MM ortho-image patches onto aerial patches (thesis 3.4.5.2).
 //!
 //! `x' = s·R(θ)·x + t = [a −b; b a]·x + (tx, ty)` with `a = s cos θ`, `b = s sin θ`.

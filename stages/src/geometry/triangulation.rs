@@ -1,4 +1,4 @@
-//! Multi-view ray triangulation with a covariance (ALGORITHMS.md §10; thesis 3.4.4.5 and 3.4.5.4): the point
+//! Multi-view ray triangulation with a covariance (Hartley & Zisserman 2004, ch. 12; thesis 3.4.4.5 and 3.4.5.4): the point
 //! minimising the weighted sum of squared perpendicular distances to n ≥ 2 rays.
 //!
 //! Model: ray k has origin c_k, unit direction d_k and angular precision σ_k (radians). Its perpendicular

@@ -1,5 +1,5 @@
 //! The trifocal tensor of three cameras with known projection matrices, and point transfer (thesis 4.4.1;
-//! ALGORITHMS.md §7; Hartley 1997 eq. 8; Hartley & Zisserman 2004 §15.1–15.3).
+//! Hartley & Zisserman 2004, ch. 15–16; Hartley 1997 eq. 8; Hartley & Zisserman 2004 §15.1–15.3).
 //!
 //! Index convention: `t[i][j][k]` = T_i^(jk), where i is the covariant index of the view-1 point, j pairs
 //! with a line in view 2 and k gives the view-3 point: `x''^k = Σ_i Σ_j x^i · l'_j · T_i^(jk)`.
@@ -124,7 +124,7 @@ impl TrifocalTensor {
         }
     }
 
-    /// `Σ_i x^i·T_i` (a 3×3 matrix indexed [j][k]).
+    /// `Σ_i x^i·T_i` (a 3×3 matrix indexed `[j][k]`).
     pub fn contract_point(&self, x: &Vector3<f64>) -> Matrix3<f64> {
         let mut m = Matrix3::zeros();
         for i in 0..3 {
@@ -144,7 +144,7 @@ impl TrifocalTensor {
         (skew(&h(x2)).transpose() * self.contract_point(&h(x1)) * skew(&h(x3))).norm()
     }
 
-    /// Point transfer (ALGORITHMS.md §7 steps 1, 3, 4): the view-3 pixel of the point seen at `x1` in view 1
+    /// Point transfer (Hartley & Zisserman 2004, ch. 15–16 steps 1, 3, 4): the view-3 pixel of the point seen at `x1` in view 1
     /// and `x2` in view 2, through the line in view 2 that passes `x2` perpendicular to the epipolar line of
     /// `x1`.
     pub fn transfer(&self, x1: [f64; 2], x2: [f64; 2]) -> Result<[f64; 2], TransferError> {

@@ -33,7 +33,7 @@ pub fn scharr_gradient(img: &GrayImage) -> Gradient {
     scharr_gradient_step(img, 1)
 }
 
-/// Scharr derivative with taps spaced `step_px` apart (KAZE's scale-dependent derivative, ALGORITHMS.md §1):
+/// Scharr derivative with taps spaced `step_px` apart (KAZE's scale-dependent derivative, Alcantarilla, Bartoli & Davison 2012):
 /// derivative `[−1, 0…0, +1] / (2·step)` × smoothing `[3, 0…0, 10, 0…0, 3] / 16`. Unit gain per pixel; OpenCV's
 /// `compute_derivative_kernels` for scale s equals `s` times this. `step_px = 0` is treated as 1.
 pub fn scharr_gradient_step(img: &GrayImage, step_px: usize) -> Gradient {

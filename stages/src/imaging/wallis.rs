@@ -1,5 +1,5 @@
 //! Wallis filter: local radiometric normalisation to a target mean and standard deviation (thesis 3.4.5.2,
-//! ALGORITHMS.md §3; Wallis 1976 in the photogrammetric form of Baltsavias 1991).
+//! Wallis 1976; Baltsavias 1991; Wallis 1976 in the photogrammetric form of Baltsavias 1991).
 //!
 //! Parameterisation implemented (and no other): with local mean m_g and std s_g over a W × W window,
 //! `g_w = r1·(g − m_g) + b·m_f + (1 − b)·m_g`, `r1 = c·s_f / (c·s_g + (1 − c)·s_f)`, which is the same as

@@ -1,5 +1,5 @@
-//! Mattes mutual information between a fixed and a translated moving image (Mattes et al. 2001; ALGORITHMS.md
-//! §5, as ITK v3 `MattesMutualInformationImageToImageMetric`), the similarity of the fine patch registration
+//! Mattes mutual information between a fixed and a translated moving image (Mattes et al. 2001, as ITK v3
+//! `MattesMutualInformationImageToImageMetric`), the similarity of the fine patch registration
 //! (thesis 4.4.6).
 //!
 //! - A fixed sample set of fixed-image pixels is drawn once ([`MattesMi::new`]): all valid pixels, or `N`
@@ -51,7 +51,7 @@ pub enum MiError {
     MaximumOnBorder(f64, f64),
 }
 
-/// Cubic B-spline kernel β3(u) (ALGORITHMS.md §5).
+/// Cubic B-spline kernel β3(u) (Mattes et al. 2001; Styner et al. 2000).
 #[inline]
 pub fn bspline3(u: f64) -> f64 {
     let a = u.abs();

@@ -1,5 +1,5 @@
 //! Normalised cross-correlation template matching with OpenCV `TM_CCOEFF_NORMED` semantics and a sub-pixel
-//! peak (thesis 3.4.4.4: MM↔MM corner tracking; ALGORITHMS.md §12).
+//! peak (thesis 3.4.4.4: MM↔MM corner tracking; OpenCV TM_CCOEFF_NORMED).
 //!
 //! `R(x, y) = Σ T'·I'(x,y) / sqrt(Σ T'² · Σ I'(x,y)²)` over the window whose top-left pixel is (x, y); the map is
 //! `(W − w + 1) × (H − h + 1)`. The numerator is computed directly (Σ T'·I, the template zero-mean) in f64, the

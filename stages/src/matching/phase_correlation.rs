@@ -1,5 +1,5 @@
 //! Phase correlation: translation between two images from the normalised cross-power spectrum
-//! (thesis 3.4.5.3, eq. 3/1; Kuglin & Hines 1975, Reddy & Chatterji 1996; ALGORITHMS.md §4).
+//! (thesis 3.4.5.3, eq. 3/1; Kuglin & Hines 1975, Reddy & Chatterji 1996; Kuglin & Hines 1975; Reddy & Chatterji 1996).
 //!
 //! Convention (same sign and axis order as OpenCV's `phaseCorrelate`): if `moving(x) = reference(x − t)`, i.e.
 //! content at p in `reference` appears at p + t in `moving`, the result is `(dx, dy) = t` in pixels.
@@ -134,7 +134,7 @@ pub fn fft_friendly_size(n: usize) -> usize {
     loop {
         let mut r = m;
         for p in [2, 3, 5] {
-            while r % p == 0 {
+            while r.is_multiple_of(p) {
                 r /= p;
             }
         }
@@ -744,7 +744,7 @@ impl LocalSurface {
                 let e = self.twiddle_x[(kx * x) % pw];
                 let mirrored = if kx == 0 || 2 * kx == pw { 1.0 } else { 2.0 };
                 for (j, s) in sums.iter().enumerate() {
-                    n[j][i] += mirrored * (s.re * e.re - s.im * e.im) as f64;
+                    n[j][i] += mirrored * (s.re * e.re - s.im * e.im);
                 }
             }
         }
@@ -782,7 +782,7 @@ fn find_peak(r: &[Real], pw: usize, ph: usize, fit: PeakFit) -> PhaseShift {
         let y = (py + ph + j - 1) % ph;
         for (i, v) in row.iter_mut().enumerate() {
             let x = (px + pw + i - 1) % pw;
-            *v = r[y * pw + x] as f64;
+            *v = r[y * pw + x];
         }
     }
     peak_from_neighbourhood(&n, px, py, pw, ph, fit)

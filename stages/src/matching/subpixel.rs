@@ -1,5 +1,5 @@
 //! Sub-pixel peak location by a second-order polynomial fit to the 3 × 3 neighbourhood of an integer peak
-//! (thesis 3.4.5.3, eq. 3/1 and the text after it; ALGORITHMS.md §4 gives the least-squares formulas).
+//! (thesis 3.4.5.3, eq. 3/1 and the text after it; Kuglin & Hines 1975; Reddy & Chatterji 1996 gives the least-squares formulas).
 //!
 //! `n[dy + 1][dx + 1]` holds the value at offset (dx, dy) ∈ {−1, 0, 1}² from the integer peak. The fit
 //! `r ≈ a + b·x + c·y + d·x² + e·xy + g·y²` is the least-squares solution on the 9 samples; its vertex is the
@@ -27,7 +27,7 @@ pub fn quadratic_peak_2d(n: &[[f64; 3]; 3]) -> Option<(f64, f64)> {
     let g = (row(0) + row(2) - 2.0 * row(1)) / 6.0;
     // Solve [2d e; e 2g]·δ = −[b; c].
     let det = 4.0 * d * g - e * e;
-    if !(d < 0.0 && g < 0.0 && det > 0.0) || !det.is_finite() {
+    if !(d < 0.0 && g < 0.0 && det > 0.0 && det.is_finite()) {
         return None;
     }
     let dx = (-b * 2.0 * g + c * e) / det;

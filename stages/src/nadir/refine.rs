@@ -129,7 +129,7 @@ pub fn cut_ortho_template(
     out.data.clear();
     for row in y0 as usize..y0 as usize + size {
         let start = row * ortho.image.width + x0 as usize;
-        if ortho.valid[start..start + size].iter().any(|&v| v == 0) {
+        if ortho.valid[start..start + size].contains(&0) {
             return false;
         }
         out.data

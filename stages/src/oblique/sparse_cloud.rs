@@ -216,7 +216,7 @@ fn side_cloud(
 }
 
 /// The sparse cloud of the triplet `recs` (trajectory order; `panos[i]` is the panorama of `recs[i]`).
-/// Parameters are assumed valid ([`SparseCloudParams::validate`]).
+/// Parameters are assumed valid ([`Params::validate`](crate::params::Params::validate)).
 pub fn sparse_cloud(
     recs: [&Recording; 3],
     panos: [&GrayImage; 3],

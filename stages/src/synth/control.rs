@@ -9,6 +9,10 @@ use crate::campaign::{CheckPoint, Observation, Recording};
 use crate::geometry::PanoramaCamera;
 use nalgebra::Vector3;
 
+/// A check-point candidate: position along the route (m), id, world position, and its observations as
+/// (recording index, (u, v) px).
+type ScoredCandidate = (f64, String, Vector3<f64>, Vec<(usize, (f64, f64))>);
+
 /// Largest gap (m) between the distance to the first hit and to the point for it to count as visible.
 const VISIBILITY_TOLERANCE_M: f64 = 0.05;
 
@@ -88,7 +92,7 @@ pub fn plan_control(
         return ControlSet::default();
     }
     // Candidates with their position along the route (that of the nearest panorama) and observations.
-    let mut scored: Vec<(f64, String, Vector3<f64>, Vec<(usize, (f64, f64))>)> = Vec::new();
+    let mut scored: Vec<ScoredCandidate> = Vec::new();
     for (kind, p) in scene.checkpoint_candidates() {
         let (nearest, d2) = recordings
             .iter()

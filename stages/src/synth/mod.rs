@@ -3,7 +3,7 @@
 //! by a named error [`profile`], true poses, check points and their observations, written in the campaign
 //! format. It is skytie's embedded default data and the judge of every stage.
 //!
-//! Entry points: [`generate`] / [`generate_preset`] (or the two steps [`render_campaign`] and
+//! Entry points: [`generate`](mod@generate) / [`generate_preset`] (or the two steps [`render_campaign`] and
 //! [`apply_profile`]); the pieces ([`render`], [`aerial_plan`], [`trajectory`], [`profile`], [`control`],
 //! [`postprocess`], [`vehicle`]) are public for tests and benchmarks.
 

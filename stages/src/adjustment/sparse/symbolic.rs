@@ -24,9 +24,9 @@ pub enum Slot {
 /// The structure of L for a pattern and an ordering.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Symbolic {
-    /// perm[new] = old.
+    /// `perm[new] = old`.
     perm: Vec<usize>,
-    /// inverse[old] = new.
+    /// `inverse[old] = new`.
     inverse: Vec<usize>,
     /// Elimination-tree parent (new numbering), `usize::MAX` for a root.
     parent: Vec<usize>,
@@ -74,7 +74,7 @@ impl Symbolic {
         self.perm.len()
     }
 
-    /// perm[new] = old.
+    /// `perm[new] = old`.
     pub fn perm(&self) -> &[usize] {
         &self.perm
     }

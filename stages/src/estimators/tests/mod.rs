@@ -1,4 +1,4 @@
-//! Known-answer tests of the estimators (ALGORITHMS.md §11).
+//! Known-answer tests of the estimators (Hartley & Zisserman 2004, ch. 4).
 
 mod ransac_homography_tests;
 mod ransac_similarity_tests;

@@ -1,4 +1,4 @@
-//! RANSAC homography (ALGORITHMS.md §11 KAT): 40 % outliers, noisy inliers, degenerate samples, determinism.
+//! RANSAC homography (Hartley & Zisserman 2004, ch. 4 KAT): 40 % outliers, noisy inliers, degenerate samples, determinism.
 
 use crate::estimators::{ransac, RansacParams, SplitMix64};
 use crate::geometry::{Homography, PointPair};

@@ -1,4 +1,4 @@
-//! RANSAC similarity (ALGORITHMS.md §11 KAT): 50 % outliers, noisy inliers, determinism.
+//! RANSAC similarity (Hartley & Zisserman 2004, ch. 4 KAT): 50 % outliers, noisy inliers, determinism.
 
 use crate::estimators::{ransac, ransac_filtered, RansacParams, SplitMix64};
 use crate::geometry::{PointPair, Similarity2};

@@ -5,7 +5,7 @@ use crate::params::Params;
 
 #[test]
 fn trial_counts_match_the_formula() {
-    // ALGORITHMS.md §11: p = 0.99, w = 0.5 → 17 (s = 2) and 72 (s = 4).
+    // Hartley & Zisserman 2004, ch. 4: p = 0.99, w = 0.5 → 17 (s = 2) and 72 (s = 4).
     assert_eq!(required_iterations(0.99, 0.5, 2), 17);
     assert_eq!(required_iterations(0.99, 0.5, 4), 72);
     assert_eq!(required_iterations(0.99, 1.0, 4), 0);

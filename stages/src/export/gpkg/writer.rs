@@ -344,7 +344,13 @@ mod tests {
             code: 28992,
             definition: None,
         };
-        write_geopackage(&p, &srs, &[layer.clone()], "2020-01-01T00:00:00.000Z").unwrap();
+        write_geopackage(
+            &p,
+            &srs,
+            std::slice::from_ref(&layer),
+            "2020-01-01T00:00:00.000Z",
+        )
+        .unwrap();
         let first = std::fs::read(&p).unwrap();
         write_geopackage(&p, &srs, &[layer], "2020-01-01T00:00:00.000Z").unwrap();
         assert_eq!(first, std::fs::read(&p).unwrap(), "deterministic bytes");

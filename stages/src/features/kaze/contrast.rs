@@ -1,4 +1,4 @@
-//! Contrast factor k of the conductance (ALGORITHMS.md §1, KAZE paper §4.1): the `percentile` point of the
+//! Contrast factor k of the conductance (Alcantarilla, Bartoli & Davison 2012, KAZE paper §4.1): the `percentile` point of the
 //! gradient-magnitude histogram of the Gaussian-smoothed base level.
 
 use crate::imaging::gaussian::gaussian_blur;

@@ -1,4 +1,4 @@
-//! M-SURF descriptor of KAZE (ALGORITHMS.md §1 "Descriptor"; Agrawal et al. 2008 as used by KAZE; thesis
+//! M-SURF descriptor of KAZE (Alcantarilla, Bartoli & Davison 2012 "Descriptor"; Agrawal et al. 2008 as used by KAZE; thesis
 //! 3.4.5.2 uses the extended, upright variant).
 //!
 //! With s = round(σ) and the keypoint frame rotated by θ (θ = 0 when upright): a 4×4 grid of sub-regions

@@ -1,4 +1,4 @@
-//! KAZE keypoint detector (ALGORITHMS.md §1 "Detector"; KAZE paper §4.2): 3×3×3 maxima of the
+//! KAZE keypoint detector (Alcantarilla, Bartoli & Davison 2012 "Detector"; KAZE paper §4.2): 3×3×3 maxima of the
 //! scale-normalised det(Hessian) above a threshold, duplicate suppression across neighbouring levels, and
 //! sub-pixel / sub-scale refinement by a quadratic fit.
 //!

@@ -1,4 +1,4 @@
-//! Nonlinear diffusion of the KAZE scale space (ALGORITHMS.md §1; KAZE paper §3–4; thesis 3.4.4.2 uses it
+//! Nonlinear diffusion of the KAZE scale space (Alcantarilla, Bartoli & Davison 2012; KAZE paper §3–4; thesis 3.4.4.2 uses it
 //! through KAZE): conductance images, the AOS scheme with a Thomas tridiagonal solver, and Fast Explicit
 //! Diffusion (FED) cycles.
 //!
@@ -243,7 +243,10 @@ pub fn fed_step_sizes(total_time: f64) -> Vec<f64> {
 }
 
 fn is_prime(n: usize) -> bool {
-    n >= 2 && (2..).take_while(|d| d * d <= n).all(|d| n % d != 0)
+    n >= 2
+        && (2..)
+            .take_while(|d| d * d <= n)
+            .all(|d| !n.is_multiple_of(d))
 }
 
 /// One explicit step L ← L + τ · Σ_q ½(g_p + g_q)(L_q − L_p), written into `out`. Per pixel the flux sums

@@ -1,7 +1,7 @@
 //! KAZE features (Alcantarilla, Bartoli, Davison, ECCV 2012): nonlinear-scale-space detector and M-SURF
 //! descriptor, as used by skytie's nadir pipeline (thesis 3.4.4.2: MM↔MM ortho homography, upright, one
 //! octave; thesis 3.4.5.2: MM↔aerial after Wallis, extended 128, upright, one octave).
-//! Specification: ALGORITHMS.md §1.
+//! Specification: Alcantarilla, Bartoli & Davison 2012.
 //!
 //! Pixel convention (campaign-format.md): keypoint (u, v) are continuous pixel coordinates with the centre
 //! of the first pixel at (0.5, 0.5). A maximum found at array index (col, row) is at (col + 0.5, row + 0.5)

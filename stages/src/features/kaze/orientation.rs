@@ -1,4 +1,4 @@
-//! Dominant orientation of a KAZE keypoint (ALGORITHMS.md §1 "Orientation"; SURF-style, KAZE paper §4.3).
+//! Dominant orientation of a KAZE keypoint (Alcantarilla, Bartoli & Davison 2012 "Orientation"; SURF-style, KAZE paper §4.3).
 //!
 //! With s = round(σ): derivative samples (Lx, Ly) of the keypoint's level at the pixels containing
 //! (u + i·s, v + j·s), integer i, j with i² + j² < 36 (109 samples), Gaussian-weighted (σ = 2.5·s) by the

@@ -1,9 +1,9 @@
-//! KAZE parameters (ALGORITHMS.md §1 table; defaults = OpenCV `KAZE::create`, thesis 3.4.5.2 overrides
+//! KAZE parameters (Alcantarilla, Bartoli & Davison 2012 table; defaults = OpenCV `KAZE::create`, thesis 3.4.5.2 overrides
 //! upright / extended / one octave per stage).
 
 use serde::{Deserialize, Serialize};
 
-/// Conductance function g(|∇Lσ|²/k²) of the nonlinear diffusion (ALGORITHMS.md §1).
+/// Conductance function g(|∇Lσ|²/k²) of the nonlinear diffusion (Alcantarilla, Bartoli & Davison 2012).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Diffusivity {
     /// Perona–Malik 1 ("sharpedge"): g = exp(−m).

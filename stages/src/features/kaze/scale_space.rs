@@ -1,4 +1,4 @@
-//! The KAZE nonlinear scale space (ALGORITHMS.md §1, thesis 3.4.4.2 / 3.4.5.2): N = O·S full-resolution
+//! The KAZE nonlinear scale space (Alcantarilla, Bartoli & Davison 2012, thesis 3.4.4.2 / 3.4.5.2): N = O·S full-resolution
 //! levels at σ_i = σ0·2^(o + s/S), evolution time t_i = σ_i²/2, each level diffused from the previous one
 //! with the conductance of the previous one (FED or AOS), plus the scale-normalised derivatives and the
 //! det(Hessian) response the detector, orientation and descriptor need.

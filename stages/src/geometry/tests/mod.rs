@@ -1,4 +1,4 @@
-//! Known-answer tests of the geometry core (campaign-format.md conventions, ALGORITHMS.md §10–11).
+//! Known-answer tests of the geometry core (campaign-format.md conventions, Hartley & Zisserman 2004).
 
 mod closest_approach_tests;
 mod frame_tests;

@@ -172,7 +172,7 @@ fn pixel_ray_pixel_round_trip_dense_grid() {
             }
         }
     }
-    // Away from the poles the round trip is far better than required (ALGORITHMS.md §10 asks 1e-9).
+    // Away from the poles the round trip is far better than required (Hartley & Zisserman 2004, ch. 12 asks 1e-9).
     assert!(worst < 1e-6);
 }
 

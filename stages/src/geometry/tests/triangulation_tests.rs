@@ -58,7 +58,7 @@ fn two_skew_rays_match_the_closed_form() {
     let d2 = Vector3::new(-10.0, 10.0, -0.01).normalize();
     let rays = [Ray::new(c1, d1), Ray::new(c2, d2)];
     let t = triangulate_rays(&rays, &[1e-3, 1e-3]).unwrap();
-    // Closed form (ALGORITHMS.md §10).
+    // Closed form (Hartley & Zisserman 2004, ch. 12).
     let b = d1.dot(&d2);
     let w0 = c1 - c2;
     let (p, q) = (d1.dot(&w0), d2.dot(&w0));
@@ -129,7 +129,7 @@ fn perturb(d: &Vector3<f64>, sigma: f64, rng: &mut SplitMix64) -> Vector3<f64> {
 
 #[test]
 fn monte_carlo_covariance_matches_prediction() {
-    // ALGORITHMS.md §10 KAT: 10 000 trials with angular noise; empirical covariance ≈ N⁻¹ (5 %), σ̂0² ≈ 1.
+    // Hartley & Zisserman 2004, ch. 12 KAT: 10 000 trials with angular noise; empirical covariance ≈ N⁻¹ (5 %), σ̂0² ≈ 1.
     let x = rd_point();
     let centres = street_centres(4, 1.0);
     let sigma = [2e-3, 1e-3, 1e-3, 3e-3];

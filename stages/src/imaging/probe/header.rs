@@ -60,7 +60,7 @@ pub enum Layout {
     },
 }
 
-/// What [`probe`] found out about an image file.
+/// What [`probe`](super::probe) found out about an image file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct ImageHeader {
     pub format: ImageFormat,

@@ -70,8 +70,9 @@ fn locate(
     let half = p.template_half_px;
     let (sc, sr) = (corner.u_px.floor() as i64, corner.v_px.floor() as i64);
     let (dc, dr) = (predicted.0.floor() as i64, predicted.1.floor() as i64);
-    if !(predicted.0.is_finite() && predicted.1.is_finite())
-        || !nb.valid.square_valid(dc, dr, half as i64 + radius as i64)
+    if !(predicted.0.is_finite()
+        && predicted.1.is_finite()
+        && nb.valid.square_valid(dc, dr, half as i64 + radius as i64))
     {
         return None;
     }

@@ -1,5 +1,5 @@
 //! Template matching of one corner between two ortho images (thesis 3.4.4.4): normalised cross-correlation
-//! (OpenCV `TM_CCOEFF_NORMED` semantics, ALGORITHMS.md §12) of a square template around a corner in the
+//! (OpenCV `TM_CCOEFF_NORMED` semantics, OpenCV TM_CCOEFF_NORMED) of a square template around a corner in the
 //! detecting image over a small square search range in the neighbour, with a sub-pixel peak from the 3 × 3
 //! quadratic fit (`matching::subpixel`). Also the validity index that tells whether a box of an ortho image is
 //! free of masked (vehicle) pixels.

@@ -5,7 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 
-/// How the non-uniform box grid (thesis 4.4.4, ALGORITHMS.md §9) splits a box that holds too many points.
+/// How the non-uniform box grid (thesis 4.4.4, Pomerleau et al. 2013) splits a box that holds too many points.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum ThinningSplit {
     /// At the median point along the longest box dimension (libpointmatcher): every leaf keeps ⌈K/2⌉..K

@@ -1,4 +1,4 @@
-//! Non-uniform box-grid thinning of a plane's inliers (thesis 4.4.4; Pomerleau et al. 2013; ALGORITHMS.md §9).
+//! Non-uniform box-grid thinning of a plane's inliers (thesis 4.4.4; Pomerleau et al. 2013; Pomerleau et al. 2013).
 //!
 //! A box holding more than K points is split along its longest dimension — at the median point
 //! ([`ThinningSplit::Median`]: left gets n − ⌊n/2⌋ points) or at the spatial midpoint

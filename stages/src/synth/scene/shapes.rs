@@ -238,7 +238,10 @@ pub fn sphere_hit(
 }
 
 /// Vertical cylinder (axis through (cx, cy), radius r, from z0 to z1): nearest hit on the side or caps.
+/// The shape's five numbers and the ray's four are passed flat, like the other `*_hit` primitives, because
+/// this runs per ray and per object in the renderer's inner loop.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 pub fn cylinder_hit(
     cx: f64,
     cy: f64,
