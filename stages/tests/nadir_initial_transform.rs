@@ -485,7 +485,7 @@ fn evaluate_campaign(root: &Path, p: &TransformParams) -> CampaignStats {
                 worst = worst.max((est.x - truth_px.0).hypot(est.y - truth_px.1));
             }
             stats.max_point_error_px.push(worst);
-            let offset = centre_offset_world(&t.ortho_to_aerial, &ortho.georef, &cam).unwrap();
+            let offset = centre_offset_world(&t.ortho_to_aerial, &ortho.georef, cam).unwrap();
             stats
                 .offset_error_m
                 .push((offset[0] + error[0]).hypot(offset[1] + error[1]));

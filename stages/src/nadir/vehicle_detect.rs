@@ -214,7 +214,7 @@ fn fit_box(
     let front = pick(&ahead, &|p| p[0])?;
     let rear = pick(&behind, &|p| -p[0])?;
     let half_width = pick(&sides, &|p| p[1].abs())?;
-    (front > 0.0 && rear > 0.0 && half_width > 0.0).then(|| VehicleMask {
+    (front > 0.0 && rear > 0.0 && half_width > 0.0).then_some(VehicleMask {
         enabled: true,
         detect: true,
         roof_drop_m,

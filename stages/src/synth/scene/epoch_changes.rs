@@ -96,6 +96,7 @@ pub fn cones(r: &Roadworks, axis: StreetAxis, ground_z: impl Fn(f64, f64) -> f64
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::synth::scene::objects::IN_AERIAL;
 
     #[test]
     fn roadworks_lie_on_the_oncoming_lane_within_the_street_and_have_one_epoch() {

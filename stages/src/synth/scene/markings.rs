@@ -211,13 +211,17 @@ pub struct StreetMarkingInput {
     pub manhole_phase: f64,
 }
 
+/// A painted element with its bounding box (s_min, s_max, q_min, q_max in street coordinates, m) and the epochs
+/// it is painted in.
+type PlacedPaint = (Paint, (f64, f64, f64, f64), u8);
+
 /// All markings of one street.
 #[derive(Clone, Debug)]
 pub struct StreetMarkings {
     pub axis: StreetAxis,
     half_width_m: f64,
     /// Each element with its bounding box and the epochs it is painted in.
-    paints: Vec<(Paint, (f64, f64, f64, f64), u8)>,
+    paints: Vec<PlacedPaint>,
     manholes: Vec<(f64, f64)>,
 }
 
