@@ -9,7 +9,7 @@ use std::path::PathBuf;
 /// Arguments of `skytie check`.
 #[derive(Args, Debug)]
 pub struct CheckArgs {
-    /// The campaign folder (see shared/docs/campaign-format.md).
+    /// The campaign folder (see docs/campaign-format.md).
     pub campaign: PathBuf,
     /// Print the report as JSON instead of text.
     #[arg(long)]

@@ -97,7 +97,7 @@ pub fn tables() -> Vec<ParamTable> {
         ),
         table::<RefineParams>(
             nadir::refine::STAGE,
-            "refine the transform by mutual-information registration of patches (thesis 3.4.5.3)",
+            "locate the tie points in the aerial image by phase correlation (thesis 3.4.5.3)",
         ),
         table::<ControlParams>(
             nadir::control_points::STAGE,

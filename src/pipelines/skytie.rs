@@ -90,7 +90,7 @@ impl Pipeline for SkytiePipeline {
         let inputs = metadata_inputs(&root);
         if inputs.is_empty() {
             return Err(PipelineError::Input(format!(
-                "{}: not a campaign (no campaign.toml or mm/recordings.csv; see shared/docs/campaign-format.md)",
+                "{}: not a campaign (no campaign.toml or mm/recordings.csv; see docs/campaign-format.md)",
                 root.display()
             )));
         }

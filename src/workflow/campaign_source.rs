@@ -1,5 +1,5 @@
 //! Where a workflow's campaign comes from: a campaign folder on disk, or the synthetic generator
-//! (`campaign = "synth:demo"`), see docs/campaign-format.md.
+//! (`campaign = "synth:demo"`), see `docs/campaign-format.md`.
 
 use std::path::{Path, PathBuf};
 

@@ -2,7 +2,7 @@
 //!
 //! Layers (bottom to top): [`geometry`] (cameras, rotations, triangulation, 2-D transforms),
 //! [`imaging`] (image buffers, sampling, filters), [`campaign`] (the input/output contract of
-//! `shared/docs/campaign-format.md`), [`synth`] (the synthetic campaign generator). The engine in the
+//! `docs/campaign-format.md`), [`synth`] (the synthetic campaign generator). The engine in the
 //! root crate wraps the stages built from these as cached DAG nodes.
 
 pub mod adjustment;

@@ -1,4 +1,4 @@
-//! The campaign contract (shared/docs/campaign-format.md): model, reading with validation, writers.
+//! The campaign contract (docs/campaign-format.md): model, reading with validation, writers.
 
 pub mod accounting;
 pub mod cameras;

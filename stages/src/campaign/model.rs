@@ -1,4 +1,4 @@
-//! In-memory model of a campaign (shared/docs/campaign-format.md): one struct per CSV row kind.
+//! In-memory model of a campaign (docs/campaign-format.md): one struct per CSV row kind.
 //!
 //! Units: world coordinates in metres (f64, projected frame X = east, Y = north, Z = up), angles in degrees,
 //! pixels in continuous pixel coordinates. Field names carry units where the CSV column name does not.

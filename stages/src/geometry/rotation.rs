@@ -1,4 +1,4 @@
-//! Rotation matrices of the campaign contract (shared/docs/campaign-format.md).
+//! Rotation matrices of the campaign contract (docs/campaign-format.md).
 //!
 //! - Elementary right-handed rotations `Rx`, `Ry`, `Rz` about the world axes X (east), Y (north), Z (up).
 //! - Aerial attitude ω-φ-κ: `R = Rx(ω)·Ry(φ)·Rz(κ)` maps camera-frame vectors to world-frame vectors.

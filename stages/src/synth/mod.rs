@@ -1,7 +1,7 @@
 //! The synthetic urban campaign: a procedural street scene (by "scene": [`scene`], [`noise`], [`texture`])
 //! rendered into mobile-mapping panoramas and aerial nadir/oblique frames, with recorded tables made erroneous
 //! by a named error [`profile`], true poses, check points and their observations, written in the campaign
-//! format. It is skytie's embedded default data and the judge of every stage.
+//! format (docs/campaign-format.md). It is skytie's embedded default data and the judge of every stage.
 //!
 //! Entry points: [`generate`](mod@generate) / [`generate_preset`] (or the two steps [`render_campaign`] and
 //! [`apply_profile`]); the pieces ([`render`], [`aerial_plan`], [`trajectory`], [`profile`], [`control`],
