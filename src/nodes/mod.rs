@@ -26,5 +26,5 @@ pub use campaign::load::{
     CampaignSnapshot, LoadCampaign, LoadCampaignParams, SelectRecording, SelectRecordingParams,
 };
 pub use campaign::summary::{CampaignSummary, SummarizeCampaign, SummaryParams};
-pub use campaign::synth::{GeneratedCampaign, SynthCampaign, SynthParams};
+pub use campaign::synth::{GeneratedCampaign, RenderCampaign, SynthCampaign, SynthParams};
 pub use nadir::ortho::OrthoProject;

@@ -248,7 +248,7 @@ fn pano_match(rec: &Recording, u: f64, v: f64, px: [f64; 2]) -> PatchMatch {
 #[test]
 fn with_the_scene_the_reference_is_the_seen_surface_and_hidden_points_are_non_matchable() {
     // The tiny preset's scene; a panorama on its route looking sideways at a façade 2 m above the road.
-    let scenes = build_scenes(Preset::Tiny, 3);
+    let scenes = build_scenes(Preset::Tiny, 3, None);
     let route = along_polyline(scenes[0].route_world(), 5.0);
     let (p, q) = (route[route.len() / 2], route[route.len() / 2 + 1]);
     let ground = scenes[0].ground_height_m(p[0], p[1]);
