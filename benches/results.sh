@@ -24,8 +24,9 @@ BIN="${CARGO_TARGET_DIR:-$REPO/target}/release/skytie"
 TIME=/usr/bin/time
 [ -x "$TIME" ] || { echo "GNU time ($TIME) is needed: apt-get install time" >&2; exit 1; }
 
-# runs.tsv: label, command shown to the reader, workflow argument, exit code, wall s, peak KiB, rerun exit code,
-# rerun wall s, output folder, rerun output folder, workflow file text (escaped newlines) or "-"
+# runs.tsv: label, command shown to the reader, workflow argument, exit code, wall s, peak KiB, CPU s, load average
+# at the start, rerun exit code, rerun wall s, output folder, rerun output folder, workflow file text (escaped
+# newlines) or "-"
 RUNS="$WORK/runs.tsv"
 : > "$RUNS"
 
@@ -35,17 +36,20 @@ run() {
     local cache="$WORK/$label/cache" out="$WORK/$label/out" out2="$WORK/$label/out-rerun"
     mkdir -p "$WORK/$label"
     echo "== $label: $shown"
-    local code=0 code2=0
-    (cd "$WORK/$label" && "$TIME" -f "%e %M" -o "$WORK/$label/time" \
+    local code=0 code2=0 load
+    load="$(cut -d' ' -f1 /proc/loadavg 2>/dev/null || echo '?')"
+    (cd "$WORK/$label" && "$TIME" -f "%e %M %U %S" -o "$WORK/$label/time" \
         "$BIN" run "$wf" --cache "$cache" --out "$out" --quiet >"$WORK/$label/log" 2>&1) || code=$?
     tail -n 12 "$WORK/$label/log"
     (cd "$WORK/$label" && "$TIME" -f "%e %M" -o "$WORK/$label/time-rerun" \
         "$BIN" run "$wf" --cache "$cache" --out "$out2" --quiet >"$WORK/$label/log-rerun" 2>&1) || code2=$?
     # GNU time writes "Command exited with non-zero status N" before the measurement when the exit code is not 0.
-    read -r wall rss < <(tail -n 1 "$WORK/$label/time")
+    read -r wall rss user sys < <(tail -n 1 "$WORK/$label/time")
+    local cpu
+    cpu="$(python3 -c "print(round($user + $sys, 1))")"
     read -r wall2 _ < <(tail -n 1 "$WORK/$label/time-rerun")
-    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$label" "$shown" "$wf" "$code" "$wall" "$rss" \
-        "$code2" "$wall2" "$out" "$out2" "$text" >> "$RUNS"
+    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$label" "$shown" "$wf" "$code" "$wall" \
+        "$rss" "$cpu" "$load" "$code2" "$wall2" "$out" "$out2" "$text" >> "$RUNS"
 }
 
 run tiny "skytie run tiny" tiny "-"
@@ -78,7 +82,8 @@ runs = []
 for line in open(runs_file, encoding="utf-8"):
     f = line.rstrip("\n").split("\t")
     runs.append(dict(label=f[0], shown=f[1], wf=f[2], code=int(f[3]), wall=float(f[4]), rss_kib=int(f[5]),
-                     code2=int(f[6]), wall2=float(f[7]), out=f[8], out2=f[9], text=f[10]))
+                     cpu=float(f[6]), load=f[7], code2=int(f[8]), wall2=float(f[9]), out=f[10], out2=f[11],
+                     text=f[12]))
 
 def metrics(path):
     with open(os.path.join(path, "metrics.json"), encoding="utf-8") as fh:
@@ -127,15 +132,18 @@ w("")
 w("## Runs")
 w("")
 w("Each run starts with an empty cache (`--cache` of its own) and includes generating the synthetic campaign; the")
-w("rerun is the same command on the warm cache. Wall time and peak memory are measured by GNU time, one run")
-w("each; wall times vary with whatever else the machine is doing.")
+w("rerun is the same command on the warm cache. Wall time, CPU time (user + system, all threads) and peak memory")
+w("are measured by GNU time, one run each. Wall time grows with whatever else the machine is doing (the load")
+w("average when the run started is given); CPU time hardly does.")
 w("")
-w("| run | command | exit | wall, fresh cache | peak memory | nodes | rerun: wall | rerun: nodes executed |")
-w("|---|---|---|---|---|---|---|---|")
+w("| run | command | exit | wall, fresh cache | CPU time | load average | peak memory | nodes | rerun: wall | "
+  "rerun: nodes executed |")
+w("|---|---|---|---|---|---|---|---|---|---|")
 for r in runs:
     e, e2 = r["m"]["engine"], r["m2"]["engine"]
     w(f"| {r['label']} | `{r['shown']} --cache CACHE --out OUT` | {r['code']} | {r['wall']:.0f} s | "
-      f"{r['rss_kib'] / 1024:.0f} MiB | {e['nodes_total']} | {r['wall2']:.1f} s | {e2['nodes_executed']} |")
+      f"{r['cpu']:.0f} s | {r['load']} | {r['rss_kib'] / 1024:.0f} MiB | {e['nodes_total']} | "
+      f"{r['wall2']:.1f} s | {e2['nodes_executed']} |")
 w("")
 for r in runs:
     if r["text"] != "-":

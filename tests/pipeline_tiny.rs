@@ -1,7 +1,9 @@
 //! End-to-end on the real `skytie` binary and the tiny synthetic campaign: `synth` + `check` are clean, the
 //! `synth:` workflow node generates the same bytes as the CLI, a second run executes nothing, and adding one
 //! recording to a user campaign re-runs only that recording's nodes, and the shipped full chain
-//! (`workflows/tiny.toml`) runs through registration, adjustment, verification and the exports.
+//! (`workflows/tiny.toml`) runs through registration, adjustment, verification and the exports — with nadir
+//! results that must hold (MM tie points correct against the truth, initial transforms accepted) and the
+//! delivered files following the adjustment's verdict.
 
 #[path = "support/cli.rs"]
 mod cli;
@@ -49,10 +51,44 @@ fn write_workflow(dir: &Path, campaign: &str, gsd_m: f64) -> PathBuf {
     let wf = dir.join(format!("wf-{gsd_m}.toml"));
     std::fs::write(
         &wf,
-        format!("name = \"t\"\ncampaign = \"{campaign}\"\nseed = 1\nstages = [\"synth\", \"load\", \"ortho\", \"summary\"]\n[ortho]\ngsd_m = {gsd_m}\n"),
+        // The vehicle box as given: a detected box depends on the sampled panoramas, so a campaign that grows
+        // by a recording may get a slightly different mask and re-run every ortho image (correctly: the mask
+        // changed); this workflow checks the per-recording caching alone.
+        format!("name = \"t\"\ncampaign = \"{campaign}\"\nseed = 1\nstages = [\"synth\", \"load\", \"ortho\", \"summary\"]\n[ortho]\ngsd_m = {gsd_m}\n[ortho.vehicle]\ndetect = false\n"),
     )
     .unwrap();
     wf
+}
+
+/// What the tiny campaign (seed 1, thesis profile: 0.80 m systematic + N(0, 0.10 m)) must reach in the nadir
+/// chain up to the initial transforms: measured 62 MM tie points (61 correct against the truth), 7 of 14
+/// initial transforms accepted. The refinement's default peak threshold (0.75) locates too few tie points in
+/// tiny's 1024-px panoramas for aerial control (0 control points; with `[refine] min_peak = 0.5`: 15
+/// correspondences, 5 control points, check points 0.740 → 0.532 m), so the correction itself is not asserted
+/// here; the exit code and the delivered files follow the adjustment's verdict.
+fn registration_holds(m: &serde_json::Value) {
+    let n = &m["nadir"];
+    let num = |k: &str| {
+        n[k].as_f64()
+            .unwrap_or_else(|| panic!("nadir.{k} missing in {m}"))
+    };
+    assert!(num("mm_tie_points") >= 40.0, "MM tie points: {n}");
+    assert!(
+        num("mm_tie_points_correct") >= 0.9 * num("mm_tie_points_graded"),
+        "MM tie points against the truth: {n}"
+    );
+    assert!(
+        num("transforms_accepted") >= 5.0 && num("transforms_tried") >= 10.0,
+        "initial transforms: {n}"
+    );
+    // The deterioration shows at the check points before the adjustment.
+    let cp0 = m["adjust"]["combined"]["checkpoints"]["before"]["2d"]
+        .as_f64()
+        .unwrap_or_else(|| panic!("check points missing in {m}"));
+    assert!(
+        cp0 > 0.5,
+        "the deterioration must show at the check points: {cp0}"
+    );
 }
 
 #[test]
@@ -91,9 +127,11 @@ fn tiny_campaign_end_to_end() {
         .map(|e| e.unwrap().path().join("campaign"))
         .filter(|p| p.join("campaign.toml").is_file())
         .collect();
-    assert_eq!(generated.len(), 1);
+    // Two folders: the error-free rendering and the campaign with the error profile applied to it.
+    assert_eq!(generated.len(), 2, "{generated:?}");
+    let camp_files = files(&camp);
     assert!(
-        files(&generated[0]) == files(&camp),
+        generated.iter().any(|g| files(g) == camp_files),
         "the synth node's campaign differs from `skytie synth`'s"
     );
     let m = run_workflow(&wf, &cache, &out);
@@ -146,7 +184,7 @@ fn tiny_campaign_end_to_end() {
     }
     assert!(m["nadir"]["mm_tie_points"].as_u64().unwrap() > 0, "{m}");
     assert!(m["nadir"]["transforms_tried"].as_u64().unwrap() > 0, "{m}");
-    assert!(m["nadir"]["inlier_ratio"].is_number(), "{m}");
+    registration_holds(&m);
     assert_eq!(
         m["adjust"]["combined"]["recordings"]["after"]["count"].as_u64(),
         Some(recordings),
@@ -167,6 +205,13 @@ fn tiny_campaign_end_to_end() {
         m["oblique"]["inlier_ratio_after_consensus"].is_number(),
         "{m}"
     );
+    // Each street side's oblique correspondences are reported, so a side without façade matches shows.
+    for side in ["left", "right"] {
+        assert!(
+            m["oblique"]["sides"][side]["correspondences"].is_u64(),
+            "{m}"
+        );
+    }
     // The generator wrote truth/scene.toml, so the grading compares with the seen surface and can tell
     // non-matchable correspondences (a count, not null).
     assert_eq!(
@@ -174,11 +219,9 @@ fn tiny_campaign_end_to_end() {
         "{m}"
     );
     assert!(m["oblique"]["non_matchable"].is_u64(), "{m}");
-    // The adjusted trajectory is delivered only when the adjustment corrected something; otherwise the run
-    // says so (exit 3, verdict in the metrics) and withholds it.
-    let corrected = m["adjust"]
-        .to_string()
-        .contains("\"verdict\":\"corrected\"");
+    // The adjusted trajectory is delivered exactly when the adjustment corrected something (verdict
+    // `corrected`); otherwise the run says so (exit 3) and withholds it.
+    let corrected = m["adjust"]["combined"]["verdict"].as_str() == Some("corrected");
     assert_eq!(
         out3.join("trajectory_adjusted.csv").is_file(),
         corrected,

@@ -9,6 +9,7 @@ pub mod builtin_workflows;
 pub mod cache;
 pub mod check;
 pub mod common;
+pub mod eval;
 pub mod explain;
 pub mod import;
 pub mod init;
@@ -51,6 +52,8 @@ pub enum Command {
     Synth(synth::SynthArgs),
     /// Validate a campaign folder and list every problem.
     Check(check::CheckArgs),
+    /// Held-out evaluation: presets × error profiles × seeds, one table, compared with a baseline.
+    Eval(eval::EvalArgs),
     /// Every workflow parameter with default, unit, range and meaning (`skytie params refine`).
     Params(params::ParamsArgs),
     /// List the built-in workflows, or print one (`show NAME`).
@@ -75,6 +78,7 @@ pub fn main() -> i32 {
         Command::Cache(a) => cache::main(a),
         Command::Synth(a) => synth::main(a),
         Command::Check(a) => check::main(a),
+        Command::Eval(a) => eval::main(a),
         Command::Import(a) => import::main(a),
         Command::Init(a) => init::main(a),
         Command::Tool(t) => tool::main(t),

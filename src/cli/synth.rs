@@ -1,9 +1,11 @@
-//! `skytie synth --preset P --seed N --out DIR`: write a synthetic campaign (campaign-format.md + `truth/`).
+//! `skytie synth --preset P --seed N [--profile thesis+outage…] --out DIR`: write a synthetic campaign
+//! (campaign format + `truth/`) with the named error profile.
 
 use clap::Args;
-use skytie_stages::synth::generate::SizeOptions;
 use skytie_stages::synth::output::{aerial_format_from, parse_size_px};
-use skytie_stages::synth::{generate, Deterioration, Preset, SynthOptions};
+use skytie_stages::synth::profile::COMPONENTS;
+use skytie_stages::synth::sizes::SizeOptions;
+use skytie_stages::synth::{generate, Preset, Profile, SynthOptions};
 use std::path::PathBuf;
 
 /// Arguments of `skytie synth`.
@@ -13,15 +15,19 @@ pub struct SynthArgs {
     /// sensor sizes on a short street).
     #[arg(long, default_value = "demo")]
     pub preset: String,
-    /// Seed of the scene, noise and deterioration (same seed ⇒ byte-identical folder).
+    /// Seed of the scene, noise and errors (same seed ⇒ byte-identical folder).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Output folder (created; an existing synthetic campaign there is replaced, anything else is refused).
+    #[arg(long, required_unless_present = "list_profiles")]
+    pub out: Option<PathBuf>,
+    /// Print the error-profile components and what each does, then exit.
     #[arg(long)]
-    pub out: PathBuf,
-    /// Recorded-position deterioration: thesis (0.80 m systematic + N(0, 0.10 m)) or none.
+    pub list_profiles: bool,
+    /// Error profile: components joined by '+' (thesis, outage, ins, vertical, aerial, lens, lens-unknown,
+    /// epoch), or none, or all; `--list-profiles` prints what each does.
     #[arg(long, default_value = "thesis")]
-    pub deterioration: String,
+    pub profile: String,
     /// Rayon threads (default: all cores). The output does not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
@@ -76,6 +82,12 @@ pub fn main(a: &SynthArgs) -> i32 {
             return 2;
         }
     };
+    let Some(out) = a.out.as_ref().filter(|_| !a.list_profiles) else {
+        for (_, name, what) in COMPONENTS {
+            println!("{name:14} {what}");
+        }
+        return 0;
+    };
     let mut options = SynthOptions::new(preset, a.seed);
     options.panorama_width_px = a.panorama_width;
     options.sizes = match size_options(a, preset) {
@@ -85,15 +97,14 @@ pub fn main(a: &SynthArgs) -> i32 {
             return 2;
         }
     };
-    options.deterioration = match a.deterioration.as_str() {
-        "thesis" => Deterioration::Thesis,
-        "none" => Deterioration::None,
-        other => {
-            eprintln!("error: unknown --deterioration '{other}': use thesis or none");
+    options.profile = match Profile::parse(&a.profile) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: --profile: {e}");
             return 2;
         }
     };
-    let run = || generate(&options, &a.out);
+    let run = || generate(&options, out);
     let result = match a.threads {
         Some(n) => match rayon::ThreadPoolBuilder::new()
             .num_threads(n.max(1))
@@ -120,7 +131,7 @@ pub fn main(a: &SynthArgs) -> i32 {
                 s.observations,
                 s.seconds,
                 s.rays_per_second() / 1e6,
-                a.out.display()
+                out.display()
             );
             0
         }

@@ -17,7 +17,7 @@ pub use builder::{BuildError, Dag, DagBuilder};
 pub use error::StageError;
 pub use executor::{execute, Env, Mode, NodeReport, NodeStatus, Outcome};
 pub use inputs::{optional_all, Handle, InputSet, NodeId, Optional, RawFile, RawFileValue};
-pub use stage::{NodeCtx, Stage};
+pub use stage::{InputsOf, NodeCtx, RunResult, Stage};
 pub mod pipeline;
 pub mod session;
 

@@ -41,6 +41,12 @@ pub trait Stage: Send + Sync + 'static {
     }
 }
 
+/// The input values `Stage::run` of `S` receives (what its `Inputs` resolve to).
+pub type InputsOf<S> = <<S as Stage>::Inputs as InputSet>::Values;
+
+/// What `Stage::run` of `S` returns.
+pub type RunResult<S> = Result<<S as Stage>::Output, StageError>;
+
 /// What a running node may know about itself.
 pub struct NodeCtx {
     pub(crate) stage: &'static str,

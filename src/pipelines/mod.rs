@@ -8,6 +8,7 @@ pub mod nadir;
 pub mod oblique;
 pub mod skytie;
 pub mod validate;
+pub mod vehicle;
 
 use crate::dag::{Pipeline, PipelineError};
 use crate::workflow::Workflow;

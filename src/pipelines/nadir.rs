@@ -108,11 +108,11 @@ pub fn add_nadir(
     snapshot: &CampaignSnapshot,
     snap: Handle<CampaignSnapshot>,
     items: &[RecordingItem<'_>],
+    ortho_base: &OrthoParams,
 ) -> Result<NadirHandles, PipelineError> {
     let on = |s: &str| wf.stages.iter().any(|x| x == s);
     let options: NadirOptions = wf.params(stage::NADIR, variant).map_err(wf_err)?;
     let mm_params: MmMatchParams = wf.params(stage::MM_MATCH, variant).map_err(wf_err)?;
-    let ortho_base: OrthoParams = wf.params(stage::ORTHO, variant).map_err(wf_err)?;
     let transform_params: TransformParams = wf.params(stage::TRANSFORM, variant).map_err(wf_err)?;
     let refine_params: RefineParams = wf.params(stage::REFINE, variant).map_err(wf_err)?;
     let control_params: ControlParams = wf.params(stage::CONTROL, variant).map_err(wf_err)?;

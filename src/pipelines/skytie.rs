@@ -2,7 +2,8 @@
 //!
 //! Phases (each built from the values of the previous one — staged planning):
 //! 1. `campaign`: the synthetic generator node when the workflow says `campaign = "synth:<preset>"`;
-//! 2. `load`: read and validate the campaign;
+//! 2. `load`: read and validate the campaign (its images probed by content); then `vehicle`: the recording vehicle found in a sample of the
+//!    panoramas (`pipelines::vehicle`), which masks every ortho image;
 //! 3. `items`, per sweep variant: per recording `recording` → `ortho` (thesis 3.4.3), the nadir chain
 //!    (`pipelines::nadir`, thesis chapter 3), the oblique chain (`pipelines::oblique`, chapter 4), the
 //!    adjustment, grading and verification (`pipelines::adjust`, chapter 5), then the global `summary`.
@@ -11,14 +12,15 @@
 //! A stage name the pipeline does not know is refused with the list of available ones.
 
 use super::validate::add_validated_snapshot;
-use super::{adjust, nadir, oblique, stage, wf_err};
+use super::{adjust, nadir, oblique, stage, vehicle, wf_err};
 use crate::dag::{optional_all, DagBuilder, Pipeline, PipelineError, RawFile, Session};
 use crate::exports::{write_exports, ExportInputs};
 use crate::nodes::campaign::ingest::ingest_file;
 use crate::nodes::campaign::load::{listing_hash, metadata_inputs};
 use crate::nodes::{
-    CampaignSummary, LoadCampaign, LoadCampaignParams, OrthoProject, SelectRecording,
-    SelectRecordingParams, SummarizeCampaign, SummaryParams, SynthCampaign, SynthParams,
+    CampaignSummary, LoadCampaign, LoadCampaignParams, OrthoProject, RenderCampaign,
+    SelectRecording, SelectRecordingParams, SummarizeCampaign, SummaryParams, SynthCampaign,
+    SynthParams,
 };
 use crate::workflow::{CampaignSource, Workflow};
 use skytie_stages::nadir::OrthoParams;
@@ -65,8 +67,12 @@ impl Pipeline for SkytiePipeline {
                 let mut params: SynthParams = wf.params(stage::SYNTH, "default").map_err(wf_err)?;
                 params.preset = preset.clone();
                 params.seed = *seed;
+                let options = params
+                    .options()
+                    .map_err(|v| wf_err(format!("[synth] {v}")))?;
                 let mut b = DagBuilder::new();
-                let h = b.add(SynthCampaign, preset, params, ())?;
+                let rendered = b.add(RenderCampaign, preset, options.render_identity(), ())?;
+                let h = b.add(SynthCampaign, preset, params, rendered)?;
                 b.request(h);
                 let values = session.execute("campaign", b.build());
                 values.require(h, "the synthetic campaign")?.path()
@@ -108,6 +114,15 @@ impl Pipeline for SkytiePipeline {
                 root.display()
             );
         }
+        // Phase 2c: the recording vehicle, found in the panoramas (masks every ortho image).
+        let campaign = vehicle::LoadedCampaign {
+            root: &root,
+            load_params: &load_params,
+            inputs: &inputs,
+            loaded: &loaded,
+            validated: &snapshot,
+        };
+        let vehicle = vehicle::detect(wf, session, &campaign)?;
         // Phase 3: per-recording stages and the summary, for every variant.
         let ortho_on = wf.stages.iter().any(|s| s == stage::ORTHO);
         let nadir_on = nadir::enabled(wf)?;
@@ -117,7 +132,7 @@ impl Pipeline for SkytiePipeline {
         for variant in wf.variants() {
             b.set_variant(&variant);
             let snap = add_validated_snapshot(&mut b, &root, &load_params, &inputs, &loaded)?;
-            let ortho: OrthoParams = wf.params(stage::ORTHO, &variant).map_err(wf_err)?;
+            let ortho: OrthoParams = vehicle::ortho_params(wf, &variant, vehicle.as_ref())?;
             let mut orthos = Vec::new();
             let mut items = Vec::new();
             for rec in &snapshot.campaign.recordings {
@@ -149,7 +164,7 @@ impl Pipeline for SkytiePipeline {
             }
             let nadir_handles = if nadir_on {
                 Some(nadir::add_nadir(
-                    &mut b, wf, &variant, &root, &snapshot, snap, &items,
+                    &mut b, wf, &variant, &root, &snapshot, snap, &items, &ortho,
                 )?)
             } else {
                 None

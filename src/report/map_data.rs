@@ -278,15 +278,7 @@ mod tests {
     #[test]
     fn correspondence_kinds_per_recording() {
         let t = CsvTable::from_cells(
-            &[
-                "source",
-                "point_id",
-                "image_kind",
-                "image_id",
-                "u",
-                "v",
-                "score",
-            ],
+            &skytie_stages::export::CORRESPONDENCES_CSV_HEADER,
             &[
                 &["nadir", "p1", "panorama", "a", "1", "2", ""],
                 &["nadir", "p1", "nadir", "n1", "1", "2", "0.9"],

@@ -7,7 +7,6 @@ use nalgebra::Vector3;
 use skytie_stages::adjustment::prepared::{Prepared, Rejected};
 use skytie_stages::adjustment::residuals::State;
 use skytie_stages::adjustment::{adjust, AdjustOptions, SyntheticBlockSpec};
-use skytie_stages::geometry::LocalOrigin;
 use std::time::Instant;
 
 fn main() {
@@ -54,21 +53,7 @@ fn main() {
         adj.variance_factor.unwrap_or(f64::NAN)
     );
     // Export the same problem for the scipy peer.
-    let origin = LocalOrigin::at_mean(b.recordings.iter().map(|r| &r.camera.center_world)).unwrap();
-    let state = State {
-        origin,
-        centers_local: b
-            .recordings
-            .iter()
-            .map(|r| origin.to_local(&r.camera.center_world))
-            .collect(),
-        yaw_correction_rad: vec![0.0; b.recordings.len()],
-        points_local: b
-            .points_initial_world
-            .iter()
-            .map(|p| origin.to_local(p))
-            .collect(),
-    };
+    let state = State::initial(b).unwrap();
     let prep = Prepared::new(b, &options, &state, &Rejected::none(b)).unwrap();
     let v3 = |v: &Vector3<f64>| serde_json::json!([v.x, v.y, v.z]);
     let json = serde_json::json!({

@@ -11,7 +11,6 @@ use skytie_stages::adjustment::prepared::{Prepared, Rejected};
 use skytie_stages::adjustment::residuals::State;
 use skytie_stages::adjustment::synthetic_streets::StreetBlockSpec;
 use skytie_stages::adjustment::{adjust, AdjustOptions, Block};
-use skytie_stages::geometry::LocalOrigin;
 use std::time::Instant;
 
 fn peak_rss_mib() -> f64 {
@@ -36,22 +35,7 @@ fn rms_xy(
 }
 
 fn structure(block: &Block, options: &AdjustOptions) -> ReducedStructure {
-    let origin =
-        LocalOrigin::at_mean(block.recordings.iter().map(|r| &r.camera.center_world)).unwrap();
-    let state = State {
-        origin,
-        centers_local: block
-            .recordings
-            .iter()
-            .map(|r| origin.to_local(&r.camera.center_world))
-            .collect(),
-        yaw_correction_rad: vec![0.0; block.recordings.len()],
-        points_local: block
-            .points_initial_world
-            .iter()
-            .map(|p| origin.to_local(p))
-            .collect(),
-    };
+    let state = State::initial(block).unwrap();
     Prepared::new(block, options, &state, &Rejected::none(block))
         .unwrap()
         .structure

@@ -49,20 +49,17 @@ fn pad_seam(img: &GrayImage) -> GrayImage {
 
 fn recording() -> Recording {
     Recording {
-        image_id: "bench".into(),
-        file: "bench.jpg".into(),
         time: "2020-01-01T00:00:00Z".into(),
-        time_s: 1_577_836_800.0,
-        x: 92_345.678,
-        y: 437_123.456,
-        z: 3.5,
-        heading_deg: 30.0,
-        camera_height_m: 2.2,
-        sigma_xy_m: None,
-        sigma_z_m: None,
         yaw_deg: 0.4,
         pitch_deg: -0.3,
         roll_deg: 0.2,
+        ..Recording::new(
+            "bench",
+            1_577_836_800.0,
+            [92_345.678, 437_123.456, 3.5],
+            30.0,
+            2.2,
+        )
     }
 }
 

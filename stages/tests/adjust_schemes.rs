@@ -7,20 +7,8 @@
 use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
 use skytie_stages::adjustment::trajectory_errors::trajectory_errors;
 use skytie_stages::adjustment::{
-    run, AdjustConfig, AdjustInputs, AdjustmentRun, ControlWeighting, Dimensions, LossKind,
-    SyntheticBlockSpec,
+    run, AdjustConfig, AdjustmentRun, ControlWeighting, Dimensions, LossKind, SyntheticBlockSpec,
 };
-
-fn inputs(c: &SyntheticCampaign) -> AdjustInputs<'_> {
-    AdjustInputs {
-        recordings: &c.recordings,
-        pano_size_px: &c.pano_size_px,
-        tie_points: &c.tie_points,
-        control: &c.control,
-        nadir: &c.nadir,
-        oblique: &[],
-    }
-}
 
 /// (max 2-D, max 3-D, RMSE 2-D) error of the adjusted positions against the truth, metres.
 fn errors(c: &SyntheticCampaign, r: &AdjustmentRun) -> (f64, f64, f64) {
@@ -80,13 +68,13 @@ fn all_three_schemes_recover_the_true_poses_from_exact_observations() {
     let singles = c.control.iter().filter(|cp| cp.aerial.len() == 1).count();
     assert!(singles >= 2, "{singles} single-aerial control points");
 
-    let a = run(&inputs(&c), &thesis()).unwrap();
+    let a = run(&c.adjust_inputs(), &thesis()).unwrap();
     assert_eq!(a.build.control_as_gcp, c.control.len() - singles);
     assert_eq!(a.build.control_unused, singles);
     assert_eq!(a.observations.aerial, 0);
     let (ea, _, _) = errors(&c, &a);
 
-    let b = run(&inputs(&c), &aerial_in_bundle()).unwrap();
+    let b = run(&c.adjust_inputs(), &aerial_in_bundle()).unwrap();
     assert_eq!(b.build.control_as_aerial_observations, c.control.len());
     assert_eq!(b.observations.control, 0);
     assert_eq!(
@@ -101,9 +89,9 @@ fn all_three_schemes_recover_the_true_poses_from_exact_observations() {
     let co = spec.generate();
     let injected = &co.truth.outlier_observations;
     assert!(injected.len() >= 5, "{} outliers", injected.len());
-    let rc = run(&inputs(&co), &robust()).unwrap();
+    let rc = run(&co.adjust_inputs(), &robust()).unwrap();
     let (ec, _, _) = errors(&co, &rc);
-    let plain = run(&inputs(&co), &thesis()).unwrap();
+    let plain = run(&co.adjust_inputs(), &thesis()).unwrap();
     let (e_plain, _, _) = errors(&co, &plain);
     eprintln!(
         "exact block, max 3-D error: (a) thesis {ea:.2e} m, (b) aerial in bundle {eb:.2e} m, \
@@ -130,10 +118,10 @@ fn single_aerial_points_alone_fix_the_block_only_with_aerial_observations() {
     };
     let c = spec.generate();
     assert!(c.control.iter().all(|cp| cp.aerial.len() == 1));
-    let a = run(&inputs(&c), &thesis()).unwrap();
+    let a = run(&c.adjust_inputs(), &thesis()).unwrap();
     assert_eq!(a.build.control_as_gcp, 0);
     let (ea, _, _) = errors(&c, &a);
-    let b = run(&inputs(&c), &aerial_in_bundle()).unwrap();
+    let b = run(&c.adjust_inputs(), &aerial_in_bundle()).unwrap();
     let (eb, _, _) = errors(&c, &b);
     eprintln!("single-aerial control only: thesis scheme {ea:.3} m, aerial in bundle {eb:.2e} m");
     assert!(ea > 0.5, "without control the block keeps its offset: {ea}");
@@ -196,7 +184,7 @@ fn noisy_block_all_schemes_within_their_precision() {
         ),
     ];
     for (name, config) in configs {
-        let r = run(&inputs(&c), &config).unwrap();
+        let r = run(&c.adjust_inputs(), &config).unwrap();
         let (max2, max3, rmse2) = errors(&c, &r);
         eprintln!(
             "noisy block (0.5 px pano and aerial noise), {name}: RMSE 2-D {rmse2:.4} m, max 2-D {max2:.4} m, \
@@ -247,7 +235,7 @@ fn trajectory_errors_against_truth_and_determinism_across_thread_counts() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| run(&inputs(&c), &config).unwrap())
+            .install(|| run(&c.adjust_inputs(), &config).unwrap())
     };
     let one = in_pool(1);
     let two = in_pool(2);
@@ -281,7 +269,7 @@ fn aerial_observations_behind_the_camera_are_skipped_not_fatal() {
         .flat_map(|cp| &cp.aerial)
         .filter(|a| a.image_id == victim)
         .count();
-    let r = run(&inputs(&c), &aerial_in_bundle()).unwrap();
+    let r = run(&c.adjust_inputs(), &aerial_in_bundle()).unwrap();
     assert_eq!(r.build.aerial_observations_skipped, seen_by_victim);
     assert_eq!(
         r.build.aerial_observations + seen_by_victim,

@@ -30,28 +30,14 @@ fn image(path: &Path, width: usize, height: usize) {
 
 fn aerial(id: &str, file: &str, y: f64, omega_deg: f64) -> AerialImage {
     AerialImage {
-        image_id: id.into(),
         file: file.into(),
-        x: 155_012.5,
-        y,
-        z: 300.0,
-        omega_deg,
-        phi_deg: 0.0,
-        kappa_deg: 0.0,
-        focal_px: 100.0,
-        cx_px: 40.0,
-        cy_px: 30.0,
-        width_px: 80,
-        height_px: 60,
-        k1: 0.0,
-        k2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
+        ..AerialImage::ideal(
+            id,
+            [155_012.5, y, 300.0],
+            [omega_deg, 0.0, 0.0],
+            100.0,
+            [80, 60],
+        )
     }
 }
 
@@ -60,20 +46,14 @@ fn aerial(id: &str, file: &str, y: f64, omega_deg: f64) -> AerialImage {
 fn write_base(root: &Path) {
     let recordings: Vec<Recording> = (0..6)
         .map(|i| Recording {
-            image_id: format!("pano_{i}"),
-            file: format!("pano_{i}.jpg"),
             time: format!("2019-06-14T10:31:{:02}.000Z", 10 + i),
-            time_s: 1_560_508_270.0 + i as f64,
-            x: 155_000.0 + 5.0 * i as f64,
-            y: 463_000.0,
-            z: 2.5,
-            heading_deg: 90.0,
-            camera_height_m: 2.4,
-            sigma_xy_m: None,
-            sigma_z_m: None,
-            yaw_deg: 0.0,
-            pitch_deg: 0.0,
-            roll_deg: 0.0,
+            ..Recording::new(
+                &format!("pano_{i}"),
+                1_560_508_270.0 + i as f64,
+                [155_000.0 + 5.0 * i as f64, 463_000.0, 2.5],
+                90.0,
+                2.4,
+            )
         })
         .collect();
     for r in &recordings {

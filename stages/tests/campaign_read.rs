@@ -22,47 +22,30 @@ fn image(path: &Path, width: usize, height: usize) {
 
 fn recording(i: usize, file: &str) -> Recording {
     Recording {
-        image_id: format!("pano_{i}"),
         file: file.into(),
         time: format!("2019-06-14T10:31:{:02}.250Z", 7 + i),
-        time_s: 1_560_508_267.25 + i as f64,
-        x: 155_000.123_456_789 + 5.0 * i as f64,
-        y: 463_000.1 + 0.01 * i as f64,
-        z: 2.5 + 0.1 * i as f64,
-        heading_deg: 89.5,
-        camera_height_m: 2.4,
         sigma_xy_m: if i == 1 { Some(0.8) } else { None },
         sigma_z_m: if i == 2 { Some(1.5) } else { None },
         yaw_deg: if i == 3 { 0.35 } else { 0.0 },
-        pitch_deg: 0.0,
         roll_deg: if i == 3 { -0.1 } else { 0.0 },
+        ..Recording::new(
+            &format!("pano_{i}"),
+            1_560_508_267.25 + i as f64,
+            [
+                155_000.123_456_789 + 5.0 * i as f64,
+                463_000.1 + 0.01 * i as f64,
+                2.5 + 0.1 * i as f64,
+            ],
+            89.5,
+            2.4,
+        )
     }
 }
 
 fn aerial(id: &str, file: &str) -> AerialImage {
     AerialImage {
-        image_id: id.into(),
         file: file.into(),
-        x: 155_007.5,
-        y: 463_000.0,
-        z: 300.0,
-        omega_deg: 0.0,
-        phi_deg: 0.0,
-        kappa_deg: 0.0,
-        focal_px: 100.0,
-        cx_px: 40.0,
-        cy_px: 30.0,
-        width_px: 80,
-        height_px: 60,
-        k1: 0.0,
-        k2: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
+        ..AerialImage::ideal(id, [155_007.5, 463_000.0, 300.0], [0.0; 3], 100.0, [80, 60])
     }
 }
 

@@ -9,20 +9,18 @@ use std::collections::BTreeMap;
 
 fn recording(i: usize) -> Recording {
     Recording {
-        image_id: format!("pano_{i:03}"),
-        file: format!("pano_{i:03}.jpg"),
-        time: String::new(),
-        time_s: 1_560_508_267.25 + i as f64,
-        x: 155_000.123_456_789 + i as f64 * 5.0,
-        y: 463_000.987_654_321,
-        z: 2.0 + 0.25 * i as f64,
-        heading_deg: 90.0,
-        camera_height_m: 2.5,
         sigma_xy_m: if i == 0 { Some(0.5) } else { None },
-        sigma_z_m: None,
-        yaw_deg: 0.0,
-        pitch_deg: 0.0,
-        roll_deg: 0.0,
+        ..Recording::new(
+            &format!("pano_{i:03}"),
+            1_560_508_267.25 + i as f64,
+            [
+                155_000.123_456_789 + i as f64 * 5.0,
+                463_000.987_654_321,
+                2.0 + 0.25 * i as f64,
+            ],
+            90.0,
+            2.5,
+        )
     }
 }
 
@@ -163,28 +161,8 @@ fn other_tables_and_toml_have_documented_columns() {
     assert_eq!(toml_value["crs"].as_str(), Some("EPSG:28992"));
 
     let a = AerialImage {
-        image_id: "n,1".into(),
         file: "n1.png".into(),
-        x: 1.5,
-        y: 2.5,
-        z: 500.0,
-        omega_deg: 0.0,
-        phi_deg: 0.0,
-        kappa_deg: 0.0,
-        focal_px: 1000.0,
-        cx_px: 50.0,
-        cy_px: 40.0,
-        width_px: 100,
-        height_px: 80,
-        k1: 0.0,
-        k2: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
+        ..AerialImage::ideal("n,1", [1.5, 2.5, 500.0], [0.0; 3], 1000.0, [100, 80])
     };
     write_aerial_cameras_csv(&d.join("nadir.csv"), std::slice::from_ref(&a)).unwrap();
     assert_eq!(

@@ -6,7 +6,7 @@
 use skytie_stages::adjustment::campaign_checkpoints::compare_checkpoints;
 use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
 use skytie_stages::adjustment::{
-    run, AdjustConfig, AdjustInputs, AdjustmentRun, SyntheticBlockSpec, ViewSelection,
+    run, AdjustConfig, AdjustmentRun, SyntheticBlockSpec, ViewSelection,
 };
 use skytie_stages::export::checkpoint_rows;
 use skytie_stages::export::gpkg::{run_layers, srs_for, write_geopackage, RunLayers};
@@ -25,14 +25,7 @@ fn setup() -> (SyntheticCampaign, AdjustmentRun) {
         ..SyntheticCampaignSpec::default()
     }
     .generate();
-    let inputs = AdjustInputs {
-        recordings: &c.recordings,
-        pano_size_px: &c.pano_size_px,
-        tie_points: &c.tie_points,
-        control: &c.control,
-        nadir: &c.nadir,
-        oblique: &[],
-    };
+    let inputs = c.adjust_inputs();
     let r = run(&inputs, &AdjustConfig::default()).unwrap();
     (c, r)
 }

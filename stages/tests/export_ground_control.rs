@@ -66,44 +66,13 @@ fn the_reader_accepts_the_documented_examples() {
 
 fn campaign(crs: &str) -> Campaign {
     let rec = |id: &str, file: &str| Recording {
-        image_id: id.into(),
         file: file.into(),
         time: "2020-01-01T00:00:00Z".into(),
-        time_s: 1_577_836_800.0,
-        x: 1.0,
-        y: 2.0,
-        z: 3.0,
-        heading_deg: 0.0,
-        camera_height_m: 2.5,
-        sigma_xy_m: None,
-        sigma_z_m: None,
-        yaw_deg: 0.0,
-        pitch_deg: 0.0,
-        roll_deg: 0.0,
+        ..Recording::new(id, 1_577_836_800.0, [1.0, 2.0, 3.0], 0.0, 2.5)
     };
     let nadir = |id: &str, file: &str| AerialImage {
-        image_id: id.into(),
         file: file.into(),
-        x: 0.0,
-        y: 0.0,
-        z: 4000.0,
-        omega_deg: 0.0,
-        phi_deg: 0.0,
-        kappa_deg: 0.0,
-        focal_px: 10000.0,
-        cx_px: 2000.0,
-        cy_px: 1500.0,
-        width_px: 4000,
-        height_px: 3000,
-        k1: 0.0,
-        k2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
+        ..AerialImage::ideal(id, [0.0, 0.0, 4000.0], [0.0; 3], 10000.0, [4000, 3000])
     };
     Campaign {
         crs: crs.into(),

@@ -7,7 +7,7 @@ use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 use skytie_stages::adjustment::campaign_checkpoints::{adjusted_cameras, compare_checkpoints};
 use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
 use skytie_stages::adjustment::{
-    run, AdjustConfig, AdjustInputs, AdjustmentRun, SyntheticBlockSpec, ViewSelection,
+    run, AdjustConfig, AdjustmentRun, SyntheticBlockSpec, ViewSelection,
 };
 use skytie_stages::campaign::{read_recordings_csv, write_recordings_csv};
 use skytie_stages::export::{
@@ -38,14 +38,7 @@ fn setup() -> (SyntheticCampaign, AdjustmentRun) {
         yaw_prior_sigma_deg: 100.0,
         ..AdjustConfig::default()
     };
-    let inputs = AdjustInputs {
-        recordings: &c.recordings,
-        pano_size_px: &c.pano_size_px,
-        tie_points: &c.tie_points,
-        control: &c.control,
-        nadir: &c.nadir,
-        oblique: &[],
-    };
+    let inputs = c.adjust_inputs();
     let r = run(&inputs, &config).unwrap();
     (c, r)
 }

@@ -7,20 +7,11 @@ use skytie_stages::features::daisy::{
     describe_points, DaisyExtractor, DaisyNormalization, DaisyParams,
 };
 use skytie_stages::imaging::GrayImage;
+use skytie_stages::rng::SplitMix64;
 
-/// Tiny deterministic PRNG (SplitMix64).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
+/// Uniform in [lo, hi).
+fn range(rng: &mut SplitMix64, lo: f64, hi: f64) -> f64 {
+    lo + (hi - lo) * rng.next_f64()
 }
 
 /// Rectangles (integer world pixel bounds, grey level) over a smooth texture; pixel (c, r) of a render with
@@ -33,25 +24,28 @@ struct Scene {
 
 impl Scene {
     fn new(seed: u64, n_rects: usize, extent: f64) -> Self {
-        let mut rng = Rng(seed);
+        let mut rng = SplitMix64::new(seed);
         let rects = (0..n_rects)
             .map(|_| {
-                let (x, y) = (rng.range(-40.0, extent), rng.range(-40.0, extent));
-                let (w, h) = (rng.range(8.0, 50.0), rng.range(8.0, 50.0));
+                let (x, y) = (
+                    range(&mut rng, -40.0, extent),
+                    range(&mut rng, -40.0, extent),
+                );
+                let (w, h) = (range(&mut rng, 8.0, 50.0), range(&mut rng, 8.0, 50.0));
                 (
                     x as i64,
                     y as i64,
                     (x + w) as i64,
                     (y + h) as i64,
-                    rng.range(0.1, 0.9),
+                    range(&mut rng, 0.1, 0.9),
                 )
             })
             .collect();
         let waves = (0..6)
             .map(|_| {
-                let a = rng.range(0.0, std::f64::consts::TAU);
-                let f = rng.range(0.05, 0.25);
-                (f * a.cos(), f * a.sin(), rng.range(0.0, 6.3), 0.03)
+                let a = range(&mut rng, 0.0, std::f64::consts::TAU);
+                let f = range(&mut rng, 0.05, 0.25);
+                (f * a.cos(), f * a.sin(), range(&mut rng, 0.0, 6.3), 0.03)
             })
             .collect();
         Self { rects, waves }
@@ -278,12 +272,12 @@ fn daisy_nearest_neighbour_matching_recovers_the_shift() {
     let (sx, sy) = (-13i64, 8i64);
     let (a, b) = textured_pair(23, (sx, sy));
     // Independent noise on the copy (σ = 1 grey level), re-quantised to 8 bit.
-    let mut rng = Rng(99);
+    let mut rng = SplitMix64::new(99);
     let data = b
         .data
         .iter()
         .map(|&v| {
-            let n = (rng.next() + rng.next() + rng.next() - 1.5) * 2.0 / 255.0;
+            let n = (rng.next_f64() + rng.next_f64() + rng.next_f64() - 1.5) * 2.0 / 255.0;
             (((v as f64 + n).clamp(0.0, 1.0) * 255.0).round() / 255.0) as f32
         })
         .collect();

@@ -144,28 +144,8 @@ fn metashape_model_matches_its_formula_and_round_trips() {
     let model = CameraModel::from_metashape(&m);
     assert_eq!(model.to_metashape(), m);
     let mut row = AerialImage {
-        image_id: "a".into(),
         file: "a".into(),
-        x: 0.0,
-        y: 0.0,
-        z: 100.0,
-        omega_deg: 0.0,
-        phi_deg: 0.0,
-        kappa_deg: 0.0,
-        focal_px: 0.0,
-        cx_px: 0.0,
-        cy_px: 0.0,
-        width_px: 0,
-        height_px: 0,
-        k1: 0.0,
-        k2: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
+        ..AerialImage::ideal("a", [0.0, 0.0, 100.0], [0.0; 3], 0.0, [0, 0])
     };
     model.apply_to(&mut row);
     let cam = FrameCamera::from_aerial(&row);

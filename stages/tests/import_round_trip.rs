@@ -52,21 +52,18 @@ fn aerial(id: &str, i: usize, oblique: bool, extended: bool) -> AerialImage {
 fn recording(i: usize) -> Recording {
     let f = i as f64;
     let time = format!("2019-06-14T10:31:{:02}.250Z", 7 + 2 * i);
+    let time_s = skytie_stages::campaign::parse_time_s(&time).unwrap();
+    let centre = [
+        RD_E + 5.0 * f + 0.0123,
+        RD_N + 3.0 * f - 0.0456,
+        2.345 + 0.01 * f,
+    ];
     Recording {
-        image_id: format!("pano_{i:03}"),
-        file: format!("pano_{i:03}.jpg"),
-        time_s: skytie_stages::campaign::parse_time_s(&time).unwrap(),
         time,
-        x: RD_E + 5.0 * f + 0.0123,
-        y: RD_N + 3.0 * f - 0.0456,
-        z: 2.345 + 0.01 * f,
-        heading_deg: 59.0 + 0.5 * f,
-        camera_height_m: 2.4,
-        sigma_xy_m: None,
-        sigma_z_m: None,
         yaw_deg: 1.5 - 0.2 * f,
         pitch_deg: 0.3,
         roll_deg: -0.4 + 0.1 * f,
+        ..Recording::new(&format!("pano_{i:03}"), time_s, centre, 59.0 + 0.5 * f, 2.4)
     }
 }
 

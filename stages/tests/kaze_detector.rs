@@ -5,18 +5,7 @@
 
 use skytie_stages::features::kaze::{detect_and_describe, Features, KazeParams, Scheme};
 use skytie_stages::imaging::GrayImage;
-
-/// SplitMix64 → uniform [0, 1).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+use skytie_stages::rng::SplitMix64;
 
 /// A continuous texture: 0.5 + Σ signed Gaussian blobs (centre, radius 1.5..5 px, amplitude ±0.25).
 struct Texture {
@@ -26,14 +15,14 @@ struct Texture {
 impl Texture {
     /// `count` blobs with centres uniform in [lo, hi)².
     fn new(seed: u64, count: usize, lo: f64, hi: f64) -> Self {
-        let mut rng = Rng(seed);
+        let mut rng = SplitMix64::new(seed);
         let blobs = (0..count)
             .map(|_| {
-                let amp = if rng.next() < 0.5 { -0.25 } else { 0.25 };
+                let amp = if rng.next_f64() < 0.5 { -0.25 } else { 0.25 };
                 [
-                    lo + (hi - lo) * rng.next(),
-                    lo + (hi - lo) * rng.next(),
-                    1.5 + 3.5 * rng.next(),
+                    lo + (hi - lo) * rng.next_f64(),
+                    lo + (hi - lo) * rng.next_f64(),
+                    1.5 + 3.5 * rng.next_f64(),
                     amp,
                 ]
             })

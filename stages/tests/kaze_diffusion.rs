@@ -9,18 +9,7 @@ use skytie_stages::features::kaze::diffusion::{
 use skytie_stages::features::kaze::Diffusivity;
 use skytie_stages::imaging::gaussian::gaussian_blur;
 use skytie_stages::imaging::GrayImage;
-
-/// SplitMix64 → uniform [0, 1).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+use skytie_stages::rng::SplitMix64;
 
 /// Dense Gaussian elimination with partial pivoting (reference solver).
 fn dense_solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
@@ -49,20 +38,20 @@ fn dense_solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
 
 #[test]
 fn thomas_matches_dense_lu_on_random_diagonally_dominant_systems() {
-    let mut rng = Rng(7);
+    let mut rng = SplitMix64::new(7);
     for trial in 0..50 {
         let n: usize = 1 + trial * 3;
         let off: Vec<f64> = (0..n.saturating_sub(1))
-            .map(|_| rng.next() * 4.0 - 2.0)
+            .map(|_| rng.next_f64() * 4.0 - 2.0)
             .collect();
         let diag: Vec<f64> = (0..n)
             .map(|k| {
                 let left = if k > 0 { off[k - 1].abs() } else { 0.0 };
                 let right = if k + 1 < n { off[k].abs() } else { 0.0 };
-                left + right + 0.1 + rng.next()
+                left + right + 0.1 + rng.next_f64()
             })
             .collect();
-        let rhs: Vec<f64> = (0..n).map(|_| rng.next() * 10.0 - 5.0).collect();
+        let rhs: Vec<f64> = (0..n).map(|_| rng.next_f64() * 10.0 - 5.0).collect();
         let mut x = vec![0.0; n];
         let mut scratch = vec![0.0; n];
         thomas_solve(&diag, &off, &rhs, &mut x, &mut scratch);
@@ -87,23 +76,23 @@ fn thomas_matches_dense_lu_on_random_diagonally_dominant_systems() {
 }
 
 fn random_image(w: usize, h: usize, seed: u64) -> GrayImage {
-    let mut rng = Rng(seed);
-    let data = (0..w * h).map(|_| rng.next() as f32).collect();
+    let mut rng = SplitMix64::new(seed);
+    let data = (0..w * h).map(|_| rng.next_f64() as f32).collect();
     GrayImage::from_vec(w, h, data).unwrap()
 }
 
 /// A smooth random image: sum of random low-frequency sinusoids, range ≈ [0, 1].
 fn smooth_image(w: usize, h: usize, seed: u64) -> GrayImage {
-    let mut rng = Rng(seed);
+    let mut rng = SplitMix64::new(seed);
     let waves: Vec<[f64; 4]> = (0..6)
         .map(|_| {
-            let angle = rng.next() * std::f64::consts::TAU;
-            let freq = 0.03 + 0.04 * rng.next(); // rad/px: wavelengths 90..200 px
+            let angle = rng.next_f64() * std::f64::consts::TAU;
+            let freq = 0.03 + 0.04 * rng.next_f64(); // rad/px: wavelengths 90..200 px
             [
                 freq * angle.cos(),
                 freq * angle.sin(),
-                rng.next() * std::f64::consts::TAU,
-                0.5 + rng.next(),
+                rng.next_f64() * std::f64::consts::TAU,
+                0.5 + rng.next_f64(),
             ]
         })
         .collect();

@@ -5,34 +5,24 @@
 use skytie_stages::features::kaze::{detect_and_describe, KazeParams};
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::matching::descriptor_match::{match_ratio, match_windowed, MatchError};
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+use skytie_stages::rng::SplitMix64;
 
 #[test]
 fn ratio_and_mutual_matching_recover_a_planted_permutation() {
     let (len, n, distractors) = (64usize, 200usize, 300usize);
-    let mut rng = Rng(1);
-    let query: Vec<f32> = (0..n * len).map(|_| rng.next() as f32).collect();
+    let mut rng = SplitMix64::new(1);
+    let query: Vec<f32> = (0..n * len).map(|_| rng.next_f64() as f32).collect();
     // Train: the queries in a scrambled order (train index of query q is (q·37 + 11) mod n) plus noise,
     // followed by unrelated distractors.
     let perm = |q: usize| (q * 37 + 11) % n;
     let mut train = vec![0.0f32; (n + distractors) * len];
     for q in 0..n {
         for k in 0..len {
-            train[perm(q) * len + k] = query[q * len + k] + 0.01 * (rng.next() as f32 - 0.5);
+            train[perm(q) * len + k] = query[q * len + k] + 0.01 * (rng.next_f64() as f32 - 0.5);
         }
     }
     for v in &mut train[n * len..] {
-        *v = rng.next() as f32;
+        *v = rng.next_f64() as f32;
     }
     for mutual in [false, true] {
         let m = match_ratio(&query, &train, len, 0.8, mutual).unwrap();
@@ -60,9 +50,9 @@ fn ratio_and_mutual_matching_recover_a_planted_permutation() {
 #[test]
 fn windowed_matching_only_considers_train_features_in_the_window() {
     let len = 8usize;
-    let mut rng = Rng(2);
+    let mut rng = SplitMix64::new(2);
     let n = 50;
-    let query: Vec<f32> = (0..n * len).map(|_| rng.next() as f32).collect();
+    let query: Vec<f32> = (0..n * len).map(|_| rng.next_f64() as f32).collect();
     let predicted: Vec<[f64; 2]> = (0..n)
         .map(|i| [20.0 * (i % 10) as f64, 20.0 * (i / 10) as f64])
         .collect();
@@ -164,14 +154,14 @@ impl Similarity {
 }
 
 fn texture(seed: u64, count: usize, size: f64) -> Vec<[f64; 4]> {
-    let mut rng = Rng(seed);
+    let mut rng = SplitMix64::new(seed);
     (0..count)
         .map(|_| {
-            let amp = if rng.next() < 0.5 { -0.25 } else { 0.25 };
+            let amp = if rng.next_f64() < 0.5 { -0.25 } else { 0.25 };
             [
-                size * rng.next(),
-                size * rng.next(),
-                1.5 + 3.5 * rng.next(),
+                size * rng.next_f64(),
+                size * rng.next_f64(),
+                1.5 + 3.5 * rng.next_f64(),
                 amp,
             ]
         })

@@ -1,10 +1,12 @@
 //! Known-answer tests of the oblique 3-D median consensus, consensus tracking and the oblique control points
 //! (thesis 4.4.7), on registration sets built in code.
 
-use nalgebra::{Matrix3, Vector3};
-use skytie_stages::campaign::{AerialImage, Recording};
+mod support;
+
+use nalgebra::Vector3;
+use skytie_stages::campaign::Recording;
 use skytie_stages::correspondence::{MmTiePoint, PanoObservation};
-use skytie_stages::geometry::{matrix_to_opk, FrameCamera};
+use skytie_stages::geometry::FrameCamera;
 use skytie_stages::oblique::consensus::{
     consensus, consensus_with_diagnostics, ConsensusParams, SmallSetPolicy,
 };
@@ -14,60 +16,7 @@ use skytie_stages::oblique::{
 };
 use skytie_stages::params::Params;
 use skytie_stages::rng::SplitMix64;
-
-const E0: f64 = 500_000.0;
-const N0: f64 = 5_400_000.0;
-
-fn recording(id: &str, i: usize) -> Recording {
-    Recording {
-        image_id: id.into(),
-        file: format!("{id}.jpg"),
-        time: String::new(),
-        time_s: i as f64,
-        x: E0 + 5.0 * i as f64,
-        y: N0,
-        z: 102.0,
-        heading_deg: 90.0,
-        camera_height_m: 2.5,
-        sigma_xy_m: None,
-        sigma_z_m: None,
-        yaw_deg: 0.0,
-        pitch_deg: 0.0,
-        roll_deg: 0.0,
-    }
-}
-
-/// An oblique camera at `centre` looking at `target` (45°-ish), 4000×3000 px, f = 8000 px.
-fn oblique_image(id: &str, centre: Vector3<f64>, target: Vector3<f64>) -> AerialImage {
-    let back = (centre - target).normalize();
-    let x = Vector3::z().cross(&back).normalize();
-    let y = back.cross(&x);
-    let (omega_deg, phi_deg, kappa_deg) = matrix_to_opk(&Matrix3::from_columns(&[x, y, back]));
-    AerialImage {
-        image_id: id.into(),
-        file: format!("{id}.jpg"),
-        x: centre.x,
-        y: centre.y,
-        z: centre.z,
-        omega_deg,
-        phi_deg,
-        kappa_deg,
-        focal_px: 8000.0,
-        cx_px: 2000.0,
-        cy_px: 1500.0,
-        width_px: 4000,
-        height_px: 3000,
-        k1: 0.0,
-        k2: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
-    }
-}
+use support::{oblique_looking_at, street_recording, E0, N0};
 
 fn patch_match(point_id: &str, object: [f64; 3], t: [f64; 3], oblique: &str) -> PatchMatch {
     PatchMatch {
@@ -132,7 +81,7 @@ fn constructed_set(recording: &str, seed: u64) -> (PatchRegistrationSet, Vec<boo
 #[test]
 fn consensus_keeps_exactly_the_twenty_inliers() {
     let (s, good) = constructed_set("r1", 7);
-    let recs = vec![recording("r1", 1)];
+    let recs = vec![street_recording("r1", 1, 102.0)];
     let p = ConsensusParams::default();
     let r = consensus(&[s], &[], &recs, &[], &[(1600, 800)], &p);
     let kept: Vec<bool> = r.correspondences.iter().map(|c| c.kept).collect();
@@ -170,7 +119,7 @@ fn coarse_rejected_matches_do_not_enter() {
     let (mut s, _) = constructed_set("r1", 9);
     s.matches[0].rejected_coarse = true;
     s.matches[2].rejected_coarse = true; // an outlier
-    let recs = vec![recording("r1", 1)];
+    let recs = vec![street_recording("r1", 1, 102.0)];
     let (r, d) =
         consensus_with_diagnostics(&[s], &[], &recs, &[], &[], &ConsensusParams::default());
     assert_eq!(r.stats.correspondences, 23);
@@ -203,7 +152,9 @@ fn tracking_sets() -> Vec<PatchRegistrationSet> {
 #[test]
 fn tracking_rescues_a_small_wrong_set_with_its_neighbours() {
     let sets = tracking_sets();
-    let recs: Vec<Recording> = (1..=3).map(|i| recording(&format!("r{i}"), i)).collect();
+    let recs: Vec<Recording> = (1..=3)
+        .map(|i| street_recording(&format!("r{i}"), i, 102.0))
+        .collect();
     let kept_of = |r: &skytie_stages::oblique::ObliqueResult| -> Vec<bool> {
         r.correspondences
             .iter()
@@ -238,7 +189,7 @@ fn tracking_rescues_a_small_wrong_set_with_its_neighbours() {
 fn small_sets_follow_the_policy_and_are_counted() {
     let (mut s, _) = constructed_set("r1", 3);
     s.matches.truncate(2);
-    let recs = vec![recording("r1", 1)];
+    let recs = vec![street_recording("r1", 1, 102.0)];
     let keep = consensus(
         &[s.clone()],
         &[],
@@ -263,8 +214,8 @@ fn small_sets_follow_the_policy_and_are_counted() {
 fn control_points_from_two_oblique_cameras_triangulate_to_under_a_millimetre() {
     let target = Vector3::new(E0 + 10.0, N0 + 12.0, 105.0);
     let images = vec![
-        oblique_image("oA", Vector3::new(E0 - 700.0, N0 + 12.0, 900.0), target),
-        oblique_image("oB", Vector3::new(E0 + 10.0, N0 + 800.0, 950.0), target),
+        oblique_looking_at("oA", Vector3::new(E0 - 700.0, N0 + 12.0, 900.0), target),
+        oblique_looking_at("oB", Vector3::new(E0 + 10.0, N0 + 800.0, 950.0), target),
     ];
     let cams: Vec<FrameCamera> = images.iter().map(FrameCamera::from_aerial).collect();
     // Three sparse points; their MM positions are off by the common 0.8 m error, the matches point at the
@@ -326,7 +277,9 @@ fn control_points_from_two_oblique_cameras_triangulate_to_under_a_millimetre() {
         set("r1", "oB", s1b),
         set("r2", "oA", s2),
     ];
-    let recs: Vec<Recording> = (0..3).map(|i| recording(&format!("r{i}"), i)).collect();
+    let recs: Vec<Recording> = (0..3)
+        .map(|i| street_recording(&format!("r{i}"), i, 102.0))
+        .collect();
     let (r, d) = consensus_with_diagnostics(
         &sets,
         &clouds,

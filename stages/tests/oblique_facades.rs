@@ -25,20 +25,8 @@ const Y0: f64 = 437_000.0;
 
 fn recording(id: &str, x: f64, y: f64, heading_deg: f64) -> Recording {
     Recording {
-        image_id: id.into(),
-        file: format!("{id}.jpg"),
         time: "2019-06-14T10:00:00Z".into(),
-        time_s: 0.0,
-        x,
-        y,
-        z: 2.2,
-        heading_deg,
-        camera_height_m: 2.2,
-        sigma_xy_m: None,
-        sigma_z_m: None,
-        yaw_deg: 0.0,
-        pitch_deg: 0.0,
-        roll_deg: 0.0,
+        ..Recording::new(id, 0.0, [x, y, 2.2], heading_deg, 2.2)
     }
 }
 
@@ -147,30 +135,13 @@ fn street_scene(
 
 /// An oblique camera 450 m up looking north, tilted 45°, whose axis passes through local (x, y_aim, 9 m).
 fn oblique_north(id: &str, x: f64, y_aim: f64, focal_px: f64) -> AerialImage {
-    AerialImage {
-        image_id: id.into(),
-        file: format!("{id}.jpg"),
-        x: X0 + x,
-        y: Y0 + y_aim - 441.0,
-        z: 450.0,
-        omega_deg: 45.0,
-        phi_deg: 0.0,
-        kappa_deg: 0.0,
+    AerialImage::ideal(
+        id,
+        [X0 + x, Y0 + y_aim - 441.0, 450.0],
+        [45.0, 0.0, 0.0],
         focal_px,
-        cx_px: 400.0,
-        cy_px: 300.0,
-        width_px: 800,
-        height_px: 600,
-        k1: 0.0,
-        k2: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
-    }
+        [800, 600],
+    )
 }
 
 fn angle_deg(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -570,30 +541,17 @@ fn camera_looking_at(
     elev_deg: f64,
     focal_px: f64,
 ) -> FrameCamera {
-    FrameCamera::from_aerial(&AerialImage {
-        image_id: "cam".into(),
-        file: "cam.jpg".into(),
-        x: centroid.x,
-        y: centroid.y - dist,
-        z: centroid.z + dist * elev_deg.to_radians().tan(),
-        omega_deg: 90.0 - elev_deg,
-        phi_deg: 0.0,
-        kappa_deg: 0.0,
+    FrameCamera::from_aerial(&AerialImage::ideal(
+        "cam",
+        [
+            centroid.x,
+            centroid.y - dist,
+            centroid.z + dist * elev_deg.to_radians().tan(),
+        ],
+        [90.0 - elev_deg, 0.0, 0.0],
         focal_px,
-        cx_px: 400.0,
-        cy_px: 300.0,
-        width_px: 800,
-        height_px: 600,
-        k1: 0.0,
-        k2: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
-    })
+        [800, 600],
+    ))
 }
 
 #[test]

@@ -1,14 +1,16 @@
 //! Known-answer tests of the oblique truth grading: exact synthetic correspondences are correct, one moved by
 //! 5 oblique pixels (in either image direction, so also along the epipolar line) is wrong.
 
+mod support;
+
 use std::collections::HashMap;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
 use skytie_stages::correspondence::{
     AerialControlPoint, AerialObservation, MmTiePoint, PanoObservation,
 };
-use skytie_stages::geometry::{matrix_to_opk, FrameCamera, PanoramaCamera};
+use skytie_stages::geometry::{FrameCamera, PanoramaCamera};
 use skytie_stages::oblique::grading::{grade_match, grade_oblique, SceneOracle, Truth, Verdict};
 use skytie_stages::oblique::{
     ConsensusStats, ObliqueCorrespondence, ObliqueResult, PatchMatch, SparseCloud,
@@ -16,61 +18,10 @@ use skytie_stages::oblique::{
 };
 use skytie_stages::synth::preset::Preset;
 use skytie_stages::synth::scene_truth::{along_polyline, build_scenes};
+use support::{oblique_looking_at, street_recording, E0, N0};
 
-const E0: f64 = 500_000.0;
-const N0: f64 = 5_400_000.0;
 const W: u32 = 1600;
 const H: u32 = 800;
-
-fn recording(id: &str, i: usize) -> Recording {
-    Recording {
-        image_id: id.into(),
-        file: format!("{id}.jpg"),
-        time: String::new(),
-        time_s: i as f64,
-        x: E0 + 5.0 * i as f64,
-        y: N0,
-        z: 102.5,
-        heading_deg: 90.0,
-        camera_height_m: 2.5,
-        sigma_xy_m: None,
-        sigma_z_m: None,
-        yaw_deg: 0.0,
-        pitch_deg: 0.0,
-        roll_deg: 0.0,
-    }
-}
-
-fn oblique_image(id: &str, centre: Vector3<f64>, target: Vector3<f64>) -> AerialImage {
-    let back = (centre - target).normalize();
-    let x = Vector3::z().cross(&back).normalize();
-    let y = back.cross(&x);
-    let (omega_deg, phi_deg, kappa_deg) = matrix_to_opk(&Matrix3::from_columns(&[x, y, back]));
-    AerialImage {
-        image_id: id.into(),
-        file: format!("{id}.jpg"),
-        x: centre.x,
-        y: centre.y,
-        z: centre.z,
-        omega_deg,
-        phi_deg,
-        kappa_deg,
-        focal_px: 8000.0,
-        cx_px: 2000.0,
-        cy_px: 1500.0,
-        width_px: 4000,
-        height_px: 3000,
-        k1: 0.0,
-        k2: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
-    }
-}
 
 struct Scene {
     truth: Truth,
@@ -82,9 +33,12 @@ struct Scene {
 /// Two panoramas 5 m apart (true poses), façade points 10 m north (left side when driving east) and south,
 /// one oblique image looking north-down at the street; exact matches of every point from panorama r1.
 fn scene() -> Scene {
-    let recs = [recording("r1", 1), recording("r2", 2)];
+    let recs = [
+        street_recording("r1", 1, 102.5),
+        street_recording("r2", 2, 102.5),
+    ];
     let target = Vector3::new(E0 + 7.5, N0, 105.0);
-    let oblique = oblique_image("o1", Vector3::new(E0 + 7.5, N0 - 750.0, 850.0), target);
+    let oblique = oblique_looking_at("o1", Vector3::new(E0 + 7.5, N0 - 750.0, 850.0), target);
     let cam = FrameCamera::from_aerial(&oblique);
     let panos: Vec<PanoramaCamera> = recs
         .iter()
@@ -294,7 +248,7 @@ fn pano_match(rec: &Recording, u: f64, v: f64, px: [f64; 2]) -> PatchMatch {
 #[test]
 fn with_the_scene_the_reference_is_the_seen_surface_and_hidden_points_are_non_matchable() {
     // The tiny preset's scene; a panorama on its route looking sideways at a façade 2 m above the road.
-    let scenes = build_scenes(Preset::Tiny, 3);
+    let scenes = build_scenes(Preset::Tiny, 3, None);
     let route = along_polyline(scenes[0].route_world(), 5.0);
     let (p, q) = (route[route.len() / 2], route[route.len() / 2 + 1]);
     let ground = scenes[0].ground_height_m(p[0], p[1]);
@@ -306,7 +260,7 @@ fn with_the_scene_the_reference_is_the_seen_surface_and_hidden_points_are_non_ma
         z: ground + 2.2,
         heading_deg,
         camera_height_m: 2.2,
-        ..recording("r1", 0)
+        ..street_recording("r1", 0, 102.5)
     };
     let pano = PanoramaCamera::from_recording(&rec, W, H);
     // Find a panorama column, on the horizon row, that sees a surface within 40 m (a façade).
@@ -326,9 +280,9 @@ fn with_the_scene_the_reference_is_the_seen_surface_and_hidden_points_are_non_ma
     // the buildings across the street.
     let out = (Vector3::new(p[0], p[1], x.z) - x).normalize();
     let up = Vector3::new(0.0, 0.0, 1.0);
-    let seeing = oblique_image("o1", x + out * 150.0 + up * 900.0, x);
+    let seeing = oblique_looking_at("o1", x + out * 150.0 + up * 900.0, x);
     // The same camera behind the façade: the building hides the point.
-    let hidden = oblique_image("o1", x - out * 150.0 + up * 900.0, x);
+    let hidden = oblique_looking_at("o1", x - out * 150.0 + up * 900.0, x);
     let truth_with = |img: &AerialImage| Truth {
         recordings: HashMap::from([("r1".to_string(), (rec.clone(), W, H))]),
         aerial: HashMap::from([("o1".to_string(), img.clone())]),

@@ -70,48 +70,17 @@ fn trace(origin: &Vector3<f64>, dir: &Vector3<f64>) -> f32 {
 
 fn true_recording() -> Recording {
     Recording {
-        image_id: "pano_0001".into(),
-        file: "pano_0001.jpg".into(),
         time: "2020-01-01T00:00:00Z".into(),
-        time_s: 0.0,
-        x: X0,
-        y: Y0,
-        z: 2.5,
-        heading_deg: 90.0,
-        camera_height_m: 2.5,
-        sigma_xy_m: None,
-        sigma_z_m: None,
-        yaw_deg: 0.0,
-        pitch_deg: 0.0,
-        roll_deg: 0.0,
+        ..Recording::new("pano_0001", 0.0, [X0, Y0, 2.5], 90.0, 2.5)
     }
 }
 
 /// Oblique camera south of the façade, 300 m up, looking north 45° down at the façade centre (ω = 45°).
 fn oblique_image() -> AerialImage {
+    let centre = [X0, FACADE_Y - 290.0, 300.0];
     AerialImage {
-        image_id: "obl_0001".into(),
         file: "obl_0001.tif".into(),
-        x: X0,
-        y: FACADE_Y - 290.0,
-        z: 300.0,
-        omega_deg: 45.0,
-        phi_deg: 0.0,
-        kappa_deg: 0.0,
-        focal_px: 7000.0,
-        cx_px: 500.0,
-        cy_px: 500.0,
-        width_px: 1000,
-        height_px: 1000,
-        k1: 0.0,
-        k2: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
+        ..AerialImage::ideal("obl_0001", centre, [45.0, 0.0, 0.0], 7000.0, [1000, 1000])
     }
 }
 

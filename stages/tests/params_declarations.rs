@@ -26,12 +26,14 @@ fn every_declared_stage_parameter_struct() {
     use skytie_stages::nadir::initial_transform::TransformParams;
     use skytie_stages::nadir::mm_matching::MmMatchParams;
     use skytie_stages::nadir::refine::RefineParams;
+    use skytie_stages::nadir::vehicle_detect::VehicleDetectParams;
     use skytie_stages::nadir::vehicle_mask::VehicleMask;
     use skytie_stages::nadir::OrthoParams;
     use skytie_stages::oblique::consensus::ConsensusParams;
     use skytie_stages::oblique::facades::FacadeParams;
     use skytie_stages::oblique::patch_registration::PatchParams;
     use skytie_stages::oblique::sparse_cloud::SparseCloudParams;
+    use skytie_stages::synth::profile::ComponentParams;
 
     check::<OrthoParams>();
     check::<VehicleMask>();
@@ -52,4 +54,6 @@ fn every_declared_stage_parameter_struct() {
     check::<PlaneFitParams>();
     check::<OnePlusOneParams>();
     check::<WallisParams>();
+    check::<VehicleDetectParams>();
+    check::<ComponentParams>();
 }

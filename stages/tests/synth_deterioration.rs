@@ -1,11 +1,13 @@
-//! Statistics of the demo campaign's truth (thesis 3.5.1.2, 3.5.3), without rendering:
-//! recorded − true positions have a systematic horizontal offset of 0.80 m and per-axis SD 0.10 m (within
-//! sampling error), heights untouched; check-point observations reproject with the true poses within the
-//! 0.5 px measurement noise (per-axis RMS 0.35–0.65 px) and are far off with the recorded poses.
+//! Statistics of the demo campaign's truth (thesis 3.5.1.2, 3.5.3), without rendering: with the `thesis` error
+//! profile, recorded − true positions have a systematic horizontal offset of 0.80 m and per-axis SD 0.10 m
+//! (within sampling error), heights untouched; check-point observations reproject with the true poses within
+//! the 0.5 px measurement noise (per-axis RMS 0.35–0.65 px) and are far off with the recorded poses. The other
+//! profiles on the demo trajectory: outage drift above 1.5 m and back, INS heading errors in range.
 
 use skytie_stages::geometry::PanoramaCamera;
 use skytie_stages::synth::generate::plan_campaign;
-use skytie_stages::synth::{Deterioration, DriftProfile, Preset, SynthOptions};
+use skytie_stages::synth::profile::Routes;
+use skytie_stages::synth::{Preset, Profile, SynthOptions};
 
 fn mean_sd(v: &[f64]) -> (f64, f64) {
     let n = v.len() as f64;
@@ -25,13 +27,13 @@ fn demo_deterioration_and_observations_have_the_documented_statistics() {
 
     // Seed 1 alone: n ≈ 40 ⇒ SE of a mean ≈ 0.016 m, SE of an SD ≈ 0.011 m; bounds are ≈ 4 SE.
     let dx: Vec<f64> = plan
-        .recorded
+        .recorded()
         .iter()
         .zip(&truth)
         .map(|(r, t)| r.x - t.x)
         .collect();
     let dy: Vec<f64> = plan
-        .recorded
+        .recorded()
         .iter()
         .zip(&truth)
         .map(|(r, t)| r.y - t.y)
@@ -45,18 +47,18 @@ fn demo_deterioration_and_observations_have_the_documented_statistics() {
         "SDs {sx} {sy}"
     );
     let az = mx.atan2(my).to_degrees().rem_euclid(360.0);
-    let daz = (az - plan.deterioration.azimuth_deg + 180.0).rem_euclid(360.0) - 180.0;
+    let documented = Profile::thesis().params.thesis.azimuth_for(1);
+    let daz = (az - documented + 180.0).rem_euclid(360.0) - 180.0;
     assert!(
         daz.abs() < 6.0,
-        "offset azimuth {az} vs documented {}",
-        plan.deterioration.azimuth_deg
+        "offset azimuth {az} vs documented {documented}"
     );
     assert!(
-        plan.recorded.iter().zip(&truth).all(|(r, t)| r.z == t.z),
+        plan.recorded().iter().zip(&truth).all(|(r, t)| r.z == t.z),
         "heights must be untouched"
     );
     assert!(plan
-        .recorded
+        .recorded()
         .iter()
         .zip(&truth)
         .all(|(r, t)| r.heading_deg == t.heading_deg
@@ -66,14 +68,20 @@ fn demo_deterioration_and_observations_have_the_documented_statistics() {
     // Pooled over 25 seeds (≈ 1000 panoramas): residuals about each seed's systematic offset have per-axis
     // mean 0 (SE ≈ 0.003 m) and SD 0.10 m (SE ≈ 0.0023 m).
     let (mut rx, mut ry) = (Vec::new(), Vec::new());
+    let tables = plan.true_tables();
     for seed in 1..=25u64 {
-        let model = Deterioration::Thesis.resolve(seed);
+        let thesis = Profile::thesis();
         assert_eq!(
-            (model.offset_m, model.sigma_m, model.z_sigma_m),
-            (0.80, 0.10, 0.0)
+            (thesis.params.thesis.offset_m, thesis.params.thesis.sigma_m),
+            (0.80, 0.10)
         );
-        let (sa, ca) = model.azimuth_deg.to_radians().sin_cos();
-        let rec = model.apply(&truth, &plan.areas[0].along_m, seed);
+        let (sa, ca) = thesis
+            .params
+            .thesis
+            .azimuth_for(seed)
+            .to_radians()
+            .sin_cos();
+        let rec = thesis.apply(seed, &tables).tables.recordings;
         for (r, t) in rec.iter().zip(&truth) {
             rx.push(r.x - t.x - 0.80 * sa);
             ry.push(r.y - t.y - 0.80 * ca);
@@ -136,7 +144,7 @@ fn demo_deterioration_and_observations_have_the_documented_statistics() {
         (0.35..0.65).contains(&ru) && (0.35..0.65).contains(&rv),
         "RMS u {ru}, v {rv}"
     );
-    let (bu, bv) = residuals(&plan.recorded);
+    let (bu, bv) = residuals(plan.recorded());
     eprintln!("observation RMS with recorded poses: u {bu:.1} px, v {bv:.1} px");
     assert!(
         bu.hypot(bv) > 5.0,
@@ -157,43 +165,68 @@ fn demo_deterioration_and_observations_have_the_documented_statistics() {
 }
 
 #[test]
-fn drift_and_height_error_options_are_applied() {
-    let mut opts = SynthOptions::new(Preset::Tiny, 3);
-    opts.deterioration = Deterioration::Custom {
-        offset_m: 0.0,
-        azimuth_deg: 0.0,
-        sigma_m: 0.0,
-        z_sigma_m: 0.0,
-        drift: Some(DriftProfile {
-            start_m: 5.0,
-            length_m: 10.0,
-            peak_m: 2.0,
-            azimuth_deg: 90.0,
-        }),
-    };
-    let plan = plan_campaign(&opts).unwrap();
-    let truth = plan.truth();
-    let along = &plan.areas[0].along_m;
-    for ((r, t), s) in plan.recorded.iter().zip(&truth).zip(along) {
-        let want = DriftProfile {
-            start_m: 5.0,
-            length_m: 10.0,
-            peak_m: 2.0,
-            azimuth_deg: 90.0,
+fn demo_profiles_have_their_documented_sizes() {
+    // Outage: on every demo seed the error rises above 1.5 m and is back to centimetres at the outage's ends.
+    for seed in 1..=5u64 {
+        let mut opts = SynthOptions::new(Preset::Demo, seed);
+        opts.profile = Profile::parse("outage").unwrap();
+        let plan = plan_campaign(&opts).unwrap();
+        let truth = plan.truth();
+        let errors: Vec<f64> = plan
+            .recorded()
+            .iter()
+            .zip(&truth)
+            .map(|(r, t)| (r.x - t.x).hypot(r.y - t.y))
+            .collect();
+        let largest = errors.iter().copied().fold(0.0, f64::max);
+        assert!(largest > 1.4, "seed {seed}: largest error {largest} m");
+        let routes = Routes::of(&truth);
+        let o = opts.profile.params.outage.draw(seed, 0, routes.length_m[0]);
+        for (i, e) in errors.iter().enumerate() {
+            if o.phase(routes.along_m[i]).is_none() {
+                assert!(*e < 0.1, "seed {seed}: {e} m outside the outage");
+            }
         }
-        .magnitude_m(*s);
+        let readme = profile_readme(&plan, &opts);
         assert!(
-            (r.x - t.x - want).abs() < 1e-9 && (r.y - t.y).abs() < 1e-9 && r.z == t.z,
-            "at {s} m"
+            readme.contains("GNSS outage") && readme.contains("turns with the"),
+            "{readme}"
         );
     }
-    assert!(
-        (plan.recorded[2].x - truth[2].x - 2.0).abs() < 1e-9,
-        "peak at 10 m along"
-    );
-    let readme = plan.deterioration.readme("x", 3, truth.len());
-    assert!(
-        readme.contains("drift") && readme.contains("2.000 m"),
-        "{readme}"
-    );
+    // INS: yaw errors of 0.1–0.5° plus a slow wander, positions untouched; all-components readme lists each.
+    let mut opts = SynthOptions::new(Preset::Demo, 2);
+    opts.profile = Profile::parse("ins").unwrap();
+    let plan = plan_campaign(&opts).unwrap();
+    for (r, t) in plan.recorded().iter().zip(&plan.truth()) {
+        let d = (r.yaw_deg - t.yaw_deg).abs();
+        assert!((0.05..0.6).contains(&d), "{d}");
+        assert_eq!((r.x, r.y, r.z), (t.x, t.y, t.z));
+    }
+    opts.profile = Profile::parse("all").unwrap();
+    let plan = plan_campaign(&opts).unwrap();
+    let readme = profile_readme(&plan, &opts);
+    for c in [
+        "`thesis`",
+        "`outage`",
+        "`ins`",
+        "`vertical`",
+        "`aerial`",
+        "`lens`",
+        "`epoch`",
+    ] {
+        assert!(readme.contains(c), "{c} missing in {readme}");
+    }
+    assert!(plan.applied.aerial_changed);
+}
+
+fn profile_readme(
+    plan: &skytie_stages::synth::generate::CampaignPlan,
+    opts: &SynthOptions,
+) -> String {
+    skytie_stages::synth::profile::readme::readme(
+        &plan.name,
+        opts.seed,
+        &opts.profile,
+        &plan.applied,
+    )
 }

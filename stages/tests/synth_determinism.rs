@@ -155,12 +155,12 @@ fn tiny_is_byte_identical_across_runs_and_thread_counts() {
 
 #[test]
 fn seeds_change_the_campaign() {
-    // Different seeds give different deteriorations (cheap: no rendering needed to see it).
+    // Different seeds give different errors (cheap: no rendering needed to see it).
     let a =
         skytie_stages::synth::generate::plan_campaign(&SynthOptions::new(Preset::Tiny, 1)).unwrap();
     let b =
         skytie_stages::synth::generate::plan_campaign(&SynthOptions::new(Preset::Tiny, 2)).unwrap();
-    assert_ne!(a.recorded[0].x, b.recorded[0].x);
+    assert_ne!(a.recorded()[0].x, b.recorded()[0].x);
     assert_eq!(a.name, "synth-tiny-seed1");
 }
 
@@ -213,4 +213,72 @@ fn a_resumed_generation_takes_the_stored_images_and_gives_the_same_folder() {
     let third = dir.path().join("third");
     let (_, reused) = generate_resumable(&options, &third, &store_dir).unwrap();
     assert_eq!(reused, 0);
+}
+
+/// Table-only error profiles share one rendering: the profile is applied to the rendered error-free folder,
+/// the images are hard links to its files (same bytes, no copy), only the tables and `truth/` differ, and the
+/// tables are the ones the in-memory plan makes (so a workflow's nodes and `skytie synth` write the same).
+#[test]
+fn table_profiles_share_one_rendering_of_the_images() {
+    use skytie_stages::campaign::{read_aerial_csv, read_recordings_csv};
+    use skytie_stages::synth::generate::plan_campaign;
+    use skytie_stages::synth::{apply_profile, render_campaign, Profile};
+    use std::os::unix::fs::MetadataExt;
+    let dir = tempfile::tempdir().unwrap();
+    let rendered = dir.path().join("rendered");
+    let thesis = SynthOptions::new(Preset::Tiny, 3);
+    render_campaign(&thesis, &rendered, &dir.path().join("store")).unwrap();
+    let mut rich = thesis.clone();
+    rich.profile = Profile::parse("outage+ins+vertical+aerial").unwrap();
+    assert_eq!(rich.render_identity(), thesis.render_identity());
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    apply_profile(&rendered, &thesis, &a).unwrap();
+    apply_profile(&rendered, &rich, &b).unwrap();
+    let (ta, tb) = (read_tree(&a), read_tree(&b));
+    let mut differ: Vec<String> = Vec::new();
+    for (k, v) in &ta {
+        if k.starts_with("mm/panoramas")
+            || k.starts_with("aerial") && k.extension().is_some_and(|e| e == "jpg")
+        {
+            assert!(tb[k] == *v, "{} differs", k.display());
+            let (ia, ib) = (
+                std::fs::metadata(a.join(k)).unwrap().ino(),
+                std::fs::metadata(b.join(k)).unwrap().ino(),
+            );
+            assert_eq!(ia, ib, "{} is not shared", k.display());
+        } else if tb.get(k) != Some(v) {
+            differ.push(k.display().to_string());
+        }
+    }
+    differ.sort();
+    assert_eq!(
+        differ,
+        [
+            "aerial/nadir/cameras.csv",
+            "aerial/oblique/cameras.csv",
+            "campaign.toml",
+            "mm/recordings.csv",
+            "truth/README.md"
+        ]
+    );
+    assert!(
+        tb.contains_key(Path::new("truth/aerial_nadir.csv"))
+            && !ta.contains_key(Path::new("truth/aerial_nadir.csv"))
+    );
+    // The tables are those of the plan (the in-memory path).
+    for (options, root) in [(&thesis, &a), (&rich, &b)] {
+        let plan = plan_campaign(options).unwrap();
+        let (recs, _) = read_recordings_csv(&root.join("mm/recordings.csv"));
+        assert_eq!(recs.len(), plan.recorded().len());
+        for (r, p) in recs.iter().zip(plan.recorded()) {
+            assert_eq!(
+                (r.x, r.y, r.z, r.yaw_deg, r.heading_deg),
+                (p.x, p.y, p.z, p.yaw_deg, p.heading_deg)
+            );
+        }
+        let (nadir, _) = read_aerial_csv(&root.join("aerial/nadir/cameras.csv"));
+        assert_eq!(nadir, plan.applied.tables.nadir);
+    }
+    let readme = String::from_utf8(tb[Path::new("truth/README.md")].clone()).unwrap();
+    assert!(readme.contains("`outage+ins+vertical+aerial`"), "{readme}");
 }

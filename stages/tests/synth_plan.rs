@@ -85,10 +85,10 @@ fn paper_has_four_separate_areas_of_about_a_hundred_panoramas() {
         }
     }
     let ids: std::collections::BTreeSet<_> =
-        plan.recorded.iter().map(|r| r.image_id.clone()).collect();
+        plan.recorded().iter().map(|r| r.image_id.clone()).collect();
     assert_eq!(
         ids.len(),
-        plan.recorded.len(),
+        plan.recorded().len(),
         "image ids unique across areas"
     );
 }

@@ -4,7 +4,7 @@
 //! before/after (thesis 3.5.3: check points triangulated from their panorama observations with the recorded
 //! and the adjusted poses, two-view and multi-view). Check points are never used as control.
 
-use crate::dag::{Handle, NodeCtx, Optional, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RawFile, RunResult, Stage, StageError};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::panorama_sizes::pano_sizes;
 use crate::nodes::oblique::consensus::ObliqueOutput;
@@ -24,28 +24,7 @@ use std::sync::Arc;
 pub const CHECKPOINT_SIGMA_PX: f64 = 0.5;
 
 /// Root-mean-square check-point errors, metres (thesis Tables 3-3…3-5, 5-2…5-9).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Rmse {
-    pub x: f64,
-    pub y: f64,
-    pub z: f64,
-    pub d2: f64,
-    pub d3: f64,
-    pub count: usize,
-}
-
-impl From<&RmseSummary> for Rmse {
-    fn from(r: &RmseSummary) -> Self {
-        Rmse {
-            x: r.x,
-            y: r.y,
-            z: r.z,
-            d2: r.d2,
-            d3: r.d3,
-            count: r.count,
-        }
-    }
-}
+pub type Rmse = RmseSummary;
 
 /// Check-point errors before/after with one view selection (thesis 3.5.3).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -61,8 +40,8 @@ pub struct CheckPointSummary {
 impl CheckPointSummary {
     fn of(c: &CheckPointComparison) -> Self {
         CheckPointSummary {
-            before: Rmse::from(&c.before.rmse),
-            after: Rmse::from(&c.after.rmse),
+            before: c.before.rmse,
+            after: c.after.rmse,
             rows: checkpoint_rows(c),
             skipped_observations: c.skipped_observations,
         }
@@ -202,10 +181,7 @@ fn spread(mut values: Vec<f64>) -> serde_json::Value {
 pub struct AdjustStage;
 
 impl Stage for AdjustStage {
-    const NAME: &'static str = skytie_stages::adjustment::from_correspondences::STAGE.name;
-    const VERSION: &'static str = skytie_stages::adjustment::from_correspondences::STAGE.version;
-    type Params = AdjustConfig;
-    type Output = AdjustReport;
+    crate::nodes::stage_types!(skytie_stages::adjustment::from_correspondences::STAGE, AdjustConfig => AdjustReport);
     type Inputs = (
         Handle<CampaignSnapshot>,
         Vec<RawFile>,
@@ -215,19 +191,8 @@ impl Stage for AdjustStage {
         Vec<Optional<ObliqueOutput>>,
     );
 
-    fn run(
-        &self,
-        config: &AdjustConfig,
-        (snap, panos, windows, control, clouds, oblique): (
-            Arc<CampaignSnapshot>,
-            Vec<RawFileValue>,
-            Vec<Option<Arc<MmWindowMatch>>>,
-            Vec<Option<Arc<RecordingControl>>>,
-            Vec<Option<Arc<SparseCloud>>>,
-            Vec<Option<Arc<ObliqueOutput>>>,
-        ),
-        _: &NodeCtx,
-    ) -> Result<AdjustReport, StageError> {
+    fn run(&self, config: &AdjustConfig, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (snap, panos, windows, control, clouds, oblique) = inputs;
         // Items whose nodes failed are absent: the adjustment uses the rest (the failures are counted).
         let (windows, control, clouds, oblique) =
             (flat(windows), flat(control), flat(clouds), flat(oblique));

@@ -3,7 +3,7 @@
 //! pass/fail flag against a tolerance. The node verifies the recorded positions (no adjustment given: the
 //! thesis' verification without adjusting) or, given the adjustment's result, the adjusted ones.
 
-use crate::dag::{Handle, NodeCtx, Optional, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RawFile, RunResult, Stage, StageError};
 use crate::nodes::adjust::adjustment::AdjustReport;
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::panorama_sizes::pano_sizes;
@@ -13,7 +13,6 @@ use skytie_stages::campaign::Recording;
 use skytie_stages::correspondence::AerialControlPoint;
 use skytie_stages::nadir::RecordingControl;
 use std::collections::HashMap;
-use std::sync::Arc;
 
 crate::serde_artifact!(Verification);
 
@@ -44,10 +43,7 @@ pub fn verify_metrics(v: &Verification) -> serde_json::Value {
 pub struct VerifyStage;
 
 impl Stage for VerifyStage {
-    const NAME: &'static str = skytie_stages::adjustment::verify::STAGE.name;
-    const VERSION: &'static str = skytie_stages::adjustment::verify::STAGE.version;
-    type Params = VerifyConfig;
-    type Output = Verification;
+    crate::nodes::stage_types!(skytie_stages::adjustment::verify::STAGE, VerifyConfig => Verification);
     /// The campaign, its panoramas, the aerial control points, and no or one adjustment whose poses replace the
     /// recorded ones.
     type Inputs = (
@@ -57,17 +53,8 @@ impl Stage for VerifyStage {
         Vec<Handle<AdjustReport>>,
     );
 
-    fn run(
-        &self,
-        config: &VerifyConfig,
-        (snap, panos, control, adjusted): (
-            Arc<CampaignSnapshot>,
-            Vec<RawFileValue>,
-            Vec<Option<Arc<RecordingControl>>>,
-            Vec<Arc<AdjustReport>>,
-        ),
-        _: &NodeCtx,
-    ) -> Result<Verification, StageError> {
+    fn run(&self, config: &VerifyConfig, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (snap, panos, control, adjusted) = inputs;
         let sizes = pano_sizes(&panos)?;
         let points: Vec<AerialControlPoint> = control
             .iter()

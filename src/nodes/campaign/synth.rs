@@ -1,31 +1,41 @@
-//! `synth`: the synthetic campaign generator as a cached node (`campaign = "synth:<preset>"` in a workflow).
+//! The synthetic campaign generator as two cached nodes (`campaign = "synth:<preset>"` in a workflow):
+//! `render` renders the error-free campaign of a preset and seed (the images depend only on the render
+//! identity: preset, seed, size overrides and the `lens`/`epoch` profile components), and `synth` applies the
+//! error profile of the `[synth]` table to it, writing new tables and hard-linking the images. So a workflow or
+//! an evaluation that runs one scene under several table-only profiles renders it once.
 //!
-//! The node writes the whole campaign folder into its own cache folder (`<cache>/dirs/<key>/campaign`), so a
-//! second run — or any workflow naming the same preset, seed and options — reuses it. Finished images are kept
-//! in the node's partial folder (`<cache>/dirs/.partial-<key>`) until the campaign is complete, so an interrupted
-//! generation resumes (`skytie_stages::synth::render_store`). The output records every file's size; a cached
-//! folder whose files went missing or changed size is regenerated.
+//! Each node writes its folder into its own cache folder (`<cache>/dirs/<key>/campaign`), so a second run — or
+//! any workflow naming the same options — reuses it. Finished images are kept in the render node's partial
+//! folder (`<cache>/dirs/.partial-<key>`) until the rendering is complete, so an interrupted generation resumes
+//! (`skytie_stages::synth::render_store`). The outputs record every file's size; a cached folder whose files
+//! went missing or changed size is regenerated.
 
-use crate::dag::{NodeCtx, Stage, StageError};
+use crate::dag::{Handle, NodeCtx, Stage, StageError};
 use serde::{Deserialize, Serialize};
 use skytie_stages::params::Violation;
+use skytie_stages::synth::generate::{RenderIdentity, RENDER_STAGE, STAGE};
 use skytie_stages::synth::output::{aerial_format_from, parse_size_px};
+use skytie_stages::synth::profile::{
+    AerialEoParams, ComponentParams, EpochParams, InsParams, LensParams, OutageParams,
+    ThesisParams, VerticalParams,
+};
 use skytie_stages::synth::{
-    generate_resumable, Deterioration, Preset, SynthError, SynthOptions, SynthSummary,
+    apply_profile, render_campaign, Preset, Profile, SynthError, SynthOptions, SynthSummary,
 };
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 skytie_stages::params! {
     /// Parameters of the `[synth]` workflow table (preset and seed come from `campaign = "synth:<preset>"` and
-    /// `seed`).
+    /// `seed`); the component tables `[synth.outage]`, `[synth.ins]`, … override a component's defaults.
     pub struct SynthParams {
         /// Preset: `tiny`, `demo`, `paper` or `realsize`.
         preset: String = "demo".into();
         /// Seed of the generator.
         seed: u64 = 1;
-        /// Recorded-position deterioration: `thesis` (0.80 m systematic + N(0, 0.10 m), thesis 3.5.1.2) or
-        /// `none`.
-        deterioration: String = "thesis".into();
+        /// Error profile: components joined by `+` (`thesis`, `outage`, `ins`, `vertical`, `aerial`, `lens`,
+        /// `lens-unknown`, `epoch`), or `none`, or `all`; see docs/error-profiles.md.
+        profile: String = "thesis".into();
         /// Override of the panorama width (even; 0 = the preset's).
         panorama_width_px: u32 = 0, unit "px";
         /// Override of the number of recordings per route (0 = the preset's).
@@ -46,10 +56,27 @@ skytie_stages::params! {
         render_max_width_px: u32 = 0, unit "px";
         /// Write the campaign at its render size (the demo-size twin of a real-size preset).
         at_render_size: bool = false;
+        /// `[synth.thesis]`: constant offset + noise (thesis 3.5.1.2).
+        thesis: ThesisParams = ThesisParams::default(), section;
+        /// `[synth.outage]`: GNSS outage drift.
+        outage: OutageParams = OutageParams::default(), section;
+        /// `[synth.ins]`: inertial heading, pitch and roll errors.
+        ins: InsParams = InsParams::default(), section;
+        /// `[synth.vertical]`: height and camera-height errors.
+        vertical: VerticalParams = VerticalParams::default(), section;
+        /// `[synth.aerial]`: aerial orientation errors.
+        aerial: AerialEoParams = AerialEoParams::default(), section;
+        /// `[synth.lens]`: nadir lens distortion.
+        lens: LensParams = LensParams::default(), section;
+        /// `[synth.epoch]`: aerial vs mobile-mapping epoch differences.
+        epoch: EpochParams = EpochParams::default(), section;
     }
     check(p, v) {
-        if let Err(violation) = p.options() {
-            v.push(violation);
+        // The sections' own violations are already listed; the options add the preset's and the profile's.
+        if v.is_empty() {
+            if let Err(violation) = p.options() {
+                v.push(violation);
+            }
         }
     }
 }
@@ -60,16 +87,18 @@ impl SynthParams {
         let preset =
             Preset::from_name(&self.preset).map_err(|e| Violation::new("preset", e.to_string()))?;
         let mut o = SynthOptions::new(preset, self.seed);
-        o.deterioration = match self.deterioration.as_str() {
-            "thesis" => Deterioration::Thesis,
-            "none" => Deterioration::None,
-            other => {
-                return Err(Violation::new(
-                    "deterioration",
-                    format!("unknown deterioration '{other}': use \"thesis\" or \"none\""),
-                ))
-            }
+        let mut profile =
+            Profile::parse(&self.profile).map_err(|e| Violation::new("profile", e.to_string()))?;
+        profile.params = ComponentParams {
+            thesis: self.thesis.clone(),
+            outage: self.outage.clone(),
+            ins: self.ins.clone(),
+            vertical: self.vertical.clone(),
+            aerial: self.aerial.clone(),
+            lens: self.lens.clone(),
+            epoch: self.epoch.clone(),
         };
+        o.profile = profile;
         if self.panorama_width_px != 0 {
             o.panorama_width_px = Some(self.panorama_width_px);
         }
@@ -124,6 +153,24 @@ impl GeneratedCampaign {
     pub fn path(&self) -> PathBuf {
         PathBuf::from(&self.dir)
     }
+
+    /// The campaign as written into `tmp` (the node's temporary folder) and recorded at `ctx`'s final folder.
+    fn record(tmp: &Path, ctx: &NodeCtx, summary: SynthSummary) -> Result<Self, StageError> {
+        Ok(GeneratedCampaign {
+            dir: ctx
+                .output_dir()
+                .join("campaign")
+                .to_string_lossy()
+                .into_owned(),
+            files: list_files(&tmp.join("campaign"))?,
+            summary,
+        })
+    }
+
+    /// Whether the folder still holds exactly the recorded files (by size).
+    fn intact(&self) -> bool {
+        list_files(&self.path()).is_ok_and(|files| files == self.files)
+    }
 }
 
 /// Every file below `root` as (relative path with '/', size), sorted.
@@ -153,48 +200,80 @@ pub fn list_files(root: &Path) -> std::io::Result<Vec<(String, u64)>> {
     Ok(out)
 }
 
-/// The generator node.
-pub struct SynthCampaign;
+/// The render node: the error-free campaign of a render identity.
+pub struct RenderCampaign;
 
-impl Stage for SynthCampaign {
-    const NAME: &'static str = skytie_stages::synth::generate::STAGE.name;
-    const VERSION: &'static str = skytie_stages::synth::generate::STAGE.version;
-    type Params = SynthParams;
+impl Stage for RenderCampaign {
+    const NAME: &'static str = RENDER_STAGE.name;
+    const VERSION: &'static str = RENDER_STAGE.version;
+    type Params = RenderIdentity;
     type Output = GeneratedCampaign;
     type Inputs = ();
 
-    fn run(&self, p: &SynthParams, _: (), ctx: &NodeCtx) -> Result<GeneratedCampaign, StageError> {
-        let options = p
-            .options()
-            .map_err(|v| StageError::new(format!("synth parameter {v}")))?;
+    fn run(
+        &self,
+        identity: &RenderIdentity,
+        _: (),
+        ctx: &NodeCtx,
+    ) -> Result<GeneratedCampaign, StageError> {
+        let options = SynthOptions::rendering(identity);
         let tmp = ctx.output_dir_tmp()?;
-        let (summary, reused) =
-            generate_resumable(&options, &tmp.join("campaign"), &ctx.partial_dir()).map_err(|e| {
+        let (summary, reused) = render_campaign(&options, &tmp.join("campaign"), &ctx.partial_dir())
+            .map_err(|e| {
                 StageError::new(format!(
-                    "synthetic campaign generation failed: {e} (the images rendered so far are kept in {}; \
+                    "synthetic campaign rendering failed: {e} (the images rendered so far are kept in {}; \
                      the next run resumes from them)",
                     ctx.partial_dir().display()
                 ))
             })?;
         if reused > 0 {
             eprintln!(
-                "synth: resumed an interrupted generation: {reused} images taken from {}",
+                "render: resumed an interrupted rendering: {reused} images taken from {}",
                 ctx.partial_dir().display()
             );
         }
-        let files = list_files(&tmp.join("campaign"))?;
-        let dir = ctx.output_dir().join("campaign");
-        Ok(GeneratedCampaign {
-            dir: dir.to_string_lossy().into_owned(),
-            files,
-            summary,
-        })
+        GeneratedCampaign::record(&tmp, ctx, summary)
     }
 
     fn cached_output_ok(&self, out: &GeneratedCampaign, _ctx: &NodeCtx) -> bool {
-        match list_files(&out.path()) {
-            Ok(files) => files == out.files,
-            Err(_) => false,
-        }
+        out.intact()
+    }
+}
+
+/// The generator node: the rendered campaign with the `[synth]` error profile applied.
+pub struct SynthCampaign;
+
+impl Stage for SynthCampaign {
+    const NAME: &'static str = STAGE.name;
+    const VERSION: &'static str = STAGE.version;
+    type Params = SynthParams;
+    type Output = GeneratedCampaign;
+    type Inputs = Handle<GeneratedCampaign>;
+
+    fn run(
+        &self,
+        p: &SynthParams,
+        rendered: Arc<GeneratedCampaign>,
+        ctx: &NodeCtx,
+    ) -> Result<GeneratedCampaign, StageError> {
+        let options = p
+            .options()
+            .map_err(|v| StageError::new(format!("synth parameter {v}")))?;
+        let tmp = ctx.output_dir_tmp()?;
+        apply_profile(&rendered.path(), &options, &tmp.join("campaign")).map_err(|e| {
+            StageError::new(format!(
+                "applying the error profile '{}' failed: {e}",
+                options.profile.name()
+            ))
+        })?;
+        let summary = SynthSummary {
+            name: options.campaign_name(),
+            ..rendered.summary.clone()
+        };
+        GeneratedCampaign::record(&tmp, ctx, summary)
+    }
+
+    fn cached_output_ok(&self, out: &GeneratedCampaign, _ctx: &NodeCtx) -> bool {
+        out.intact()
     }
 }

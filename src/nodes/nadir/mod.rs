@@ -1,6 +1,6 @@
 //! The nadir pipeline's nodes (thesis chapter 3): ortho-projection, MM-to-MM matching, the aerial-oriented
 //! orthos, initial transforms and their agreement, phase-correlation refinement (or the chapter-2 baseline),
-//! aerial control points, the summary and the grading on truth.
+//! aerial control points, the summary and the grading on truth; the recording vehicle found in the panoramas.
 
 pub mod baseline;
 pub mod control;
@@ -13,3 +13,4 @@ pub mod refine;
 pub mod summary;
 pub mod transform;
 pub mod transform_agreement;
+pub mod vehicle;

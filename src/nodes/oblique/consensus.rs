@@ -2,14 +2,13 @@
 //! registration set, optional consensus tracking, and the oblique control points (thesis 4.4.7,
 //! `skytie_stages::oblique::consensus`), with the pipeline's own counts (`oblique.*` metrics that need no truth).
 
-use crate::dag::{Handle, NodeCtx, Optional, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RawFile, RunResult, Stage};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::panorama_sizes::pano_sizes;
 use serde::{Deserialize, Serialize};
 use skytie_stages::oblique::consensus::{consensus, ConsensusParams};
 use skytie_stages::oblique::summary::ObliqueSummary;
 use skytie_stages::oblique::{ObliqueResult, PatchRegistrationSet, SparseCloud, TripletFacades};
-use std::sync::Arc;
 
 /// The consensus node's output: the correspondences and control points, and the pipeline's counts.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -24,10 +23,7 @@ crate::serde_artifact!(ObliqueOutput);
 pub struct ConsensusStage;
 
 impl Stage for ConsensusStage {
-    const NAME: &'static str = skytie_stages::oblique::consensus::STAGE.name;
-    const VERSION: &'static str = skytie_stages::oblique::consensus::STAGE.version;
-    type Params = ConsensusParams;
-    type Output = ObliqueOutput;
+    crate::nodes::stage_types!(skytie_stages::oblique::consensus::STAGE, ConsensusParams => ObliqueOutput);
     type Inputs = (
         Handle<CampaignSnapshot>,
         Vec<RawFile>,
@@ -36,18 +32,8 @@ impl Stage for ConsensusStage {
         Vec<Optional<PatchRegistrationSet>>,
     );
 
-    fn run(
-        &self,
-        p: &ConsensusParams,
-        (snap, panos, clouds, facades, sets): (
-            Arc<CampaignSnapshot>,
-            Vec<RawFileValue>,
-            Vec<Option<Arc<SparseCloud>>>,
-            Vec<Option<Arc<TripletFacades>>>,
-            Vec<Option<Arc<PatchRegistrationSet>>>,
-        ),
-        _: &NodeCtx,
-    ) -> Result<ObliqueOutput, StageError> {
+    fn run(&self, p: &ConsensusParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (snap, panos, clouds, facades, sets) = inputs;
         let c = &snap.campaign;
         let sizes = pano_sizes(&panos)?;
         let clouds: Vec<SparseCloud> = clouds.iter().flatten().map(|x| (**x).clone()).collect();

@@ -5,7 +5,7 @@
 //! three recording rows, and the rows of the oblique images that may see the centre recording's street
 //! (`skytie_stages::oblique::candidates`).
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::oblique::facades::{find_facades, FacadeParams};
 use skytie_stages::oblique::{SparseCloud, TripletFacades};
@@ -17,26 +17,15 @@ crate::serde_artifact!(TripletFacades);
 pub struct FacadesStage;
 
 impl Stage for FacadesStage {
-    const NAME: &'static str = skytie_stages::oblique::facades::STAGE.name;
-    const VERSION: &'static str = skytie_stages::oblique::facades::STAGE.version;
-    type Params = FacadeParams;
-    type Output = TripletFacades;
+    crate::nodes::stage_types!(skytie_stages::oblique::facades::STAGE, FacadeParams => TripletFacades);
     type Inputs = (
         Vec<Handle<SparseCloud>>,
         Vec<Handle<Recording>>,
         Vec<Handle<AerialImage>>,
     );
 
-    fn run(
-        &self,
-        p: &FacadeParams,
-        (clouds, recs, oblique): (
-            Vec<Arc<SparseCloud>>,
-            Vec<Arc<Recording>>,
-            Vec<Arc<AerialImage>>,
-        ),
-        _: &NodeCtx,
-    ) -> Result<TripletFacades, StageError> {
+    fn run(&self, p: &FacadeParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (clouds, recs, oblique) = inputs;
         if recs.len() != 3 {
             return Err(StageError::new(
                 "internal: facades needs the triplet's three recordings",

@@ -3,7 +3,7 @@
 //! (`skytie_stages::oblique::grading`; the rule is stated there and in the README). Added by the pipeline only
 //! when `truth/recordings.csv` exists; no processing stage reads `truth/`.
 
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RunResult, Stage, StageError};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::summary::SummaryParams;
 use crate::nodes::nadir::grade::load_truth;
@@ -11,7 +11,6 @@ use crate::nodes::oblique::consensus::ObliqueOutput;
 use skytie_stages::oblique::grading::{grade_oblique, ObliqueGrade};
 use skytie_stages::oblique::SparseCloud;
 use skytie_stages::synth::scene_truth::SceneTruth;
-use std::sync::Arc;
 
 crate::serde_artifact!(ObliqueGrade);
 
@@ -35,10 +34,7 @@ impl GradeOblique {
 }
 
 impl Stage for GradeOblique {
-    const NAME: &'static str = skytie_stages::oblique::grading::STAGE.name;
-    const VERSION: &'static str = skytie_stages::oblique::grading::STAGE.version;
-    type Params = SummaryParams;
-    type Output = ObliqueGrade;
+    crate::nodes::stage_types!(skytie_stages::oblique::grading::STAGE, SummaryParams => ObliqueGrade);
     type Inputs = (
         Handle<CampaignSnapshot>,
         Vec<RawFile>,
@@ -48,19 +44,8 @@ impl Stage for GradeOblique {
         Handle<ObliqueOutput>,
     );
 
-    fn run(
-        &self,
-        _: &SummaryParams,
-        (snap, truth_files, scene_files, panos, clouds, result): (
-            Arc<CampaignSnapshot>,
-            Vec<RawFileValue>,
-            Vec<RawFileValue>,
-            Vec<RawFileValue>,
-            Vec<Arc<SparseCloud>>,
-            Arc<ObliqueOutput>,
-        ),
-        _: &NodeCtx,
-    ) -> Result<ObliqueGrade, StageError> {
+    fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (snap, truth_files, scene_files, panos, clouds, result) = inputs;
         let truth = load_truth(
             &snap,
             &truth_files,

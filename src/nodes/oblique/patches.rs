@@ -3,14 +3,13 @@
 //! image that the visibility hypothesis did not accept for any plane gives an empty set. The sparse clouds
 //! are the same list as the `facades` node's (the triplet's own first, then its neighbours).
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use crate::nodes::campaign::image_tiles;
 use crate::nodes::campaign::ingest::IngestedImage;
 use crate::nodes::oblique::facades::neighbourhood_cloud;
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::oblique::patch_registration::{register_patches, PatchParams};
 use skytie_stages::oblique::{PatchRegistrationSet, PatchStats, SparseCloud, TripletFacades};
-use std::sync::Arc;
 
 crate::serde_artifact!(PatchRegistrationSet);
 
@@ -18,10 +17,7 @@ crate::serde_artifact!(PatchRegistrationSet);
 pub struct PatchesStage;
 
 impl Stage for PatchesStage {
-    const NAME: &'static str = skytie_stages::oblique::patch_registration::STAGE.name;
-    const VERSION: &'static str = skytie_stages::oblique::patch_registration::STAGE.version;
-    type Params = PatchParams;
-    type Output = PatchRegistrationSet;
+    crate::nodes::stage_types!(skytie_stages::oblique::patch_registration::STAGE, PatchParams => PatchRegistrationSet);
     type Inputs = (
         Handle<Recording>,
         Handle<IngestedImage>,
@@ -31,19 +27,8 @@ impl Stage for PatchesStage {
         Handle<TripletFacades>,
     );
 
-    fn run(
-        &self,
-        p: &PatchParams,
-        (rec, pano, oblique, oblique_file, clouds, facades): (
-            Arc<Recording>,
-            Arc<IngestedImage>,
-            Arc<AerialImage>,
-            Arc<IngestedImage>,
-            Vec<Arc<SparseCloud>>,
-            Arc<TripletFacades>,
-        ),
-        _: &NodeCtx,
-    ) -> Result<PatchRegistrationSet, StageError> {
+    fn run(&self, p: &PatchParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (rec, pano, oblique, oblique_file, clouds, facades) = inputs;
         let sees = facades
             .planes
             .iter()

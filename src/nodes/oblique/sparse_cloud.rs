@@ -3,7 +3,7 @@
 //! outlier removal, triangulation in the original equirectangular geometry. Inputs: the three recording rows
 //! and panorama files (hashed by content).
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use crate::nodes::campaign::image_tiles;
 use crate::nodes::campaign::ingest::IngestedImage;
 use skytie_stages::campaign::Recording;
@@ -11,7 +11,6 @@ use skytie_stages::imaging::equirect::PanoramaLevels;
 use skytie_stages::imaging::pyramid::TileSource;
 use skytie_stages::oblique::sparse_cloud::{panorama_bands, sparse_cloud, SparseCloudParams};
 use skytie_stages::oblique::SparseCloud;
-use std::sync::Arc;
 
 crate::serde_artifact!(SparseCloud);
 
@@ -19,18 +18,11 @@ crate::serde_artifact!(SparseCloud);
 pub struct SparseCloudStage;
 
 impl Stage for SparseCloudStage {
-    const NAME: &'static str = skytie_stages::oblique::sparse_cloud::STAGE.name;
-    const VERSION: &'static str = skytie_stages::oblique::sparse_cloud::STAGE.version;
-    type Params = SparseCloudParams;
-    type Output = SparseCloud;
+    crate::nodes::stage_types!(skytie_stages::oblique::sparse_cloud::STAGE, SparseCloudParams => SparseCloud);
     type Inputs = (Vec<Handle<Recording>>, Vec<Handle<IngestedImage>>);
 
-    fn run(
-        &self,
-        p: &SparseCloudParams,
-        (recs, panos): (Vec<Arc<Recording>>, Vec<Arc<IngestedImage>>),
-        _: &NodeCtx,
-    ) -> Result<SparseCloud, StageError> {
+    fn run(&self, p: &SparseCloudParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (recs, panos) = inputs;
         if recs.len() != 3 || panos.len() != 3 {
             return Err(StageError::new(
                 "internal: sparse_cloud needs exactly three recordings and panoramas",

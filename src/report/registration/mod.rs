@@ -670,15 +670,7 @@ mod tests {
     #[test]
     fn points_group_observations_by_source_and_id() {
         let t = CsvTable::from_cells(
-            &[
-                "source",
-                "point_id",
-                "image_kind",
-                "image_id",
-                "u",
-                "v",
-                "score",
-            ],
+            &skytie_stages::export::CORRESPONDENCES_CSV_HEADER,
             &[
                 &["nadir", "p1", "panorama", "a", "1", "2", ""],
                 &["nadir", "p1", "nadir", "n1", "3", "4", "0.9"],

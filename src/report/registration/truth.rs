@@ -125,49 +125,11 @@ mod tests {
     use super::*;
 
     fn recording(x: f64, y: f64) -> Recording {
-        Recording {
-            image_id: "r".into(),
-            file: "r.jpg".into(),
-            time: String::new(),
-            time_s: 0.0,
-            x,
-            y,
-            z: 2.0,
-            heading_deg: 30.0,
-            camera_height_m: 2.0,
-            sigma_xy_m: None,
-            sigma_z_m: None,
-            yaw_deg: 0.0,
-            pitch_deg: 0.0,
-            roll_deg: 0.0,
-        }
+        Recording::new("r", 0.0, [x, y, 2.0], 30.0, 2.0)
     }
 
     fn nadir_camera() -> AerialImage {
-        AerialImage {
-            image_id: "n".into(),
-            file: "n.jpg".into(),
-            x: 5.0,
-            y: 5.0,
-            z: 500.0,
-            omega_deg: 0.0,
-            phi_deg: 0.0,
-            kappa_deg: 0.0,
-            focal_px: 5000.0,
-            cx_px: 500.0,
-            cy_px: 500.0,
-            width_px: 1000,
-            height_px: 1000,
-            k1: 0.0,
-            k2: 0.0,
-            p1: 0.0,
-            p2: 0.0,
-            k3: 0.0,
-            k4: 0.0,
-            b1: 0.0,
-            b2: 0.0,
-            sigma_px: 0.5,
-        }
+        AerialImage::ideal("n", [5.0, 5.0, 500.0], [0.0; 3], 5000.0, [1000, 1000])
     }
 
     #[test]

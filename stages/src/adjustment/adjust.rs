@@ -16,7 +16,6 @@ use super::prepared::{Prepared, Rejected};
 use super::problem::{AdjustOptions, Block};
 use super::residuals::{pano_residual, State};
 use super::solver::{solve, SolveReport, Termination};
-use crate::geometry::LocalOrigin;
 use nalgebra::Vector3;
 
 /// One adjusted recording.
@@ -88,22 +87,8 @@ pub struct Adjustment {
 pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, AdjustError> {
     block.validate()?;
     options.validate()?;
-    let origin = LocalOrigin::at_mean(block.recordings.iter().map(|r| &r.camera.center_world))
-        .ok_or(AdjustError::NoRecordings)?;
-    let mut state = State {
-        origin,
-        centers_local: block
-            .recordings
-            .iter()
-            .map(|r| origin.to_local(&r.camera.center_world))
-            .collect(),
-        yaw_correction_rad: vec![0.0; block.recordings.len()],
-        points_local: block
-            .points_initial_world
-            .iter()
-            .map(|p| origin.to_local(p))
-            .collect(),
-    };
+    let mut state = State::initial(block).ok_or(AdjustError::NoRecordings)?;
+    let origin = state.origin;
     let mut rejected = Rejected::none(block);
     let mut rounds = Vec::new();
     let max_rounds = if options.rejection_threshold.is_some() {

@@ -38,8 +38,8 @@ pub struct CheckPointError {
     pub error_m: Vector3<f64>,
 }
 
-/// Root-mean-square errors, metres.
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
+/// Root-mean-square errors, metres (thesis Tables 3-3…3-5, 5-2…5-9).
+#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct RmseSummary {
     pub x: f64,
     pub y: f64,

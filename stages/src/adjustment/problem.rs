@@ -165,6 +165,29 @@ impl AdjustOptions {
     }
 }
 
+/// What is wrong with an image observation, if anything: `image` = (kind, plural, index, count) of the image
+/// it is in, `point` = (index, count) of its point, its pixel coordinates and σ.
+fn observation_problem(
+    image: (&str, &str, usize, usize),
+    point: (usize, usize),
+    uv_px: [f64; 2],
+    sigma_px: f64,
+) -> Option<String> {
+    let (kind, plural, index, count) = image;
+    let (point, n_pts) = point;
+    if index >= count {
+        Some(format!("{kind} index {index} ≥ {count} {plural}"))
+    } else if point >= n_pts {
+        Some(format!("point index {point} ≥ {n_pts} points"))
+    } else if !uv_px.iter().all(|v| v.is_finite()) {
+        Some("pixel coordinates are not finite".to_string())
+    } else if !positive_finite(sigma_px) {
+        Some(format!("sigma_px = {sigma_px} must be finite and > 0"))
+    } else {
+        None
+    }
+}
+
 fn positive_finite(x: f64) -> bool {
     x.is_finite() && x > 0.0
 }
@@ -219,27 +242,19 @@ impl Block {
         let n_rec = self.recordings.len();
         let n_pts = self.points_initial_world.len();
         for (index, o) in self.pano_observations.iter().enumerate() {
-            let problem = if o.recording >= n_rec {
-                Some(format!(
-                    "recording index {} ≥ {n_rec} recordings",
-                    o.recording
-                ))
-            } else if o.point >= n_pts {
-                Some(format!("point index {} ≥ {n_pts} points", o.point))
-            } else if !(o.u_px.is_finite() && o.v_px.is_finite()) {
-                Some("pixel coordinates are not finite".to_string())
-            } else if !positive_finite(o.sigma_px) {
-                Some(format!("sigma_px = {} must be finite and > 0", o.sigma_px))
-            } else {
-                let cam = &self.recordings[o.recording].camera;
-                let v_max = f64::from(cam.height_px);
-                (!(o.v_px > 0.0 && o.v_px < v_max)).then(|| {
-                    format!(
-                        "v_px = {} outside (0, {v_max}) (the poles have no azimuth)",
-                        o.v_px
-                    )
-                })
-            };
+            let image = ("recording", "recordings", o.recording, n_rec);
+            let problem =
+                observation_problem(image, (o.point, n_pts), [o.u_px, o.v_px], o.sigma_px).or_else(
+                    || {
+                        let v_max = f64::from(self.recordings[o.recording].camera.height_px);
+                        (!(o.v_px > 0.0 && o.v_px < v_max)).then(|| {
+                            format!(
+                                "v_px = {} outside (0, {v_max}) (the poles have no azimuth)",
+                                o.v_px
+                            )
+                        })
+                    },
+                );
             if let Some(problem) = problem {
                 return Err(AdjustError::InvalidPanoObservation { index, problem });
             }
@@ -275,20 +290,9 @@ impl Block {
         }
         let n_cam = self.aerial_cameras.len();
         for (index, o) in self.aerial_observations.iter().enumerate() {
-            let problem = if o.camera >= n_cam {
-                Some(format!(
-                    "camera index {} ≥ {n_cam} aerial cameras",
-                    o.camera
-                ))
-            } else if o.point >= n_pts {
-                Some(format!("point index {} ≥ {n_pts} points", o.point))
-            } else if !(o.u_px.is_finite() && o.v_px.is_finite()) {
-                Some("pixel coordinates are not finite".to_string())
-            } else if !positive_finite(o.sigma_px) {
-                Some(format!("sigma_px = {} must be finite and > 0", o.sigma_px))
-            } else {
-                None
-            };
+            let image = ("camera", "aerial cameras", o.camera, n_cam);
+            let problem =
+                observation_problem(image, (o.point, n_pts), [o.u_px, o.v_px], o.sigma_px);
             if let Some(problem) = problem {
                 return Err(AdjustError::InvalidAerialObservation { index, problem });
             }

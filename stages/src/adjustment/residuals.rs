@@ -13,7 +13,7 @@
 //! σ_θ = σ_px·2π/W: matching noise is isotropic in pixels, so the azimuth component is deliberately not scaled
 //! by cos E (which would model noise isotropic on the sphere and under-weight rays far from the horizon).
 
-use super::problem::AdjustOptions;
+use super::problem::{AdjustOptions, Block};
 use crate::geometry::{rot_z, LocalOrigin};
 use nalgebra::{Matrix2x3, Matrix3, SMatrix, Vector2, Vector3, Vector4};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -63,6 +63,26 @@ pub struct State {
 }
 
 impl State {
+    /// The state the adjustment starts from: a local origin at the mean recorded centre, the recorded
+    /// centres, no yaw corrections and the initial tie points; `None` for a block without recordings.
+    pub fn initial(block: &Block) -> Option<State> {
+        let origin = LocalOrigin::at_mean(block.recordings.iter().map(|r| &r.camera.center_world))?;
+        Some(State {
+            origin,
+            centers_local: block
+                .recordings
+                .iter()
+                .map(|r| origin.to_local(&r.camera.center_world))
+                .collect(),
+            yaw_correction_rad: vec![0.0; block.recordings.len()],
+            points_local: block
+                .points_initial_world
+                .iter()
+                .map(|p| origin.to_local(p))
+                .collect(),
+        })
+    }
+
     /// Adds an update of the camera parameters (per recording over (x, y, z, ψ); fixed ones are zero) and of
     /// the points (3 per point; undetermined points get zero).
     pub fn apply(&self, camera_step: &[Vector4<f64>], point_step: &[Vector3<f64>]) -> State {

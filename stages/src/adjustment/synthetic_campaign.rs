@@ -60,6 +60,20 @@ pub struct SyntheticCampaign {
     pub truth: SyntheticBlock,
 }
 
+impl SyntheticCampaign {
+    /// The adjustment's inputs: the recordings, their tie points and the nadir control (no oblique images).
+    pub fn adjust_inputs(&self) -> super::AdjustInputs<'_> {
+        super::AdjustInputs {
+            recordings: &self.recordings,
+            pano_size_px: &self.pano_size_px,
+            tie_points: &self.tie_points,
+            control: &self.control,
+            nadir: &self.nadir,
+            oblique: &[],
+        }
+    }
+}
+
 /// `image_id` of recording `r`.
 pub fn recording_id(r: usize) -> String {
     format!("pano_{r:04}")
@@ -172,28 +186,18 @@ impl SyntheticCampaignSpec {
                 (0.0, 0.0)
             };
             let row = AerialImage {
-                image_id: format!("nadir_{k:03}"),
-                file: format!("nadir_{k:03}.jpg"),
-                x: center.x,
-                y: center.y,
-                z: center.z,
-                omega_deg: omega,
-                phi_deg: phi,
-                kappa_deg: kappa,
-                focal_px,
                 cx_px: f64::from(aw) / 2.0 + 3.5,
                 cy_px: f64::from(ah) / 2.0 - 2.25,
-                width_px: aw,
-                height_px: ah,
                 k1,
-                k2: 0.0,
                 p1,
-                p2: 0.0,
-                k3: 0.0,
-                k4: 0.0,
-                b1: 0.0,
-                b2: 0.0,
                 sigma_px: self.aerial_sigma_px,
+                ..AerialImage::ideal(
+                    &format!("nadir_{k:03}"),
+                    [center.x, center.y, center.z],
+                    [omega, phi, kappa],
+                    focal_px,
+                    [aw, ah],
+                )
             };
             cameras.push(FrameCamera::from_aerial(&row));
             nadir.push(row);

@@ -3,15 +3,16 @@
 //! same point triangulated from its MM observations alone with the RECORDED poses; the offset `MM − aerial`
 //! estimates the local trajectory error. Per trajectory segment (a number of recordings or an along-track
 //! length): mean and SD of the offsets in X, Y, Z and of their 3-D length (Table 5-13), the uncertainty of the
-//! mean, and pass/fail against a tolerance.
+//! mean, and pass/fail against a tolerance (horizontal; vertical only with `check_height`).
 //!
 //! Uncertainty of the mean per axis: the larger of the empirical `SD/√n` and the propagated
 //! `√(Σ σ²_k)/n` with `σ²_k` the diagonal of `C_MM + C_aerial` (a-priori triangulation covariances), so a
 //! segment with few points is not overconfident. Status: `fail` when the mean offset exceeds a tolerance
-//! *significantly* — the horizontal offset minus `confidence_k` σ of it above `tolerance_xy_m`, or |mean Z| minus
-//! `confidence_k` σ above `tolerance_z_m` — `insufficient` with fewer than `min_points` points, `pass` otherwise.
-//! The significance test matters for Z: nadir images from ≈ 4500 m give aerial heights with metre-level σ
-//! (thesis 3.5.1.1), and an offset the data cannot resolve must not fail a good campaign.
+//! *significantly* — the horizontal offset minus `confidence_k` σ of it above `tolerance_xy_m`, or (with
+//! `check_height`) |mean Z| minus `confidence_k` σ above `tolerance_z_m` — `insufficient` with fewer than
+//! `min_points` points, `pass` otherwise. The height is not tested by default: nadir images from ≈ 4500 m give
+//! aerial heights with metre-level errors (thesis 3.5.1.1), larger than their a-priori σ says once the aerial
+//! orientations are a few centimetres off, and an offset the data cannot resolve must not fail a good campaign.
 
 use crate::campaign::Recording;
 use crate::correspondence::AerialControlPoint;
@@ -28,7 +29,7 @@ use std::path::Path;
 /// changes.
 pub const STAGE: StageId = StageId {
     name: "verify",
-    version: "3",
+    version: "4",
 };
 
 crate::params! {
@@ -40,8 +41,13 @@ crate::params! {
         segment_length_m: Option<f64> = None, unit "m", above 0.0;
         /// Largest acceptable mean horizontal offset.
         tolerance_xy_m: f64 = 0.20, unit "m", above 0.0;
-        /// Largest acceptable |mean vertical offset|.
+        /// Largest acceptable |mean vertical offset| (with `check_height`).
         tolerance_z_m: f64 = 0.30, unit "m", above 0.0;
+        /// Also fail a segment on its mean vertical offset. Off by default: heights triangulated from nadir
+        /// images at ≈ 4.5 km are metres off (thesis 3.5.1.1), and centimetre errors of the aerial orientations
+        /// make them worse still, so a height test flags good trajectories (measured: the `aerial` error
+        /// profile, demo seed 1, segment mean Z +3.9 m with the recorded positions exact).
+        check_height: bool = false;
         /// Fewer points in a segment give status `insufficient`.
         min_points: usize = 3, min 1;
         /// A segment fails only when an offset exceeds its tolerance by more than this many σ of the mean.
@@ -308,7 +314,8 @@ fn statistics(
         VerifyStatus::Insufficient
     } else if offset_2d - config.confidence_k * sigma_mean[0].max(sigma_mean[1])
         > config.tolerance_xy_m
-        || mean[2].abs() - config.confidence_k * sigma_mean[2] > config.tolerance_z_m
+        || (config.check_height
+            && mean[2].abs() - config.confidence_k * sigma_mean[2] > config.tolerance_z_m)
     {
         VerifyStatus::Fail
     } else {

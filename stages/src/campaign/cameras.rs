@@ -53,28 +53,20 @@ mod tests {
     #[test]
     fn from_aerial_matches_from_opk() {
         let img = AerialImage {
-            image_id: "n1".into(),
             file: "n1.tif".into(),
-            x: 92_000.0,
-            y: 437_000.0,
-            z: 1_000.0,
-            omega_deg: 1.0,
-            phi_deg: -2.0,
-            kappa_deg: 93.0,
-            focal_px: 3_000.0,
             cx_px: 1_503.5,
             cy_px: 997.75,
-            width_px: 3_000,
-            height_px: 2_000,
             k1: -0.1,
             k2: 0.02,
             p1: 1e-3,
             p2: -1e-3,
-            k3: 0.0,
-            k4: 0.0,
-            b1: 0.0,
-            b2: 0.0,
-            sigma_px: 0.5,
+            ..AerialImage::ideal(
+                "n1",
+                [92_000.0, 437_000.0, 1_000.0],
+                [1.0, -2.0, 93.0],
+                3_000.0,
+                [3_000, 2_000],
+            )
         };
         let cam = FrameCamera::from_aerial(&img);
         let expected = FrameCamera::from_opk(
@@ -101,20 +93,11 @@ mod tests {
     #[test]
     fn from_recording_uses_pose_and_rotation() {
         let rec = Recording {
-            image_id: "p1".into(),
-            file: "p1.jpg".into(),
             time: "2019-06-14T10:31:07.250Z".into(),
-            time_s: 0.0,
-            x: 92_000.0,
-            y: 437_000.0,
-            z: 4.0,
-            heading_deg: 90.0,
-            camera_height_m: 2.5,
-            sigma_xy_m: None,
-            sigma_z_m: None,
             yaw_deg: 1.0,
             pitch_deg: 2.0,
             roll_deg: 3.0,
+            ..Recording::new("p1", 0.0, [92_000.0, 437_000.0, 4.0], 90.0, 2.5)
         };
         let cam = PanoramaCamera::from_recording(&rec, 4_800, 2_400);
         assert_eq!(

@@ -6,8 +6,9 @@
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
-/// One panorama row of `mm/recordings.csv` (also the row type of `truth/recordings.csv`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// One panorama row of `mm/recordings.csv` (also the row type of `truth/recordings.csv`). The default is an
+/// empty row with every number 0 (a base for struct update syntax, not a valid recording).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Recording {
     pub image_id: String,
     /// Path relative to `mm/panoramas/`.
@@ -34,8 +35,9 @@ pub struct Recording {
     pub roll_deg: f64,
 }
 
-/// One row of `aerial/{nadir,oblique}/cameras.csv`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// One row of `aerial/{nadir,oblique}/cameras.csv`. The default is an empty row with every number 0 (a base
+/// for struct update syntax, not a valid camera).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct AerialImage {
     pub image_id: String,
     /// Path relative to the folder of the CSV.
@@ -71,6 +73,66 @@ pub struct AerialImage {
     pub b2: f64,
     /// Image measurement precision, pixels (optional, default 0.5).
     pub sigma_px: f64,
+}
+
+impl Recording {
+    /// A recording whose projection centre is `centre_world_m` (world frame, metres), with every optional
+    /// column at its default (no a-priori σ, no residual rotation), file `<image_id>.jpg`, and `time` left
+    /// empty: the campaign writer formats it from `time_s`.
+    pub fn new(
+        image_id: &str,
+        time_s: f64,
+        centre_world_m: [f64; 3],
+        heading_deg: f64,
+        camera_height_m: f64,
+    ) -> Self {
+        let [x, y, z] = centre_world_m;
+        Self {
+            image_id: image_id.into(),
+            file: format!("{image_id}.jpg"),
+            time_s,
+            x,
+            y,
+            z,
+            heading_deg,
+            camera_height_m,
+            ..Self::default()
+        }
+    }
+}
+
+impl AerialImage {
+    /// A distortion-free frame camera at `centre_world_m` (world frame, metres) with attitude
+    /// `opk_deg` = (ω, φ, κ) in degrees, focal length `focal_px` and an image of `size_px` = (width, height)
+    /// pixels whose principal point is the image centre; σ 0.5 px (the column's default), file `<image_id>.jpg`.
+    pub fn ideal(
+        image_id: &str,
+        centre_world_m: [f64; 3],
+        opk_deg: [f64; 3],
+        focal_px: f64,
+        size_px: [u32; 2],
+    ) -> Self {
+        let [x, y, z] = centre_world_m;
+        let [omega_deg, phi_deg, kappa_deg] = opk_deg;
+        let [width_px, height_px] = size_px;
+        Self {
+            image_id: image_id.into(),
+            file: format!("{image_id}.jpg"),
+            x,
+            y,
+            z,
+            omega_deg,
+            phi_deg,
+            kappa_deg,
+            focal_px,
+            cx_px: f64::from(width_px) / 2.0,
+            cy_px: f64::from(height_px) / 2.0,
+            width_px,
+            height_px,
+            sigma_px: 0.5,
+            ..Self::default()
+        }
+    }
 }
 
 /// Which aerial folder an image came from.

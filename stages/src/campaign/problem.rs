@@ -125,14 +125,10 @@ impl Problem {
         message: impl Into<String>,
         hint: impl Into<String>,
     ) -> Self {
-        Self::new(
-            Severity::Warning,
-            file.into(),
-            row,
-            field,
-            message.into(),
-            hint.into(),
-        )
+        Self {
+            severity: Severity::Warning,
+            ..Self::error(file, row, field, message, hint)
+        }
     }
 
     fn new(

@@ -262,22 +262,17 @@ pub(crate) mod tests {
 
     /// The campaign row of fixture recording `i` (same position and id).
     pub(crate) fn campaign_recording(a: &crate::adjustment::RunRecording, t: f64) -> Recording {
-        Recording {
-            image_id: a.image_id.clone(),
-            file: format!("{}.jpg", a.image_id),
-            time: String::new(),
-            time_s: t,
-            x: a.recorded_world[0],
-            y: a.recorded_world[1],
-            z: a.recorded_world[2],
-            heading_deg: 90.0,
-            camera_height_m: 2.5,
-            sigma_xy_m: None,
-            sigma_z_m: None,
-            yaw_deg: 0.0,
-            pitch_deg: 0.0,
-            roll_deg: 0.0,
-        }
+        Recording::new(
+            &a.image_id,
+            t,
+            [
+                a.recorded_world[0],
+                a.recorded_world[1],
+                a.recorded_world[2],
+            ],
+            90.0,
+            2.5,
+        )
     }
 
     /// Four recordings 5 m and 0.5 s apart, each moved by a known vector; control at every recording.

@@ -63,15 +63,7 @@ pub fn read_metashape_xml(path: &Path) -> Result<(MetashapeDocument, Vec<Problem
             "export the cameras again from Metashape as Agisoft XML",
         )
     };
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        vec![Problem::error(
-            path,
-            None,
-            None,
-            format!("cannot be read ({e})"),
-            "check the path in the import configuration",
-        )]
-    })?;
+    let text = std::fs::read_to_string(path).map_err(|e| vec![super::unreadable(path, &e)])?;
     let doc = roxmltree::Document::parse(&text).map_err(|e| {
         vec![err(
             Some(e.pos().row as usize),

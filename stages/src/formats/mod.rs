@@ -19,3 +19,17 @@ pub mod points;
 pub mod sbet;
 pub mod text_table;
 pub mod trajectory_csv;
+
+use crate::campaign::Problem;
+use std::path::Path;
+
+/// The problem of an import source file that cannot be read at all (missing, no permission, ...).
+pub(crate) fn unreadable(path: &Path, e: &std::io::Error) -> Problem {
+    Problem::error(
+        path,
+        None,
+        None,
+        format!("cannot be read ({e})"),
+        "check the path in the import configuration",
+    )
+}

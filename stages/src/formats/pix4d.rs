@@ -54,15 +54,7 @@ impl Pix4dCamFile {
 
 /// Read a `.cam` file; every key must appear once with a finite number (K1…K3, T1, T2 default to 0).
 pub fn read_pix4d_cam(path: &Path) -> Result<Pix4dCamFile, Vec<Problem>> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        vec![Problem::error(
-            path,
-            None,
-            None,
-            format!("cannot be read ({e})"),
-            "check the path in the import configuration",
-        )]
-    })?;
+    let text = std::fs::read_to_string(path).map_err(|e| vec![super::unreadable(path, &e)])?;
     let mut cam = Pix4dCamFile::default();
     let mut seen = [false; 3];
     let mut problems = Vec::new();

@@ -83,16 +83,7 @@ pub fn read_sbet(path: &Path) -> (Vec<SbetRecord>, Vec<Problem>) {
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
         Err(e) => {
-            return (
-                Vec::new(),
-                vec![Problem::error(
-                    path,
-                    None,
-                    None,
-                    format!("cannot be read ({e})"),
-                    "check the path in the import configuration",
-                )],
-            );
+            return (Vec::new(), vec![super::unreadable(path, &e)]);
         }
     };
     if bytes.is_empty() || bytes.len() % RECORD_BYTES != 0 {

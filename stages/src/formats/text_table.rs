@@ -48,15 +48,7 @@ impl TextTable {
         has_header: bool,
         comment_header: bool,
     ) -> Result<Self, Problem> {
-        let bytes = std::fs::read(path).map_err(|e| {
-            Problem::error(
-                path,
-                None,
-                None,
-                format!("cannot be read ({e})"),
-                "check the path in the import configuration",
-            )
-        })?;
+        let bytes = std::fs::read(path).map_err(|e| super::unreadable(path, &e))?;
         let text = String::from_utf8(bytes).map_err(|e| {
             let line = 1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
                 .iter()

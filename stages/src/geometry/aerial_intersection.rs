@@ -141,11 +141,7 @@ mod tests {
     fn oblique(east_m: f64, kappa_deg: f64) -> FrameCamera {
         let target = Vector3::new(500_000.0, 5_400_000.0, 50.0);
         let centre = Vector3::new(500_000.0 + east_m, 5_400_000.0 + 30.0, 1000.0);
-        // Build a look-at rotation: camera −z towards the target, x roughly horizontal.
-        let back = (centre - target).normalize();
-        let x = Vector3::z().cross(&back).normalize();
-        let y = back.cross(&x);
-        let r = Matrix3::from_columns(&[x, y, back]);
+        let r = crate::geometry::look_at_matrix(&centre, &target);
         let mut cam = FrameCamera::from_opk(
             centre,
             0.0,

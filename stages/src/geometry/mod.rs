@@ -35,6 +35,8 @@ pub use local_frame::LocalOrigin;
 pub use panorama::PanoramaCamera;
 pub use point_pair::PointPair;
 pub use ray::{intersect_ray_plane, Plane, Ray};
-pub use rotation::{matrix_to_opk, opk_to_matrix, panorama_rotation, rot_x, rot_y, rot_z};
+pub use rotation::{
+    look_at_matrix, matrix_to_opk, opk_to_matrix, panorama_rotation, rot_x, rot_y, rot_z,
+};
 pub use similarity2::Similarity2;
 pub use triangulation::{triangulate_rays, Triangulation, TriangulationError};

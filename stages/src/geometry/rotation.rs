@@ -6,7 +6,7 @@
 //!
 //! All matrices are f64; angles are radians in the `rot_*` functions and degrees elsewhere (`_deg`).
 
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Vector3};
 
 /// Right-handed rotation by `a_rad` about the X axis: `[[1,0,0],[0,cos,−sin],[0,sin,cos]]`.
 pub fn rot_x(a_rad: f64) -> Matrix3<f64> {
@@ -61,4 +61,13 @@ pub fn matrix_to_opk(r: &Matrix3<f64>) -> (f64, f64, f64) {
 /// column (north), positive roll lowers the direction shown at u = 3W/4 (east).
 pub fn panorama_rotation(yaw_deg: f64, pitch_deg: f64, roll_deg: f64) -> Matrix3<f64> {
     rot_z(-yaw_deg.to_radians()) * rot_x(pitch_deg.to_radians()) * rot_y(roll_deg.to_radians())
+}
+
+/// Camera-to-world rotation of a frame camera at `centre_world` whose viewing direction (camera −z) points at
+/// `target_world`, with the camera x axis horizontal (`Z_world × back`). Undefined for a vertical view.
+pub fn look_at_matrix(centre_world: &Vector3<f64>, target_world: &Vector3<f64>) -> Matrix3<f64> {
+    let back = (centre_world - target_world).normalize();
+    let x = Vector3::z().cross(&back).normalize();
+    let y = back.cross(&x);
+    Matrix3::from_columns(&[x, y, back])
 }

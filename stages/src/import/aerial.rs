@@ -224,20 +224,8 @@ fn convert_poses(
             omega_deg,
             phi_deg,
             kappa_deg,
-            focal_px: 0.0,
-            cx_px: 0.0,
-            cy_px: 0.0,
-            width_px: 0,
-            height_px: 0,
-            k1: 0.0,
-            k2: 0.0,
-            p1: 0.0,
-            p2: 0.0,
-            k3: 0.0,
-            k4: 0.0,
-            b1: 0.0,
-            b2: 0.0,
             sigma_px: src.sigma_px.unwrap_or(0.5),
+            ..AerialImage::default()
         };
         camera.apply_to(&mut row);
         out.push(row);

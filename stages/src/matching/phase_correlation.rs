@@ -181,6 +181,32 @@ pub struct PhaseCorrelator {
     local: LocalSurface,
 }
 
+/// Defines the public method `$name(&mut self, …)` that runs `$imp` compiled with AVX2 (through `$avx`) when
+/// the CPU has it, and plainly otherwise. AVX2 only widens the vectors of the loading, packing, normalisation
+/// and 3 × 3 loops (no FMA), so every operation and hence every result is the same either way.
+macro_rules! avx2_dispatch {
+    (
+        $(#[$meta:meta])*
+        pub fn $name:ident / $avx:ident => $imp:ident($($arg:ident: $ty:ty),* $(,)?) -> $ret:ty
+    ) => {
+        $(#[$meta])*
+        pub fn $name(&mut self, $($arg: $ty),*) -> $ret {
+            #[cfg(target_arch = "x86_64")]
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU supports AVX2 (checked just above).
+                return unsafe { self.$avx($($arg),*) };
+            }
+            self.$imp($($arg),*)
+        }
+
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2")]
+        unsafe fn $avx(&mut self, $($arg: $ty),*) -> $ret {
+            self.$imp($($arg),*)
+        }
+    };
+}
+
 impl PhaseCorrelator {
     /// A correlator for `width × height` images ([`Self::correlate`]) or search windows
     /// ([`Self::locate_template`]); both must be ≥ 3.
@@ -248,31 +274,13 @@ impl PhaseCorrelator {
         &self.params
     }
 
-    /// Shift t of `moving` relative to `reference` (both `width × height`): `moving(x) ≈ reference(x − t)`.
-    /// Same result as [`phase_correlate`].
-    pub fn correlate(
-        &mut self,
-        reference: &GrayImage,
-        moving: &GrayImage,
-    ) -> Result<PhaseShift, PhaseCorrelationError> {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { self.correlate_avx2(reference, moving) };
-        }
-        self.correlate_impl(reference, moving)
-    }
-
-    /// [`Self::correlate`] compiled with AVX2 (wider vectors for the loading, packing, normalisation and
-    /// 3 × 3 loops; no FMA, so every operation and hence every result is the same as without).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn correlate_avx2(
-        &mut self,
-        reference: &GrayImage,
-        moving: &GrayImage,
-    ) -> Result<PhaseShift, PhaseCorrelationError> {
-        self.correlate_impl(reference, moving)
+    avx2_dispatch! {
+        /// Shift t of `moving` relative to `reference` (both `width × height`): `moving(x) ≈ reference(x − t)`.
+        /// Same result as [`phase_correlate`].
+        pub fn correlate / correlate_avx2 => correlate_impl(
+            reference: &GrayImage,
+            moving: &GrayImage,
+        ) -> Result<PhaseShift, PhaseCorrelationError>
     }
 
     #[inline(always)]
@@ -282,14 +290,7 @@ impl PhaseCorrelator {
         moving: &GrayImage,
     ) -> Result<PhaseShift, PhaseCorrelationError> {
         let (w, h) = (reference.width, reference.height);
-        if (moving.width, moving.height) != (w, h) {
-            return Err(PhaseCorrelationError::SizeMismatch {
-                ref_w: w,
-                ref_h: h,
-                mov_w: moving.width,
-                mov_h: moving.height,
-            });
-        }
+        check_same_size(reference, moving)?;
         self.check_size(w, h)?;
         check_finite(reference)?;
         check_finite(moving)?;
@@ -306,30 +307,13 @@ impl PhaseCorrelator {
         }))
     }
 
-    /// Centre of `template` (at most `width × height`) in `search` (`width × height`); same result as
-    /// [`locate_template`].
-    pub fn locate_template(
-        &mut self,
-        template: &GrayImage,
-        search: &GrayImage,
-    ) -> Result<TemplateLocation, PhaseCorrelationError> {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { self.locate_template_avx2(template, search) };
-        }
-        self.locate_template_impl(template, search)
-    }
-
-    /// [`Self::locate_template`] compiled with AVX2 (see [`Self::correlate_avx2`]).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn locate_template_avx2(
-        &mut self,
-        template: &GrayImage,
-        search: &GrayImage,
-    ) -> Result<TemplateLocation, PhaseCorrelationError> {
-        self.locate_template_impl(template, search)
+    avx2_dispatch! {
+        /// Centre of `template` (at most `width × height`) in `search` (`width × height`); same result as
+        /// [`locate_template`].
+        pub fn locate_template / locate_template_avx2 => locate_template_impl(
+            template: &GrayImage,
+            search: &GrayImage,
+        ) -> Result<TemplateLocation, PhaseCorrelationError>
     }
 
     #[inline(always)]
@@ -339,20 +323,7 @@ impl PhaseCorrelator {
         search: &GrayImage,
     ) -> Result<TemplateLocation, PhaseCorrelationError> {
         let (tw, th, sw, sh) = (template.width, template.height, search.width, search.height);
-        if tw > sw || th > sh {
-            return Err(PhaseCorrelationError::TemplateLarger {
-                t_w: tw,
-                t_h: th,
-                s_w: sw,
-                s_h: sh,
-            });
-        }
-        if tw < 3 || th < 3 {
-            return Err(PhaseCorrelationError::TooSmall {
-                width: tw,
-                height: th,
-            });
-        }
+        check_template_fits(template, search)?;
         self.check_size(sw, sh)?;
         check_finite(template)?;
         check_finite(search)?;
@@ -860,14 +831,7 @@ pub fn phase_correlate(
     params: &PhaseCorrelationParams,
 ) -> Result<PhaseShift, PhaseCorrelationError> {
     let (w, h) = (reference.width, reference.height);
-    if (moving.width, moving.height) != (w, h) {
-        return Err(PhaseCorrelationError::SizeMismatch {
-            ref_w: w,
-            ref_h: h,
-            mov_w: moving.width,
-            mov_h: moving.height,
-        });
-    }
+    check_same_size(reference, moving)?;
     with_cached_correlator(w, h, params, |c| c.correlate(reference, moving))
 }
 
@@ -879,6 +843,29 @@ pub fn locate_template(
     search: &GrayImage,
     params: &PhaseCorrelationParams,
 ) -> Result<TemplateLocation, PhaseCorrelationError> {
+    let (sw, sh) = (search.width, search.height);
+    check_template_fits(template, search)?;
+    with_cached_correlator(sw, sh, params, |c| c.locate_template(template, search))
+}
+
+/// `Err` unless `moving` has the size of `reference`.
+fn check_same_size(reference: &GrayImage, moving: &GrayImage) -> Result<(), PhaseCorrelationError> {
+    if (moving.width, moving.height) != (reference.width, reference.height) {
+        return Err(PhaseCorrelationError::SizeMismatch {
+            ref_w: reference.width,
+            ref_h: reference.height,
+            mov_w: moving.width,
+            mov_h: moving.height,
+        });
+    }
+    Ok(())
+}
+
+/// `Err` unless `template` fits into `search` and is at least 3 × 3 pixels.
+fn check_template_fits(
+    template: &GrayImage,
+    search: &GrayImage,
+) -> Result<(), PhaseCorrelationError> {
     let (tw, th, sw, sh) = (template.width, template.height, search.width, search.height);
     if tw > sw || th > sh {
         return Err(PhaseCorrelationError::TemplateLarger {
@@ -894,7 +881,7 @@ pub fn locate_template(
             height: th,
         });
     }
-    with_cached_correlator(sw, sh, params, |c| c.locate_template(template, search))
+    Ok(())
 }
 
 #[cfg(test)]

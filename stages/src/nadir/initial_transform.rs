@@ -23,7 +23,7 @@
 use super::aerial_patch::{aerial_ground_similarity, extract_patch, level_of_scale};
 use super::ortho::{OrthoGeoref, OrthoImage};
 use super::registration::{InitialTransform, TransformOutcome};
-use super::translation_consensus::translation_consensus;
+use super::translation_consensus::{false_alarms, translation_consensus};
 use crate::campaign::{AerialImage, Recording};
 use crate::estimators::{mix_seed, ransac_filtered, RansacParams};
 use crate::features::kaze::{detect_and_describe, Features, KazeParams};
@@ -104,6 +104,12 @@ crate::params! {
         /// implied recording offset lies farther than this from the median offset implied by ≥ 2 other accepted
         /// transforms of the same recording is rejected; 0 = no check.
         max_offset_disagreement_m: f64 = 1.2, unit "m", min 0.0;
+        /// A-contrario test of the translation consensus (translation mode): reject it when random matches would
+        /// give a consensus as large this often or more (expected number of false alarms,
+        /// [`super::translation_consensus::false_alarms`]). 0.1: with ±15 px windows and a 2 px threshold a
+        /// consensus of 7 among 105 matches (NFA 0.40, what chance gives) is rejected, 6 among 60 (NFA 0.09) and
+        /// 6 among 8 (NFA < 10⁻⁶) are kept.
+        max_false_alarms: f64 = 0.1, above 0.0;
     }
     check(p, v) {
         crate::params::check_finite("wallis_target_mean", &p.wallis_target_mean, v);
@@ -516,6 +522,18 @@ fn transform_with_patch(
                 format!(
                     "{n_matches} matches: ambiguous translation ({n} inliers, a competing one has {})",
                     c.runner_up
+                ),
+                n_matches,
+                n,
+            );
+        }
+        let nfa = false_alarms(n_matches, n, p.ransac_threshold_px, window_px);
+        if nfa > p.max_false_alarms {
+            return reject(
+                format!(
+                    "{n_matches} matches: a consensus of {n} is what chance gives (expected {nfa:.2} among \
+                     random matches > {})",
+                    p.max_false_alarms
                 ),
                 n_matches,
                 n,

@@ -15,6 +15,7 @@ pub mod registration;
 pub mod summary;
 pub mod transform_agreement;
 pub mod translation_consensus;
+pub mod vehicle_detect;
 pub mod vehicle_mask;
 
 pub use ortho::{ortho_project, ortho_project_whole, OrthoGeoref, OrthoImage, OrthoParams};

@@ -7,7 +7,8 @@
 //! (ties: smaller residual sum, then lower index). The consensus is then refined by averaging its members'
 //! translations and re-selecting them until the member set is stable. One free 2-D parameter per sample instead
 //! of the similarity's four makes a random consensus far less likely than with 2-point similarity samples: a
-//! wrong match agrees with a random translation only by falling into a `threshold_px` disc.
+//! wrong match agrees with a random translation only by falling into a `threshold_px` disc. [`false_alarms`]
+//! says how often chance alone gives a consensus of a given size (the a-contrario test of the initial transform).
 
 use crate::geometry::{PointPair, Similarity2};
 use nalgebra::Vector2;
@@ -24,6 +25,40 @@ pub struct TranslationConsensus {
     /// Size of the best consensus among hypotheses more than `2 × threshold_px` away from the winner (how much
     /// support a competing translation has; 0 when none).
     pub runner_up: usize,
+}
+
+/// How many translations supported by `k` or more of `n` matches (within `threshold_px`) random matches would
+/// produce: the number of false alarms of the a-contrario test. Under the null hypothesis each match's offset
+/// is uniform over the ±`window_px` matching window, so another match agrees with a given one with probability
+/// `p = π r² / (2W)²`; every match is a hypothesis, so NFA = n · P[Bin(n − 1, p) ≥ k − 1]. A consensus with
+/// NFA ≪ 1 is meaningful; NFA ≳ 1 is what chance gives.
+pub fn false_alarms(n: usize, k: usize, threshold_px: f64, window_px: f64) -> f64 {
+    if n == 0 || k <= 1 {
+        return n as f64;
+    }
+    let area = (2.0 * window_px).powi(2);
+    let p = (std::f64::consts::PI * threshold_px * threshold_px / area).min(1.0);
+    if p >= 1.0 {
+        return n as f64;
+    }
+    let (m, j0) = (n - 1, k - 1);
+    if j0 > m {
+        return 0.0;
+    }
+    let (lp, lq) = (p.ln(), (1.0 - p).ln());
+    let ln_choose: f64 = (1..=j0)
+        .map(|i| ((m - j0 + i) as f64 / i as f64).ln())
+        .sum();
+    let mut term = (ln_choose + j0 as f64 * lp + (m - j0) as f64 * lq).exp();
+    let mut tail = 0.0;
+    for j in j0..=m {
+        tail += term;
+        if term < tail * 1e-16 {
+            break;
+        }
+        term *= (m - j) as f64 / (j + 1) as f64 * p / (1.0 - p);
+    }
+    n as f64 * tail
 }
 
 fn members(offsets: &[Vector2<f64>], t: &Vector2<f64>, threshold_px: f64) -> (Vec<usize>, f64) {
@@ -115,4 +150,28 @@ pub fn translation_consensus(
         inliers,
         runner_up,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn false_alarms_follow_the_binomial_tail() {
+        // p = π·4/900 = 0.01396: with 3 matches, all 3 agreeing by chance: 3 · p² = 5.85e-4.
+        let p = std::f64::consts::PI * 4.0 / 900.0;
+        assert!((false_alarms(3, 3, 2.0, 15.0) - 3.0 * p * p).abs() < 1e-12);
+        // k = 2 of 2: 2 · p.
+        assert!((false_alarms(2, 2, 2.0, 15.0) - 2.0 * p).abs() < 1e-12);
+        // A random-looking consensus (7 of 105) is expected 0.4 times by chance, 6 of 60 0.09 times; 20 of 60
+        // never.
+        let chance = false_alarms(105, 7, 2.0, 15.0);
+        assert!(chance > 0.3 && chance < 0.5, "{chance}");
+        let weak = false_alarms(60, 6, 2.0, 15.0);
+        assert!(weak > 0.05 && weak < 0.1, "{weak}");
+        assert!(false_alarms(60, 20, 2.0, 15.0) < 1e-15);
+        assert!(false_alarms(8, 6, 2.0, 15.0) < 1e-3);
+        assert_eq!(false_alarms(5, 1, 2.0, 15.0), 5.0);
+        assert_eq!(false_alarms(4, 9, 2.0, 15.0), 0.0);
+    }
 }

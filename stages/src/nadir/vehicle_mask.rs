@@ -14,6 +14,9 @@ crate::params! {
     pub struct VehicleMask {
         /// Mask the vehicle at all.
         enabled: bool = true;
+        /// Find the box in the panoramas (the `vehicle` stage) and use the values below only when that fails;
+        /// `false` = use the values below (an override for a known vehicle).
+        detect: bool = true;
         /// Vertical distance from the projection centre down to the vehicle's top face.
         roof_drop_m: f64 = 0.4, unit "m", min 0.0, below 20.0;
         /// Extent of the body ahead of the projection centre (bonnet).

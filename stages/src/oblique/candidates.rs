@@ -76,50 +76,21 @@ mod tests {
 
     fn recording() -> Recording {
         Recording {
-            image_id: "r".into(),
-            file: "r.jpg".into(),
             time: "2019-06-14T10:00:00Z".into(),
-            time_s: 0.0,
-            x: 1000.0,
-            y: 2000.0,
-            z: 2.2,
-            heading_deg: 90.0,
-            camera_height_m: 2.2,
-            sigma_xy_m: None,
-            sigma_z_m: None,
-            yaw_deg: 0.0,
-            pitch_deg: 0.0,
-            roll_deg: 0.0,
+            ..Recording::new("r", 0.0, [1000.0, 2000.0, 2.2], 90.0, 2.2)
         }
     }
 
     /// An oblique camera 450 m up, looking north at 45° (ω = 45°: the image top tilts towards north), whose
     /// axis meets the ground at (x0, y0).
     fn looking_north_at(id: &str, x0: f64, y0: f64) -> AerialImage {
-        AerialImage {
-            image_id: id.into(),
-            file: format!("{id}.jpg"),
-            x: x0,
-            y: y0 - 450.0,
-            z: 450.0,
-            omega_deg: 45.0,
-            phi_deg: 0.0,
-            kappa_deg: 0.0,
-            focal_px: 6000.0,
-            cx_px: 400.0,
-            cy_px: 300.0,
-            width_px: 800,
-            height_px: 600,
-            k1: 0.0,
-            k2: 0.0,
-            p1: 0.0,
-            p2: 0.0,
-            k3: 0.0,
-            k4: 0.0,
-            b1: 0.0,
-            b2: 0.0,
-            sigma_px: 0.5,
-        }
+        AerialImage::ideal(
+            id,
+            [x0, y0 - 450.0, 450.0],
+            [45.0, 0.0, 0.0],
+            6000.0,
+            [800, 600],
+        )
     }
 
     #[test]

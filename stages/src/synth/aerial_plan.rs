@@ -57,6 +57,16 @@ pub fn plan_nadir(
     .max(2);
     let n_exposures = (extent[along_axis] / base_m).ceil() as usize + 2;
     let focal_px = plan.altitude_m / plan.gsd_m;
+    let [k1, k2, p1, p2] = if plan.corner_distortion_px > 0.0 {
+        small_distortion(
+            focal_px,
+            plan.width_px,
+            plan.height_px,
+            plan.corner_distortion_px,
+        )
+    } else {
+        [0.0; 4]
+    };
     let clamp_deg = 0.9;
     let mut out = Vec::with_capacity(n_strips * n_exposures);
     for s in 0..n_strips {
@@ -97,10 +107,10 @@ pub fn plan_nadir(
                 cy_px: f64::from(plan.height_px) / 2.0,
                 width_px: plan.width_px,
                 height_px: plan.height_px,
-                k1: 0.0,
-                k2: 0.0,
-                p1: 0.0,
-                p2: 0.0,
+                k1,
+                k2,
+                p1,
+                p2,
                 k3: 0.0,
                 k4: 0.0,
                 b1: 0.0,
@@ -253,6 +263,7 @@ mod tests {
             forward_overlap: 0.6,
             side_overlap: 0.4,
             attitude_sigma_deg: 0.3,
+            corner_distortion_px: 0.0,
         }
     }
 

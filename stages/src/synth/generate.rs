@@ -1,23 +1,26 @@
-//! Generation of a whole synthetic campaign folder: plan (scenes, true trajectory, deterioration, aerial
-//! flight plans, check points), render every image, write the campaign format plus `truth/`, and install the
-//! folder atomically (written to a temporary sibling, then renamed).
+//! Generation of a whole synthetic campaign folder in two steps: [`render_campaign`] renders the error-free
+//! campaign (every image, the true tables, check points, `truth/`), then the error profile is applied to it
+//! ([`super::profile::apply_profile_dir`]: new tables, the images hard-linked), so campaigns that differ only
+//! in table-only profiles share one rendering. Both steps install their folder atomically (written to a
+//! temporary sibling, then renamed).
 //!
 //! Deterministic: same options ⇒ byte-identical folder whatever the thread count (all randomness is hashed
 //! from (seed, item); images are rendered row-parallel with ordered collects; files are written in a fixed
 //! order). Timings are returned in [`SynthSummary`], never written into the folder.
 
-use super::aerial_plan::{plan_nadir, plan_oblique};
-use super::control::{plan_control, ControlParams, ControlSet};
-use super::deteriorate::{Deterioration, DeteriorationModel};
-use super::output::{render_factor, write_aerial_image, write_jpeg, AerialFormat};
+pub use super::options::{RenderIdentity, SynthOptions};
+use super::output::{render_factor, write_aerial_image, write_jpeg};
+pub use super::plan::{plan_campaign, AreaPlan, CampaignPlan};
+
 use super::postprocess::{apply_look, EpochLook};
 use super::preset::{Preset, PresetParams};
+use super::profile::readme::readme;
+use super::profile::{apply_profile_dir, Profile};
 use super::render::{primary_rays, render_frame, render_panorama_with_vehicle};
 use super::render_store::RenderStore;
-use super::rng::hash_str;
+use super::rng::{hash_str, Stream};
 use super::scene::{Epoch, Scene};
-use super::scene_truth::{build_scenes, SceneTruth, SCENE_TRUTH_FILE};
-use super::trajectory::{sample_route, true_recordings};
+use super::scene_truth::SCENE_TRUTH_FILE;
 use super::vehicle::VehicleBody;
 use super::SynthError;
 use crate::campaign::write as cw;
@@ -30,184 +33,19 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
-/// changes.
+/// The identity of the generator stage (the rendered campaign with an error profile applied) in cache keys;
+/// bump the version whenever its output for the same inputs and parameters changes.
 pub const STAGE: StageId = StageId {
     name: "synth",
-    version: "1",
+    version: "2",
 };
 
-/// What to generate.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SynthOptions {
-    pub preset: Preset,
-    pub seed: u64,
-    pub deterioration: Deterioration,
-    /// Override the nadir flying height above ground, m (the GSD is kept, so the focal length follows).
-    pub nadir_altitude_m: Option<f64>,
-    /// Override the oblique flying height above ground, m (GSD kept).
-    pub oblique_altitude_m: Option<f64>,
-    /// Override the panorama width (even; height = width / 2).
-    pub panorama_width_px: Option<u32>,
-    /// Override the maximum number of panoramas per route.
-    pub max_recordings_per_route: Option<usize>,
-    /// Sensor sizes and image files.
-    #[serde(default)]
-    pub sizes: SizeOptions,
-}
-
-/// Overrides of the preset's sensor sizes and image files.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct SizeOptions {
-    /// Nadir camera width × height, px; the footprint is kept (the GSD scales with the width).
-    pub nadir_px: Option<(u32, u32)>,
-    /// Oblique camera width × height, px; the footprint and the distortion coefficients are kept.
-    pub oblique_px: Option<(u32, u32)>,
-    /// File format of the aerial frames.
-    pub aerial_format: Option<AerialFormat>,
-    /// Render at most this wide and upsample (`Some(0)`: render at the camera's size).
-    pub render_max_width_px: Option<u32>,
-    /// Write the campaign at the size it is rendered at (cameras divided by the render factors): the
-    /// demo-size twin of a real-size preset, with the same scene, trajectory, flight plans and content.
-    pub at_render_size: bool,
-}
-
-impl SizeOptions {
-    /// `p` with these overrides applied.
-    fn apply(&self, p: &mut PresetParams) -> Result<(), SynthError> {
-        let bad = |option: &str, message: String| SynthError::InvalidOption {
-            option: option.into(),
-            message,
-        };
-        let size_ok = |(w, h): (u32, u32)| w >= 16 && h >= 16 && w <= 1 << 20 && h <= 1 << 20;
-        if let Some((w, h)) = self.nadir_px {
-            if !size_ok((w, h)) {
-                return Err(bad(
-                    "nadir_px",
-                    format!("{w} × {h}; give sides in [16, 1048576]"),
-                ));
-            }
-            p.nadir.gsd_m *= f64::from(p.nadir.width_px) / f64::from(w);
-            (p.nadir.width_px, p.nadir.height_px) = (w, h);
-        }
-        if let Some((w, h)) = self.oblique_px {
-            if !size_ok((w, h)) {
-                return Err(bad(
-                    "oblique_px",
-                    format!("{w} × {h}; give sides in [16, 1048576]"),
-                ));
-            }
-            let f = f64::from(w) / f64::from(p.oblique.width_px);
-            p.oblique.gsd_center_m /= f;
-            p.oblique.corner_distortion_px *= f;
-            (p.oblique.width_px, p.oblique.height_px) = (w, h);
-        }
-        if let Some(format) = self.aerial_format {
-            format.check().map_err(|m| bad("aerial_format", m))?;
-            p.aerial_format = format;
-        }
-        if let Some(cap) = self.render_max_width_px {
-            p.render_max_width_px = (cap > 0).then_some(cap);
-        }
-        if self.at_render_size {
-            at_render_size(p);
-        }
-        Ok(())
-    }
-}
-
-/// The preset at the size its images are rendered at: every camera divided by its render factor, GSDs and
-/// pixel-sized noise and distortion scaled to match, nothing upsampled.
-fn at_render_size(p: &mut PresetParams) {
-    let cap = p.render_max_width_px;
-    let k = f64::from(render_factor(p.nadir.width_px, p.nadir.height_px, cap));
-    p.nadir.width_px = (f64::from(p.nadir.width_px) / k) as u32;
-    p.nadir.height_px = (f64::from(p.nadir.height_px) / k) as u32;
-    p.nadir.gsd_m *= k;
-    let k = f64::from(render_factor(p.oblique.width_px, p.oblique.height_px, cap));
-    p.oblique.width_px = (f64::from(p.oblique.width_px) / k) as u32;
-    p.oblique.height_px = (f64::from(p.oblique.height_px) / k) as u32;
-    p.oblique.gsd_center_m *= k;
-    p.oblique.corner_distortion_px /= k;
-    let k = render_factor(p.panorama_width_px, p.panorama_height_px(), cap);
-    p.panorama_width_px /= k;
-    p.observation_sigma_px /= f64::from(k);
-    p.render_max_width_px = None;
-}
-
-impl SynthOptions {
-    /// Preset defaults with the thesis deterioration (3.5.1.2).
-    pub fn new(preset: Preset, seed: u64) -> Self {
-        Self {
-            preset,
-            seed,
-            deterioration: Deterioration::Thesis,
-            nadir_altitude_m: None,
-            oblique_altitude_m: None,
-            panorama_width_px: None,
-            max_recordings_per_route: None,
-            sizes: SizeOptions::default(),
-        }
-    }
-
-    /// What identifies the images of a generation with these options in a [`RenderStore`] (the options as
-    /// JSON).
-    pub fn store_identity(&self) -> Result<String, SynthError> {
-        serde_json::to_string(self).map_err(|e| SynthError::InvalidOption {
-            option: "options".into(),
-            message: format!("cannot serialise the options ({e})"),
-        })
-    }
-
-    /// The preset's parameters with this option set's overrides applied and checked.
-    pub fn params(&self) -> Result<PresetParams, SynthError> {
-        let mut p = self.preset.params();
-        let bad = |option: &str, message: String| SynthError::InvalidOption {
-            option: option.into(),
-            message,
-        };
-        if let Some(a) = self.nadir_altitude_m {
-            if !(a.is_finite() && a > 10.0) {
-                return Err(bad(
-                    "nadir_altitude_m",
-                    format!("{a} m; give a height above ground > 10 m"),
-                ));
-            }
-            p.nadir.altitude_m = a;
-        }
-        if let Some(a) = self.oblique_altitude_m {
-            if !(a.is_finite() && a > 10.0) {
-                return Err(bad(
-                    "oblique_altitude_m",
-                    format!("{a} m; give a height above ground > 10 m"),
-                ));
-            }
-            p.oblique.altitude_m = a;
-        }
-        if let Some(w) = self.panorama_width_px {
-            if w < 16 || w % 2 != 0 {
-                return Err(bad(
-                    "panorama_width_px",
-                    format!("{w}; give an even width ≥ 16"),
-                ));
-            }
-            p.panorama_width_px = w;
-        }
-        if let Some(n) = self.max_recordings_per_route {
-            if n == 0 {
-                return Err(bad("max_recordings_per_route", "0; give at least 1".into()));
-            }
-            p.max_recordings_per_route = n;
-        }
-        self.sizes.apply(&mut p)?;
-        Ok(p)
-    }
-
-    /// `synth-<preset>-seed<N>`.
-    pub fn campaign_name(&self) -> String {
-        format!("synth-{}-seed{}", self.preset.name(), self.seed)
-    }
-}
+/// The identity of the render stage (the error-free campaign of a [`RenderIdentity`]); bump the version
+/// whenever the generator renders differently (scenes, presets, cameras, looks).
+pub const RENDER_STAGE: StageId = StageId {
+    name: "render",
+    version: "4",
+};
 
 /// What was generated and how long it took.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -234,132 +72,13 @@ impl SynthSummary {
     }
 }
 
-/// One scene area with its route's plan.
-pub struct AreaPlan {
-    pub scene: Scene,
-    /// True poses in driving order.
-    pub truth: Vec<Recording>,
-    /// Distance of each recording along the route, m.
-    pub along_m: Vec<f64>,
-    pub nadir: Vec<AerialImage>,
-    pub oblique: Vec<AerialImage>,
-    pub control: ControlSet,
-}
-
-/// Everything about a campaign except its pixels.
-pub struct CampaignPlan {
-    pub name: String,
-    pub seed: u64,
-    pub params: PresetParams,
-    pub deterioration: DeteriorationModel,
-    pub areas: Vec<AreaPlan>,
-    /// Recorded (deteriorated) poses of all areas, in the order of the truth.
-    pub recorded: Vec<Recording>,
-    /// What `truth/scene.toml` records (how to rebuild the scenes for evaluation).
-    pub scene_truth: SceneTruth,
-}
-
-impl CampaignPlan {
-    /// True poses of all areas.
-    pub fn truth(&self) -> Vec<Recording> {
-        self.areas
-            .iter()
-            .flat_map(|a| a.truth.iter().cloned())
-            .collect()
+/// The exposure gain of image `image_id`: exp(N(0, σ)) with σ = the preset's `exposure_log_sigma` (1 when 0).
+fn exposure_gain(p: &PresetParams, seed: u64, image_id: &str) -> f32 {
+    if p.exposure_log_sigma <= 0.0 {
+        return 1.0;
     }
-}
-
-/// Whether any of `recordings`' projection centres projects into the aerial frame `img`.
-fn sees_any(img: &AerialImage, recordings: &[Recording]) -> bool {
-    let cam = crate::geometry::FrameCamera::from_aerial(img);
-    recordings.iter().any(|r| {
-        cam.project_world(&nalgebra::Vector3::new(r.x, r.y, r.z))
-            .is_some_and(|(u, v)| cam.contains(u, v))
-    })
-}
-
-/// Plan a campaign without rendering: scenes, true and recorded trajectory, aerial flight plans, check points.
-pub fn plan_campaign(options: &SynthOptions) -> Result<CampaignPlan, SynthError> {
-    let params = options.params()?;
-    let seed = options.seed;
-    let mut areas = Vec::new();
-    let scenes = build_scenes(options.preset, seed);
-    let scene_truth = SceneTruth::of(options.preset, seed, &scenes);
-    for (area, scene) in scenes.into_iter().enumerate() {
-        let samples = sample_route(
-            scene.route_world(),
-            params.recording_spacing_m,
-            params.max_recordings_per_route,
-        );
-        if samples.len() < 2 {
-            return Err(SynthError::EmptyRoute {
-                preset: options.preset.name().into(),
-                area,
-            });
-        }
-        let truth = true_recordings(&samples, area, &params, seed, |x, y| {
-            scene.ground_height_m(x, y)
-        });
-        let along_m: Vec<f64> = samples.iter().map(|s| s.along_m).collect();
-        let route_xy: Vec<[f64; 2]> = truth.iter().map(|r| [r.x, r.y]).collect();
-        let mid = route_xy[route_xy.len() / 2];
-        let ground_z_m = scene.ground_height_m(mid[0], mid[1]);
-        let nadir = plan_nadir(
-            &route_xy,
-            ground_z_m,
-            &params.nadir,
-            seed,
-            &format!("nadir_{area}"),
-        );
-        let oblique = plan_oblique(
-            &route_xy,
-            ground_z_m,
-            &params.oblique,
-            &format!("oblique_{area}"),
-        );
-        let control_params = ControlParams {
-            spacing_m: params.checkpoint_spacing_m,
-            max_route_distance_m: params.checkpoint_max_route_distance_m,
-            max_observation_distance_m: params.observation_max_distance_m,
-            sigma_px: params.observation_sigma_px,
-            panorama_width_px: params.panorama_width_px,
-            id_prefix: format!("cp_{area}"),
-        };
-        let control = plan_control(&scene, &truth, &along_m, &control_params, seed);
-        areas.push(AreaPlan {
-            scene,
-            truth,
-            along_m,
-            nadir,
-            oblique,
-            control,
-        });
-    }
-    let extension = params.aerial_format.extension();
-    for a in &mut areas {
-        for img in a.nadir.iter_mut().chain(a.oblique.iter_mut()) {
-            img.file = format!("{}.{extension}", img.image_id);
-        }
-    }
-    let deterioration = options.deterioration.resolve(seed);
-    let mut recorded = Vec::new();
-    for a in &mut areas {
-        let area_recorded = deterioration.apply(&a.truth, &a.along_m, seed);
-        // An aerial frame that sees none of the recorded positions is of no use to the pipeline (and
-        // `skytie check` warns about it): the flight plan covers more than the route, so leave those out.
-        a.nadir.retain(|img| sees_any(img, &area_recorded));
-        a.oblique.retain(|img| sees_any(img, &area_recorded));
-        recorded.extend(area_recorded);
-    }
-    Ok(CampaignPlan {
-        name: options.campaign_name(),
-        seed,
-        params,
-        deterioration,
-        areas,
-        recorded,
-        scene_truth,
-    })
+    let mut s = Stream::new(&[seed, hash_str("exposure"), hash_str(image_id)]);
+    (p.exposure_log_sigma * s.normal()).exp() as f32
 }
 
 /// Render, post-process and save one panorama at its true pose; returns the primary rays traced.
@@ -392,12 +111,8 @@ fn write_panorama(
         Epoch::MobileMapping,
         p.panorama_spp_axis,
     );
-    let img = apply_look(
-        &linear,
-        &EpochLook::mobile_mapping(),
-        seed,
-        hash_str(&rec.image_id),
-    );
+    let look = EpochLook::mobile_mapping().exposed(exposure_gain(p, seed, &rec.image_id));
+    let img = apply_look(&linear, &look, seed, hash_str(&rec.image_id));
     let path = dir.join(&rec.file);
     write_jpeg(&img, k, &path, p.jpeg_quality)?;
     Ok(primary_rays(
@@ -426,7 +141,8 @@ fn write_aerial(
     camera.width_px /= k;
     camera.height_px /= k;
     let linear = render_frame(scene, &camera, Epoch::Aerial, p.aerial_spp_axis);
-    let img = apply_look(&linear, &EpochLook::aerial(), seed, hash_str(&a.image_id));
+    let look = EpochLook::aerial().exposed(exposure_gain(p, seed, &a.image_id));
+    let img = apply_look(&linear, &look, seed, hash_str(&a.image_id));
     let path = dir.join(&a.file);
     write_aerial_image(&img, k, &path, p.aerial_format, p.jpeg_quality)?;
     Ok(primary_rays(
@@ -436,11 +152,13 @@ fn write_aerial(
     ))
 }
 
-/// Write every file of the planned campaign into `root` (which must exist and be empty), taking the images an
-/// interrupted generation left in `store` and keeping the new ones there; returns the primary rays traced and
-/// the number of images taken from the store.
-fn write_campaign(
+/// Write every file of the planned campaign without errors (the true tables as the recorded ones), named
+/// `name`, into `root` (which must exist and be empty), taking the images an interrupted generation left in
+/// `store` and keeping the new ones there; returns the primary rays traced and the number of images taken from
+/// the store.
+fn write_error_free(
     plan: &CampaignPlan,
+    name: &str,
     root: &Path,
     store: &RenderStore,
 ) -> Result<(u64, usize), SynthError> {
@@ -480,26 +198,17 @@ fn write_campaign(
             })?;
         }
     }
+    let truth = plan.true_tables();
     let path = root.join("campaign.toml");
-    cw::write_campaign_toml(&path, &plan.name, "EPSG:28992").map_err(io(path))?;
-    let path = root.join("mm/recordings.csv");
-    cw::write_recordings_csv(&path, &plan.recorded).map_err(io(path))?;
-    let path = root.join("truth/recordings.csv");
-    cw::write_recordings_csv(&path, &plan.truth()).map_err(io(path))?;
-    let nadir: Vec<AerialImage> = plan
-        .areas
-        .iter()
-        .flat_map(|a| a.nadir.iter().cloned())
-        .collect();
+    cw::write_campaign_toml(&path, name, "EPSG:28992").map_err(io(path))?;
+    for rel in ["mm/recordings.csv", "truth/recordings.csv"] {
+        let path = root.join(rel);
+        cw::write_recordings_csv(&path, &truth.recordings).map_err(io(path))?;
+    }
     let path = root.join("aerial/nadir/cameras.csv");
-    cw::write_aerial_cameras_csv(&path, &nadir).map_err(io(path))?;
-    let oblique: Vec<AerialImage> = plan
-        .areas
-        .iter()
-        .flat_map(|a| a.oblique.iter().cloned())
-        .collect();
+    cw::write_aerial_cameras_csv(&path, &truth.nadir).map_err(io(path))?;
     let path = root.join("aerial/oblique/cameras.csv");
-    cw::write_aerial_cameras_csv(&path, &oblique).map_err(io(path))?;
+    cw::write_aerial_cameras_csv(&path, &truth.oblique).map_err(io(path))?;
     let checkpoints: Vec<_> = plan
         .areas
         .iter()
@@ -514,9 +223,8 @@ fn write_campaign(
         .collect();
     let path = root.join("control/observations.csv");
     cw::write_observations_csv(&path, &observations).map_err(io(path))?;
-    let readme = plan
-        .deterioration
-        .readme(&plan.name, plan.seed, plan.recorded.len());
+    let none = Profile::none();
+    let readme = readme(name, plan.seed, &none, &none.apply(plan.seed, &truth));
     let path = root.join("truth/README.md");
     crate::fsutil::atomic_write(&path, readme.as_bytes()).map_err(io(path))?;
     let path = root.join(SCENE_TRUTH_FILE);
@@ -569,10 +277,11 @@ fn install(tmp: &Path, out: &Path) -> Result<(), SynthError> {
 }
 
 /// Generate the whole campaign described by `options` into the folder `out` (created, or replacing a previous
-/// synthetic campaign; any other existing folder is refused). Written into a temporary sibling first, then
-/// renamed, so `out` is never half-written. Finished images are kept in the render store
-/// `.<out name>.render-store` beside `out` until the campaign is installed, so an interrupted generation
-/// resumes ([`RenderStore`]).
+/// synthetic campaign; any other existing folder is refused): the error-free campaign is rendered into a
+/// sibling folder, the profile applied from there into `out`, and the sibling removed. Every folder is written
+/// into a temporary sibling first, then renamed, so `out` is never half-written. Finished images are kept in
+/// the render store `.<out name>.render-store` beside `out` until the rendering is installed, so an interrupted
+/// generation resumes ([`RenderStore`]).
 pub fn generate(options: &SynthOptions, out: &Path) -> Result<SynthSummary, SynthError> {
     let name = out
         .file_name()
@@ -583,18 +292,68 @@ pub fn generate(options: &SynthOptions, out: &Path) -> Result<SynthSummary, Synt
 }
 
 /// [`generate`] with the render store at `store_dir`; also returns how many images were taken from the store
-/// (rendered by an interrupted generation with the same options) instead of being rendered.
+/// (rendered by an interrupted generation with the same images) instead of being rendered.
 pub fn generate_resumable(
     options: &SynthOptions,
     out: &Path,
     store_dir: &Path,
 ) -> Result<(SynthSummary, usize), SynthError> {
     let start = Instant::now();
+    check_replaceable(out)?;
+    let rendered = sibling(out, "rendered");
+    let (mut summary, reused) = render_campaign(options, &rendered, store_dir)?;
+    let applied = apply_profile(&rendered, options, out);
+    let _ = std::fs::remove_dir_all(&rendered);
+    applied?;
+    summary.name = options.campaign_name();
+    summary.seconds = start.elapsed().as_secs_f64();
+    Ok((summary, reused))
+}
+
+/// Apply `options.profile` to the error-free campaign folder `rendered` (made by [`render_campaign`] with the
+/// same options' render identity) and install the result as `out` (replacing a previous synthetic campaign).
+pub fn apply_profile(
+    rendered: &Path,
+    options: &SynthOptions,
+    out: &Path,
+) -> Result<(), SynthError> {
+    check_replaceable(out)?;
+    let tmp = sibling(out, "tmp");
+    let result = apply_profile_dir(
+        rendered,
+        &options.profile,
+        options.seed,
+        &options.campaign_name(),
+        &tmp,
+    )
+    .and_then(|_| install(&tmp, out));
+    if result.is_err() {
+        let _ = std::fs::remove_dir_all(&tmp);
+    }
+    result
+}
+
+/// Refuse an existing `out` that is neither empty nor a synthetic campaign.
+fn check_replaceable(out: &Path) -> Result<(), SynthError> {
     if out.exists() && !replaceable(out) {
         return Err(SynthError::OutputExists {
             path: out.display().to_string(),
         });
     }
+    Ok(())
+}
+
+/// Render the error-free campaign of `options` (its images depend only on [`SynthOptions::render_identity`];
+/// the tables hold the true values, `truth/README.md` says so) into the folder `out`, created or replacing a
+/// previous synthetic campaign. Finished images are kept in the render store at `store_dir` until the folder
+/// is installed; returns the summary and how many images were taken from the store.
+pub fn render_campaign(
+    options: &SynthOptions,
+    out: &Path,
+    store_dir: &Path,
+) -> Result<(SynthSummary, usize), SynthError> {
+    let start = Instant::now();
+    check_replaceable(out)?;
     let plan = plan_campaign(options)?;
     if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent).map_err(|e| SynthError::io(parent, e))?;
@@ -602,8 +361,13 @@ pub fn generate_resumable(
     let store = RenderStore::open(store_dir, &options.store_identity()?)?;
     let tmp = sibling(out, "tmp");
     std::fs::create_dir_all(&tmp).map_err(|e| SynthError::io(&tmp, e))?;
+    let name = SynthOptions {
+        profile: Profile::none(),
+        ..options.clone()
+    }
+    .campaign_name();
     let render_start = Instant::now();
-    let written = write_campaign(&plan, &tmp, &store);
+    let written = write_error_free(&plan, &name, &tmp, &store);
     let render_seconds = render_start.elapsed().as_secs_f64();
     let (rays, reused) = match written.and_then(|w| install(&tmp, out).map(|_| w)) {
         Ok(w) => w,
@@ -614,8 +378,8 @@ pub fn generate_resumable(
     };
     store.remove()?;
     let summary = SynthSummary {
-        name: plan.name.clone(),
-        recordings: plan.recorded.len(),
+        name,
+        recordings: plan.recorded().len(),
         nadir_images: plan.areas.iter().map(|a| a.nadir.len()).sum(),
         oblique_images: plan.areas.iter().map(|a| a.oblique.len()).sum(),
         checkpoints: plan.areas.iter().map(|a| a.control.checkpoints.len()).sum(),
@@ -631,7 +395,7 @@ pub fn generate_resumable(
     Ok((summary, reused))
 }
 
-/// Generate preset `preset` (`tiny`, `demo`, `paper`) with seed `seed` and the thesis deterioration.
+/// Generate preset `preset` (`tiny`, `demo`, `paper`) with seed `seed` and the thesis' error profile.
 pub fn generate_preset(preset: &str, seed: u64, out: &Path) -> Result<SynthSummary, SynthError> {
     generate(&SynthOptions::new(Preset::from_name(preset)?, seed), out)
 }

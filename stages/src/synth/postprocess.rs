@@ -48,6 +48,14 @@ impl EpochLook {
     }
 }
 
+impl EpochLook {
+    /// This look with every channel's gain multiplied by `gain` (an image's own exposure).
+    pub fn exposed(mut self, gain: f32) -> Self {
+        self.gain_rgb = self.gain_rgb.map(|g| g * gain);
+        self
+    }
+}
+
 /// Normalised 1-D Gaussian kernel of radius ⌈3σ⌉.
 fn gaussian_kernel(sigma_px: f32) -> Vec<f32> {
     let radius = (3.0 * sigma_px).ceil().max(1.0) as i64;

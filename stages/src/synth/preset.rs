@@ -98,6 +98,7 @@ impl Preset {
             forward_overlap: 0.60,
             side_overlap: 0.40,
             attitude_sigma_deg: 0.15,
+            corner_distortion_px: 0.0,
         };
         let oblique = |width_px, height_px| ObliquePlan {
             altitude_m: 450.0,
@@ -111,6 +112,8 @@ impl Preset {
         match self {
             Preset::Tiny => PresetParams {
                 panorama_width_px: 1024,
+                // Three check points along the 25 m route instead of one.
+                checkpoint_spacing_m: 8.0,
                 panorama_spp_axis: 2,
                 max_recordings_per_route: 6,
                 nadir: nadir(512, 384),
@@ -182,6 +185,8 @@ pub struct NadirPlan {
     pub side_overlap: f64,
     /// SD of the small random ω and φ (clamped to < 1°), degrees.
     pub attitude_sigma_deg: f64,
+    /// Radial lens distortion at the image corners, pixels (0 = none; the `lens` profiles set it).
+    pub corner_distortion_px: f64,
 }
 
 /// Parameters of the oblique (pentacam-style) flight plan (thesis 4.5).
@@ -243,6 +248,9 @@ pub struct PresetParams {
     pub render_max_width_px: Option<u32>,
     /// File format of the aerial frames (panoramas are always JPEG).
     pub aerial_format: AerialFormat,
+    /// SD of the natural logarithm of each image's exposure gain (0 = every image exposed alike; the `epoch`
+    /// profile sets it).
+    pub exposure_log_sigma: f64,
 }
 
 impl PresetParams {
@@ -265,6 +273,7 @@ impl PresetParams {
                 forward_overlap: 0.6,
                 side_overlap: 0.4,
                 attitude_sigma_deg: 0.15,
+                corner_distortion_px: 0.0,
             },
             oblique: ObliquePlan {
                 altitude_m: 450.0,
@@ -285,6 +294,7 @@ impl PresetParams {
             jpeg_quality: 92,
             render_max_width_px: None,
             aerial_format: AerialFormat::Jpeg,
+            exposure_log_sigma: 0.0,
         }
     }
 

@@ -11,7 +11,8 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::preset::Preset;
-use super::scene::{Epoch, Scene};
+use super::profile::EpochParams;
+use super::scene::{Epoch, EpochChangeSpec, Scene, SceneSpec};
 use crate::geometry::ray::Ray;
 
 /// The file, relative to the campaign root.
@@ -28,13 +29,32 @@ pub fn scene_seed(seed: u64, area: usize) -> u64 {
     seed ^ ((area as u64) << 48)
 }
 
-/// The scenes of `preset` with campaign seed `seed`, one per area, as the generator builds them.
-pub fn build_scenes(preset: Preset, seed: u64) -> Vec<Scene> {
+/// The scene spec of an area with the epoch differences of profile `epoch` (when given): more parked cars in
+/// one epoch only, the mobile-mapping sun lower, changed markings, roadworks and grown crowns.
+pub fn with_epoch_changes(mut spec: SceneSpec, epoch: Option<&EpochParams>) -> SceneSpec {
+    if let Some(e) = epoch {
+        spec.car_mm_only_fraction = e.moved_car_fraction / 2.0;
+        spec.car_aerial_only_fraction = e.moved_car_fraction / 2.0;
+        spec.sun_mobile_mapping.elevation_deg = e.mm_sun_elevation_deg;
+        spec.changes = Some(EpochChangeSpec {
+            changed_marking_fraction: e.changed_marking_fraction,
+            roadworks_per_street: e.roadworks_per_street,
+            crown_growth_m: e.crown_growth_m,
+        });
+    }
+    spec
+}
+
+/// The scenes of `preset` with campaign seed `seed` (and the epoch differences of the `epoch` profile), one
+/// per area, as the generator builds them.
+pub fn build_scenes(preset: Preset, seed: u64, epoch: Option<&EpochParams>) -> Vec<Scene> {
     preset
         .scene_specs()
-        .iter()
+        .into_iter()
         .enumerate()
-        .map(|(area, spec)| Scene::generate(spec, scene_seed(seed, area)))
+        .map(|(area, spec)| {
+            Scene::generate(&with_epoch_changes(spec, epoch), scene_seed(seed, area))
+        })
         .collect()
 }
 
@@ -97,27 +117,36 @@ pub struct SceneTruth {
     pub seed: u64,
     /// [`fingerprint`] of the scenes.
     pub fingerprint: String,
+    /// The epoch differences of the `epoch` error profile, if the campaign has them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub epoch: Option<EpochParams>,
 }
 
 impl SceneTruth {
-    /// The record of `scenes`, built for (`preset`, `seed`).
-    pub fn of(preset: Preset, seed: u64, scenes: &[Scene]) -> Self {
+    /// The record of `scenes`, built for (`preset`, `seed`, `epoch`).
+    pub fn of(preset: Preset, seed: u64, epoch: Option<&EpochParams>, scenes: &[Scene]) -> Self {
         Self {
             generator: GENERATOR.into(),
             preset: preset.name().into(),
             seed,
             fingerprint: fingerprint(scenes),
+            epoch: epoch.cloned(),
         }
     }
 
     /// The file's text (a comment saying what it is for, then the keys).
     pub fn to_toml(&self) -> String {
-        format!(
+        let mut t = format!(
             "# Rebuilds this synthetic campaign's scene for evaluation (visibility, true surface points).\n\
              # Never read by the pipeline. Written by skytie's generator; other software leaves it out.\n\
              generator = {:?}\npreset = {:?}\nseed = {}\nfingerprint = {:?}\n",
             self.generator, self.preset, self.seed, self.fingerprint
-        )
+        );
+        if let Some(e) = &self.epoch {
+            let table = toml::to_string(e).unwrap_or_default();
+            t.push_str(&format!("\n[epoch]\n{table}"));
+        }
+        t
     }
 
     /// Parse the file's text; the error says what is wrong.
@@ -135,7 +164,7 @@ impl SceneTruth {
     /// Rebuild the scenes and check the fingerprint.
     pub fn rebuild(&self) -> Result<SceneOracle, String> {
         let preset = Preset::from_name(&self.preset).map_err(|e| e.to_string())?;
-        let scenes = build_scenes(preset, self.seed);
+        let scenes = build_scenes(preset, self.seed, self.epoch.as_ref());
         let got = fingerprint(&scenes);
         if got != self.fingerprint {
             return Err(format!(
@@ -200,13 +229,13 @@ mod tests {
 
     #[test]
     fn the_record_round_trips_and_rebuilds_the_same_scene() {
-        let scenes = build_scenes(Preset::Tiny, 7);
-        let t = SceneTruth::of(Preset::Tiny, 7, &scenes);
+        let scenes = build_scenes(Preset::Tiny, 7, None);
+        let t = SceneTruth::of(Preset::Tiny, 7, None, &scenes);
         let back = SceneTruth::parse(&t.to_toml()).expect("parses");
         assert_eq!(back, t);
         assert!(back.rebuild().is_ok());
         assert_ne!(
-            fingerprint(&build_scenes(Preset::Tiny, 8)),
+            fingerprint(&build_scenes(Preset::Tiny, 8, None)),
             t.fingerprint,
             "another seed builds another scene"
         );
@@ -227,7 +256,7 @@ mod tests {
 
     #[test]
     fn a_wrong_fingerprint_or_generator_is_refused_with_the_reason() {
-        let mut t = SceneTruth::of(Preset::Tiny, 7, &build_scenes(Preset::Tiny, 7));
+        let mut t = SceneTruth::of(Preset::Tiny, 7, None, &build_scenes(Preset::Tiny, 7, None));
         t.fingerprint = "0000000000000000".into();
         let e = SceneTruth::parse(&t.to_toml())
             .unwrap()
@@ -245,7 +274,7 @@ mod tests {
 
     #[test]
     fn a_facade_point_seen_from_the_street_is_visible_from_above_and_a_point_behind_it_is_not() {
-        let scenes = build_scenes(Preset::Tiny, 3);
+        let scenes = build_scenes(Preset::Tiny, 3, None);
         let route = along_polyline(scenes[0].route_world(), 5.0);
         assert!(route.len() > 3, "the tiny route is longer than 15 m");
         let oracle = SceneOracle::new(scenes);

@@ -425,17 +425,27 @@ fn add_tree(
         Material::Trunk,
         IN_BOTH,
     ));
-    objects.push(Object::new(
-        Shape::Crown {
-            centre,
-            inv_r,
-            hole_seed: rng.next_u64(),
-        },
-        Material::Leaves {
-            seed: rng.next_u64(),
-        },
-        IN_BOTH,
-    ));
+    let (hole_seed, leaf_seed) = (rng.next_u64(), rng.next_u64());
+    let growth_m = spec.changes.map_or(0.0, |c| c.crown_growth_m);
+    let crown = |inv_r: Vector3<f64>, epochs| {
+        Object::new(
+            Shape::Crown {
+                centre,
+                inv_r,
+                hole_seed,
+            },
+            Material::Leaves { seed: leaf_seed },
+            epochs,
+        )
+    };
+    if growth_m > 0.0 {
+        // The aerial epoch's crown is larger (grown by the time of the flight).
+        let grown = inv_r.map(|v| 1.0 / (1.0 / v + growth_m));
+        objects.push(crown(inv_r, IN_MM));
+        objects.push(crown(grown, IN_AERIAL));
+    } else {
+        objects.push(crown(inv_r, IN_BOTH));
+    }
 }
 
 fn add_trees(spec: &SceneSpec, rng: &mut SplitMix64, ground: &Ground, objects: &mut Vec<Object>) {

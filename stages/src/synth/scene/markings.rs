@@ -6,6 +6,9 @@
 //! a stop line across that lane, and a zebra crossing (0.5 m stripes, 1.0 m period: repetitive on purpose)
 //! across the whole carriageway. Manhole covers (r = 0.3 m) sit in the lanes at a fixed spacing.
 
+use super::epoch_draw::changed_epochs;
+use super::objects::IN_BOTH;
+
 /// Maps street coordinates (s, q) to local XY and back. Main street: s = x, q = y.
 /// Cross street (crown at x = xj, running along +y): s = y, q = xj − x (left of +y is −x).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -188,6 +191,8 @@ pub enum GroundMark {
         ds: f64,
         dq: f64,
     },
+    /// Fresh asphalt of roadworks (covers any marking).
+    Roadworks,
 }
 
 /// Layout inputs for one street's markings.
@@ -206,12 +211,17 @@ pub struct StreetMarkingInput {
     pub manhole_phase: f64,
 }
 
+/// A painted element with its bounding box (s_min, s_max, q_min, q_max in street coordinates, m) and the epochs
+/// it is painted in.
+type PlacedPaint = (Paint, (f64, f64, f64, f64), u8);
+
 /// All markings of one street.
 #[derive(Clone, Debug)]
 pub struct StreetMarkings {
     pub axis: StreetAxis,
     half_width_m: f64,
-    paints: Vec<(Paint, (f64, f64, f64, f64))>,
+    /// Each element with its bounding box and the epochs it is painted in.
+    paints: Vec<PlacedPaint>,
     manholes: Vec<(f64, f64)>,
 }
 
@@ -357,7 +367,7 @@ impl StreetMarkings {
                 }
             }
         }
-        let paints = paints.into_iter().map(|p| (p, p.bbox())).collect();
+        let paints = paints.into_iter().map(|p| (p, p.bbox(), IN_BOTH)).collect();
         Self {
             axis: inp.axis,
             half_width_m: hw,
@@ -366,8 +376,19 @@ impl StreetMarkings {
         }
     }
 
-    /// The mark at street coordinates (s, q).
-    pub fn mark_at(&self, s: f64, q: f64) -> GroundMark {
+    /// Make a `fraction` of the painted elements present in one epoch only (repainted or removed between the
+    /// epochs); which ones and in which epoch is hashed from (`seed`, `street`, element index).
+    pub fn vary_epochs(&mut self, seed: u64, street: usize, fraction: f64) {
+        for (k, (_, _, epochs)) in self.paints.iter_mut().enumerate() {
+            let key = (street as u64) << 32 | k as u64;
+            if let Some(e) = changed_epochs(seed, 0x9A17, key, fraction) {
+                *epochs = e;
+            }
+        }
+    }
+
+    /// The mark at street coordinates (s, q) in the epoch(s) `epoch_bits` (`IN_MM`, `IN_AERIAL`).
+    pub fn mark_at(&self, s: f64, q: f64, epoch_bits: u8) -> GroundMark {
         if q.abs() > self.half_width_m {
             return GroundMark::None;
         }
@@ -377,19 +398,27 @@ impl StreetMarkings {
                 return GroundMark::Manhole { ds, dq };
             }
         }
-        for (p, (sl, sh, ql, qh)) in &self.paints {
-            if s >= *sl && s <= *sh && q >= *ql && q <= *qh && p.contains(s, q) {
+        for (p, (sl, sh, ql, qh), epochs) in &self.paints {
+            if epochs & epoch_bits != 0
+                && s >= *sl
+                && s <= *sh
+                && q >= *ql
+                && q <= *qh
+                && p.contains(s, q)
+            {
                 return GroundMark::Paint;
             }
         }
         GroundMark::None
     }
 
-    /// Feature points in local XY with their kind.
+    /// Feature points in local XY with their kind (of elements painted in both epochs).
     pub fn features_local(&self) -> Vec<(&'static str, [f64; 2])> {
         let mut f = Vec::new();
-        for (p, _) in &self.paints {
-            p.features(&mut f);
+        for (p, _, epochs) in &self.paints {
+            if *epochs == IN_BOTH {
+                p.features(&mut f);
+            }
         }
         let mut out: Vec<(&'static str, [f64; 2])> = f
             .into_iter()
@@ -427,7 +456,7 @@ mod tests {
         let mut prev = false;
         for i in 0..900 {
             let q = -4.5 + i as f64 * 0.01;
-            let on = m.mark_at(113.0, q) == GroundMark::Paint;
+            let on = m.mark_at(113.0, q, IN_BOTH) == GroundMark::Paint;
             if on && !prev {
                 stripes += 1;
             }
@@ -435,9 +464,9 @@ mod tests {
         }
         assert_eq!(stripes, 8);
         // first dash starts at s = 0.5 on the crown
-        assert_eq!(m.mark_at(0.6, 0.0), GroundMark::Paint);
-        assert_eq!(m.mark_at(3.6, 0.0), GroundMark::None);
-        assert_eq!(m.mark_at(9.6, 0.0), GroundMark::Paint);
+        assert_eq!(m.mark_at(0.6, 0.0, IN_BOTH), GroundMark::Paint);
+        assert_eq!(m.mark_at(3.6, 0.0, IN_BOTH), GroundMark::None);
+        assert_eq!(m.mark_at(9.6, 0.0, IN_BOTH), GroundMark::Paint);
         // stop line corner is exactly on the paint boundary; its inside is painted
         let f = m.features_local();
         let stop: Vec<_> = f.iter().filter(|(k, _)| *k == "stop_line_corner").collect();
@@ -446,8 +475,8 @@ mod tests {
         assert_eq!(arrows.len(), 2);
         // just behind the arrow tip (towards −s for dir +1) is paint, in front is not
         let tip = arrows.iter().find(|(_, p)| p[0] < 120.0).unwrap().1;
-        assert_eq!(m.mark_at(tip[0] - 0.05, tip[1]), GroundMark::Paint);
-        assert_eq!(m.mark_at(tip[0] + 0.05, tip[1]), GroundMark::None);
+        assert_eq!(m.mark_at(tip[0] - 0.05, tip[1], IN_BOTH), GroundMark::Paint);
+        assert_eq!(m.mark_at(tip[0] + 0.05, tip[1], IN_BOTH), GroundMark::None);
         assert!(f.iter().any(|(k, _)| *k == "manhole_centre"));
     }
 

@@ -10,6 +10,8 @@
 //! street-local frame in f64.
 
 pub mod accel;
+pub mod epoch_changes;
+pub mod epoch_draw;
 pub mod frame;
 pub mod ground;
 pub mod layout;
@@ -26,6 +28,7 @@ use markings::{StreetAxis, StreetMarkingInput, StreetMarkings};
 use nalgebra::Vector3;
 use objects::{Material, Object, Shape, IN_AERIAL, IN_BOTH, IN_MM};
 
+pub use epoch_changes::{EpochChangeSpec, Roadworks};
 pub use layout::{Building, Car};
 pub use spec::{CanalSpec, CrossStreetSpec, RouteSpec, SceneSpec, SunSpec};
 
@@ -110,6 +113,8 @@ pub struct Scene {
     /// Flat grey ground without texture (markers-only scenes).
     plain_ground: bool,
     streets: Vec<StreetMarkings>,
+    /// Roadworks patches (epoch changes), in their street's coordinates.
+    roadworks: Vec<Roadworks>,
     sidewalk_width_m: f64,
     kerb_band_m: f64,
     objects: Vec<Object>,
@@ -193,7 +198,24 @@ impl Scene {
                 manhole_phase: phase(0x3A12),
             }));
         }
-        let lay = layout::generate(spec, seed, &ground);
+        let mut lay = layout::generate(spec, seed, &ground);
+        let mut roadworks = Vec::new();
+        if let Some(ch) = &spec.changes {
+            let mut ranges = vec![((0.0, spec.street_length_m), hw)];
+            if let Some(c) = spec.cross_street {
+                ranges.push(((-c.extent_right_m, c.extent_left_m), c.half_width_m));
+            }
+            for (k, (st, (s_range, half))) in streets.iter_mut().zip(ranges).enumerate() {
+                st.vary_epochs(seed, k, ch.changed_marking_fraction);
+                for r in epoch_changes::place_roadworks(ch, seed, k, s_range, half) {
+                    lay.objects
+                        .extend(epoch_changes::cones(&r, st.axis, |x, y| {
+                            ground.height(x, y)
+                        }));
+                    roadworks.push(r);
+                }
+            }
+        }
         let grid = Grid::build(&lay.objects, GRID_CELL_M);
         let route_local = route_polyline(spec);
         let route_world = route_local.iter().map(|p| frame.to_world_xy(*p)).collect();
@@ -216,6 +238,7 @@ impl Scene {
             ground,
             plain_ground: false,
             streets,
+            roadworks,
             sidewalk_width_m: sw,
             kerb_band_m: spec.kerb_band_m,
             objects: lay.objects,
@@ -239,6 +262,7 @@ impl Scene {
             ground: Ground::flat(ground_z_m),
             plain_ground: true,
             streets: Vec::new(),
+            roadworks: Vec::new(),
             sidewalk_width_m: 0.0,
             kerb_band_m: 0.0,
             objects: Vec::new(),
@@ -443,7 +467,7 @@ impl Scene {
             distance_m: h.t,
             point_world: origin_world + dir_world / n * h.t,
             normal_world: self.frame.dir_to_world(&h.n),
-            surface: self.surface_kind(&h),
+            surface: self.surface_kind(&h, epoch),
         })
     }
 
@@ -475,7 +499,11 @@ impl Scene {
         let mut out = Vec::new();
         for st in &self.streets {
             for (kind, xy) in st.features_local() {
-                if !self.ground.on_road(xy[0], xy[1]) {
+                let under_roadworks = self.roadworks.iter().any(|r| {
+                    let (s, q) = self.streets[r.street].axis.to_sq(xy[0], xy[1]);
+                    r.contains(s, q)
+                });
+                if !self.ground.on_road(xy[0], xy[1]) || under_roadworks {
                     continue;
                 }
                 let z = self.ground.height(xy[0], xy[1]);

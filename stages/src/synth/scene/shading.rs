@@ -12,15 +12,24 @@ use nalgebra::Vector3;
 const SUN_RGB: [f32; 3] = [0.80, 0.77, 0.71];
 /// Sky (ambient) irradiance on an upward-facing surface.
 const SKY_RGB: [f32; 3] = [0.26, 0.29, 0.35];
+/// Fresh asphalt of roadworks is this much darker than the worn road.
+const FRESH_ASPHALT: f32 = 0.55;
 /// Albedo of the plain grey ground of markers-only scenes.
 const PLAIN_GREY: f32 = 0.5;
 
 impl Scene {
-    /// The mark (paint, manhole) on the carriageway at local (x, y), with the street coordinates used.
-    fn mark_at(&self, x: f64, y: f64) -> (GroundMark, f64, f64) {
+    /// The mark (paint, manhole, roadworks) on the carriageway at local (x, y) in `epoch`, with the street
+    /// coordinates used.
+    fn mark_at(&self, x: f64, y: f64, epoch: Epoch) -> (GroundMark, f64, f64) {
+        for r in &self.roadworks {
+            let (s, q) = self.streets[r.street].axis.to_sq(x, y);
+            if r.epochs & epoch.bit() != 0 && r.contains(s, q) {
+                return (GroundMark::Roadworks, s, q);
+            }
+        }
         for st in &self.streets {
             let (s, q) = st.axis.to_sq(x, y);
-            let m = st.mark_at(s, q);
+            let m = st.mark_at(s, q, epoch.bit());
             if m != GroundMark::None {
                 return (m, s, q);
             }
@@ -40,7 +49,7 @@ impl Scene {
         (x, y)
     }
 
-    pub(crate) fn surface_kind(&self, h: &LocalHit) -> SurfaceKind {
+    pub(crate) fn surface_kind(&self, h: &LocalHit, epoch: Epoch) -> SurfaceKind {
         match h.what {
             HitWhat::Ground { face: true, .. } => SurfaceKind::Kerb,
             HitWhat::Ground { class, .. } => {
@@ -48,7 +57,7 @@ impl Scene {
                     return SurfaceKind::Road;
                 }
                 match class {
-                    GroundClass::Road => match self.mark_at(h.p.x, h.p.y).0 {
+                    GroundClass::Road => match self.mark_at(h.p.x, h.p.y, epoch).0 {
                         GroundMark::Paint => SurfaceKind::Marking,
                         _ => SurfaceKind::Road,
                     },
@@ -130,7 +139,7 @@ impl Scene {
         }
     }
 
-    fn albedo(&self, h: &LocalHit) -> [f32; 3] {
+    fn albedo(&self, h: &LocalHit, epoch: Epoch) -> [f32; 3] {
         let seed = self.texture_seed;
         let p = &h.p;
         match h.what {
@@ -146,10 +155,13 @@ impl Scene {
                     return [PLAIN_GREY; 3];
                 }
                 match class {
-                    GroundClass::Road => match self.mark_at(p.x, p.y) {
+                    GroundClass::Road => match self.mark_at(p.x, p.y, epoch) {
                         (GroundMark::Paint, _, _) => texture::paint(p.x, p.y, seed),
                         (GroundMark::Manhole { ds, dq }, _, _) => {
                             texture::manhole(ds, dq, MANHOLE_RADIUS_M, seed)
+                        }
+                        (GroundMark::Roadworks, _, _) => {
+                            texture::asphalt(p.x, p.y, seed ^ 0x4E57).map(|v| v * FRESH_ASPHALT)
                         }
                         _ => texture::asphalt(p.x, p.y, seed),
                     },
@@ -237,7 +249,7 @@ impl Scene {
         }
         // normal facing the viewer
         let n = if h.n.dot(d) > 0.0 { -h.n } else { h.n };
-        let albedo = self.albedo(h);
+        let albedo = self.albedo(h, epoch);
         let sun = &self.sun_local[epoch.index()];
         let cos_s = n.dot(sun);
         let mut direct = 0.0f32;

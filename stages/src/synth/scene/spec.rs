@@ -6,6 +6,8 @@
 //! rotation by `street_heading_deg` about Z plus the offset `origin_world` (so no street is gifted as
 //! being grid-aligned).
 
+use super::epoch_changes::EpochChangeSpec;
+
 /// Sun position: azimuth clockwise from grid north, elevation above the horizon.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SunSpec {
@@ -125,27 +127,37 @@ pub struct SceneSpec {
     pub route: RouteSpec,
     pub sun_mobile_mapping: SunSpec,
     pub sun_aerial: SunSpec,
+    /// Differences between the epochs beyond sun and cars (markings, roadworks, grown crowns); `None` = none.
+    pub changes: Option<EpochChangeSpec>,
 }
 
 impl SceneSpec {
-    /// About 30 m of straight street, one block on each side, no junction: fast tests.
+    /// About 60 m of straight street ending at a T-junction, buildings on both sides: fast tests. The route (six
+    /// panoramas, 20–45 m) runs between façades on both sides up to the junction approach, whose arrow, stop line
+    /// and zebra crossing it sees along with dashes and manholes, so both the nadir chain (road markings) and the
+    /// oblique chain (façades on both sides) have content to register.
     pub fn tiny() -> Self {
         Self {
-            street_length_m: 30.0,
-            cross_street: None,
+            street_length_m: 60.0,
+            cross_street: Some(CrossStreetSpec {
+                at_x_m: 55.0,
+                half_width_m: 4.0,
+                extent_right_m: 0.0,
+                extent_left_m: 20.0,
+            }),
             manhole_spacing_m: 12.0,
             setback_m: [1.0, 1.0],
-            building_width_m: [26.0, 26.0],
-            building_gap_m: [0.0, 0.0],
+            building_width_m: [9.0, 13.0],
+            building_gap_m: [0.0, 1.0],
             tree_spacing_m: 14.0,
             buildings_on_cross_street: false,
             route: RouteSpec {
-                start_x_m: 2.0,
+                start_x_m: 20.0,
                 lane_offset_m: 1.5,
                 turn_right: false,
                 turn_radius_m: 6.0,
                 length_after_junction_m: 0.0,
-                end_x_m: 28.0,
+                end_x_m: 47.0,
             },
             ..Self::demo()
         }
@@ -210,6 +222,7 @@ impl SceneSpec {
                 azimuth_deg: 205.0,
                 elevation_deg: 47.0,
             },
+            changes: None,
         }
     }
 

@@ -1,0 +1,266 @@
+//! The numbers of one evaluation cell, read from its run's output folder and the campaign's `truth/`: nadir
+//! and oblique inlier ratios, recordings and check points before/after the adjustment (RMSE 2D/3D, largest 2D
+//! error), and the verification's flags compared with the true offset of each segment.
+
+use crate::report::inputs::{num_at, read_csv_opt, RunOutputs};
+use serde_json::Value;
+use skytie_stages::campaign::{read_recordings_csv, Recording};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Which way a metric gets better.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Better {
+    Higher,
+    Lower,
+    /// Not judged (a property of the input, e.g. the error before adjustment).
+    Shown,
+}
+
+/// One reported number.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MetricDef {
+    pub key: &'static str,
+    /// Column title in the table.
+    pub title: &'static str,
+    pub better: Better,
+    /// Smallest change that counts as a regression (the noise band is at least this), in the metric's unit.
+    pub floor: f64,
+}
+
+/// A segment counts as off when its recorded positions are off by more than this on average, m.
+pub const SEGMENT_OFF_M: f64 = 0.3;
+/// A flagged segment whose true mean offset is below this is a false alarm, m.
+pub const SEGMENT_GOOD_M: f64 = 0.2;
+
+/// Every metric, in table order.
+pub const METRICS: [MetricDef; 16] = [
+    MetricDef {
+        key: "nadir_inlier",
+        title: "nadir inlier",
+        better: Better::Higher,
+        floor: 0.005,
+    },
+    MetricDef {
+        key: "nadir_registered",
+        title: "rec. w/ aerial",
+        better: Better::Higher,
+        floor: 0.03,
+    },
+    MetricDef {
+        key: "oblique_inlier",
+        title: "obl. inlier",
+        better: Better::Higher,
+        floor: 0.01,
+    },
+    MetricDef {
+        key: "oblique_inlier_nm",
+        title: "obl. inl. +nm",
+        better: Better::Higher,
+        floor: 0.01,
+    },
+    MetricDef {
+        key: "corrected",
+        title: "corrected",
+        better: Better::Higher,
+        floor: 0.001,
+    },
+    MetricDef {
+        key: "rec_2d_before",
+        title: "rec 2D before",
+        better: Better::Shown,
+        floor: 0.0,
+    },
+    MetricDef {
+        key: "rec_2d_after",
+        title: "rec 2D after",
+        better: Better::Lower,
+        floor: 0.005,
+    },
+    MetricDef {
+        key: "rec_3d_after",
+        title: "rec 3D after",
+        better: Better::Lower,
+        floor: 0.01,
+    },
+    MetricDef {
+        key: "rec_max_2d_after",
+        title: "rec max 2D",
+        better: Better::Lower,
+        floor: 0.01,
+    },
+    MetricDef {
+        key: "cp_2d_before",
+        title: "cp 2D before",
+        better: Better::Shown,
+        floor: 0.0,
+    },
+    MetricDef {
+        key: "cp_2d_after",
+        title: "cp 2D after",
+        better: Better::Lower,
+        floor: 0.005,
+    },
+    MetricDef {
+        key: "cp_3d_after",
+        title: "cp 3D after",
+        better: Better::Lower,
+        floor: 0.01,
+    },
+    MetricDef {
+        key: "cp_max_2d_after",
+        title: "cp max 2D",
+        better: Better::Lower,
+        floor: 0.01,
+    },
+    MetricDef {
+        key: "segments_off",
+        title: "seg. off",
+        better: Better::Shown,
+        floor: 0.0,
+    },
+    MetricDef {
+        key: "verify_detected",
+        title: "off flagged",
+        better: Better::Higher,
+        floor: 0.001,
+    },
+    MetricDef {
+        key: "verify_false",
+        title: "false flags",
+        better: Better::Lower,
+        floor: 0.0,
+    },
+];
+
+/// The numbers of one cell (a metric is absent when the run did not produce it).
+pub type CellMetrics = BTreeMap<String, f64>;
+
+/// The one adjustment configuration's section of the metrics (`adjust.<sources>`).
+fn adjust_section(m: &Value) -> Option<&Value> {
+    let obj = m.get("adjust")?.as_object()?;
+    obj.get("combined").or_else(|| obj.values().next())
+}
+
+/// Largest 2-D error after adjustment in `checkpoints.csv`.
+fn checkpoint_max_after(out: &Path) -> Result<Option<f64>, String> {
+    let Some(t) = read_csv_opt(&out.join("checkpoints.csv"))? else {
+        return Ok(None);
+    };
+    Ok(t.rows
+        .iter()
+        .filter_map(|r| t.num(r, "after_2d"))
+        .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v)))))
+}
+
+/// Per verification segment: (true mean horizontal offset of its recordings, flagged as failed).
+fn segment_truth(out: &Path, campaign: &Path) -> Result<Vec<(f64, bool)>, String> {
+    let Some(v) = read_csv_opt(&out.join("verification.csv"))? else {
+        return Ok(Vec::new());
+    };
+    let read = |rel: &str| -> Vec<Recording> { read_recordings_csv(&campaign.join(rel)).0 };
+    let (mut recorded, truth) = (read("mm/recordings.csv"), read("truth/recordings.csv"));
+    recorded.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+    let true_of: BTreeMap<&str, &Recording> =
+        truth.iter().map(|t| (t.image_id.as_str(), t)).collect();
+    let pos = |id: &str| recorded.iter().position(|r| r.image_id == id);
+    let mut out_rows = Vec::new();
+    for row in &v.rows {
+        if v.text(row, "segment") == "all" {
+            continue;
+        }
+        let (Some(a), Some(b)) = (
+            pos(v.text(row, "first_image_id")),
+            pos(v.text(row, "last_image_id")),
+        ) else {
+            continue;
+        };
+        let (mut dx, mut dy, mut n) = (0.0, 0.0, 0.0);
+        for r in &recorded[a.min(b)..=a.max(b)] {
+            if let Some(t) = true_of.get(r.image_id.as_str()) {
+                dx += r.x - t.x;
+                dy += r.y - t.y;
+                n += 1.0;
+            }
+        }
+        if n > 0.0 {
+            out_rows.push(((dx / n).hypot(dy / n), v.text(row, "status") == "fail"));
+        }
+    }
+    Ok(out_rows)
+}
+
+/// The numbers of the run in `out` (the campaign folder is taken from its provenance).
+pub fn grade_cell(out: &Path) -> Result<CellMetrics, String> {
+    let run = RunOutputs::read(out)?;
+    let m = &run.metrics;
+    let mut c = CellMetrics::new();
+    let mut put = |k: &str, v: Option<f64>| {
+        if let Some(v) = v.filter(|v| v.is_finite()) {
+            c.insert(k.to_string(), v);
+        }
+    };
+    // A ratio of nothing is no ratio: only with graded correspondences.
+    let graded = |k: &str| num_at(m, k).is_some_and(|n| n > 0.0);
+    put(
+        "nadir_inlier",
+        num_at(m, "nadir.inlier_ratio").filter(|_| graded("nadir.graded_tie_points")),
+    );
+    put(
+        "nadir_registered",
+        num_at(m, "nadir.recordings_with_aerial_fraction"),
+    );
+    let oblique =
+        graded("oblique.inliers_after_consensus") || graded("oblique.outliers_after_consensus");
+    put(
+        "oblique_inlier",
+        num_at(m, "oblique.inlier_ratio_after_consensus").filter(|_| oblique),
+    );
+    put(
+        "oblique_inlier_nm",
+        num_at(m, "oblique.inlier_ratio_after_consensus_incl_non_matchable").filter(|_| oblique),
+    );
+    if let Some(a) = adjust_section(m) {
+        // 1 when the run delivered the adjusted trajectory (verdict `corrected`), 0 when it withheld it.
+        let verdict = a.get("verdict").and_then(Value::as_str);
+        put(
+            "corrected",
+            verdict.map(|v| f64::from(u8::from(v == "corrected"))),
+        );
+        put("rec_2d_before", num_at(a, "recordings.before.rmse_2d"));
+        put("rec_2d_after", num_at(a, "recordings.after.rmse_2d"));
+        put("rec_3d_after", num_at(a, "recordings.after.rmse_3d"));
+        put("rec_max_2d_after", num_at(a, "recordings.after.max_2d"));
+        put("cp_2d_before", num_at(a, "checkpoints.before.2d"));
+        put("cp_2d_after", num_at(a, "checkpoints.after.2d"));
+        put("cp_3d_after", num_at(a, "checkpoints.after.3d"));
+    }
+    put("cp_max_2d_after", checkpoint_max_after(out)?);
+    let campaign = run.campaign_dir().ok_or_else(|| {
+        format!(
+            "{}: provenance.json names no campaign folder",
+            out.display()
+        )
+    })?;
+    if campaign.join("truth/recordings.csv").is_file() {
+        let segments = segment_truth(out, &campaign)?;
+        let off: Vec<bool> = segments
+            .iter()
+            .filter(|(d, _)| *d > SEGMENT_OFF_M)
+            .map(|(_, f)| *f)
+            .collect();
+        put("segments_off", Some(off.len() as f64));
+        if !off.is_empty() {
+            let flagged = off.iter().filter(|f| **f).count();
+            put("verify_detected", Some(flagged as f64 / off.len() as f64));
+        }
+        if !segments.is_empty() {
+            let false_flags = segments
+                .iter()
+                .filter(|(d, f)| *f && *d < SEGMENT_GOOD_M)
+                .count();
+            put("verify_false", Some(false_flags as f64));
+        }
+    }
+    Ok(c)
+}

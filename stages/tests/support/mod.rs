@@ -1,0 +1,31 @@
+//! Fixtures shared by the integration tests of `skytie-stages`: a straight street of recordings driving east
+//! and oblique cameras aimed at known points (each test file uses what it needs).
+
+#![allow(dead_code)]
+
+use nalgebra::Vector3;
+use skytie_stages::campaign::{AerialImage, Recording};
+use skytie_stages::geometry::{look_at_matrix, matrix_to_opk};
+
+/// Easting of the street's first recording, metres.
+pub const E0: f64 = 500_000.0;
+/// Northing of the street, metres.
+pub const N0: f64 = 5_400_000.0;
+
+/// Recording `i` of the street: 5 m and 1 s apart driving east (heading 90°) from (E0, N0), projection centre
+/// at height `z_m`, camera 2.5 m above the road.
+pub fn street_recording(id: &str, i: usize, z_m: f64) -> Recording {
+    Recording::new(id, i as f64, [E0 + 5.0 * i as f64, N0, z_m], 90.0, 2.5)
+}
+
+/// An ideal oblique camera at `centre` looking at `target` (world frame, metres), 4000×3000 px, f = 8000 px.
+pub fn oblique_looking_at(id: &str, centre: Vector3<f64>, target: Vector3<f64>) -> AerialImage {
+    let (omega_deg, phi_deg, kappa_deg) = matrix_to_opk(&look_at_matrix(&centre, &target));
+    AerialImage::ideal(
+        id,
+        [centre.x, centre.y, centre.z],
+        [omega_deg, phi_deg, kappa_deg],
+        8000.0,
+        [4000, 3000],
+    )
+}
