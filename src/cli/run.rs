@@ -41,6 +41,10 @@ pub struct RunArgs {
     pub out: Option<PathBuf>,
     #[command(flatten)]
     pub threads: ThreadsOpt,
+    /// Memory budget for decoding images, e.g. 4G (suffixes K, M, G, T; default: a quarter of the available
+    /// memory, 512 MiB to 2 GiB, or $SKYTIE_MEMORY_BUDGET). The image tile cache takes a quarter of it.
+    #[arg(long, value_name = "SIZE")]
+    pub memory_budget: Option<String>,
     /// Print only errors and the final summary.
     #[arg(long)]
     pub quiet: bool,
@@ -68,6 +72,11 @@ pub fn main(args: &RunArgs) -> i32 {
 
 /// Run a workflow as the CLI does. Err = (exit code, message).
 pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
+    if let Some(size) = &args.memory_budget {
+        let bytes = skytie_stages::imaging::budget::parse_size(size)
+            .map_err(|e| (2, format!("--memory-budget {size}: {e}")))?;
+        skytie_stages::imaging::budget::global().set_total(bytes);
+    }
     let (wf, pipeline) =
         load_workflow(&args.workflow, args.campaign.as_deref()).map_err(|e| (2, e))?;
     let store = args.cache.open().map_err(|e| (2, e))?;

@@ -2,7 +2,7 @@
 //! ([`super::pyramid`]), row by row — the one full pass over an image's pixels the pipeline makes.
 
 use super::decode::{decode_grey, GreyInfo, GreyRowSink};
-use super::io::ImageIoError;
+use super::io_error::ImageIoError;
 use super::pyramid::{PyramidBuilder, PyramidSummary, DEFAULT_TILE_SIDE};
 use std::io;
 use std::path::{Path, PathBuf};

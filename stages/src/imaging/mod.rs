@@ -11,6 +11,7 @@ pub mod equirect;
 pub mod image;
 pub mod ingest;
 pub mod io;
+pub mod io_error;
 pub mod probe;
 pub mod pyramid;
 pub mod tiff_write;

@@ -5,7 +5,7 @@
 
 use super::limits::{reserve, MAX_SIDE_PX};
 use super::{sink_error, GreyInfo, GreyRowSink, ImageFormat, ImageHeader};
-use crate::imaging::io::ImageIoError;
+use crate::imaging::io_error::ImageIoError;
 use crate::imaging::pyramid::SampleDepth;
 use std::path::Path;
 use zune_jpeg::zune_core::bytestream::ZCursor;

@@ -3,7 +3,7 @@
 //! header sizes are refused earlier, by the probe every decode starts with ([`crate::imaging::probe`]).
 
 use crate::imaging::budget::{self, human_bytes, Reservation, RAISE_HINT};
-use crate::imaging::io::ImageIoError;
+use crate::imaging::io_error::ImageIoError;
 use std::path::Path;
 
 /// Largest side accepted, pixels (TIFF allows 2^32; no camera comes near this).

@@ -28,7 +28,7 @@ mod tiff_lzw;
 
 pub use geotiff::GeoTiffTags;
 
-use super::io::ImageIoError;
+use super::io_error::ImageIoError;
 use super::probe::probe;
 pub use super::probe::{ImageFormat, ImageHeader};
 use super::pyramid::SampleDepth;

@@ -4,7 +4,7 @@
 use super::grey::{grey_row16, grey_row8, Channels};
 use super::limits::reserve;
 use super::{sink_error, GreyInfo, GreyRowSink, ImageFormat};
-use crate::imaging::io::ImageIoError;
+use crate::imaging::io_error::ImageIoError;
 use crate::imaging::pyramid::SampleDepth;
 use png::{BitDepth, ColorType, Transformations};
 use std::io::BufReader;

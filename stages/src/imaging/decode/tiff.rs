@@ -8,7 +8,7 @@ use super::grey::{grey_row16, grey_row8, Channels};
 use super::limits::reserve;
 use super::tiff_lzw::{read_lzw_chunk, ChunkCoding};
 use super::{sink_error, GreyInfo, GreyRowSink, ImageHeader};
-use crate::imaging::io::ImageIoError;
+use crate::imaging::io_error::ImageIoError;
 use crate::imaging::pyramid::SampleDepth;
 use std::io::BufReader;
 use std::path::Path;

@@ -5,7 +5,7 @@
 //! one call into a buffer of its full size, which does not hit that path; a chunk whose end code is missing
 //! but whose pixels are complete is accepted, as libtiff does.
 
-use crate::imaging::io::ImageIoError;
+use crate::imaging::io_error::ImageIoError;
 use std::fs::File;
 use std::os::unix::fs::FileExt;
 use std::path::Path;
