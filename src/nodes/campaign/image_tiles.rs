@@ -72,8 +72,11 @@ pub fn cached_bytes() -> usize {
     cache().lock().unwrap_or_else(|p| p.into_inner()).bytes
 }
 
-fn open_files() -> &'static Mutex<Vec<([u8; 32], Arc<TiledPyramid>)>> {
-    static OPEN: OnceLock<Mutex<Vec<([u8; 32], Arc<TiledPyramid>)>>> = OnceLock::new();
+/// The open pyramid files, least recently used first, each with its index hash.
+type OpenFiles = Vec<([u8; 32], Arc<TiledPyramid>)>;
+
+fn open_files() -> &'static Mutex<OpenFiles> {
+    static OPEN: OnceLock<Mutex<OpenFiles>> = OnceLock::new();
     OPEN.get_or_init(Default::default)
 }
 

@@ -36,7 +36,7 @@ impl Default for IngestParams {
 impl StageParams for IngestParams {
     fn validate(&self) -> Result<(), Vec<ParamError>> {
         let t = self.tile_side_px;
-        if (64..=2048).contains(&t) && t % 16 == 0 {
+        if (64..=2048).contains(&t) && t.is_multiple_of(16) {
             Ok(())
         } else {
             Err(vec![ParamError::new(
