@@ -17,6 +17,7 @@ pub mod params;
 pub mod plan;
 pub mod report;
 pub mod run;
+pub mod shard;
 pub mod synth;
 pub mod tool;
 pub mod workflows;

@@ -16,8 +16,9 @@
 //! not load, unknown pipeline, cache cannot be opened) or when the output files cannot be written.
 
 use crate::cli::common::{load_workflow, CacheOpt, ThreadsOpt, DEFAULT_WORKFLOW};
+use crate::cli::shard::ShardOpt;
 use crate::dag::progress::{Progress, ProgressMode};
-use crate::dag::{Mode, NodeStatus, PipelineError, Session};
+use crate::dag::{Mode, NodeStatus, Partition, PipelineError, Session};
 use crate::hashing::StatCache;
 use crate::metrics::{add_sections, sweep_csv, write_json, Summary};
 use crate::report::headline::{Headline, Status};
@@ -47,6 +48,8 @@ pub struct RunArgs {
     /// Also print the per-stage table (nodes executed / cached / failed / skipped, seconds).
     #[arg(long)]
     pub timings: bool,
+    #[command(flatten)]
+    pub shard: ShardOpt,
 }
 
 /// What a finished run reports back (for the exit code and for tests).
@@ -89,8 +92,10 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
         .map(|d| d.as_secs())
         .unwrap_or(0);
     let start = Instant::now();
+    let partition = args.shard.partition();
     let mut session = Session::new(&store, &stat_cache, &progress, Mode::Run);
-    session.out_dir = Some(out_dir.clone());
+    session.partition = partition;
+    session.out_dir = partition.writes_outputs().then(|| out_dir.clone());
     let result = args
         .threads
         .install(|| pipeline.run(&wf, &mut session))
@@ -98,11 +103,18 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
     if let Err(PipelineError::Workflow(m)) = &result {
         return Err((2, m.clone()));
     }
+    if let (Partition::Merge { .. }, Err(e)) = (partition, &result) {
+        // Nothing of the campaign's outputs is written until every shard is complete.
+        return Err((1, e.to_string()));
+    }
     let wall = start.elapsed().as_secs_f64();
     if let Err(e) = stat_cache.save() {
         progress.warn(&format!("could not save the stat cache: {e}"));
     }
     let summary = Summary::of(session.reports());
+    if !partition.writes_outputs() {
+        return super::shard::finish_part(&session, &summary, result, &out_dir, partition, wall);
+    }
     let metrics = write_outputs(&wf, &session, &out_dir, started_unix_s, wall).map_err(|e| {
         (
             2,
@@ -286,7 +298,7 @@ pub fn produced_something(session: &Session<'_>) -> bool {
         .any(|&id| last.reports[id].status.is_ok())
 }
 
-fn print_problems(session: &Session<'_>) {
+pub(crate) fn print_problems(session: &Session<'_>) {
     const MAX: usize = 30;
     let failed: Vec<_> = session
         .reports()
