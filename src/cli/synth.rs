@@ -9,7 +9,7 @@ use std::path::PathBuf;
 /// Arguments of `skytie synth`.
 #[derive(Args, Debug)]
 pub struct SynthArgs {
-    /// Preset: tiny (CI smoke), demo (README default), paper (four areas, full resolution).
+    /// Preset: tiny (CI smoke), demo (README default), paper (four areas, full resolution), street (320 panoramas along 1.6 km at tiny's image sizes, for sharded runs).
     #[arg(long, default_value = "demo")]
     pub preset: String,
     /// Seed of the scene, noise and errors (same seed ⇒ byte-identical folder).

@@ -1,4 +1,4 @@
-//! The three synthetic campaign presets (`tiny`, `demo`, `paper`) and every knob they fix: scene areas,
+//! The synthetic campaign presets (`tiny`, `demo`, `paper`, `street`) and every knob they fix: scene areas,
 //! panorama size and supersampling, aerial flight plans, check-point density.
 //!
 //! Aerial geometry follows the thesis data: nadir at ≈ 4470 m above ground with ≈ 10 cm GSD and 60 % / 40 %
@@ -17,7 +17,12 @@ pub enum Preset {
     Demo,
     /// The thesis-sized campaign: four areas of ~100 panoramas each at full resolution (slow).
     Paper,
+    /// A long street at `tiny`'s image sizes: 320 panoramas along 1.6 km, for sharded and cluster runs.
+    Street,
 }
+
+/// Number of panoramas of the `street` preset (at 5 m: a 1595 m route).
+pub const STREET_RECORDINGS: usize = 320;
 
 /// Distance between the origins of the four `paper` areas along world X, m.
 pub const PAPER_AREA_SPACING_M: f64 = 2000.0;
@@ -26,15 +31,16 @@ pub const PAPER_AREA_SPACING_M: f64 = 2000.0;
 pub const PAPER_ROUTE_LENGTH_M: f64 = 495.0;
 
 /// Valid preset names, in the order shown in messages.
-pub const PRESET_NAMES: [&str; 3] = ["tiny", "demo", "paper"];
+pub const PRESET_NAMES: [&str; 4] = ["tiny", "demo", "paper", "street"];
 
 impl Preset {
-    /// Parse a preset name (`tiny`, `demo`, `paper`, case-insensitive).
+    /// Parse a preset name (`tiny`, `demo`, `paper`, `street`, case-insensitive).
     pub fn from_name(name: &str) -> Result<Preset, SynthError> {
         match name.trim().to_ascii_lowercase().as_str() {
             "tiny" => Ok(Preset::Tiny),
             "demo" => Ok(Preset::Demo),
             "paper" => Ok(Preset::Paper),
+            "street" => Ok(Preset::Street),
             _ => Err(SynthError::UnknownPreset {
                 name: name.to_string(),
                 valid: PRESET_NAMES.join(", "),
@@ -48,6 +54,7 @@ impl Preset {
             Preset::Tiny => "tiny",
             Preset::Demo => "demo",
             Preset::Paper => "paper",
+            Preset::Street => "street",
         }
     }
 
@@ -56,6 +63,9 @@ impl Preset {
         match self {
             Preset::Tiny => vec![SceneSpec::tiny()],
             Preset::Demo => vec![SceneSpec::demo()],
+            Preset::Street => vec![SceneSpec::long_street(
+                STREET_RECORDINGS as f64 * PresetParams::common().recording_spacing_m,
+            )],
             // The areas share one origin in their specs; they are placed side by side, far enough apart that
             // no aerial footprint of one area reaches another, and lengthened to ~100 panoramas each.
             Preset::Paper => (0..4)
@@ -112,6 +122,10 @@ impl Preset {
                 oblique: oblique(320, 240),
                 aerial_spp_axis: 2,
                 ..PresetParams::common()
+            },
+            Preset::Street => PresetParams {
+                max_recordings_per_route: STREET_RECORDINGS,
+                ..Preset::Tiny.params()
             },
             Preset::Demo => PresetParams {
                 // 1600 × 800 (0.225°/px) instead of 2048 × 1024: measured 2.3 M primary rays/s per core of CPU
@@ -271,12 +285,15 @@ mod tests {
 
     #[test]
     fn names_round_trip_and_unknown_names_list_the_valid_ones() {
-        for p in [Preset::Tiny, Preset::Demo, Preset::Paper] {
+        for p in [Preset::Tiny, Preset::Demo, Preset::Paper, Preset::Street] {
             assert_eq!(Preset::from_name(p.name()).unwrap(), p);
         }
         assert_eq!(Preset::from_name(" Demo ").unwrap(), Preset::Demo);
         let e = Preset::from_name("huge").unwrap_err().to_string();
-        assert!(e.contains("huge") && e.contains("tiny, demo, paper"), "{e}");
+        assert!(
+            e.contains("huge") && e.contains("tiny, demo, paper, street"),
+            "{e}"
+        );
     }
 
     #[test]
