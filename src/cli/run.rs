@@ -15,7 +15,7 @@
 //! requested output failed or was skipped. **2** for usage/setup errors before anything ran (workflow does
 //! not load, unknown pipeline, cache cannot be opened) or when the output files cannot be written.
 
-use crate::cli::common::{load_workflow, CacheOpt, ThreadsOpt, DEFAULT_WORKFLOW};
+use crate::cli::common::{load_workflow, print_problems, CacheOpt, ThreadsOpt, DEFAULT_WORKFLOW};
 use crate::cli::shard::ShardOpt;
 use crate::dag::progress::{Progress, ProgressMode};
 use crate::dag::{Mode, NodeStatus, Partition, PipelineError, Session};
@@ -113,7 +113,13 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
     }
     let summary = Summary::of(session.reports());
     if !partition.writes_outputs() {
-        return super::shard::finish_part(&session, &summary, result, &out_dir, partition, wall);
+        let exit_code =
+            super::shard::finish_part(&session, &summary, result, &out_dir, partition, wall)?;
+        return Ok(RunResult {
+            exit_code,
+            out_dir,
+            summary,
+        });
     }
     let metrics = write_outputs(&wf, &session, &out_dir, started_unix_s, wall).map_err(|e| {
         (
@@ -296,40 +302,6 @@ pub fn produced_something(session: &Session<'_>) -> bool {
     last.requested
         .iter()
         .any(|&id| last.reports[id].status.is_ok())
-}
-
-pub(crate) fn print_problems(session: &Session<'_>) {
-    const MAX: usize = 30;
-    let failed: Vec<_> = session
-        .reports()
-        .filter(|r| matches!(r.status, NodeStatus::Failed(_)))
-        .collect();
-    let skipped: Vec<_> = session
-        .reports()
-        .filter(|r| matches!(r.status, NodeStatus::Skipped { .. }))
-        .collect();
-    if !failed.is_empty() {
-        println!("failed ({}):", failed.len());
-        for r in failed.iter().take(MAX) {
-            if let NodeStatus::Failed(m) = &r.status {
-                println!("  {}: {m}", r.identity);
-            }
-        }
-        if failed.len() > MAX {
-            println!("  … and {} more", failed.len() - MAX);
-        }
-    }
-    if !skipped.is_empty() {
-        println!("skipped (upstream failed) ({}):", skipped.len());
-        for r in skipped.iter().take(MAX) {
-            if let NodeStatus::Skipped { upstream } = &r.status {
-                println!("  {} (upstream {upstream})", r.identity);
-            }
-        }
-        if skipped.len() > MAX {
-            println!("  … and {} more", skipped.len() - MAX);
-        }
-    }
 }
 
 /// Write metrics.json, provenance.json and, for sweeps, per-variant metrics and sweep.csv. Returns the metrics

@@ -7,7 +7,7 @@
 //! that fail on bad input are not a reason to hold back the merge, which reports them as a single run would —
 //! and 1 when it could not run (e.g. the campaign cannot be read).
 
-use crate::cli::run::{print_problems, RunResult};
+use crate::cli::common::print_problems;
 use crate::dag::{NodeStatus, Partition, PipelineError, Session, ShardSpec};
 use crate::metrics::{write_json, Summary};
 use clap::Args;
@@ -44,7 +44,7 @@ impl ShardOpt {
     }
 }
 
-/// The end of a shard or prepare run: its summary file, the failed nodes, one line, the exit code.
+/// The end of a shard or prepare run: its summary file, the failed nodes, one line; returns the exit code.
 pub fn finish_part(
     session: &Session<'_>,
     summary: &Summary,
@@ -52,7 +52,7 @@ pub fn finish_part(
     out_dir: &Path,
     partition: Partition,
     wall_seconds: f64,
-) -> Result<RunResult, (i32, String)> {
+) -> Result<i32, (i32, String)> {
     let (name, what) = match partition {
         Partition::Shard(s) => (
             format!("shard-{}-of-{}.json", s.index, s.count),
@@ -96,9 +96,5 @@ pub fn finish_part(
             1
         }
     };
-    Ok(RunResult {
-        exit_code,
-        out_dir: out_dir.to_path_buf(),
-        summary: Summary::of(session.reports()),
-    })
+    Ok(exit_code)
 }
