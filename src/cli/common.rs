@@ -116,3 +116,38 @@ pub fn plan_stop(
         Err(e) => Err(e),
     }
 }
+
+/// Print the failed and skipped nodes of a run (at most 30 of each).
+pub(crate) fn print_problems(session: &crate::dag::Session<'_>) {
+    const MAX: usize = 30;
+    let failed: Vec<_> = session
+        .reports()
+        .filter(|r| matches!(r.status, crate::dag::NodeStatus::Failed(_)))
+        .collect();
+    let skipped: Vec<_> = session
+        .reports()
+        .filter(|r| matches!(r.status, crate::dag::NodeStatus::Skipped { .. }))
+        .collect();
+    if !failed.is_empty() {
+        println!("failed ({}):", failed.len());
+        for r in failed.iter().take(MAX) {
+            if let crate::dag::NodeStatus::Failed(m) = &r.status {
+                println!("  {}: {m}", r.identity);
+            }
+        }
+        if failed.len() > MAX {
+            println!("  … and {} more", failed.len() - MAX);
+        }
+    }
+    if !skipped.is_empty() {
+        println!("skipped (upstream failed) ({}):", skipped.len());
+        for r in skipped.iter().take(MAX) {
+            if let crate::dag::NodeStatus::Skipped { upstream } = &r.status {
+                println!("  {} (upstream {upstream})", r.identity);
+            }
+        }
+        if skipped.len() > MAX {
+            println!("  … and {} more", skipped.len() - MAX);
+        }
+    }
+}

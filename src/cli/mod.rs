@@ -17,6 +17,8 @@ pub mod params;
 pub mod plan;
 pub mod report;
 pub mod run;
+pub mod shard;
+pub mod slurm;
 pub mod synth;
 pub mod tool;
 pub mod workflows;
@@ -40,6 +42,8 @@ pub struct Cli {
 pub enum Command {
     /// Run a workflow (only nodes whose inputs changed are recomputed).
     Run(run::RunArgs),
+    /// Run a workflow on a Slurm cluster: prepare job, shard job array, merge job (docs/cluster.md).
+    Slurm(slurm::SlurmArgs),
     /// (Re)build the HTML report OUT/report/index.html of a run's output folder.
     Report(report::ReportArgs),
     /// Say which nodes are cached and which will run, and why.
@@ -72,6 +76,7 @@ pub fn main() -> i32 {
     let cli = Cli::parse();
     match &cli.command {
         Command::Run(a) => run::main(a),
+        Command::Slurm(a) => slurm::main(a),
         Command::Report(a) => report::main(a),
         Command::Plan(a) => plan::main(a),
         Command::Explain(a) => explain::main(a),

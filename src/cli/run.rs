@@ -15,9 +15,10 @@
 //! requested output failed or was skipped. **2** for usage/setup errors before anything ran (workflow does
 //! not load, unknown pipeline, cache cannot be opened) or when the output files cannot be written.
 
-use crate::cli::common::{load_workflow, CacheOpt, ThreadsOpt, DEFAULT_WORKFLOW};
+use crate::cli::common::{load_workflow, print_problems, CacheOpt, ThreadsOpt, DEFAULT_WORKFLOW};
+use crate::cli::shard::ShardOpt;
 use crate::dag::progress::{Progress, ProgressMode};
-use crate::dag::{Mode, NodeStatus, PipelineError, Session};
+use crate::dag::{Mode, NodeStatus, Partition, PipelineError, Session};
 use crate::hashing::StatCache;
 use crate::metrics::{add_sections, sweep_csv, write_json, Summary};
 use crate::report::headline::{Headline, Status};
@@ -51,6 +52,8 @@ pub struct RunArgs {
     /// Also print the per-stage table (nodes executed / cached / failed / skipped, seconds).
     #[arg(long)]
     pub timings: bool,
+    #[command(flatten)]
+    pub shard: ShardOpt,
 }
 
 /// What a finished run reports back (for the exit code and for tests).
@@ -98,8 +101,10 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
         .map(|d| d.as_secs())
         .unwrap_or(0);
     let start = Instant::now();
+    let partition = args.shard.partition();
     let mut session = Session::new(&store, &stat_cache, &progress, Mode::Run);
-    session.out_dir = Some(out_dir.clone());
+    session.partition = partition;
+    session.out_dir = partition.writes_outputs().then(|| out_dir.clone());
     let result = args
         .threads
         .install(|| pipeline.run(&wf, &mut session))
@@ -107,11 +112,24 @@ pub fn run(args: &RunArgs) -> Result<RunResult, (i32, String)> {
     if let Err(PipelineError::Workflow(m)) = &result {
         return Err((2, m.clone()));
     }
+    if let (Partition::Merge { .. }, Err(e)) = (partition, &result) {
+        // Nothing of the campaign's outputs is written until every shard is complete.
+        return Err((1, e.to_string()));
+    }
     let wall = start.elapsed().as_secs_f64();
     if let Err(e) = stat_cache.save() {
         progress.warn(&format!("could not save the stat cache: {e}"));
     }
     let summary = Summary::of(session.reports());
+    if !partition.writes_outputs() {
+        let exit_code =
+            super::shard::finish_part(&session, &summary, result, &out_dir, partition, wall)?;
+        return Ok(RunResult {
+            exit_code,
+            out_dir,
+            summary,
+        });
+    }
     let metrics = write_outputs(&wf, &session, &out_dir, started_unix_s, wall).map_err(|e| {
         (
             2,
@@ -293,40 +311,6 @@ pub fn produced_something(session: &Session<'_>) -> bool {
     last.requested
         .iter()
         .any(|&id| last.reports[id].status.is_ok())
-}
-
-fn print_problems(session: &Session<'_>) {
-    const MAX: usize = 30;
-    let failed: Vec<_> = session
-        .reports()
-        .filter(|r| matches!(r.status, NodeStatus::Failed(_)))
-        .collect();
-    let skipped: Vec<_> = session
-        .reports()
-        .filter(|r| matches!(r.status, NodeStatus::Skipped { .. }))
-        .collect();
-    if !failed.is_empty() {
-        println!("failed ({}):", failed.len());
-        for r in failed.iter().take(MAX) {
-            if let NodeStatus::Failed(m) = &r.status {
-                println!("  {}: {m}", r.identity);
-            }
-        }
-        if failed.len() > MAX {
-            println!("  … and {} more", failed.len() - MAX);
-        }
-    }
-    if !skipped.is_empty() {
-        println!("skipped (upstream failed) ({}):", skipped.len());
-        for r in skipped.iter().take(MAX) {
-            if let NodeStatus::Skipped { upstream } = &r.status {
-                println!("  {} (upstream {upstream})", r.identity);
-            }
-        }
-        if skipped.len() > MAX {
-            println!("  … and {} more", skipped.len() - MAX);
-        }
-    }
 }
 
 /// Write metrics.json, provenance.json and, for sweeps, per-variant metrics and sweep.csv. Returns the metrics

@@ -12,7 +12,8 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct SynthArgs {
     /// Preset: tiny (CI smoke), demo (README default), paper (four areas, full resolution), realsize (real
-    /// sensor sizes on a short street).
+    /// sensor sizes on a short street), street (320 panoramas along 1.6 km at tiny's image sizes, for sharded
+    /// runs).
     #[arg(long, default_value = "demo")]
     pub preset: String,
     /// Seed of the scene, noise and errors (same seed ⇒ byte-identical folder).

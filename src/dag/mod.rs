@@ -10,6 +10,7 @@ pub mod key;
 pub mod node;
 pub mod progress;
 pub mod record;
+pub mod shard;
 pub mod stage;
 pub mod status;
 
@@ -23,3 +24,4 @@ pub mod session;
 
 pub use pipeline::Pipeline;
 pub use session::{Phase, PhaseValues, PipelineError, Session};
+pub use shard::{Partition, Seeds, ShardSpec};

@@ -11,6 +11,7 @@ use crate::dag::executor::{execute, Env, Mode, NodeReport, Outcome};
 use crate::dag::inputs::{Handle, NodeId};
 use crate::dag::node::AnyValue;
 use crate::dag::progress::Progress;
+use crate::dag::shard::{Partition, Seeds};
 use crate::hashing::StatCache;
 use crate::store::Store;
 use std::collections::HashMap;
@@ -105,6 +106,8 @@ pub struct Session<'a> {
     /// Where a run writes its outputs (`None` when planning): pipelines write their user-facing exports here
     /// after the phase that produced them (sweeps: into `variants/<name>/`).
     pub out_dir: Option<std::path::PathBuf>,
+    /// Which part of the sharded phase this process runs (see [`crate::dag::shard`]).
+    pub partition: Partition,
 }
 
 impl<'a> Session<'a> {
@@ -121,6 +124,7 @@ impl<'a> Session<'a> {
             mode,
             phases: Vec::new(),
             out_dir: None,
+            partition: Partition::Whole,
         }
     }
 
@@ -175,6 +179,45 @@ impl<'a> Session<'a> {
             values,
             mode: self.mode,
             failed,
+        }
+    }
+
+    /// Execute the phase whose per-item nodes are sharded, as [`Session::partition`] says: everything, nothing
+    /// (`Prepare`), the nodes one segment of `seeds` owns (`Shard`; no values come back), or everything once
+    /// every segment is complete (`Merge`). See [`crate::dag::shard`].
+    pub fn execute_sharded(
+        &mut self,
+        name: &str,
+        dag: Dag,
+        seeds: &Seeds<'_>,
+    ) -> Result<PhaseValues, PipelineError> {
+        match self.partition {
+            Partition::Whole => Ok(self.execute(name, dag)),
+            Partition::Prepare => Ok(PhaseValues {
+                values: HashMap::new(),
+                mode: self.mode,
+                failed: HashMap::new(),
+            }),
+            Partition::Shard(spec) => {
+                let targets = crate::dag::shard::segment_targets(&dag, seeds, spec);
+                let (mut sub, _) = dag.into_subgraph(&targets);
+                for n in &mut sub.nodes {
+                    n.requested = false;
+                }
+                Ok(self.execute(name, sub))
+            }
+            Partition::Merge { count } => {
+                if self.mode == Mode::Run {
+                    let env = Env {
+                        store: self.store,
+                        stat_cache: self.stat_cache,
+                        progress: self.progress,
+                    };
+                    crate::dag::shard::check_complete(&dag, seeds, count, &env)
+                        .map_err(PipelineError::Failed)?;
+                }
+                Ok(self.execute(name, dag))
+            }
         }
     }
 

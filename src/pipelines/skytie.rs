@@ -13,7 +13,9 @@
 
 use super::validate::add_validated_snapshot;
 use super::{adjust, nadir, oblique, stage, vehicle, wf_err};
-use crate::dag::{optional_all, DagBuilder, Pipeline, PipelineError, RawFile, Session};
+use crate::dag::{
+    optional_all, DagBuilder, NodeId, Pipeline, PipelineError, RawFile, Seeds, Session,
+};
 use crate::exports::{write_exports, ExportInputs};
 use crate::nodes::campaign::ingest::ingest_file;
 use crate::nodes::campaign::load::{listing_hash, metadata_inputs};
@@ -24,6 +26,7 @@ use crate::nodes::{
 };
 use crate::workflow::{CampaignSource, Workflow};
 use skytie_stages::nadir::OrthoParams;
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 /// See the module documentation.
@@ -129,6 +132,9 @@ impl Pipeline for SkytiePipeline {
         let oblique_on = oblique::enabled(wf)?;
         let mut b = DagBuilder::new();
         let mut exports = Vec::new();
+        // The shard seeds: one node per recording, in trajectory order (shared by every variant).
+        let mut seeds: Vec<NodeId> = Vec::new();
+        let mut seeded: HashSet<NodeId> = HashSet::new();
         for variant in wf.variants() {
             b.set_variant(&variant);
             let snap = add_validated_snapshot(&mut b, &root, &load_params, &inputs, &loaded)?;
@@ -145,6 +151,9 @@ impl Pipeline for SkytiePipeline {
                     },
                     snap,
                 )?;
+                if seeded.insert(row.id) {
+                    seeds.push(row.id);
+                }
                 let pano = RawFile(root.join("mm/panoramas").join(&rec.file));
                 let pano_image = ingest_file(&mut b, &label, pano.0.clone())?;
                 let ortho = if ortho_on {
@@ -209,7 +218,14 @@ impl Pipeline for SkytiePipeline {
             b.metrics(summary, "campaign", |s: &CampaignSummary| s.metrics().0);
             b.metrics(summary, "ortho", |s: &CampaignSummary| s.metrics().1);
         }
-        let values = session.execute("items", b.build());
+        let seeds = Seeds {
+            nodes: &seeds,
+            per_item_stages: &super::shards::PER_ITEM_STAGES,
+        };
+        let values = session.execute_sharded("items", b.build(), &seeds)?;
+        if !session.partition.writes_outputs() {
+            return Ok(());
+        }
         if let Some(out) = session.out_dir.clone() {
             for (variant, h, nadir_control, oblique_result) in &exports {
                 let report = h.report.and_then(|r| values.get(r));

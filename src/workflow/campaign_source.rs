@@ -7,7 +7,7 @@ use super::suggest::did_you_mean;
 
 /// Presets the synthetic generator knows (`skytie_stages::synth`); checked when the workflow is loaded so a typo
 /// is reported at its line instead of when the run starts.
-pub const SYNTH_PRESETS: &[&str] = &["tiny", "demo", "paper"];
+pub const SYNTH_PRESETS: &[&str] = &["tiny", "demo", "paper", "realsize", "street"];
 
 /// The campaign a workflow runs on.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -1,5 +1,5 @@
-//! The synthetic campaign presets (`tiny`, `demo`, `paper`, `realsize`) and every knob they fix: scene areas,
-//! panorama size and supersampling, aerial flight plans, check-point density, image sizes and files.
+//! The synthetic campaign presets (`tiny`, `demo`, `paper`, `realsize`, `street`) and every knob they fix: scene
+//! areas, panorama size and supersampling, aerial flight plans, check-point density, image sizes and files.
 //!
 //! Aerial geometry follows the thesis data: nadir at ≈ 4470 m above ground with ≈ 10 cm GSD and 60 % / 40 %
 //! overlap (thesis 3.5.1.1, 5.5), pentacam obliques tilted 45° at ≈ 450 m (thesis 4.5).
@@ -23,7 +23,12 @@ pub enum Preset {
     /// Mark 3 class, tiled TIFF), 14192 × 10640 obliques, 8192 × 4096 panoramas; rendered at ≤ 2400 px wide
     /// and upsampled to those sizes ([`super::output`]).
     Realsize,
+    /// A long street at `tiny`'s image sizes: 320 panoramas along 1.6 km, for sharded and cluster runs.
+    Street,
 }
+
+/// Number of panoramas of the `street` preset (at 5 m: a 1595 m route).
+pub const STREET_RECORDINGS: usize = 320;
 
 /// Distance between the origins of the four `paper` areas along world X, m.
 pub const PAPER_AREA_SPACING_M: f64 = 2000.0;
@@ -32,16 +37,17 @@ pub const PAPER_AREA_SPACING_M: f64 = 2000.0;
 pub const PAPER_ROUTE_LENGTH_M: f64 = 495.0;
 
 /// Valid preset names, in the order shown in messages.
-pub const PRESET_NAMES: [&str; 4] = ["tiny", "demo", "paper", "realsize"];
+pub const PRESET_NAMES: [&str; 5] = ["tiny", "demo", "paper", "realsize", "street"];
 
 impl Preset {
-    /// Parse a preset name (`tiny`, `demo`, `paper`, case-insensitive).
+    /// Parse a preset name (`tiny`, `demo`, `paper`, `street`, case-insensitive).
     pub fn from_name(name: &str) -> Result<Preset, SynthError> {
         match name.trim().to_ascii_lowercase().as_str() {
             "tiny" => Ok(Preset::Tiny),
             "demo" => Ok(Preset::Demo),
             "paper" => Ok(Preset::Paper),
             "realsize" => Ok(Preset::Realsize),
+            "street" => Ok(Preset::Street),
             _ => Err(SynthError::UnknownPreset {
                 name: name.to_string(),
                 valid: PRESET_NAMES.join(", "),
@@ -56,6 +62,7 @@ impl Preset {
             Preset::Demo => "demo",
             Preset::Paper => "paper",
             Preset::Realsize => "realsize",
+            Preset::Street => "street",
         }
     }
 
@@ -64,6 +71,9 @@ impl Preset {
         match self {
             Preset::Tiny => vec![SceneSpec::tiny()],
             Preset::Demo | Preset::Realsize => vec![SceneSpec::demo()],
+            Preset::Street => vec![SceneSpec::long_street(
+                STREET_RECORDINGS as f64 * PresetParams::common().recording_spacing_m,
+            )],
             // The areas share one origin in their specs; they are placed side by side, far enough apart that
             // no aerial footprint of one area reaches another, and lengthened to ~100 panoramas each.
             Preset::Paper => (0..4)
@@ -120,6 +130,10 @@ impl Preset {
                 oblique: oblique(320, 240),
                 aerial_spp_axis: 2,
                 ..PresetParams::common()
+            },
+            Preset::Street => PresetParams {
+                max_recordings_per_route: STREET_RECORDINGS,
+                ..Preset::Tiny.params()
             },
             Preset::Demo => PresetParams {
                 // 1600 × 800 (0.225°/px) instead of 2048 × 1024: measured 2.3 M primary rays/s per core of CPU
@@ -310,13 +324,20 @@ mod tests {
 
     #[test]
     fn names_round_trip_and_unknown_names_list_the_valid_ones() {
-        for p in [Preset::Tiny, Preset::Demo, Preset::Paper, Preset::Realsize] {
+        for p in [
+            Preset::Tiny,
+            Preset::Demo,
+            Preset::Paper,
+            Preset::Realsize,
+            Preset::Street,
+        ] {
             assert_eq!(Preset::from_name(p.name()).unwrap(), p);
         }
         assert_eq!(Preset::from_name(" Demo ").unwrap(), Preset::Demo);
         let e = Preset::from_name("huge").unwrap_err().to_string();
         assert!(
             e.contains("huge") && e.contains("tiny, demo, paper, realsize"),
+            e.contains("huge") && e.contains("tiny, demo, paper, street"),
             "{e}"
         );
     }

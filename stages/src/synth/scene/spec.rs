@@ -163,6 +163,21 @@ impl SceneSpec {
         }
     }
 
+    /// `tiny`'s street, straight and without a junction, long enough for a route of `route_length_m`.
+    pub fn long_street(route_length_m: f64) -> Self {
+        let tiny = Self::tiny();
+        let route = RouteSpec {
+            end_x_m: tiny.route.start_x_m + route_length_m,
+            ..tiny.route
+        };
+        Self {
+            street_length_m: route.end_x_m + 15.0,
+            cross_street: None,
+            route,
+            ..tiny
+        }
+    }
+
     /// One ~200 m street with a junction (cross street); the route drives ~190 m in the right-hand lane and
     /// turns right at the junction (about 40 recordings at 5 m). Buildings on both sides.
     pub fn demo() -> Self {
