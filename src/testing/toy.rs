@@ -2,7 +2,7 @@
 //! collection, and generate a folder of item files (the stand-in for the synthetic campaign generator).
 //! Every stage can sleep per node and can be told to fail or panic on one item.
 
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RawFileValue, RunResult, Stage, StageError};
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -55,12 +55,7 @@ impl Stage for ToyParse {
     type Params = ToyParseParams;
     type Output = f64;
     type Inputs = RawFile;
-    fn run(
-        &self,
-        p: &ToyParseParams,
-        file: RawFileValue,
-        ctx: &NodeCtx,
-    ) -> Result<f64, StageError> {
+    fn run(&self, p: &ToyParseParams, file: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         p.faults.apply(ctx)?;
         let text = std::fs::read_to_string(&file.path)
             .map_err(|e| StageError::new(format!("{}: cannot read: {e}", file.path.display())))?;
@@ -102,7 +97,7 @@ impl Stage for ToyScale {
     type Params = ToyScaleParams;
     type Output = f64;
     type Inputs = Handle<f64>;
-    fn run(&self, p: &ToyScaleParams, v: Arc<f64>, ctx: &NodeCtx) -> Result<f64, StageError> {
+    fn run(&self, p: &ToyScaleParams, v: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         p.faults.apply(ctx)?;
         let x = *v * p.factor;
         Ok(if p.quantum > 0.0 {
@@ -122,7 +117,7 @@ impl Stage for ToyScaleV2 {
     type Params = ToyScaleParams;
     type Output = f64;
     type Inputs = Handle<f64>;
-    fn run(&self, p: &ToyScaleParams, v: Arc<f64>, ctx: &NodeCtx) -> Result<f64, StageError> {
+    fn run(&self, p: &ToyScaleParams, v: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         ToyScale.run(p, v, ctx)
     }
 }
@@ -152,12 +147,7 @@ impl Stage for ToySum {
     type Params = ToySumParams;
     type Output = ToySummary;
     type Inputs = Vec<Handle<f64>>;
-    fn run(
-        &self,
-        p: &ToySumParams,
-        values: Vec<Arc<f64>>,
-        ctx: &NodeCtx,
-    ) -> Result<ToySummary, StageError> {
+    fn run(&self, p: &ToySumParams, values: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         p.faults.apply(ctx)?;
         // Sequential sum in input order: deterministic whatever the thread count.
         let sum = values.iter().map(|v| **v).sum::<f64>() + p.offset;
@@ -205,7 +195,7 @@ impl Stage for ToyGen {
     type Params = ToyGenParams;
     type Output = ToyDir;
     type Inputs = ();
-    fn run(&self, p: &ToyGenParams, _: (), ctx: &NodeCtx) -> Result<ToyDir, StageError> {
+    fn run(&self, p: &ToyGenParams, _: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         p.faults.apply(ctx)?;
         let tmp = ctx.output_dir_tmp()?;
         let mut files = Vec::new();

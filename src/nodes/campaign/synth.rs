@@ -10,7 +10,7 @@
 //! (`skytie_stages::synth::render_store`). The outputs record every file's size; a cached folder whose files
 //! went missing or changed size is regenerated.
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use serde::{Deserialize, Serialize};
 use skytie_stages::params::Violation;
 use skytie_stages::synth::generate::{RenderIdentity, RENDER_STAGE, STAGE};
@@ -204,18 +204,10 @@ pub fn list_files(root: &Path) -> std::io::Result<Vec<(String, u64)>> {
 pub struct RenderCampaign;
 
 impl Stage for RenderCampaign {
-    const NAME: &'static str = RENDER_STAGE.name;
-    const VERSION: &'static str = RENDER_STAGE.version;
-    type Params = RenderIdentity;
-    type Output = GeneratedCampaign;
+    crate::nodes::stage_types!(RENDER_STAGE, RenderIdentity => GeneratedCampaign);
     type Inputs = ();
 
-    fn run(
-        &self,
-        identity: &RenderIdentity,
-        _: (),
-        ctx: &NodeCtx,
-    ) -> Result<GeneratedCampaign, StageError> {
+    fn run(&self, identity: &RenderIdentity, _: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         let options = SynthOptions::rendering(identity);
         let tmp = ctx.output_dir_tmp()?;
         let (summary, reused) = render_campaign(&options, &tmp.join("campaign"), &ctx.partial_dir())
@@ -244,18 +236,10 @@ impl Stage for RenderCampaign {
 pub struct SynthCampaign;
 
 impl Stage for SynthCampaign {
-    const NAME: &'static str = STAGE.name;
-    const VERSION: &'static str = STAGE.version;
-    type Params = SynthParams;
-    type Output = GeneratedCampaign;
+    crate::nodes::stage_types!(STAGE, SynthParams => GeneratedCampaign);
     type Inputs = Handle<GeneratedCampaign>;
 
-    fn run(
-        &self,
-        p: &SynthParams,
-        rendered: Arc<GeneratedCampaign>,
-        ctx: &NodeCtx,
-    ) -> Result<GeneratedCampaign, StageError> {
+    fn run(&self, p: &SynthParams, rendered: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         let options = p
             .options()
             .map_err(|v| StageError::new(format!("synth parameter {v}")))?;

@@ -2,7 +2,7 @@
 //! sampling distance and rotated to its orientation (thesis 3.4.3 and 3.4.5.2: "the MM are ortho-projected again
 //! for this step, but with a resolution of 10 cm"), so that MM and aerial patches differ by about a translation.
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use crate::nodes::campaign::ingest::IngestedImage;
 use crate::nodes::nadir::ortho::panorama_for_ortho;
 use skytie_stages::campaign::{AerialImage, Recording};
@@ -18,22 +18,15 @@ use std::sync::Arc;
 pub struct OrthoForAerial;
 
 impl Stage for OrthoForAerial {
-    const NAME: &'static str = skytie_stages::nadir::aerial_patch::STAGE.name;
-    const VERSION: &'static str = skytie_stages::nadir::aerial_patch::STAGE.version;
-    type Params = OrthoParams;
-    type Output = OrthoImage;
+    crate::nodes::stage_types!(skytie_stages::nadir::aerial_patch::STAGE, OrthoParams => OrthoImage);
     type Inputs = (
         Handle<Recording>,
         Handle<IngestedImage>,
         Handle<AerialImage>,
     );
 
-    fn run(
-        &self,
-        base: &OrthoParams,
-        (rec, pano, aerial): (Arc<Recording>, Arc<IngestedImage>, Arc<AerialImage>),
-        _: &NodeCtx,
-    ) -> Result<OrthoImage, StageError> {
+    fn run(&self, base: &OrthoParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (rec, pano, aerial) = inputs;
         let cam = FrameCamera::from_aerial(&aerial);
         let params = ortho_params_for_aerial(&cam, foot_point_world(&rec), base);
         if let Err(errs) = skytie_stages::params::Params::validate(&params) {
