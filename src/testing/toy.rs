@@ -2,11 +2,10 @@
 //! collection, and generate a folder of item files (the stand-in for the synthetic campaign generator).
 //! Every stage can sleep per node and can be told to fail or panic on one item.
 
-use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RawFileValue, RunResult, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RunResult, Stage, StageError};
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 /// Fault injection and pacing shared by all toy stages.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]

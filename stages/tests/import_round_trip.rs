@@ -36,7 +36,7 @@ fn aerial(id: &str, i: usize, oblique: bool, extended: bool) -> AerialImage {
         cy_px: 2_001.75,
         file: format!("{id}.tif"),
         ..AerialImage::ideal(
-            &id,
+            id,
             [
                 RD_E + 310.5 * f + 0.123,
                 RD_N - 150.25 * f + 0.456,

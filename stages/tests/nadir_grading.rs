@@ -18,16 +18,12 @@ const PANO_H: u32 = 2000;
 fn recording(id: &str, x: f64, y: f64) -> Recording {
     Recording {
         time: "2020-01-01T00:00:00Z".into(),
-        file: format!("{id}.jpg"),
-        ..Recording::new(&id, 0.0, [x, y, 2.4], 90.0, 2.4)
+        ..Recording::new(id, 0.0, [x, y, 2.4], 90.0, 2.4)
     }
 }
 
 fn nadir_camera(id: &str, x: f64) -> AerialImage {
-    AerialImage {
-        file: format!("{id}.jpg"),
-        ..AerialImage::ideal(&id, [x, 0.0, 450.0], [0.0, 0.0, 0.0], 4500.0, [2000, 2000])
-    }
+    AerialImage::ideal(id, [x, 0.0, 450.0], [0.0, 0.0, 0.0], 4500.0, [2000, 2000])
 }
 
 #[test]

@@ -124,9 +124,8 @@ fn render_ortho(
 fn recording_at(id: &str, foot: [f64; 3], camera_height_m: f64) -> Recording {
     Recording {
         time: "2020-01-01T00:00:00Z".into(),
-        file: format!("{id}.jpg"),
         ..Recording::new(
-            &id,
+            id,
             0.0,
             [foot[0], foot[1], foot[2] + camera_height_m],
             30.0,

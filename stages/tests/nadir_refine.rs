@@ -62,12 +62,7 @@ impl Texture {
 }
 
 fn aerial_row(id: &str, w: u32, h: u32) -> AerialImage {
-    AerialImage {
-        cx_px: w as f64 / 2.0,
-        cy_px: h as f64 / 2.0,
-        file: format!("{id}.jpg"),
-        ..AerialImage::ideal(&id, [0.0, 0.0, 4470.0], [0.0, 0.0, 0.0], 44700.0, [w, h])
-    }
+    AerialImage::ideal(id, [0.0, 0.0, 4470.0], [0.0, 0.0, 0.0], 44700.0, [w, h])
 }
 
 fn tie_point(id: &str, p: [f64; 3]) -> MmTiePoint {

@@ -6,7 +6,6 @@ use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use skytie_stages::campaign::{AerialImage, AerialKind};
 use skytie_stages::params::StageId;
-use std::sync::Arc;
 
 crate::serde_artifact!(AerialImage);
 

@@ -72,8 +72,11 @@ pub fn cached_bytes() -> usize {
     cache().lock().unwrap_or_else(|p| p.into_inner()).bytes
 }
 
-fn open_files() -> &'static Mutex<Vec<([u8; 32], Arc<TiledPyramid>)>> {
-    static OPEN: OnceLock<Mutex<Vec<([u8; 32], Arc<TiledPyramid>)>>> = OnceLock::new();
+/// The pyramid files open now, by index hash.
+type OpenFiles = Mutex<Vec<([u8; 32], Arc<TiledPyramid>)>>;
+
+fn open_files() -> &'static OpenFiles {
+    static OPEN: OnceLock<OpenFiles> = OnceLock::new();
     OPEN.get_or_init(Default::default)
 }
 

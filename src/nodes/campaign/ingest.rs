@@ -6,8 +6,7 @@
 //! dependents are skipped and counted.
 
 use crate::dag::{
-    BuildError, DagBuilder, Handle, InputsOf, NodeCtx, RawFile, RawFileValue, RunResult, Stage,
-    StageError,
+    BuildError, DagBuilder, Handle, InputsOf, NodeCtx, RawFile, RunResult, Stage, StageError,
 };
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
@@ -37,7 +36,7 @@ impl Default for IngestParams {
 impl StageParams for IngestParams {
     fn validate(&self) -> Result<(), Vec<ParamError>> {
         let t = self.tile_side_px;
-        if (64..=2048).contains(&t) && t % 16 == 0 {
+        if (64..=2048).contains(&t) && t.is_multiple_of(16) {
             Ok(())
         } else {
             Err(vec![ParamError::new(

@@ -6,14 +6,13 @@
 //! node then re-selects its row; rows that did not change produce identical output, so by early cutoff only the
 //! new or edited recordings' downstream nodes run again.
 
-use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RawFileValue, RunResult, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RunResult, Stage, StageError};
 use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::{
     read_sourced, Campaign, Problem, Recording, SourceRows, SourcedCampaign,
 };
 use skytie_stages::params::StageId;
 use std::path::Path;
-use std::sync::Arc;
 
 /// The campaign's metadata files, in a fixed order (only those that exist are inputs).
 pub const METADATA_FILES: [&str; 6] = [

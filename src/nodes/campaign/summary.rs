@@ -1,7 +1,7 @@
 //! `summary`: a global node over the campaign snapshot and the per-recording ortho images: counts, input
 //! problems and ortho coverage, contributed to `metrics.json` under `campaign` and `ortho`.
 
-use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::{InputAccount, Severity};

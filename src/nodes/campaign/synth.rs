@@ -23,7 +23,6 @@ use skytie_stages::synth::{
     apply_profile, render_campaign, Preset, Profile, SynthError, SynthOptions, SynthSummary,
 };
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 skytie_stages::params! {
     /// Parameters of the `[synth]` workflow table (preset and seed come from `campaign = "synth:<preset>"` and

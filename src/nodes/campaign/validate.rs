@@ -5,13 +5,12 @@
 //! the wrong size or no image at all is removed with a problem naming file, row and field, before any
 //! per-item node is built for it, so one bad image never fails a node of the run.
 
-use crate::dag::{Handle, InputsOf, NodeCtx, RawFileValue, RunResult, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::summary::SummaryParams;
 use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::{apply_image_checks, image_jobs, sort_problems, ProbeOutcome};
 use skytie_stages::imaging::probe::probe;
-use std::sync::Arc;
 
 /// The outcome of probing one image file (an unusable image is a value, not a failed node).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

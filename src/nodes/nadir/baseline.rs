@@ -2,13 +2,12 @@
 //! NCC template matching, `skytie_stages::nadir::baseline`) in place of the phase-correlation `refine` node when
 //! `[nadir] matcher = "baseline"` — so thesis Table 2-10's comparison can be regenerated as a sweep.
 
-use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage};
 use crate::nodes::campaign::ingest::IngestedImage;
 use crate::nodes::nadir::refine::locate_with_accepted;
 use skytie_stages::campaign::AerialImage;
 use skytie_stages::nadir::baseline::{baseline_matches, BaselineParams};
 use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, OrthoImage, TransformOutcome};
-use std::sync::Arc;
 
 /// The baseline matching node (same inputs and output as `refine`).
 pub struct BaselineStage;

@@ -6,7 +6,6 @@ use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage, StageErr
 use skytie_stages::campaign::AerialImage;
 use skytie_stages::nadir::control_points::{aerial_control_points, ControlParams};
 use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, RecordingControl};
-use std::sync::Arc;
 
 crate::serde_artifact!(RecordingControl);
 

@@ -11,7 +11,6 @@ use skytie_stages::imaging::io::dimensions;
 use skytie_stages::nadir::grading::{grade_nadir, NadirGrade, Truth};
 use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, RecordingControl};
 use std::collections::HashMap;
-use std::sync::Arc;
 
 crate::serde_artifact!(NadirGrade);
 

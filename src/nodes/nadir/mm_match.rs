@@ -2,12 +2,11 @@
 //! along the trajectory (thesis 3.4.4, `skytie_stages::nadir::mm_matching`). Inputs: the window's recording rows,
 //! ortho images and panorama files (the panoramas only for their pixel size; they are hashed by content).
 
-use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RawFileValue, RunResult, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RunResult, Stage, StageError};
 use skytie_stages::campaign::Recording;
 use skytie_stages::imaging::io::dimensions;
 use skytie_stages::nadir::mm_matching::{match_window, MmMatchParams, OrthoView};
 use skytie_stages::nadir::{MmWindowMatch, OrthoImage};
-use std::sync::Arc;
 
 crate::serde_artifact!(MmWindowMatch);
 

@@ -10,7 +10,6 @@ use skytie_stages::imaging::equirect::PanoramaLevels;
 use skytie_stages::imaging::pyramid::TileSource;
 use skytie_stages::nadir::ortho::panorama_bands;
 use skytie_stages::nadir::{ortho_project, OrthoImage, OrthoParams};
-use std::sync::Arc;
 
 crate::serde_artifact!(OrthoImage);
 

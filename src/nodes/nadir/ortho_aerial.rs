@@ -10,7 +10,6 @@ use skytie_stages::geometry::FrameCamera;
 use skytie_stages::nadir::aerial_overlap::foot_point_world;
 use skytie_stages::nadir::aerial_patch::ortho_params_for_aerial;
 use skytie_stages::nadir::{ortho_project, OrthoImage, OrthoParams};
-use std::sync::Arc;
 
 /// The aerial-oriented ortho-projection node. Its params are the workflow's `[ortho]` table (diagonal,
 /// vehicle mask, `registration_gsd_m`); `gsd_m` and `rotation_deg` are replaced by the aerial image's (at its

@@ -13,7 +13,6 @@ use skytie_stages::nadir::refine::{refine_in_aerial, NeighbourOrtho, RefineParam
 use skytie_stages::nadir::{
     AerialRefinement, InitialTransform, MmWindowMatch, OrthoImage, TransformOutcome,
 };
-use std::sync::Arc;
 
 crate::serde_artifact!(AerialRefinement);
 

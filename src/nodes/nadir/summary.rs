@@ -1,12 +1,11 @@
 //! `nadir`: the global summary of the nadir pipeline — counts of MM pairs, tie points, transforms,
 //! correspondences and control points (`skytie_stages::nadir::summary`), contributed to metrics as `nadir`.
 
-use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::summary::SummaryParams;
 use skytie_stages::nadir::summary::NadirSummary;
 use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, RecordingControl, TransformOutcome};
-use std::sync::Arc;
 
 crate::serde_artifact!(NadirSummary);
 

@@ -8,7 +8,6 @@ use crate::nodes::campaign::ingest::IngestedImage;
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::nadir::initial_transform::{initial_transform, TransformParams};
 use skytie_stages::nadir::{OrthoImage, TransformOutcome};
-use std::sync::Arc;
 
 crate::serde_artifact!(TransformOutcome);
 

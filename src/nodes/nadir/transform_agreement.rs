@@ -2,11 +2,10 @@
 //! transforms to its other nadir images (`skytie_stages::nadir::transform_agreement`). A transform that
 //! disagrees becomes a rejection with its reason, counted with the other transform rejections.
 
-use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage};
 use skytie_stages::nadir::initial_transform::TransformParams;
 use skytie_stages::nadir::transform_agreement::check_agreement;
 use skytie_stages::nadir::TransformOutcome;
-use std::sync::Arc;
 
 /// The agreement node. Inputs: this pair's transform outcome, then all outcomes of the same recording.
 pub struct TransformAgreementStage;

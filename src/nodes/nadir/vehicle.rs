@@ -14,7 +14,6 @@ use skytie_stages::nadir::vehicle_detect::{
     detect_vehicle, detection_level, DetectedVehicle, VehicleDetectParams,
 };
 use skytie_stages::nadir::VehicleMask;
-use std::sync::Arc;
 
 /// Parameters of the node: the detection's and which recordings (image ids) were sampled.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -54,16 +54,13 @@ mod tests {
     use super::*;
 
     fn nadir(id: &str, x: f64, y: f64, kappa_deg: f64) -> AerialImage {
-        AerialImage {
-            file: format!("{id}.jpg"),
-            ..AerialImage::ideal(
-                &id,
-                [x, y, 4470.0],
-                [0.0, 0.0, kappa_deg],
-                44_700.0,
-                [512, 384],
-            )
-        }
+        AerialImage::ideal(
+            id,
+            [x, y, 4470.0],
+            [0.0, 0.0, kappa_deg],
+            44_700.0,
+            [512, 384],
+        )
     }
 
     fn rec(x: f64, y: f64) -> Recording {

@@ -98,8 +98,6 @@ pub fn plan_nadir(
                 k2,
                 p1,
                 p2,
-                cx_px: f64::from(plan.width_px) / 2.0,
-                cy_px: f64::from(plan.height_px) / 2.0,
                 ..AerialImage::ideal(
                     &image_id,
                     [xy[0], xy[1], ground_z_m + plan.altitude_m],

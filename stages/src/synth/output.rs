@@ -103,7 +103,7 @@ pub fn render_factor(width: u32, height: u32, max_width: Option<u32>) -> u32 {
     };
     let g = gcd(width, height).max(1);
     (1..=g)
-        .filter(|k| g % k == 0)
+        .filter(|k| g.is_multiple_of(*k))
         .find(|k| width / k <= cap)
         .unwrap_or(g)
 }

@@ -36,7 +36,7 @@ impl TiledTiffSpec {
             && self.height > 0
             && matches!(self.channels, 1 | 3)
             && matches!(self.bytes_per_sample, 1 | 2)
-            && self.tile_side % 16 == 0
+            && self.tile_side.is_multiple_of(16)
             && self.tile_side > 0
             && !(matches!(self.compression, TiffCompression::Jpeg(_))
                 && self.bytes_per_sample != 1);

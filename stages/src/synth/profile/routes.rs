@@ -79,10 +79,7 @@ mod tests {
     use super::*;
 
     fn rec(id: &str, t: f64, x: f64, y: f64) -> Recording {
-        Recording {
-            file: format!("{id}.jpg"),
-            ..Recording::new(&id, t, [x, y, 2.0], 90.0, 2.2)
-        }
+        Recording::new(id, t, [x, y, 2.0], 90.0, 2.2)
     }
 
     #[test]

@@ -9,7 +9,6 @@ fn rec(route: usize, i: usize, x: f64, y: f64, heading_deg: f64) -> Recording {
     Recording {
         sigma_xy_m: Some(1.0),
         sigma_z_m: Some(0.3),
-        file: format!("p{route}_{i:03}.jpg"),
         ..Recording::new(
             &format!("p{route}_{i:03}"),
             3600.0 * route as f64 + i as f64 * 0.625,
