@@ -25,7 +25,7 @@ use skytie_stages::synth::{Preset, SynthOptions};
 use std::collections::HashMap;
 use std::path::Path;
 use std::time::Instant;
-use support::tiny::{fixture, load_campaign};
+use support::tiny::{fixture, load_campaign, true_rays, TrueRays};
 
 /// An observation is correct when the true scene point re-projects within this many panorama pixels.
 const CORRECT_TOL_PX: f64 = 1.5;
@@ -85,19 +85,12 @@ fn grade(
     scene: &Scene,
     pano: (u32, u32),
 ) -> Option<Grade> {
-    let cams: Vec<PanoramaCamera> = tp
-        .observations
-        .iter()
-        .map(|o| PanoramaCamera::from_recording(&truth[&o.image_id], pano.0, pano.1))
-        .collect();
-    let rays: Vec<Ray> = tp
-        .observations
-        .iter()
-        .zip(&cams)
-        .map(|(o, c)| c.pixel_ray(o.u_px, o.v_px))
-        .collect();
-    let sigmas: Vec<f64> = cams.iter().map(|c| c.angular_sigma_rad(0.5)).collect();
-    let t = triangulate_rays(&rays, &sigmas).ok()?;
+    let TrueRays {
+        cams,
+        rays,
+        triangulation,
+    } = true_rays(tp, truth, pano);
+    let t = triangulation.ok()?;
     // Anchor: the ray of the panorama nearest to the point (its pixels are the smallest on the ground); the
     // scene point it hits must re-project into every observing panorama within tolerance.
     let anchor = (0..cams.len())

@@ -9,7 +9,6 @@
 mod support;
 
 use skytie_stages::campaign::Recording;
-use skytie_stages::geometry::{triangulate_rays, PanoramaCamera, Ray};
 use skytie_stages::imaging::equirect::PanoramaLevels;
 use skytie_stages::oblique::sparse_cloud::{sparse_cloud, SparseCloudParams};
 use skytie_stages::oblique::{SparseCloud, StreetSide};
@@ -18,7 +17,7 @@ use skytie_stages::synth::scene::{Epoch, Scene};
 use std::collections::HashMap;
 use std::path::Path;
 use std::time::Instant;
-use support::tiny::{fixture, load_campaign, Campaign};
+use support::tiny::{fixture, load_campaign, true_rays, Campaign, TrueRays};
 
 /// True-pose rays of a correct point meet within this distance, m.
 const RAYS_MEET_M: f64 = 0.15;
@@ -45,19 +44,12 @@ fn grade(
     scene: Option<&Scene>,
     pano: (u32, u32),
 ) -> (bool, Option<bool>) {
-    let cams: Vec<PanoramaCamera> = tie
-        .observations
-        .iter()
-        .map(|o| PanoramaCamera::from_recording(&truth[&o.image_id], pano.0, pano.1))
-        .collect();
-    let rays: Vec<Ray> = tie
-        .observations
-        .iter()
-        .zip(&cams)
-        .map(|(o, c)| c.pixel_ray(o.u_px, o.v_px))
-        .collect();
-    let sigmas: Vec<f64> = cams.iter().map(|c| c.angular_sigma_rad(0.5)).collect();
-    let Ok(t) = triangulate_rays(&rays, &sigmas) else {
+    let TrueRays {
+        rays,
+        triangulation,
+        ..
+    } = true_rays(tie, truth, pano);
+    let Ok(t) = triangulation else {
         return (false, Some(false));
     };
     let meet = t.residuals_m.iter().all(|&r| r <= RAYS_MEET_M);

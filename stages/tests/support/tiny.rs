@@ -3,6 +3,10 @@
 //! the true poses and the scene for grading only.
 
 use skytie_stages::campaign::{read_recordings_csv, Recording};
+use skytie_stages::correspondence::MmTiePoint;
+use skytie_stages::geometry::{
+    triangulate_rays, PanoramaCamera, Ray, Triangulation, TriangulationError,
+};
 use skytie_stages::imaging::io::load_gray;
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::synth::generate::plan_campaign;
@@ -75,4 +79,39 @@ pub fn fixture() -> &'static Fixture {
             scene: plan.areas.remove(0).scene,
         }
     })
+}
+
+/// A tie point seen with the true poses: its panorama cameras and pixel rays (in observation order) and their
+/// triangulation (σ 0.5 px per ray).
+pub struct TrueRays {
+    pub cams: Vec<PanoramaCamera>,
+    pub rays: Vec<Ray>,
+    pub triangulation: Result<Triangulation, TriangulationError>,
+}
+
+/// The rays of `tp`'s observations from the true poses `truth` (by image id) of panoramas of `pano` (width,
+/// height) pixels.
+pub fn true_rays(
+    tp: &MmTiePoint,
+    truth: &HashMap<String, Recording>,
+    pano: (u32, u32),
+) -> TrueRays {
+    let cams: Vec<PanoramaCamera> = tp
+        .observations
+        .iter()
+        .map(|o| PanoramaCamera::from_recording(&truth[&o.image_id], pano.0, pano.1))
+        .collect();
+    let rays: Vec<Ray> = tp
+        .observations
+        .iter()
+        .zip(&cams)
+        .map(|(o, c)| c.pixel_ray(o.u_px, o.v_px))
+        .collect();
+    let sigmas: Vec<f64> = cams.iter().map(|c| c.angular_sigma_rad(0.5)).collect();
+    let triangulation = triangulate_rays(&rays, &sigmas);
+    TrueRays {
+        cams,
+        rays,
+        triangulation,
+    }
 }
