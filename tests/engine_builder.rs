@@ -3,9 +3,20 @@
 
 mod support;
 
-use skytie::dag::{DagBuilder, RawFile};
+use skytie::dag::{BuildError, DagBuilder, Handle, RawFile};
 use skytie::testing::toy::{ToyParse, ToyParseParams, ToyScale, ToyScaleParams};
+use std::path::Path;
 use support::*;
+
+/// Adds the `toy_parse[a]` node reading `file`.
+fn add_parse(b: &mut DagBuilder, file: &Path) -> Result<Handle<f64>, BuildError> {
+    b.add(
+        ToyParse,
+        "a",
+        ToyParseParams::default(),
+        RawFile(file.to_path_buf()),
+    )
+}
 
 fn scale(factor: f64) -> ToyScaleParams {
     ToyScaleParams {
@@ -19,14 +30,7 @@ fn equal_nodes_dedupe_and_variants_may_differ() {
     let dir = tempfile::tempdir().unwrap();
     let items = make_items(dir.path(), &[1.0]);
     let mut b = DagBuilder::new();
-    let parse = b
-        .add(
-            ToyParse,
-            "a",
-            ToyParseParams::default(),
-            RawFile(items[0].clone()),
-        )
-        .unwrap();
+    let parse = add_parse(&mut b, &items[0]).unwrap();
     let s1 = b.add(ToyScale, "a", scale(2.0), parse).unwrap();
     // Same identity, same key, same variant: the existing node.
     let again = b.add(ToyScale, "a", scale(2.0), parse).unwrap();
@@ -52,14 +56,7 @@ fn same_identity_with_another_key_in_one_variant_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let items = make_items(dir.path(), &[1.0, 2.0]);
     let mut b = DagBuilder::new();
-    let parse = b
-        .add(
-            ToyParse,
-            "a",
-            ToyParseParams::default(),
-            RawFile(items[0].clone()),
-        )
-        .unwrap();
+    let parse = add_parse(&mut b, &items[0]).unwrap();
     b.add(ToyScale, "a", scale(2.0), parse).unwrap();
     let err = b.add(ToyScale, "a", scale(5.0), parse).unwrap_err();
     let m = &err.message;
@@ -71,14 +68,7 @@ fn same_identity_with_another_key_in_one_variant_is_refused() {
         "{m}"
     );
     // Different inputs, equal params: also a clash (another key), explained as such.
-    let err = b
-        .add(
-            ToyParse,
-            "a",
-            ToyParseParams::default(),
-            RawFile(items[1].clone()),
-        )
-        .unwrap_err();
+    let err = add_parse(&mut b, &items[1]).unwrap_err();
     assert!(
         err.message.contains("toy_parse[a]") && err.message.contains("different inputs"),
         "{}",
@@ -93,14 +83,7 @@ fn a_shared_node_clashes_with_a_different_one_in_a_variant_that_uses_it() {
     let dir = tempfile::tempdir().unwrap();
     let items = make_items(dir.path(), &[1.0]);
     let mut b = DagBuilder::new();
-    let parse = b
-        .add(
-            ToyParse,
-            "a",
-            ToyParseParams::default(),
-            RawFile(items[0].clone()),
-        )
-        .unwrap();
+    let parse = add_parse(&mut b, &items[0]).unwrap();
     b.add(ToyScale, "a", scale(2.0), parse).unwrap();
     b.set_variant("exp1");
     // exp1 shares the default's node ...

@@ -4,72 +4,41 @@
 use std::fs::{self, File};
 use std::time::{Duration, SystemTime};
 
-use skytie::hashing::{hash_bytes, hash_file, ContentHash, KeyBuilder, StatCache};
+use skytie::hashing::{hash_bytes, hash_file, ContentHash, KeyBuilder, NodeKey, StatCache};
 
 fn h(s: &str) -> ContentHash {
     hash_bytes(s.as_bytes())
 }
 
+/// A key from its ingredients: stage, version, params (`None`: not given) and named inputs (hashes of strings).
+fn key(stage: &str, version: &str, params: Option<&[u8]>, inputs: &[(&str, &str)]) -> NodeKey {
+    let mut k = KeyBuilder::new(stage, version);
+    if let Some(p) = params {
+        k = k.params(p);
+    }
+    for (name, content) in inputs {
+        k = k.input(name, &h(content));
+    }
+    k.finish()
+}
+
 #[test]
 fn changing_any_ingredient_changes_the_key() {
-    let base = || {
-        KeyBuilder::new("ortho", "2")
-            .params(b"p")
-            .input("pano", &h("a"))
-            .input("dsm", &h("b"))
-    };
-    let k = base().finish();
-    assert_eq!(k, base().finish(), "keys are deterministic");
+    let p = Some(&b"p"[..]);
+    let inputs = [("pano", "a"), ("dsm", "b")];
+    let k = key("ortho", "2", p, &inputs);
+    assert_eq!(k, key("ortho", "2", p, &inputs), "keys are deterministic");
     let variants = [
-        KeyBuilder::new("orthO", "2")
-            .params(b"p")
-            .input("pano", &h("a"))
-            .input("dsm", &h("b"))
-            .finish(),
-        KeyBuilder::new("ortho", "3")
-            .params(b"p")
-            .input("pano", &h("a"))
-            .input("dsm", &h("b"))
-            .finish(),
-        KeyBuilder::new("ortho", "2")
-            .params(b"q")
-            .input("pano", &h("a"))
-            .input("dsm", &h("b"))
-            .finish(),
-        KeyBuilder::new("ortho", "2")
-            .params(b"p")
-            .input("pane", &h("a"))
-            .input("dsm", &h("b"))
-            .finish(),
-        KeyBuilder::new("ortho", "2")
-            .params(b"p")
-            .input("pano", &h("A"))
-            .input("dsm", &h("b"))
-            .finish(),
-        KeyBuilder::new("ortho", "2")
-            .params(b"p")
-            .input("dsm", &h("b"))
-            .input("pano", &h("a"))
-            .finish(),
-        KeyBuilder::new("ortho", "2")
-            .params(b"p")
-            .input("pano", &h("a"))
-            .finish(),
-        KeyBuilder::new("ortho", "2")
-            .params(b"p")
-            .input("pano", &h("a"))
-            .input("dsm", &h("b"))
-            .input("x", &h("c"))
-            .finish(),
-        KeyBuilder::new("ortho", "2")
-            .input("pano", &h("a"))
-            .input("dsm", &h("b"))
-            .finish(),
-        KeyBuilder::new("ortho", "2")
-            .params(b"")
-            .input("pano", &h("a"))
-            .input("dsm", &h("b"))
-            .finish(),
+        key("orthO", "2", p, &inputs),
+        key("ortho", "3", p, &inputs),
+        key("ortho", "2", Some(b"q"), &inputs),
+        key("ortho", "2", p, &[("pane", "a"), ("dsm", "b")]),
+        key("ortho", "2", p, &[("pano", "A"), ("dsm", "b")]),
+        key("ortho", "2", p, &[("dsm", "b"), ("pano", "a")]),
+        key("ortho", "2", p, &[("pano", "a")]),
+        key("ortho", "2", p, &[("pano", "a"), ("dsm", "b"), ("x", "c")]),
+        key("ortho", "2", None, &inputs),
+        key("ortho", "2", Some(b""), &inputs),
     ];
     let mut all = vec![k];
     all.extend(variants);

@@ -446,6 +446,11 @@ fn dates_are_rejected_with_position() {
 // ---------------------------------------------------------------------------------------------------------------
 // Sweeps.
 
+/// BASE followed by SWEEP with `from` replaced by `to`.
+fn sweep_with(from: &str, to: &str) -> String {
+    format!("{BASE}{}", SWEEP.replace(from, to))
+}
+
 const SWEEP: &str = r#"
 [sweep]
 base = "base"
@@ -527,11 +532,11 @@ fn variants_merge_over_stage_tables() {
 #[test]
 fn errors_in_variant_overrides_point_at_the_override() {
     // BASE has 13 lines; SWEEP starts on line 14 with an empty line, so `"oblique.patch.bins" = 32` is line 20.
-    let text = format!(
-        "{BASE}{}",
-        SWEEP.replace("\"oblique.patch.bins\" = 32", "\"oblique.patch.bns\" = 32")
-    );
-    let w = parse(&text).unwrap();
+    let w = parse(&sweep_with(
+        "\"oblique.patch.bins\" = 32",
+        "\"oblique.patch.bns\" = 32",
+    ))
+    .unwrap();
     let e = w.params::<ObliqueParams>("oblique", "bins32").unwrap_err();
     assert_error(
         &e,
@@ -542,11 +547,7 @@ fn errors_in_variant_overrides_point_at_the_override() {
     // The other variant is fine.
     assert!(w.params::<ObliqueParams>("oblique", "tight").is_ok());
 
-    let text = format!(
-        "{BASE}{}",
-        SWEEP.replace("threshold = 0.3", "threshold = 1.3")
-    );
-    let w = parse(&text).unwrap();
+    let w = parse(&sweep_with("threshold = 0.3", "threshold = 1.3")).unwrap();
     let e = w.params::<ObliqueParams>("oblique", "tight").unwrap_err();
     assert_error(
         &e,
@@ -557,74 +558,53 @@ fn errors_in_variant_overrides_point_at_the_override() {
 }
 
 #[test]
-fn unknown_stage_in_override_path() {
-    let text = format!(
-        "{BASE}{}",
-        SWEEP.replace("\"oblique.patch.bins\"", "\"obliqeu.patch.bins\"")
-    );
-    let e = parse(&text).unwrap_err();
-    assert_error(
-        &e,
-        20,
-        1,
-        "unknown stage 'obliqeu' in override of variant 'bins32'",
-    );
-    assert!(e.message.ends_with("did you mean 'oblique'?"), "{e}");
-
-    // The table form reports at the stage key of the table header.
-    let text = format!(
-        "{BASE}{}",
-        SWEEP.replace("[sweep.variant.oblique]", "[sweep.variant.oblque]")
-    );
-    let e = parse(&text).unwrap_err();
-    assert_error(
-        &e,
-        26,
-        16,
-        "unknown stage 'oblque' in override of variant 'tight'",
-    );
-
-    // An override must name a parameter, and cannot go through a scalar.
-    let text = format!(
-        "{BASE}{}",
-        SWEEP.replace("\"oblique.patch.bins\" = 32", "ortho = 32")
-    );
-    let e = parse(&text).unwrap_err();
-    assert_error(
-        &e,
-        20,
-        1,
-        "override 'ortho' in variant 'bins32' must name a parameter",
-    );
-    let text = format!(
-        "{BASE}{}",
-        SWEEP.replace(
+fn structural_errors_in_sweeps_point_at_the_line() {
+    // (replace in SWEEP, by, line, column, message)
+    let cases = [
+        (
+            "\"oblique.patch.bins\"",
+            "\"obliqeu.patch.bins\"",
+            20,
+            1,
+            "unknown stage 'obliqeu' in override of variant 'bins32'",
+        ),
+        // The table form reports at the stage key of the table header.
+        (
+            "[sweep.variant.oblique]",
+            "[sweep.variant.oblque]",
+            26,
+            16,
+            "unknown stage 'oblque' in override of variant 'tight'",
+        ),
+        // An override must name a parameter, and cannot go through a scalar.
+        (
             "\"oblique.patch.bins\" = 32",
-            "\"oblique.threshold.x\" = 32"
-        )
-    );
-    let e = parse(&text).unwrap_err();
-    assert_error(
-        &e,
-        20,
-        1,
-        "goes through 'threshold', which is a float in [oblique], not a table",
-    );
-}
-
-#[test]
-fn duplicate_variant_names() {
-    let text = format!(
-        "{BASE}{}",
-        SWEEP.replace("name = \"tight\"", "name = \"bins32\"")
-    );
-    let e = parse(&text).unwrap_err();
-    assert_error(
-        &e,
-        23,
-        8,
-        "duplicate variant name 'bins32' (first declared at line 19)",
-    );
+            "ortho = 32",
+            20,
+            1,
+            "override 'ortho' in variant 'bins32' must name a parameter",
+        ),
+        (
+            "\"oblique.patch.bins\" = 32",
+            "\"oblique.threshold.x\" = 32",
+            20,
+            1,
+            "goes through 'threshold', which is a float in [oblique], not a table",
+        ),
+        (
+            "name = \"tight\"",
+            "name = \"bins32\"",
+            23,
+            8,
+            "duplicate variant name 'bins32' (first declared at line 19)",
+        ),
+    ];
+    for (from, to, line, column, message) in cases {
+        let e = parse(&sweep_with(from, to)).unwrap_err();
+        assert_error(&e, line, column, message);
+    }
+    let e = parse(&sweep_with(cases[0].0, cases[0].1)).unwrap_err();
+    assert!(e.message.ends_with("did you mean 'oblique'?"), "{e}");
 }
 
 #[test]

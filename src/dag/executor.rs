@@ -372,6 +372,16 @@ impl<'a> Exec<'a> {
             let failures: HashMap<NodeId, String> =
                 self.ensure_values(&needed).into_iter().collect();
             // 3. run
+            if self.mode == Mode::Run {
+                let mut stages: Vec<&'static str> = to_run
+                    .iter()
+                    .map(|(id, _)| self.dag.nodes[*id].stage)
+                    .collect();
+                stages.dedup();
+                for stage in stages {
+                    self.env.progress.stage_running(stage);
+                }
+            }
             let results: Vec<(NodeId, Result<f64, String>)> = to_run
                 .par_iter()
                 .map(|&(id, _)| {

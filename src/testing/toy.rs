@@ -2,11 +2,10 @@
 //! collection, and generate a folder of item files (the stand-in for the synthetic campaign generator).
 //! Every stage can sleep per node and can be told to fail or panic on one item.
 
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RunResult, Stage, StageError};
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 /// Fault injection and pacing shared by all toy stages.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -55,12 +54,7 @@ impl Stage for ToyParse {
     type Params = ToyParseParams;
     type Output = f64;
     type Inputs = RawFile;
-    fn run(
-        &self,
-        p: &ToyParseParams,
-        file: RawFileValue,
-        ctx: &NodeCtx,
-    ) -> Result<f64, StageError> {
+    fn run(&self, p: &ToyParseParams, file: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         p.faults.apply(ctx)?;
         let text = std::fs::read_to_string(&file.path)
             .map_err(|e| StageError::new(format!("{}: cannot read: {e}", file.path.display())))?;
@@ -102,7 +96,7 @@ impl Stage for ToyScale {
     type Params = ToyScaleParams;
     type Output = f64;
     type Inputs = Handle<f64>;
-    fn run(&self, p: &ToyScaleParams, v: Arc<f64>, ctx: &NodeCtx) -> Result<f64, StageError> {
+    fn run(&self, p: &ToyScaleParams, v: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         p.faults.apply(ctx)?;
         let x = *v * p.factor;
         Ok(if p.quantum > 0.0 {
@@ -122,7 +116,7 @@ impl Stage for ToyScaleV2 {
     type Params = ToyScaleParams;
     type Output = f64;
     type Inputs = Handle<f64>;
-    fn run(&self, p: &ToyScaleParams, v: Arc<f64>, ctx: &NodeCtx) -> Result<f64, StageError> {
+    fn run(&self, p: &ToyScaleParams, v: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         ToyScale.run(p, v, ctx)
     }
 }
@@ -152,12 +146,7 @@ impl Stage for ToySum {
     type Params = ToySumParams;
     type Output = ToySummary;
     type Inputs = Vec<Handle<f64>>;
-    fn run(
-        &self,
-        p: &ToySumParams,
-        values: Vec<Arc<f64>>,
-        ctx: &NodeCtx,
-    ) -> Result<ToySummary, StageError> {
+    fn run(&self, p: &ToySumParams, values: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         p.faults.apply(ctx)?;
         // Sequential sum in input order: deterministic whatever the thread count.
         let sum = values.iter().map(|v| **v).sum::<f64>() + p.offset;
@@ -205,7 +194,7 @@ impl Stage for ToyGen {
     type Params = ToyGenParams;
     type Output = ToyDir;
     type Inputs = ();
-    fn run(&self, p: &ToyGenParams, _: (), ctx: &NodeCtx) -> Result<ToyDir, StageError> {
+    fn run(&self, p: &ToyGenParams, _: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         p.faults.apply(ctx)?;
         let tmp = ctx.output_dir_tmp()?;
         let mut files = Vec::new();

@@ -24,19 +24,6 @@ const RD_N: f64 = 455_000.0;
 fn aerial(id: &str, i: usize, oblique: bool, extended: bool) -> AerialImage {
     let f = i as f64;
     AerialImage {
-        image_id: id.into(),
-        file: format!("{id}.tif"),
-        x: RD_E + 310.5 * f + 0.123,
-        y: RD_N - 150.25 * f + 0.456,
-        z: if oblique { 450.0 } else { 1000.0 + f },
-        omega_deg: if oblique { 44.5 } else { 0.8 - 0.3 * f },
-        phi_deg: if oblique { 3.25 } else { -0.6 + 0.2 * f },
-        kappa_deg: 30.0 * f - 80.0,
-        focal_px: 10_000.5,
-        cx_px: 3_000.25,
-        cy_px: 2_001.75,
-        width_px: 6_000,
-        height_px: 4_000,
         k1: -0.12,
         k2: 0.03,
         p1: 2e-4,
@@ -45,7 +32,24 @@ fn aerial(id: &str, i: usize, oblique: bool, extended: bool) -> AerialImage {
         k4: if extended { -0.0005 } else { 0.0 },
         b1: if extended { 0.8 } else { 0.0 },
         b2: if extended { -0.3 } else { 0.0 },
-        sigma_px: 0.5,
+        cx_px: 3_000.25,
+        cy_px: 2_001.75,
+        file: format!("{id}.tif"),
+        ..AerialImage::ideal(
+            id,
+            [
+                RD_E + 310.5 * f + 0.123,
+                RD_N - 150.25 * f + 0.456,
+                if oblique { 450.0 } else { 1000.0 + f },
+            ],
+            [
+                if oblique { 44.5 } else { 0.8 - 0.3 * f },
+                if oblique { 3.25 } else { -0.6 + 0.2 * f },
+                30.0 * f - 80.0,
+            ],
+            10_000.5,
+            [6_000, 4_000],
+        )
     }
 }
 

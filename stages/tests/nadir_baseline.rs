@@ -150,30 +150,13 @@ fn scene() -> Scene {
         tie_points,
     };
     // A nadir camera whose GSD at the ground is 0.1 m (only the GSD is used by the isolation test).
-    let row = AerialImage {
-        image_id: "aer".into(),
-        file: "aer.jpg".into(),
-        x: foot[0],
-        y: foot[1],
-        z: foot[2] + 4470.0,
-        omega_deg: 0.0,
-        phi_deg: 0.0,
-        kappa_deg: 0.0,
-        focal_px: 44700.0,
-        cx_px: 200.0,
-        cy_px: 180.0,
-        width_px: 400,
-        height_px: 360,
-        k1: 0.0,
-        k2: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
-    };
+    let row = AerialImage::ideal(
+        "aer",
+        [foot[0], foot[1], foot[2] + 4470.0],
+        [0.0, 0.0, 0.0],
+        44700.0,
+        [400, 360],
+    );
     Scene {
         ortho,
         aerial,

@@ -17,48 +17,13 @@ const PANO_H: u32 = 2000;
 
 fn recording(id: &str, x: f64, y: f64) -> Recording {
     Recording {
-        image_id: id.into(),
-        file: format!("{id}.jpg"),
         time: "2020-01-01T00:00:00Z".into(),
-        time_s: 0.0,
-        x,
-        y,
-        z: 2.4,
-        heading_deg: 90.0,
-        camera_height_m: 2.4,
-        sigma_xy_m: None,
-        sigma_z_m: None,
-        yaw_deg: 0.0,
-        pitch_deg: 0.0,
-        roll_deg: 0.0,
+        ..Recording::new(id, 0.0, [x, y, 2.4], 90.0, 2.4)
     }
 }
 
 fn nadir_camera(id: &str, x: f64) -> AerialImage {
-    AerialImage {
-        image_id: id.into(),
-        file: format!("{id}.jpg"),
-        x,
-        y: 0.0,
-        z: 450.0,
-        omega_deg: 0.0,
-        phi_deg: 0.0,
-        kappa_deg: 0.0,
-        focal_px: 4500.0,
-        cx_px: 1000.0,
-        cy_px: 1000.0,
-        width_px: 2000,
-        height_px: 2000,
-        k1: 0.0,
-        k2: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
-    }
+    AerialImage::ideal(id, [x, 0.0, 450.0], [0.0, 0.0, 0.0], 4500.0, [2000, 2000])
 }
 
 #[test]

@@ -73,30 +73,13 @@ impl BlobPattern {
 }
 
 fn aerial_row(kappa_deg: f64, omega_deg: f64, phi_deg: f64) -> AerialImage {
-    AerialImage {
-        image_id: "nadir_test".into(),
-        file: "nadir_test.jpg".into(),
-        x: 100_000.0,
-        y: 400_000.0,
-        z: 4470.0 + 1.2,
-        omega_deg,
-        phi_deg,
-        kappa_deg,
-        focal_px: 44_700.0,
-        cx_px: 256.0,
-        cy_px: 192.0,
-        width_px: 512,
-        height_px: 384,
-        k1: 0.0,
-        k2: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
-    }
+    AerialImage::ideal(
+        "nadir_test",
+        [100_000.0, 400_000.0, 4470.0 + 1.2],
+        [omega_deg, phi_deg, kappa_deg],
+        44_700.0,
+        [512, 384],
+    )
 }
 
 /// The aerial image of the pattern on the plane z = `ground_z` (one ray per pixel centre).
@@ -140,20 +123,14 @@ fn render_ortho(
 
 fn recording_at(id: &str, foot: [f64; 3], camera_height_m: f64) -> Recording {
     Recording {
-        image_id: id.into(),
-        file: format!("{id}.jpg"),
         time: "2020-01-01T00:00:00Z".into(),
-        time_s: 0.0,
-        x: foot[0],
-        y: foot[1],
-        z: foot[2] + camera_height_m,
-        heading_deg: 30.0,
-        camera_height_m,
-        sigma_xy_m: None,
-        sigma_z_m: None,
-        yaw_deg: 0.0,
-        pitch_deg: 0.0,
-        roll_deg: 0.0,
+        ..Recording::new(
+            id,
+            0.0,
+            [foot[0], foot[1], foot[2] + camera_height_m],
+            30.0,
+            camera_height_m,
+        )
     }
 }
 

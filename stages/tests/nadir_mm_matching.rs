@@ -9,11 +9,11 @@
 //! nadir_mm_matching -- --ignored --nocapture`) prints counts, timings and the same grading for a campaign
 //! folder; it reads `truth/` only for grading.
 
-use skytie_stages::campaign::read_recordings_csv;
+mod support;
+
 use skytie_stages::campaign::Recording;
 use skytie_stages::correspondence::MmTiePoint;
 use skytie_stages::geometry::{triangulate_rays, PanoramaCamera, Ray};
-use skytie_stages::imaging::io::load_gray;
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::mm_matching::{match_window, MmMatchParams, OrthoView};
 use skytie_stages::nadir::{
@@ -21,72 +21,16 @@ use skytie_stages::nadir::{
 };
 use skytie_stages::synth::generate::plan_campaign;
 use skytie_stages::synth::scene::{Epoch, Scene};
-use skytie_stages::synth::{generate, Preset, SynthOptions};
+use skytie_stages::synth::{Preset, SynthOptions};
 use std::collections::HashMap;
 use std::path::Path;
-use std::sync::OnceLock;
 use std::time::Instant;
+use support::tiny::{fixture, load_campaign, true_rays, TrueRays};
 
-const SEED: u64 = 7;
 /// An observation is correct when the true scene point re-projects within this many panorama pixels.
 const CORRECT_TOL_PX: f64 = 1.5;
 /// A correspondence is correct when, with the true poses, its rays meet within this distance, m.
 const RAYS_MEET_M: f64 = 0.05;
-
-struct Campaign {
-    /// Recorded poses, in driving order.
-    recorded: Vec<Recording>,
-    /// True poses by image id (grading only).
-    truth: HashMap<String, Recording>,
-    panoramas: Vec<GrayImage>,
-}
-
-struct Fixture {
-    campaign: Campaign,
-    scene: Scene,
-}
-
-fn load_campaign(root: &Path) -> Campaign {
-    let (mut recorded, problems) = read_recordings_csv(&root.join("mm/recordings.csv"));
-    assert!(problems.is_empty(), "{problems:?}");
-    recorded.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
-    let (truth, problems) = read_recordings_csv(&root.join("truth/recordings.csv"));
-    assert!(problems.is_empty(), "{problems:?}");
-    let panoramas = recorded
-        .iter()
-        .map(|r| load_gray(&root.join("mm/panoramas").join(&r.file)).unwrap())
-        .collect();
-    Campaign {
-        recorded,
-        truth: truth.into_iter().map(|r| (r.image_id.clone(), r)).collect(),
-        panoramas,
-    }
-}
-
-fn fixture() -> &'static Fixture {
-    static F: OnceLock<Fixture> = OnceLock::new();
-    F.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
-        let root = dir.path().join("tiny");
-        let options = SynthOptions::new(Preset::Tiny, SEED);
-        generate(&options, &root).unwrap();
-        let campaign = load_campaign(&root);
-        let mut plan = plan_campaign(&options).unwrap();
-        Fixture {
-            campaign,
-            scene: plan.areas.remove(0).scene,
-        }
-    })
-}
-
-impl Campaign {
-    fn true_poses(&self) -> Vec<Recording> {
-        self.recorded
-            .iter()
-            .map(|r| self.truth[&r.image_id].clone())
-            .collect()
-    }
-}
 
 fn orthos(poses: &[Recording], panoramas: &[GrayImage]) -> Vec<OrthoImage> {
     poses
@@ -141,19 +85,12 @@ fn grade(
     scene: &Scene,
     pano: (u32, u32),
 ) -> Option<Grade> {
-    let cams: Vec<PanoramaCamera> = tp
-        .observations
-        .iter()
-        .map(|o| PanoramaCamera::from_recording(&truth[&o.image_id], pano.0, pano.1))
-        .collect();
-    let rays: Vec<Ray> = tp
-        .observations
-        .iter()
-        .zip(&cams)
-        .map(|(o, c)| c.pixel_ray(o.u_px, o.v_px))
-        .collect();
-    let sigmas: Vec<f64> = cams.iter().map(|c| c.angular_sigma_rad(0.5)).collect();
-    let t = triangulate_rays(&rays, &sigmas).ok()?;
+    let TrueRays {
+        cams,
+        rays,
+        triangulation,
+    } = true_rays(tp, truth, pano);
+    let t = triangulation.ok()?;
     // Anchor: the ray of the panorama nearest to the point (its pixels are the smallest on the ground); the
     // scene point it hits must re-project into every observing panorama within tolerance.
     let anchor = (0..cams.len())

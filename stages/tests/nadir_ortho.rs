@@ -12,20 +12,17 @@ const DISC_RADIUS_M: f64 = 0.15;
 
 fn recording(yaw: f64, pitch: f64, roll: f64, heading: f64) -> Recording {
     Recording {
-        image_id: "r1".into(),
-        file: "r1.jpg".into(),
-        time: "2020-01-01T00:00:00Z".into(),
-        time_s: 1_577_836_800.0,
-        x: 92_345.678,
-        y: 437_123.456,
-        z: 3.5,
-        heading_deg: heading,
-        camera_height_m: 2.2,
-        sigma_xy_m: None,
-        sigma_z_m: None,
         yaw_deg: yaw,
         pitch_deg: pitch,
         roll_deg: roll,
+        time: "2020-01-01T00:00:00Z".into(),
+        ..Recording::new(
+            "r1",
+            1_577_836_800.0,
+            [92_345.678, 437_123.456, 3.5],
+            heading,
+            2.2,
+        )
     }
 }
 

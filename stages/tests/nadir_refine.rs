@@ -62,30 +62,7 @@ impl Texture {
 }
 
 fn aerial_row(id: &str, w: u32, h: u32) -> AerialImage {
-    AerialImage {
-        image_id: id.into(),
-        file: format!("{id}.jpg"),
-        x: 0.0,
-        y: 0.0,
-        z: 4470.0,
-        omega_deg: 0.0,
-        phi_deg: 0.0,
-        kappa_deg: 0.0,
-        focal_px: 44700.0,
-        cx_px: w as f64 / 2.0,
-        cy_px: h as f64 / 2.0,
-        width_px: w,
-        height_px: h,
-        k1: 0.0,
-        k2: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
-    }
+    AerialImage::ideal(id, [0.0, 0.0, 4470.0], [0.0, 0.0, 0.0], 44700.0, [w, h])
 }
 
 fn tie_point(id: &str, p: [f64; 3]) -> MmTiePoint {

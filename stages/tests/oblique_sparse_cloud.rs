@@ -6,71 +6,23 @@
 //! `demo_report` (ignored; `SKYTIE_DEMO=/work/data/demo cargo test --release -p skytie-stages --test
 //! oblique_sparse_cloud -- --ignored --nocapture`) prints points and time per triplet for a campaign folder.
 
-use skytie_stages::campaign::{read_recordings_csv, Recording};
-use skytie_stages::geometry::{triangulate_rays, PanoramaCamera, Ray};
+mod support;
+
+use skytie_stages::campaign::Recording;
 use skytie_stages::imaging::equirect::PanoramaLevels;
-use skytie_stages::imaging::io::load_gray;
-use skytie_stages::imaging::GrayImage;
 use skytie_stages::oblique::sparse_cloud::{sparse_cloud, SparseCloudParams};
 use skytie_stages::oblique::{SparseCloud, StreetSide};
 use skytie_stages::params::Params;
-use skytie_stages::synth::generate::plan_campaign;
 use skytie_stages::synth::scene::{Epoch, Scene};
-use skytie_stages::synth::{generate, Preset, SynthOptions};
 use std::collections::HashMap;
 use std::path::Path;
-use std::sync::OnceLock;
 use std::time::Instant;
+use support::tiny::{fixture, load_campaign, true_rays, Campaign, TrueRays};
 
-const SEED: u64 = 7;
 /// True-pose rays of a correct point meet within this distance, m.
 const RAYS_MEET_M: f64 = 0.15;
 /// A correct true-pose point lies this close to the scene surface seen by the centre ray, m.
 const SCENE_TOL_M: f64 = 0.15;
-
-struct Campaign {
-    recorded: Vec<Recording>,
-    truth: HashMap<String, Recording>,
-    panoramas: Vec<GrayImage>,
-}
-
-struct Fixture {
-    campaign: Campaign,
-    scene: Scene,
-}
-
-fn load_campaign(root: &Path) -> Campaign {
-    let (mut recorded, problems) = read_recordings_csv(&root.join("mm/recordings.csv"));
-    assert!(problems.is_empty(), "{problems:?}");
-    recorded.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
-    let (truth, problems) = read_recordings_csv(&root.join("truth/recordings.csv"));
-    assert!(problems.is_empty(), "{problems:?}");
-    let panoramas = recorded
-        .iter()
-        .map(|r| load_gray(&root.join("mm/panoramas").join(&r.file)).unwrap())
-        .collect();
-    Campaign {
-        recorded,
-        truth: truth.into_iter().map(|r| (r.image_id.clone(), r)).collect(),
-        panoramas,
-    }
-}
-
-fn fixture() -> &'static Fixture {
-    static F: OnceLock<Fixture> = OnceLock::new();
-    F.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
-        let root = dir.path().join("tiny");
-        let options = SynthOptions::new(Preset::Tiny, SEED);
-        generate(&options, &root).unwrap();
-        let campaign = load_campaign(&root);
-        let mut plan = plan_campaign(&options).unwrap();
-        Fixture {
-            campaign,
-            scene: plan.areas.remove(0).scene,
-        }
-    })
-}
 
 fn clouds(c: &Campaign, p: &SparseCloudParams) -> Vec<SparseCloud> {
     (1..c.recorded.len().saturating_sub(1))
@@ -92,19 +44,12 @@ fn grade(
     scene: Option<&Scene>,
     pano: (u32, u32),
 ) -> (bool, Option<bool>) {
-    let cams: Vec<PanoramaCamera> = tie
-        .observations
-        .iter()
-        .map(|o| PanoramaCamera::from_recording(&truth[&o.image_id], pano.0, pano.1))
-        .collect();
-    let rays: Vec<Ray> = tie
-        .observations
-        .iter()
-        .zip(&cams)
-        .map(|(o, c)| c.pixel_ray(o.u_px, o.v_px))
-        .collect();
-    let sigmas: Vec<f64> = cams.iter().map(|c| c.angular_sigma_rad(0.5)).collect();
-    let Ok(t) = triangulate_rays(&rays, &sigmas) else {
+    let TrueRays {
+        rays,
+        triangulation,
+        ..
+    } = true_rays(tie, truth, pano);
+    let Ok(t) = triangulation else {
         return (false, Some(false));
     };
     let meet = t.residuals_m.iter().all(|&r| r <= RAYS_MEET_M);

@@ -2,11 +2,10 @@
 //! for stages that work per (recording × aerial image). Like `recording`, its unchanged output cuts off its
 //! dependents when other rows of the campaign change.
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use skytie_stages::campaign::{AerialImage, AerialKind};
 use skytie_stages::params::StageId;
-use std::sync::Arc;
 
 crate::serde_artifact!(AerialImage);
 
@@ -31,18 +30,10 @@ pub const STAGE: StageId = StageId {
 pub struct SelectAerial;
 
 impl Stage for SelectAerial {
-    const NAME: &'static str = STAGE.name;
-    const VERSION: &'static str = STAGE.version;
-    type Params = SelectAerialParams;
-    type Output = AerialImage;
+    crate::nodes::stage_types!(STAGE, SelectAerialParams => AerialImage);
     type Inputs = Handle<CampaignSnapshot>;
 
-    fn run(
-        &self,
-        p: &SelectAerialParams,
-        snap: Arc<CampaignSnapshot>,
-        _: &NodeCtx,
-    ) -> Result<AerialImage, StageError> {
+    fn run(&self, p: &SelectAerialParams, snap: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let rows = match p.kind {
             AerialKind::Nadir => &snap.campaign.nadir,
             AerialKind::Oblique => &snap.campaign.oblique,

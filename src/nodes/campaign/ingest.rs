@@ -6,7 +6,7 @@
 //! dependents are skipped and counted.
 
 use crate::dag::{
-    BuildError, DagBuilder, Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError,
+    BuildError, DagBuilder, Handle, InputsOf, NodeCtx, RawFile, RunResult, Stage, StageError,
 };
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
@@ -79,12 +79,7 @@ impl Stage for Ingest {
     type Output = IngestedImage;
     type Inputs = RawFile;
 
-    fn run(
-        &self,
-        p: &IngestParams,
-        file: RawFileValue,
-        ctx: &NodeCtx,
-    ) -> Result<IngestedImage, StageError> {
+    fn run(&self, p: &IngestParams, file: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         let tmp = ctx.output_dir_tmp()?;
         let done = ingest_with_tiles(&file.path, &tmp.join(PYRAMID_FILE), p.tile_side_px)
             .map_err(|e| StageError::new(e.to_string()))?;

@@ -6,14 +6,13 @@
 //! node then re-selects its row; rows that did not change produce identical output, so by early cutoff only the
 //! new or edited recordings' downstream nodes run again.
 
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RunResult, Stage, StageError};
 use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::{
     read_sourced, Campaign, Problem, Recording, SourceRows, SourcedCampaign,
 };
 use skytie_stages::params::StageId;
 use std::path::Path;
-use std::sync::Arc;
 
 /// The campaign's metadata files, in a fixed order (only those that exist are inputs).
 pub const METADATA_FILES: [&str; 6] = [
@@ -88,18 +87,10 @@ pub fn listing_hash(root: &Path) -> std::io::Result<String> {
 pub struct LoadCampaign;
 
 impl Stage for LoadCampaign {
-    const NAME: &'static str = skytie_stages::campaign::read::STAGE.name;
-    const VERSION: &'static str = skytie_stages::campaign::read::STAGE.version;
-    type Params = LoadCampaignParams;
-    type Output = CampaignSnapshot;
+    crate::nodes::stage_types!(skytie_stages::campaign::read::STAGE, LoadCampaignParams => CampaignSnapshot);
     type Inputs = Vec<RawFile>;
 
-    fn run(
-        &self,
-        p: &LoadCampaignParams,
-        _files: Vec<RawFileValue>,
-        _: &NodeCtx,
-    ) -> Result<CampaignSnapshot, StageError> {
+    fn run(&self, p: &LoadCampaignParams, _files: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (sourced, problems) = read_sourced(Path::new(&p.root))
             .map_err(|e| StageError::new(format!("cannot read the campaign: {e}")))?;
         Ok(CampaignSnapshot::new(sourced, problems))
@@ -125,18 +116,10 @@ pub const RECORDING_STAGE: StageId = StageId {
 pub struct SelectRecording;
 
 impl Stage for SelectRecording {
-    const NAME: &'static str = RECORDING_STAGE.name;
-    const VERSION: &'static str = RECORDING_STAGE.version;
-    type Params = SelectRecordingParams;
-    type Output = Recording;
+    crate::nodes::stage_types!(RECORDING_STAGE, SelectRecordingParams => Recording);
     type Inputs = Handle<CampaignSnapshot>;
 
-    fn run(
-        &self,
-        p: &SelectRecordingParams,
-        snap: Arc<CampaignSnapshot>,
-        _: &NodeCtx,
-    ) -> Result<Recording, StageError> {
+    fn run(&self, p: &SelectRecordingParams, snap: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         snap.campaign
             .recordings
             .iter()

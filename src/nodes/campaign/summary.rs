@@ -1,7 +1,7 @@
 //! `summary`: a global node over the campaign snapshot and the per-recording ortho images: counts, input
 //! problems and ortho coverage, contributed to `metrics.json` under `campaign` and `ortho`.
 
-use crate::dag::{Handle, NodeCtx, Optional, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::{InputAccount, Severity};
@@ -73,18 +73,11 @@ pub const STAGE: StageId = StageId {
 pub struct SummarizeCampaign;
 
 impl Stage for SummarizeCampaign {
-    const NAME: &'static str = STAGE.name;
-    const VERSION: &'static str = STAGE.version;
-    type Params = SummaryParams;
-    type Output = CampaignSummary;
+    crate::nodes::stage_types!(STAGE, SummaryParams => CampaignSummary);
     type Inputs = (Handle<CampaignSnapshot>, Vec<Optional<OrthoImage>>);
 
-    fn run(
-        &self,
-        _: &SummaryParams,
-        (snap, orthos): (Arc<CampaignSnapshot>, Vec<Option<Arc<OrthoImage>>>),
-        _: &NodeCtx,
-    ) -> Result<CampaignSummary, StageError> {
+    fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (snap, orthos) = inputs;
         let orthos: Vec<Arc<OrthoImage>> = orthos.into_iter().flatten().collect();
         let c = &snap.campaign;
         let valid_fraction = |o: &OrthoImage| {

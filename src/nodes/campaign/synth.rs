@@ -10,7 +10,7 @@
 //! (`skytie_stages::synth::render_store`). The outputs record every file's size; a cached folder whose files
 //! went missing or changed size is regenerated.
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use serde::{Deserialize, Serialize};
 use skytie_stages::params::Violation;
 use skytie_stages::synth::generate::{RenderIdentity, RENDER_STAGE, STAGE};
@@ -23,7 +23,6 @@ use skytie_stages::synth::{
     apply_profile, render_campaign, Preset, Profile, SynthError, SynthOptions, SynthSummary,
 };
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 skytie_stages::params! {
     /// Parameters of the `[synth]` workflow table (preset and seed come from `campaign = "synth:<preset>"` and
@@ -204,18 +203,10 @@ pub fn list_files(root: &Path) -> std::io::Result<Vec<(String, u64)>> {
 pub struct RenderCampaign;
 
 impl Stage for RenderCampaign {
-    const NAME: &'static str = RENDER_STAGE.name;
-    const VERSION: &'static str = RENDER_STAGE.version;
-    type Params = RenderIdentity;
-    type Output = GeneratedCampaign;
+    crate::nodes::stage_types!(RENDER_STAGE, RenderIdentity => GeneratedCampaign);
     type Inputs = ();
 
-    fn run(
-        &self,
-        identity: &RenderIdentity,
-        _: (),
-        ctx: &NodeCtx,
-    ) -> Result<GeneratedCampaign, StageError> {
+    fn run(&self, identity: &RenderIdentity, _: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         let options = SynthOptions::rendering(identity);
         let tmp = ctx.output_dir_tmp()?;
         let (summary, reused) = render_campaign(&options, &tmp.join("campaign"), &ctx.partial_dir())
@@ -244,18 +235,10 @@ impl Stage for RenderCampaign {
 pub struct SynthCampaign;
 
 impl Stage for SynthCampaign {
-    const NAME: &'static str = STAGE.name;
-    const VERSION: &'static str = STAGE.version;
-    type Params = SynthParams;
-    type Output = GeneratedCampaign;
+    crate::nodes::stage_types!(STAGE, SynthParams => GeneratedCampaign);
     type Inputs = Handle<GeneratedCampaign>;
 
-    fn run(
-        &self,
-        p: &SynthParams,
-        rendered: Arc<GeneratedCampaign>,
-        ctx: &NodeCtx,
-    ) -> Result<GeneratedCampaign, StageError> {
+    fn run(&self, p: &SynthParams, rendered: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         let options = p
             .options()
             .map_err(|v| StageError::new(format!("synth parameter {v}")))?;

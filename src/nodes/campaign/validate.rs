@@ -5,13 +5,12 @@
 //! the wrong size or no image at all is removed with a problem naming file, row and field, before any
 //! per-item node is built for it, so one bad image never fails a node of the run.
 
-use crate::dag::{Handle, NodeCtx, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::summary::SummaryParams;
 use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::{apply_image_checks, image_jobs, sort_problems, ProbeOutcome};
 use skytie_stages::imaging::probe::probe;
-use std::sync::Arc;
 
 /// The outcome of probing one image file (an unusable image is a value, not a failed node).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -30,12 +29,7 @@ impl Stage for ProbeImage {
     type Output = ImageProbe;
     type Inputs = crate::dag::RawFile;
 
-    fn run(
-        &self,
-        _: &SummaryParams,
-        file: RawFileValue,
-        _: &NodeCtx,
-    ) -> Result<ImageProbe, StageError> {
+    fn run(&self, _: &SummaryParams, file: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         Ok(ImageProbe {
             outcome: probe(&file.path),
         })
@@ -52,12 +46,8 @@ impl Stage for ValidateImages {
     type Output = CampaignSnapshot;
     type Inputs = (Handle<CampaignSnapshot>, Vec<Handle<ImageProbe>>);
 
-    fn run(
-        &self,
-        _: &SummaryParams,
-        (snap, probes): (Arc<CampaignSnapshot>, Vec<Arc<ImageProbe>>),
-        _: &NodeCtx,
-    ) -> Result<CampaignSnapshot, StageError> {
+    fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (snap, probes) = inputs;
         let sourced = snap.sourced();
         let jobs = image_jobs(&sourced);
         if jobs.len() != probes.len() {

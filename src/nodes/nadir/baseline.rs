@@ -2,22 +2,18 @@
 //! NCC template matching, `skytie_stages::nadir::baseline`) in place of the phase-correlation `refine` node when
 //! `[nadir] matcher = "baseline"` — so thesis Table 2-10's comparison can be regenerated as a sweep.
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage};
 use crate::nodes::campaign::ingest::IngestedImage;
 use crate::nodes::nadir::refine::locate_with_accepted;
 use skytie_stages::campaign::AerialImage;
 use skytie_stages::nadir::baseline::{baseline_matches, BaselineParams};
 use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, OrthoImage, TransformOutcome};
-use std::sync::Arc;
 
 /// The baseline matching node (same inputs and output as `refine`).
 pub struct BaselineStage;
 
 impl Stage for BaselineStage {
-    const NAME: &'static str = skytie_stages::nadir::baseline::STAGE.name;
-    const VERSION: &'static str = skytie_stages::nadir::baseline::STAGE.version;
-    type Params = BaselineParams;
-    type Output = AerialRefinement;
+    crate::nodes::stage_types!(skytie_stages::nadir::baseline::STAGE, BaselineParams => AerialRefinement);
     type Inputs = (
         Handle<OrthoImage>,
         Handle<IngestedImage>,
@@ -26,18 +22,8 @@ impl Stage for BaselineStage {
         Handle<MmWindowMatch>,
     );
 
-    fn run(
-        &self,
-        p: &BaselineParams,
-        (ortho, aerial_file, aerial, outcome, window): (
-            Arc<OrthoImage>,
-            Arc<IngestedImage>,
-            Arc<AerialImage>,
-            Arc<TransformOutcome>,
-            Arc<MmWindowMatch>,
-        ),
-        _: &NodeCtx,
-    ) -> Result<AerialRefinement, StageError> {
+    fn run(&self, p: &BaselineParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (ortho, aerial_file, aerial, outcome, window) = inputs;
         locate_with_accepted(&outcome, &window, &aerial, &aerial_file, |t, image| {
             baseline_matches(&ortho, image, &aerial, t, &window, p)
         })

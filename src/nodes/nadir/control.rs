@@ -2,11 +2,10 @@
 //! consistency and triangulated from the aerial images → aerial control points (thesis 3.4.5.4,
 //! `skytie_stages::nadir::control_points`).
 
-use crate::dag::{Handle, NodeCtx, Optional, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage, StageError};
 use skytie_stages::campaign::AerialImage;
 use skytie_stages::nadir::control_points::{aerial_control_points, ControlParams};
 use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, RecordingControl};
-use std::sync::Arc;
 
 crate::serde_artifact!(RecordingControl);
 
@@ -14,26 +13,15 @@ crate::serde_artifact!(RecordingControl);
 pub struct ControlStage;
 
 impl Stage for ControlStage {
-    const NAME: &'static str = skytie_stages::nadir::control_points::STAGE.name;
-    const VERSION: &'static str = skytie_stages::nadir::control_points::STAGE.version;
-    type Params = ControlParams;
-    type Output = RecordingControl;
+    crate::nodes::stage_types!(skytie_stages::nadir::control_points::STAGE, ControlParams => RecordingControl);
     type Inputs = (
         Handle<MmWindowMatch>,
         Vec<Optional<AerialRefinement>>,
         Vec<Handle<AerialImage>>,
     );
 
-    fn run(
-        &self,
-        p: &ControlParams,
-        (window, refinements, aerials): (
-            Arc<MmWindowMatch>,
-            Vec<Option<Arc<AerialRefinement>>>,
-            Vec<Arc<AerialImage>>,
-        ),
-        _: &NodeCtx,
-    ) -> Result<RecordingControl, StageError> {
+    fn run(&self, p: &ControlParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (window, refinements, aerials) = inputs;
         if refinements.len() != aerials.len() {
             return Err(StageError::new(
                 "internal: control needs one aerial row per refinement",

@@ -2,7 +2,7 @@
 //! against a synthetic campaign's `truth/` (`skytie_stages::nadir::grading`; the rule is stated there and in the
 //! README). Added by the pipeline only when `truth/recordings.csv` exists; no processing stage reads `truth/`.
 
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RawFileValue, RunResult, Stage, StageError};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::summary::SummaryParams;
 use skytie_stages::campaign::{read_aerial_csv, read_recordings_csv, AerialImage};
@@ -11,7 +11,6 @@ use skytie_stages::imaging::io::dimensions;
 use skytie_stages::nadir::grading::{grade_nadir, NadirGrade, Truth};
 use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, RecordingControl};
 use std::collections::HashMap;
-use std::sync::Arc;
 
 crate::serde_artifact!(NadirGrade);
 
@@ -110,10 +109,7 @@ pub fn load_truth(
 pub struct GradeNadir;
 
 impl Stage for GradeNadir {
-    const NAME: &'static str = skytie_stages::nadir::grading::STAGE.name;
-    const VERSION: &'static str = skytie_stages::nadir::grading::STAGE.version;
-    type Params = SummaryParams;
-    type Output = NadirGrade;
+    crate::nodes::stage_types!(skytie_stages::nadir::grading::STAGE, SummaryParams => NadirGrade);
     type Inputs = (
         Handle<CampaignSnapshot>,
         Vec<RawFile>,
@@ -123,19 +119,8 @@ impl Stage for GradeNadir {
         Vec<Handle<RecordingControl>>,
     );
 
-    fn run(
-        &self,
-        _: &SummaryParams,
-        (snap, truth_files, panos, windows, refinements, control): (
-            Arc<CampaignSnapshot>,
-            Vec<RawFileValue>,
-            Vec<RawFileValue>,
-            Vec<Arc<MmWindowMatch>>,
-            Vec<Arc<AerialRefinement>>,
-            Vec<Arc<RecordingControl>>,
-        ),
-        _: &NodeCtx,
-    ) -> Result<NadirGrade, StageError> {
+    fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (snap, truth_files, panos, windows, refinements, control) = inputs;
         let truth = load_truth(
             &snap,
             &truth_files,

@@ -2,12 +2,11 @@
 //! along the trajectory (thesis 3.4.4, `skytie_stages::nadir::mm_matching`). Inputs: the window's recording rows,
 //! ortho images and panorama files (the panoramas only for their pixel size; they are hashed by content).
 
-use crate::dag::{Handle, NodeCtx, RawFile, RawFileValue, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RunResult, Stage, StageError};
 use skytie_stages::campaign::Recording;
 use skytie_stages::imaging::io::dimensions;
 use skytie_stages::nadir::mm_matching::{match_window, MmMatchParams, OrthoView};
 use skytie_stages::nadir::{MmWindowMatch, OrthoImage};
-use std::sync::Arc;
 
 crate::serde_artifact!(MmWindowMatch);
 
@@ -15,22 +14,15 @@ crate::serde_artifact!(MmWindowMatch);
 pub struct MmMatch;
 
 impl Stage for MmMatch {
-    const NAME: &'static str = skytie_stages::nadir::mm_matching::STAGE.name;
-    const VERSION: &'static str = skytie_stages::nadir::mm_matching::STAGE.version;
-    type Params = MmMatchParams;
-    type Output = MmWindowMatch;
+    crate::nodes::stage_types!(skytie_stages::nadir::mm_matching::STAGE, MmMatchParams => MmWindowMatch);
     type Inputs = (
         Vec<Handle<Recording>>,
         Vec<Handle<OrthoImage>>,
         Vec<RawFile>,
     );
 
-    fn run(
-        &self,
-        p: &MmMatchParams,
-        (recs, orthos, panos): (Vec<Arc<Recording>>, Vec<Arc<OrthoImage>>, Vec<RawFileValue>),
-        _: &NodeCtx,
-    ) -> Result<MmWindowMatch, StageError> {
+    fn run(&self, p: &MmMatchParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (recs, orthos, panos) = inputs;
         if recs.is_empty() || recs.len() != orthos.len() || recs.len() != panos.len() {
             return Err(StageError::new(
                 "internal: mm_match needs one recording, ortho image and panorama per window member",

@@ -2,7 +2,7 @@
 //! (`skytie_stages::nadir::ortho_project`). Inputs: the recording's row and its ingested panorama, of which only
 //! the bands of rows and pyramid levels the projection samples are read.
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use crate::nodes::campaign::image_tiles;
 use crate::nodes::campaign::ingest::IngestedImage;
 use skytie_stages::campaign::Recording;
@@ -10,7 +10,6 @@ use skytie_stages::imaging::equirect::PanoramaLevels;
 use skytie_stages::imaging::pyramid::TileSource;
 use skytie_stages::nadir::ortho::panorama_bands;
 use skytie_stages::nadir::{ortho_project, OrthoImage, OrthoParams};
-use std::sync::Arc;
 
 crate::serde_artifact!(OrthoImage);
 
@@ -37,18 +36,11 @@ pub fn panorama_for_ortho(
 pub struct OrthoProject;
 
 impl Stage for OrthoProject {
-    const NAME: &'static str = skytie_stages::nadir::ortho::STAGE.name;
-    const VERSION: &'static str = skytie_stages::nadir::ortho::STAGE.version;
-    type Params = OrthoParams;
-    type Output = OrthoImage;
+    crate::nodes::stage_types!(skytie_stages::nadir::ortho::STAGE, OrthoParams => OrthoImage);
     type Inputs = (Handle<Recording>, Handle<IngestedImage>);
 
-    fn run(
-        &self,
-        p: &OrthoParams,
-        (rec, pano): (Arc<Recording>, Arc<IngestedImage>),
-        _: &NodeCtx,
-    ) -> Result<OrthoImage, StageError> {
+    fn run(&self, p: &OrthoParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (rec, pano) = inputs;
         let panorama = panorama_for_ortho(&pano, &rec, p)?;
         Ok(ortho_project(&panorama, &rec, p))
     }

@@ -2,7 +2,7 @@
 //! sampling distance and rotated to its orientation (thesis 3.4.3 and 3.4.5.2: "the MM are ortho-projected again
 //! for this step, but with a resolution of 10 cm"), so that MM and aerial patches differ by about a translation.
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use crate::nodes::campaign::ingest::IngestedImage;
 use crate::nodes::nadir::ortho::panorama_for_ortho;
 use skytie_stages::campaign::{AerialImage, Recording};
@@ -10,7 +10,6 @@ use skytie_stages::geometry::FrameCamera;
 use skytie_stages::nadir::aerial_overlap::foot_point_world;
 use skytie_stages::nadir::aerial_patch::ortho_params_for_aerial;
 use skytie_stages::nadir::{ortho_project, OrthoImage, OrthoParams};
-use std::sync::Arc;
 
 /// The aerial-oriented ortho-projection node. Its params are the workflow's `[ortho]` table (diagonal,
 /// vehicle mask, `registration_gsd_m`); `gsd_m` and `rotation_deg` are replaced by the aerial image's (at its
@@ -18,22 +17,15 @@ use std::sync::Arc;
 pub struct OrthoForAerial;
 
 impl Stage for OrthoForAerial {
-    const NAME: &'static str = skytie_stages::nadir::aerial_patch::STAGE.name;
-    const VERSION: &'static str = skytie_stages::nadir::aerial_patch::STAGE.version;
-    type Params = OrthoParams;
-    type Output = OrthoImage;
+    crate::nodes::stage_types!(skytie_stages::nadir::aerial_patch::STAGE, OrthoParams => OrthoImage);
     type Inputs = (
         Handle<Recording>,
         Handle<IngestedImage>,
         Handle<AerialImage>,
     );
 
-    fn run(
-        &self,
-        base: &OrthoParams,
-        (rec, pano, aerial): (Arc<Recording>, Arc<IngestedImage>, Arc<AerialImage>),
-        _: &NodeCtx,
-    ) -> Result<OrthoImage, StageError> {
+    fn run(&self, base: &OrthoParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (rec, pano, aerial) = inputs;
         let cam = FrameCamera::from_aerial(&aerial);
         let params = ortho_params_for_aerial(&cam, foot_point_world(&rec), base);
         if let Err(errs) = skytie_stages::params::Params::validate(&params) {

@@ -4,7 +4,7 @@
 //! views (their orthos for the same aerial image, `skytie_stages::nadir::parallax_check`). A rejected transform
 //! gives an empty refinement.
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use crate::nodes::campaign::image_tiles::{self, CachedPyramid};
 use crate::nodes::campaign::ingest::IngestedImage;
 use skytie_stages::campaign::AerialImage;
@@ -13,7 +13,6 @@ use skytie_stages::nadir::refine::{refine_in_aerial, NeighbourOrtho, RefineParam
 use skytie_stages::nadir::{
     AerialRefinement, InitialTransform, MmWindowMatch, OrthoImage, TransformOutcome,
 };
-use std::sync::Arc;
 
 crate::serde_artifact!(AerialRefinement);
 
@@ -21,10 +20,7 @@ crate::serde_artifact!(AerialRefinement);
 pub struct RefineStage;
 
 impl Stage for RefineStage {
-    const NAME: &'static str = skytie_stages::nadir::refine::STAGE.name;
-    const VERSION: &'static str = skytie_stages::nadir::refine::STAGE.version;
-    type Params = RefineParams;
-    type Output = AerialRefinement;
+    crate::nodes::stage_types!(skytie_stages::nadir::refine::STAGE, RefineParams => AerialRefinement);
     type Inputs = (
         Handle<OrthoImage>,
         Handle<IngestedImage>,
@@ -34,19 +30,8 @@ impl Stage for RefineStage {
         Vec<Handle<OrthoImage>>,
     );
 
-    fn run(
-        &self,
-        p: &RefineParams,
-        (ortho, aerial_file, aerial, outcome, window, neighbour_orthos): (
-            Arc<OrthoImage>,
-            Arc<IngestedImage>,
-            Arc<AerialImage>,
-            Arc<TransformOutcome>,
-            Arc<MmWindowMatch>,
-            Vec<Arc<OrthoImage>>,
-        ),
-        _: &NodeCtx,
-    ) -> Result<AerialRefinement, StageError> {
+    fn run(&self, p: &RefineParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (ortho, aerial_file, aerial, outcome, window, neighbour_orthos) = inputs;
         // The neighbours' orthos come in the window's neighbour order (`window.pairs`).
         let neighbours: Vec<NeighbourOrtho> = window
             .pairs

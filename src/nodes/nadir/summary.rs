@@ -1,12 +1,11 @@
 //! `nadir`: the global summary of the nadir pipeline — counts of MM pairs, tie points, transforms,
 //! correspondences and control points (`skytie_stages::nadir::summary`), contributed to metrics as `nadir`.
 
-use crate::dag::{Handle, NodeCtx, Optional, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::summary::SummaryParams;
 use skytie_stages::nadir::summary::NadirSummary;
 use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, RecordingControl, TransformOutcome};
-use std::sync::Arc;
 
 crate::serde_artifact!(NadirSummary);
 
@@ -14,10 +13,7 @@ crate::serde_artifact!(NadirSummary);
 pub struct SummarizeNadir;
 
 impl Stage for SummarizeNadir {
-    const NAME: &'static str = skytie_stages::nadir::summary::STAGE.name;
-    const VERSION: &'static str = skytie_stages::nadir::summary::STAGE.version;
-    type Params = SummaryParams;
-    type Output = NadirSummary;
+    crate::nodes::stage_types!(skytie_stages::nadir::summary::STAGE, SummaryParams => NadirSummary);
     type Inputs = (
         Handle<CampaignSnapshot>,
         Vec<Optional<MmWindowMatch>>,
@@ -26,18 +22,8 @@ impl Stage for SummarizeNadir {
         Vec<Optional<RecordingControl>>,
     );
 
-    fn run(
-        &self,
-        _: &SummaryParams,
-        (snap, windows, transforms, refinements, control): (
-            Arc<CampaignSnapshot>,
-            Vec<Option<Arc<MmWindowMatch>>>,
-            Vec<Option<Arc<TransformOutcome>>>,
-            Vec<Option<Arc<AerialRefinement>>>,
-            Vec<Option<Arc<RecordingControl>>>,
-        ),
-        _: &NodeCtx,
-    ) -> Result<NadirSummary, StageError> {
+    fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (snap, windows, transforms, refinements, control) = inputs;
         let w: Vec<&MmWindowMatch> = windows.iter().flatten().map(|x| x.as_ref()).collect();
         let t: Vec<&TransformOutcome> = transforms.iter().flatten().map(|x| x.as_ref()).collect();
         let r: Vec<&AerialRefinement> = refinements.iter().flatten().map(|x| x.as_ref()).collect();

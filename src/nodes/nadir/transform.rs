@@ -2,13 +2,12 @@
 //! oriented ortho image and the aerial image (thesis 3.4.5.2, `skytie_stages::nadir::initial_transform`).
 //! A rejected transform is a normal output (with its reason), not a failure.
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use crate::nodes::campaign::image_tiles;
 use crate::nodes::campaign::ingest::IngestedImage;
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::nadir::initial_transform::{initial_transform, TransformParams};
 use skytie_stages::nadir::{OrthoImage, TransformOutcome};
-use std::sync::Arc;
 
 crate::serde_artifact!(TransformOutcome);
 
@@ -16,10 +15,7 @@ crate::serde_artifact!(TransformOutcome);
 pub struct InitialTransformStage;
 
 impl Stage for InitialTransformStage {
-    const NAME: &'static str = skytie_stages::nadir::initial_transform::STAGE.name;
-    const VERSION: &'static str = skytie_stages::nadir::initial_transform::STAGE.version;
-    type Params = TransformParams;
-    type Output = TransformOutcome;
+    crate::nodes::stage_types!(skytie_stages::nadir::initial_transform::STAGE, TransformParams => TransformOutcome);
     type Inputs = (
         Handle<Recording>,
         Handle<OrthoImage>,
@@ -27,17 +23,8 @@ impl Stage for InitialTransformStage {
         Handle<AerialImage>,
     );
 
-    fn run(
-        &self,
-        p: &TransformParams,
-        (rec, ortho, aerial_file, aerial): (
-            Arc<Recording>,
-            Arc<OrthoImage>,
-            Arc<IngestedImage>,
-            Arc<AerialImage>,
-        ),
-        _: &NodeCtx,
-    ) -> Result<TransformOutcome, StageError> {
+    fn run(&self, p: &TransformParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (rec, ortho, aerial_file, aerial) = inputs;
         let pyramid = image_tiles::open(&aerial_file)?;
         initial_transform(&rec, &ortho, &pyramid, &aerial, p)
             .map_err(|e| StageError::new(e.to_string()))

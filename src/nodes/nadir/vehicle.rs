@@ -3,7 +3,7 @@
 //! direction, fitted with the box model that masks the car in every ortho image. When nothing stable is found
 //! (too few panoramas, a vehicle-free camera) the output says why and the `[ortho.vehicle]` values are used.
 
-use crate::dag::{Handle, NodeCtx, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use crate::nodes::campaign::image_tiles;
 use crate::nodes::campaign::ingest::IngestedImage;
 use crate::nodes::campaign::load::CampaignSnapshot;
@@ -14,7 +14,6 @@ use skytie_stages::nadir::vehicle_detect::{
     detect_vehicle, detection_level, DetectedVehicle, VehicleDetectParams,
 };
 use skytie_stages::nadir::VehicleMask;
-use std::sync::Arc;
 
 /// Parameters of the node: the detection's and which recordings (image ids) were sampled.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -65,18 +64,11 @@ impl VehicleDetection {
 pub struct DetectVehicle;
 
 impl Stage for DetectVehicle {
-    const NAME: &'static str = skytie_stages::nadir::vehicle_detect::STAGE.name;
-    const VERSION: &'static str = skytie_stages::nadir::vehicle_detect::STAGE.version;
-    type Params = VehicleNodeParams;
-    type Output = VehicleDetection;
+    crate::nodes::stage_types!(skytie_stages::nadir::vehicle_detect::STAGE, VehicleNodeParams => VehicleDetection);
     type Inputs = (Handle<CampaignSnapshot>, Vec<Handle<IngestedImage>>);
 
-    fn run(
-        &self,
-        p: &VehicleNodeParams,
-        (snap, panos): (Arc<CampaignSnapshot>, Vec<Arc<IngestedImage>>),
-        _: &NodeCtx,
-    ) -> Result<VehicleDetection, StageError> {
+    fn run(&self, p: &VehicleNodeParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (snap, panos) = inputs;
         let mut images = Vec::new();
         let mut skipped = Vec::new();
         for (id, pano) in p.image_ids.iter().zip(&panos) {

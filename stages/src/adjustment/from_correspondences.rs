@@ -167,6 +167,163 @@ pub fn build_block(
             problem: describe(&problems),
         });
     }
+    let (recording_index, recordings) = block_recordings(inputs, config)?;
+    let mut block = Block {
+        recordings,
+        ..Block::default()
+    };
+    let mut points: Vec<BlockPoint> = Vec::new();
+    let mut point_index: HashMap<String, usize> = HashMap::new();
+    let mut counts = BuildCounts::default();
+    let sigma_px = config.pano_sigma_px;
+    let resolve =
+        |owner: &str, image_id: &str| resolve_recording(&recording_index, owner, image_id);
+
+    for tp in inputs.tie_points {
+        add_tie_point(
+            tp,
+            &resolve,
+            sigma_px,
+            &mut block,
+            &mut points,
+            &mut point_index,
+        )?;
+        counts.tie_points += 1;
+    }
+
+    let mut cameras = AerialCameras::default();
+    for cp in inputs.control {
+        counts.control_points += 1;
+        let owner = format!("aerial control point '{}'", cp.tie_point_id);
+        // Resolve the aerial images (in order of first use, so the numbering is deterministic).
+        let mut aerial = Vec::with_capacity(cp.aerial.len());
+        for a in &cp.aerial {
+            let idx = cameras.index_of(inputs, a.kind, &a.image_id, &owner)?;
+            aerial.push((idx, a.u_px, a.v_px));
+        }
+        let p = match point_index.get(&cp.tie_point_id) {
+            Some(&p) => p,
+            None => {
+                // A control point whose tie point was not passed: its own point from its MM observations.
+                let mut pano = Vec::with_capacity(cp.mm.len());
+                for o in &cp.mm {
+                    pano.push((resolve(&owner, &o.image_id)?, o.u_px, o.v_px));
+                }
+                let Some(initial) = initial_point(&block, &pano, cp.point_world, sigma_px) else {
+                    counts.control_unused += 1;
+                    continue;
+                };
+                let p = points.len();
+                add_point(
+                    &mut block,
+                    &mut points,
+                    &cp.tie_point_id,
+                    initial,
+                    pano,
+                    sigma_px,
+                );
+                point_index.insert(cp.tie_point_id.clone(), p);
+                p
+            }
+        };
+        let kind = if cp.aerial.len() >= 2 {
+            PointKind::Control
+        } else {
+            PointKind::SingleAerial
+        };
+        if points[p].kind != PointKind::Control {
+            points[p].kind = kind;
+        }
+        points[p].aerial.extend(aerial.iter().copied());
+        if config.aerial_observations {
+            add_aerial_observations(&mut block, &cameras.rows, p, &aerial, &mut counts);
+        } else if let Some(xyz) = cp.point_world.filter(|_| cp.aerial.len() >= 2) {
+            block.control_points.push(ControlPoint {
+                point: p,
+                position_world: Vector3::from(xyz),
+                covariance_m2: control_covariance(config, cp, &owner)?,
+            });
+            counts.control_as_gcp += 1;
+        } else {
+            counts.control_unused += 1;
+        }
+    }
+    block.aerial_cameras = cameras
+        .rows
+        .iter()
+        .map(|r| FrameCamera::from_aerial(r))
+        .collect();
+
+    if config.relative_constraints {
+        block.relative_constraints = relative_constraints(inputs.recordings, config);
+        counts.relative_constraints = block.relative_constraints.len();
+    }
+    block.validate()?;
+    Ok(BlockBuild {
+        block,
+        options: config.options(),
+        recording_ids: inputs
+            .recordings
+            .iter()
+            .map(|r| r.image_id.clone())
+            .collect(),
+        points,
+        aerial_images: cameras.images,
+        counts,
+    })
+}
+
+/// The aerial cameras the control points use, numbered in order of first use.
+#[derive(Default)]
+struct AerialCameras<'a> {
+    index: HashMap<(AerialKind, &'a str), usize>,
+    images: Vec<AerialImageRef>,
+    rows: Vec<&'a AerialImage>,
+}
+
+impl<'a> AerialCameras<'a> {
+    /// The number of aerial image `image_id` of `kind` (named by `owner`), added on first use.
+    fn index_of(
+        &mut self,
+        inputs: &AdjustInputs<'a>,
+        kind: AerialKind,
+        image_id: &'a str,
+        owner: &str,
+    ) -> Result<usize, AdjustError> {
+        if let Some(&i) = self.index.get(&(kind, image_id)) {
+            return Ok(i);
+        }
+        let rows = match kind {
+            AerialKind::Nadir => inputs.nadir,
+            AerialKind::Oblique => inputs.oblique,
+        };
+        let row = rows
+            .iter()
+            .find(|r| r.image_id == image_id)
+            .ok_or_else(|| AdjustError::InvalidInput {
+                item: owner.to_string(),
+                problem: format!(
+                    "aerial image '{image_id}' ({kind:?}) is not among the aerial cameras passed; pass \
+                     the cameras.csv rows the control points were measured in"
+                ),
+            })?;
+        let i = self.images.len();
+        self.index.insert((kind, image_id), i);
+        self.images.push(AerialImageRef {
+            kind,
+            image_id: image_id.to_string(),
+        });
+        self.rows.push(row);
+        Ok(i)
+    }
+}
+
+/// The block's recordings (recorded poses as weak priors, thesis 5.4.3) and their index by image id; refuses
+/// a size list that does not match and duplicate image ids.
+fn block_recordings<'a>(
+    inputs: &AdjustInputs<'a>,
+    config: &AdjustConfig,
+) -> Result<(HashMap<&'a str, usize>, Vec<BlockRecording>), AdjustError> {
     let n_rec = inputs.recordings.len();
     if inputs.pano_size_px.len() != n_rec {
         return Err(AdjustError::InvalidInput {
@@ -207,229 +364,158 @@ pub fn build_block(
             ),
         });
     }
-    let mut block = Block {
-        recordings,
-        ..Block::default()
-    };
-    let mut points: Vec<BlockPoint> = Vec::new();
-    let mut point_index: HashMap<String, usize> = HashMap::new();
-    let mut counts = BuildCounts::default();
-    let sigma_px = config.pano_sigma_px;
+    Ok((recording_index, recordings))
+}
 
-    let resolve = |owner: &str, image_id: &str| -> Result<usize, AdjustError> {
-        recording_index
-            .get(image_id)
-            .copied()
-            .ok_or_else(|| AdjustError::InvalidInput {
-                item: owner.to_string(),
-                problem: format!(
-                    "panorama '{image_id}' is not among the {n_rec} recordings of the adjustment; \
-                     pass the recordings the correspondences were made with"
-                ),
-            })
-    };
+/// The recording a correspondence of `owner` names, by image id.
+fn resolve_recording(
+    recording_index: &HashMap<&str, usize>,
+    owner: &str,
+    image_id: &str,
+) -> Result<usize, AdjustError> {
+    recording_index
+        .get(image_id)
+        .copied()
+        .ok_or_else(|| AdjustError::InvalidInput {
+            item: owner.to_string(),
+            problem: format!(
+                "panorama '{image_id}' is not among the {} recordings of the adjustment; \
+                 pass the recordings the correspondences were made with",
+                recording_index.len()
+            ),
+        })
+}
 
-    for tp in inputs.tie_points {
-        let owner = format!("tie point '{}'", tp.id);
-        if point_index.contains_key(&tp.id) {
-            return Err(AdjustError::InvalidInput {
-                item: owner,
-                problem: "id occurs twice; tie-point ids must be unique".to_string(),
-            });
-        }
-        if !tp.point_world.iter().all(|v| v.is_finite()) {
-            return Err(AdjustError::InvalidInput {
-                item: owner,
-                problem: "point_world is not finite".to_string(),
-            });
-        }
-        let p = points.len();
-        let mut pano = Vec::with_capacity(tp.observations.len());
-        for o in &tp.observations {
-            let r = resolve(&owner, &o.image_id)?;
-            block.pano_observations.push(PanoObservation {
-                recording: r,
-                point: p,
-                u_px: o.u_px,
-                v_px: o.v_px,
-                sigma_px,
-            });
-            pano.push((r, o.u_px, o.v_px));
-        }
-        block
-            .points_initial_world
-            .push(Vector3::from(tp.point_world));
-        point_index.insert(tp.id.clone(), p);
-        points.push(BlockPoint {
-            id: tp.id.clone(),
-            kind: PointKind::Tie,
-            pano,
-            aerial: Vec::new(),
+/// An MM tie point as a tie-point unknown with its panorama observations (σ `sigma_px`).
+fn add_tie_point(
+    tp: &MmTiePoint,
+    resolve: &impl Fn(&str, &str) -> Result<usize, AdjustError>,
+    sigma_px: f64,
+    block: &mut Block,
+    points: &mut Vec<BlockPoint>,
+    point_index: &mut HashMap<String, usize>,
+) -> Result<(), AdjustError> {
+    let owner = format!("tie point '{}'", tp.id);
+    if point_index.contains_key(&tp.id) {
+        return Err(AdjustError::InvalidInput {
+            item: owner,
+            problem: "id occurs twice; tie-point ids must be unique".to_string(),
         });
-        counts.tie_points += 1;
     }
+    if !tp.point_world.iter().all(|v| v.is_finite()) {
+        return Err(AdjustError::InvalidInput {
+            item: owner,
+            problem: "point_world is not finite".to_string(),
+        });
+    }
+    let mut pano = Vec::with_capacity(tp.observations.len());
+    for o in &tp.observations {
+        pano.push((resolve(&owner, &o.image_id)?, o.u_px, o.v_px));
+    }
+    point_index.insert(tp.id.clone(), points.len());
+    let initial = Vector3::from(tp.point_world);
+    add_point(block, points, &tp.id, initial, pano, sigma_px);
+    Ok(())
+}
 
-    let mut aerial_index: HashMap<(AerialKind, &str), usize> = HashMap::new();
-    let mut aerial_images: Vec<AerialImageRef> = Vec::new();
-    let mut aerial_rows: Vec<&AerialImage> = Vec::new();
-    let rows_of = |kind: AerialKind| match kind {
-        AerialKind::Nadir => inputs.nadir,
-        AerialKind::Oblique => inputs.oblique,
-    };
-    for cp in inputs.control {
-        counts.control_points += 1;
-        let owner = format!("aerial control point '{}'", cp.tie_point_id);
-        // Resolve the aerial images (in order of first use, so the numbering is deterministic).
-        let mut aerial = Vec::with_capacity(cp.aerial.len());
-        for a in &cp.aerial {
-            let key = (a.kind, a.image_id.as_str());
-            let idx = match aerial_index.get(&key) {
-                Some(&i) => i,
-                None => {
-                    let row = rows_of(a.kind)
-                        .iter()
-                        .find(|r| r.image_id == a.image_id)
-                        .ok_or_else(|| AdjustError::InvalidInput {
-                            item: owner.clone(),
-                            problem: format!(
-                                "aerial image '{}' ({:?}) is not among the aerial cameras passed; pass \
-                                 the cameras.csv rows the control points were measured in",
-                                a.image_id, a.kind
-                            ),
-                        })?;
-                    let i = aerial_images.len();
-                    aerial_index.insert(key, i);
-                    aerial_images.push(AerialImageRef {
-                        kind: a.kind,
-                        image_id: a.image_id.clone(),
-                    });
-                    aerial_rows.push(row);
-                    i
-                }
-            };
-            aerial.push((idx, a.u_px, a.v_px));
-        }
-        let p = match point_index.get(&cp.tie_point_id) {
-            Some(&p) => p,
-            None => {
-                // A control point whose tie point was not passed: its own point from its MM observations.
-                let mut pano = Vec::with_capacity(cp.mm.len());
-                for o in &cp.mm {
-                    pano.push((resolve(&owner, &o.image_id)?, o.u_px, o.v_px));
-                }
-                let Some(initial) = initial_point(&block, &pano, cp.point_world, sigma_px) else {
-                    counts.control_unused += 1;
-                    continue;
-                };
-                let p = points.len();
-                for &(r, u, v) in &pano {
-                    block.pano_observations.push(PanoObservation {
-                        recording: r,
-                        point: p,
-                        u_px: u,
-                        v_px: v,
-                        sigma_px,
-                    });
-                }
-                block.points_initial_world.push(initial);
-                point_index.insert(cp.tie_point_id.clone(), p);
-                points.push(BlockPoint {
-                    id: cp.tie_point_id.clone(),
-                    kind: PointKind::Tie,
-                    pano,
-                    aerial: Vec::new(),
-                });
-                p
-            }
-        };
-        let kind = if cp.aerial.len() >= 2 {
-            PointKind::Control
-        } else {
-            PointKind::SingleAerial
-        };
-        if points[p].kind != PointKind::Control {
-            points[p].kind = kind;
-        }
-        points[p].aerial.extend(aerial.iter().copied());
-        if config.aerial_observations {
-            let initial = block.points_initial_world[p];
-            for &(camera, u, v) in &aerial {
-                if FrameCamera::from_aerial(aerial_rows[camera])
-                    .project_world(&initial)
-                    .is_none()
-                {
-                    counts.aerial_observations_skipped += 1;
-                    continue;
-                }
-                counts.aerial_observations += 1;
-                block.aerial_observations.push(AerialImageObservation {
-                    camera,
-                    point: p,
-                    u_px: u,
-                    v_px: v,
-                    sigma_px: aerial_rows[camera].sigma_px,
-                });
-            }
-            counts.control_as_aerial_observations += usize::from(!aerial.is_empty());
-        } else if let Some(xyz) = cp.point_world.filter(|_| cp.aerial.len() >= 2) {
-            let covariance_m2 = match config.control_weighting {
-                ControlWeighting::Fixed => {
-                    Matrix3::identity() * (config.control_sigma_m * config.control_sigma_m)
-                }
-                ControlWeighting::Covariance => {
-                    let c = cp.covariance_m2.ok_or_else(|| AdjustError::InvalidInput {
-                        item: owner.clone(),
-                        problem:
-                            "control_weighting = \"covariance\" but the point has no covariance_m2"
-                                .to_string(),
-                    })?;
-                    Matrix3::from_row_slice(&[
-                        c[0][0], c[0][1], c[0][2], c[1][0], c[1][1], c[1][2], c[2][0], c[2][1],
-                        c[2][2],
-                    ])
-                }
-            };
-            block.control_points.push(ControlPoint {
-                point: p,
-                position_world: Vector3::from(xyz),
-                covariance_m2,
-            });
-            counts.control_as_gcp += 1;
-        } else {
-            counts.control_unused += 1;
-        }
+/// A tie-point unknown `id` at `initial` (world, m) with its panorama observations (recording, u, v in px).
+fn add_point(
+    block: &mut Block,
+    points: &mut Vec<BlockPoint>,
+    id: &str,
+    initial: Vector3<f64>,
+    pano: Vec<(usize, f64, f64)>,
+    sigma_px: f64,
+) {
+    let p = points.len();
+    for &(recording, u_px, v_px) in &pano {
+        block.pano_observations.push(PanoObservation {
+            recording,
+            point: p,
+            u_px,
+            v_px,
+            sigma_px,
+        });
     }
-    block.aerial_cameras = aerial_rows
-        .iter()
-        .map(|r| FrameCamera::from_aerial(r))
-        .collect();
+    block.points_initial_world.push(initial);
+    points.push(BlockPoint {
+        id: id.to_string(),
+        kind: PointKind::Tie,
+        pano,
+        aerial: Vec::new(),
+    });
+}
 
-    if config.relative_constraints {
-        for i in 1..n_rec {
-            let (a, b) = (&inputs.recordings[i - 1], &inputs.recordings[i]);
-            if (a.x - b.x).hypot(a.y - b.y) <= config.relative_max_gap_m {
-                block.relative_constraints.push(RelativeConstraint {
-                    from: i - 1,
-                    to: i,
-                    sigma_m: config.relative_sigma_m,
-                });
-            }
+/// A control point's aerial pixels as observations of point `p` in the bundle (aerial orientations fixed);
+/// an observation whose camera does not see the point's initial position is skipped and counted.
+fn add_aerial_observations(
+    block: &mut Block,
+    rows: &[&AerialImage],
+    p: usize,
+    aerial: &[(usize, f64, f64)],
+    counts: &mut BuildCounts,
+) {
+    let initial = block.points_initial_world[p];
+    for &(camera, u_px, v_px) in aerial {
+        if FrameCamera::from_aerial(rows[camera])
+            .project_world(&initial)
+            .is_none()
+        {
+            counts.aerial_observations_skipped += 1;
+            continue;
         }
-        counts.relative_constraints = block.relative_constraints.len();
+        counts.aerial_observations += 1;
+        block.aerial_observations.push(AerialImageObservation {
+            camera,
+            point: p,
+            u_px,
+            v_px,
+            sigma_px: rows[camera].sigma_px,
+        });
     }
-    block.validate()?;
-    Ok(BlockBuild {
-        block,
-        options: config.options(),
-        recording_ids: inputs
-            .recordings
-            .iter()
-            .map(|r| r.image_id.clone())
-            .collect(),
-        points,
-        aerial_images,
-        counts,
-    })
+    counts.control_as_aerial_observations += usize::from(!aerial.is_empty());
+}
+
+/// The covariance of a control point tied to the aerial triangulation (thesis 5.4.3): σ = `control_sigma_m`
+/// in every axis, or the triangulation's own covariance.
+fn control_covariance(
+    config: &AdjustConfig,
+    cp: &AerialControlPoint,
+    owner: &str,
+) -> Result<Matrix3<f64>, AdjustError> {
+    match config.control_weighting {
+        ControlWeighting::Fixed => {
+            Ok(Matrix3::identity() * (config.control_sigma_m * config.control_sigma_m))
+        }
+        ControlWeighting::Covariance => {
+            let c = cp.covariance_m2.ok_or_else(|| AdjustError::InvalidInput {
+                item: owner.to_string(),
+                problem: "control_weighting = \"covariance\" but the point has no covariance_m2"
+                    .to_string(),
+            })?;
+            Ok(Matrix3::from_row_slice(&[
+                c[0][0], c[0][1], c[0][2], c[1][0], c[1][1], c[1][2], c[2][0], c[2][1], c[2][2],
+            ]))
+        }
+    }
+}
+
+/// Consecutive recordings at most `relative_max_gap_m` apart keep their recorded difference (thesis 3.4.2).
+fn relative_constraints(
+    recordings: &[Recording],
+    config: &AdjustConfig,
+) -> Vec<RelativeConstraint> {
+    (1..recordings.len())
+        .filter(|&i| {
+            let (a, b) = (&recordings[i - 1], &recordings[i]);
+            (a.x - b.x).hypot(a.y - b.y) <= config.relative_max_gap_m
+        })
+        .map(|i| RelativeConstraint {
+            from: i - 1,
+            to: i,
+            sigma_m: config.relative_sigma_m,
+        })
+        .collect()
 }
 
 /// Initial coordinates of a point from its panorama rays with the recorded poses, else `fallback`.

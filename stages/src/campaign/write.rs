@@ -7,6 +7,7 @@
 //! reader would otherwise take for a comment line). Output is deterministic: same rows ⇒ same bytes.
 
 use super::model::{AerialImage, CheckPoint, Observation, Recording};
+use super::read_recordings::RECORDING_COLUMNS;
 use super::time::format_time_iso;
 use crate::fsutil::atomic_write_with;
 use std::collections::BTreeMap;
@@ -83,16 +84,7 @@ fn write_recording_rows(path: &Path, rows: &[(&Recording, Option<[f64; 3]>)]) ->
     let has_rotation = rows
         .iter()
         .any(|(r, _)| r.yaw_deg != 0.0 || r.pitch_deg != 0.0 || r.roll_deg != 0.0);
-    let mut header = vec![
-        "image_id",
-        "file",
-        "time",
-        "x",
-        "y",
-        "z",
-        "heading",
-        "camera_height",
-    ];
+    let mut header = RECORDING_COLUMNS.to_vec();
     if has_sigma_xy {
         header.push("sigma_xy");
     }

@@ -54,48 +54,19 @@ mod tests {
     use super::*;
 
     fn nadir(id: &str, x: f64, y: f64, kappa_deg: f64) -> AerialImage {
-        AerialImage {
-            image_id: id.into(),
-            file: format!("{id}.jpg"),
-            x,
-            y,
-            z: 4470.0,
-            omega_deg: 0.0,
-            phi_deg: 0.0,
-            kappa_deg,
-            focal_px: 44_700.0,
-            cx_px: 256.0,
-            cy_px: 192.0,
-            width_px: 512,
-            height_px: 384,
-            k1: 0.0,
-            k2: 0.0,
-            p1: 0.0,
-            p2: 0.0,
-            k3: 0.0,
-            k4: 0.0,
-            b1: 0.0,
-            b2: 0.0,
-            sigma_px: 0.5,
-        }
+        AerialImage::ideal(
+            id,
+            [x, y, 4470.0],
+            [0.0, 0.0, kappa_deg],
+            44_700.0,
+            [512, 384],
+        )
     }
 
     fn rec(x: f64, y: f64) -> Recording {
         Recording {
-            image_id: "r".into(),
-            file: "r.jpg".into(),
             time: "2020-01-01T00:00:00Z".into(),
-            time_s: 0.0,
-            x,
-            y,
-            z: 2.2,
-            heading_deg: 0.0,
-            camera_height_m: 2.2,
-            sigma_xy_m: None,
-            sigma_z_m: None,
-            yaw_deg: 0.0,
-            pitch_deg: 0.0,
-            roll_deg: 0.0,
+            ..Recording::new("r", 0.0, [x, y, 2.2], 0.0, 2.2)
         }
     }
 

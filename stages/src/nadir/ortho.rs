@@ -417,20 +417,11 @@ mod tests {
         heading_deg: f64,
     ) -> (Recording, PanoramaCamera, OrthoParams, OrthoGeoref) {
         let rec = Recording {
-            image_id: "r".into(),
-            file: "r.jpg".into(),
-            time: "2020-01-01T00:00:00Z".into(),
-            time_s: 0.0,
-            x: 92_007.83,
-            y: 437_001.05,
-            z: 3.43,
-            heading_deg,
-            camera_height_m: 2.2,
-            sigma_xy_m: None,
-            sigma_z_m: None,
             yaw_deg: 0.24,
             pitch_deg: -0.49,
             roll_deg: -0.19,
+            time: "2020-01-01T00:00:00Z".into(),
+            ..Recording::new("r", 0.0, [92_007.83, 437_001.05, 3.43], heading_deg, 2.2)
         };
         let camera = PanoramaCamera::from_recording(&rec, 4000, 2000);
         let params = OrthoParams {

@@ -94,28 +94,17 @@ pub fn plan_nadir(
                 q(-azimuth_deg
                     + (plan.attitude_sigma_deg * r.normal()).clamp(-clamp_deg, clamp_deg));
             out.push(AerialImage {
-                file: format!("{image_id}.jpg"),
-                image_id,
-                x: xy[0],
-                y: xy[1],
-                z: ground_z_m + plan.altitude_m,
-                omega_deg,
-                phi_deg,
-                kappa_deg,
-                focal_px,
-                cx_px: f64::from(plan.width_px) / 2.0,
-                cy_px: f64::from(plan.height_px) / 2.0,
-                width_px: plan.width_px,
-                height_px: plan.height_px,
                 k1,
                 k2,
                 p1,
                 p2,
-                k3: 0.0,
-                k4: 0.0,
-                b1: 0.0,
-                b2: 0.0,
-                sigma_px: 0.5,
+                ..AerialImage::ideal(
+                    &image_id,
+                    [xy[0], xy[1], ground_z_m + plan.altitude_m],
+                    [omega_deg, phi_deg, kappa_deg],
+                    focal_px,
+                    [plan.width_px, plan.height_px],
+                )
             });
         }
     }
@@ -220,28 +209,23 @@ pub fn plan_oblique(
         for (j, t) in targets.iter().enumerate() {
             let image_id = format!("{id_prefix}_{letter}_{j:02}");
             out.push(AerialImage {
-                file: format!("{image_id}.jpg"),
-                image_id,
-                x: t[0] - horizontal_m * a.sin(),
-                y: t[1] - horizontal_m * a.cos(),
-                z: ground_z_m + plan.altitude_m,
-                omega_deg,
-                phi_deg,
-                kappa_deg,
-                focal_px,
-                cx_px: f64::from(plan.width_px) / 2.0 + 3.25,
-                cy_px: f64::from(plan.height_px) / 2.0 - 2.75,
-                width_px: plan.width_px,
-                height_px: plan.height_px,
                 k1,
                 k2,
                 p1,
                 p2,
-                k3: 0.0,
-                k4: 0.0,
-                b1: 0.0,
-                b2: 0.0,
-                sigma_px: 0.5,
+                cx_px: f64::from(plan.width_px) / 2.0 + 3.25,
+                cy_px: f64::from(plan.height_px) / 2.0 - 2.75,
+                ..AerialImage::ideal(
+                    &image_id,
+                    [
+                        t[0] - horizontal_m * a.sin(),
+                        t[1] - horizontal_m * a.cos(),
+                        ground_z_m + plan.altitude_m,
+                    ],
+                    [omega_deg, phi_deg, kappa_deg],
+                    focal_px,
+                    [plan.width_px, plan.height_px],
+                )
             });
         }
     }

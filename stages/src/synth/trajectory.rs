@@ -105,20 +105,19 @@ pub fn true_recordings(
             }
             let z = ground_height_m(s.x_world, s.y_world) + params.camera_height_m;
             Recording {
-                file: format!("{image_id}.jpg"),
-                image_id,
-                time: format_time_iso(t_s).unwrap_or_default(),
-                time_s: t_s,
-                x: s.x_world,
-                y: s.y_world,
-                z,
-                heading_deg: s.heading_deg,
-                camera_height_m: params.camera_height_m,
-                sigma_xy_m: Some(params.sigma_xy_m),
-                sigma_z_m: Some(params.sigma_z_m),
                 yaw_deg: yaw,
                 pitch_deg: pitch,
                 roll_deg: roll,
+                sigma_xy_m: Some(params.sigma_xy_m),
+                sigma_z_m: Some(params.sigma_z_m),
+                time: format_time_iso(t_s).unwrap_or_default(),
+                ..Recording::new(
+                    &image_id,
+                    t_s,
+                    [s.x_world, s.y_world, z],
+                    s.heading_deg,
+                    params.camera_height_m,
+                )
             }
         })
         .collect()

@@ -7,6 +7,8 @@ use nalgebra::Vector3;
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::geometry::{look_at_matrix, matrix_to_opk};
 
+pub mod tiny;
+
 /// Easting of the street's first recording, metres.
 pub const E0: f64 = 500_000.0;
 /// Northing of the street, metres.

@@ -151,30 +151,13 @@ mod tests {
     use super::*;
 
     fn nadir() -> AerialImage {
-        AerialImage {
-            image_id: "n1".into(),
-            file: "n1.jpg".into(),
-            x: 1000.0,
-            y: 2000.0,
-            z: 4471.0,
-            omega_deg: 0.1,
-            phi_deg: -0.2,
-            kappa_deg: -90.0,
-            focal_px: 44_700.0,
-            cx_px: 800.0,
-            cy_px: 600.0,
-            width_px: 1600,
-            height_px: 1200,
-            k1: 0.0,
-            k2: 0.0,
-            p1: 0.0,
-            p2: 0.0,
-            k3: 0.0,
-            k4: 0.0,
-            b1: 0.0,
-            b2: 0.0,
-            sigma_px: 0.5,
-        }
+        AerialImage::ideal(
+            "n1",
+            [1000.0, 2000.0, 4471.0],
+            [0.1, -0.2, -90.0],
+            44_700.0,
+            [1600, 1200],
+        )
     }
 
     #[test]

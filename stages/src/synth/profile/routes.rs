@@ -79,22 +79,7 @@ mod tests {
     use super::*;
 
     fn rec(id: &str, t: f64, x: f64, y: f64) -> Recording {
-        Recording {
-            image_id: id.into(),
-            file: format!("{id}.jpg"),
-            time: String::new(),
-            time_s: t,
-            x,
-            y,
-            z: 2.0,
-            heading_deg: 90.0,
-            camera_height_m: 2.2,
-            sigma_xy_m: None,
-            sigma_z_m: None,
-            yaw_deg: 0.0,
-            pitch_deg: 0.0,
-            roll_deg: 0.0,
-        }
+        Recording::new(id, t, [x, y, 2.0], 90.0, 2.2)
     }
 
     #[test]

@@ -7,20 +7,15 @@ use nalgebra::Vector3;
 
 fn rec(route: usize, i: usize, x: f64, y: f64, heading_deg: f64) -> Recording {
     Recording {
-        image_id: format!("p{route}_{i:03}"),
-        file: format!("p{route}_{i:03}.jpg"),
-        time: String::new(),
-        time_s: 3600.0 * route as f64 + i as f64 * 0.625,
-        x,
-        y,
-        z: 3.4,
-        heading_deg,
-        camera_height_m: 2.2,
         sigma_xy_m: Some(1.0),
         sigma_z_m: Some(0.3),
-        yaw_deg: 0.0,
-        pitch_deg: 0.0,
-        roll_deg: 0.0,
+        ..Recording::new(
+            &format!("p{route}_{i:03}"),
+            3600.0 * route as f64 + i as f64 * 0.625,
+            [x, y, 3.4],
+            heading_deg,
+            2.2,
+        )
     }
 }
 
@@ -36,30 +31,13 @@ fn truth() -> Tables {
     for i in 0..10 {
         recordings.push(rec(1, i, 6000.0, 2000.0 + 5.0 * i as f64, 0.0));
     }
-    let nadir = vec![AerialImage {
-        image_id: "n0".into(),
-        file: "n0.jpg".into(),
-        x: 1050.0,
-        y: 2000.0,
-        z: 4471.2,
-        omega_deg: 0.05,
-        phi_deg: -0.1,
-        kappa_deg: -90.0,
-        focal_px: 44_700.0,
-        cx_px: 800.0,
-        cy_px: 600.0,
-        width_px: 1600,
-        height_px: 1200,
-        k1: 0.0,
-        k2: 0.0,
-        p1: 0.0,
-        p2: 0.0,
-        k3: 0.0,
-        k4: 0.0,
-        b1: 0.0,
-        b2: 0.0,
-        sigma_px: 0.5,
-    }];
+    let nadir = vec![AerialImage::ideal(
+        "n0",
+        [1050.0, 2000.0, 4471.2],
+        [0.05, -0.1, -90.0],
+        44_700.0,
+        [1600, 1200],
+    )];
     Tables {
         recordings,
         nadir,
