@@ -49,6 +49,8 @@ text = open(sys.argv[1]).read()
 text = re.sub(r'stages = \[[^\]]*\]', 'stages = ["synth", "load", "ortho", "summary", "mm_match", "ortho_aerial", '
               '"transform", "refine", "control", "nadir", "grade_nadir", "adjust", "grade_adjust", "verify"]', text)
 text = text.replace('sources = "combined"', 'sources = "nadir"')
+# Drop the parameter tables of the oblique stages (a table needs its stage in `stages`).
+text = re.sub(r'(?ms)^\[(facades|patches|oblique|sparse_cloud)[^\]]*\].*?(?=^\[|\Z)', '', text)
 text = text.replace('name = "default"', 'name = "default-nadir"')
 open(sys.argv[2], "w").write(text)
 PY
@@ -60,9 +62,11 @@ for kind in twin real; do
     --out "$work/out-$kind" --quiet --timings "${threads[@]}" || echo "(run-$kind exit code $?)"
 done
 
-# One frame of each kind, ingested and decoded plainly in the same process.
+# One frame of each kind, ingested and decoded plainly in the same process (SKIP_DECODE=1 keeps an earlier
+# WORK_DIR/ingest_decode.txt).
 first() { find "$1" -maxdepth 1 -type f ! -name '*.csv' | sort | head -1; }
 files=("$(first "$work/real/aerial/nadir")" "$(first "$work/real/aerial/oblique")" "$(first "$work/real/mm/panoramas")")
-timed ingest-decode env SKYTIE_INGEST_REPS="${INGEST_REPS:-2}" "$ingest_bin" "${files[@]}" | tee "$work/ingest_decode.txt"
+[[ -n "${SKIP_DECODE:-}" && -s "$work/ingest_decode.txt" ]] ||
+  timed ingest-decode env SKYTIE_INGEST_REPS="${INGEST_REPS:-2}" "$ingest_bin" "${files[@]}" | tee "$work/ingest_decode.txt"
 
 python3 benches/realsize_summary.py "$work" | tee "$work/summary.md"

@@ -95,6 +95,7 @@ fn bench_file(path: &Path, dir: &Path, reps: usize) {
             return;
         }
     };
+    println!("{name}  ingest {ingest_s:.2} s");
     for (label, decode) in &decoders {
         match time_decode(reps, decode) {
             None => {}
