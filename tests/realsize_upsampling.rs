@@ -302,6 +302,13 @@ fn report(parts: &[&Vec<String>]) -> String {
         .join("\n")
 }
 
+/// The whole comparison with `what` upsampled must find no difference.
+fn assert_same_everywhere(what: Upsample) {
+    let d = compare_with_upsampled(what);
+    let all = report(&[&d.nadir, &d.oblique, &d.adjusted]);
+    assert!(all.is_empty(), "{all}");
+}
+
 /// The aerial frames read at their registration level: nadir frames 4× finer (2.5 cm instead of 10 cm) give
 /// the same MM tie points, initial transforms, located tie points, graded inlier ratio and aerial control
 /// points (positions within 1 mm).
@@ -314,14 +321,12 @@ fn aerial_frames_upsampled_4x_give_the_same_nadir_registration() {
 /// The whole comparison with only the aerial frames upsampled: also the oblique chain and the adjusted
 /// trajectory. Differs today: the aerial control points' σ comes from the frames' `sigma_px` (default 0.5 px
 /// of the full-resolution frame, not of the level the point was located at), so the upsampled run weights its
-/// control 4× tighter and the adjusted positions move ≈ 2 cm; the oblique inlier ratio before the consensus
+/// control 4× tighter and the adjusted positions move ≈ 2 cm (0.4 cm horizontally, 1.9 cm in height); the oblique inlier ratio before the consensus
 /// differs by one correspondence of four (0.25 vs 0.33).
 #[test]
 #[ignore = "known gap: control point σ from full-resolution pixels; see the doc comment"]
 fn aerial_frames_upsampled_4x_give_the_same_adjusted_trajectory() {
-    let d = compare_with_upsampled(Upsample::AerialOnly);
-    let all = report(&[&d.nadir, &d.oblique, &d.adjusted]);
-    assert!(all.is_empty(), "{all}");
+    assert_same_everywhere(Upsample::AerialOnly);
 }
 
 /// Every image upsampled 4× (the acceptance test). Differs today: panoramas sampled finer than their
@@ -330,7 +335,5 @@ fn aerial_frames_upsampled_4x_give_the_same_adjusted_trajectory() {
 #[test]
 #[ignore = "known gap: the MM side does not yet give the same registrations at 4x; see the doc comment"]
 fn a_campaign_upsampled_4x_registers_like_the_original() {
-    let d = compare_with_upsampled(Upsample::All);
-    let all = report(&[&d.nadir, &d.oblique, &d.adjusted]);
-    assert!(all.is_empty(), "{all}");
+    assert_same_everywhere(Upsample::All);
 }
