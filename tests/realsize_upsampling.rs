@@ -321,8 +321,8 @@ fn aerial_frames_upsampled_4x_give_the_same_nadir_registration() {
 /// The whole comparison with only the aerial frames upsampled: also the oblique chain and the adjusted
 /// trajectory. Differs today: the aerial control points' σ comes from the frames' `sigma_px` (default 0.5 px
 /// of the full-resolution frame, not of the level the point was located at), so the upsampled run weights its
-/// control 4× tighter and the adjusted positions move ≈ 2 cm (0.4 cm horizontally, 1.9 cm in height); the oblique inlier ratio before the consensus
-/// differs by one correspondence of four (0.25 vs 0.33).
+/// control 4× tighter and the adjusted positions move ≈ 2 cm (0.4 cm horizontally, 1.9 cm in height); the
+/// oblique inlier ratio before the consensus differs by one correspondence of four (0.25 vs 0.33).
 #[test]
 #[ignore = "known gap: control point σ from full-resolution pixels; see the doc comment"]
 fn aerial_frames_upsampled_4x_give_the_same_adjusted_trajectory() {
