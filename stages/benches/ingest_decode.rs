@@ -82,9 +82,12 @@ fn time_decode(
     Some(Ok(best))
 }
 
+/// A plain decode of one file: the pixel count it decoded, `None` when it does not apply to the file.
+type Decoder<'a> = dyn Fn() -> Option<Result<u64, String>> + 'a;
+
 fn bench_file(path: &Path, dir: &Path, reps: usize) {
     let name = path.display();
-    let decoders: [(&str, Box<dyn Fn() -> Option<Result<u64, String>>>); 2] = [
+    let decoders: [(&str, Box<Decoder>); 2] = [
         ("image", Box::new(|| Some(decode_image_crate(path)))),
         ("zune-jpeg luma", Box::new(|| decode_zune_luma(path))),
     ];
