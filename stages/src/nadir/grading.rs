@@ -5,7 +5,9 @@
 //! point's panorama observations, triangulated with the **true** recording poses, give its true object point X;
 //! the correspondence is correct when X, projected into the aerial image with its true pose, lies within
 //! [`CORRECT_TOLERANCE_PX`] (one aerial pixel) of the aerial observation — i.e. the MM rays and the aerial ray
-//! meet within one aerial pixel. A control point's error is its (aerial-triangulated) position minus X.
+//! meet within one aerial pixel — or within [`CORRECT_TOLERANCE_M`] (one pixel of the thesis' 10 cm frames)
+//! measured on the ground at X when that is more pixels, so the rule means the same on the ground for a frame
+//! finer than 10 cm (a 2.5 cm frame is allowed 4 px). A control point's error is its (aerial-triangulated) position minus X.
 //! An MM tie point is correct when every one of its panorama rays passes within [`MM_CORRECT_TOLERANCE_M`] of X.
 
 use crate::campaign::{AerialImage, Recording};
@@ -22,11 +24,13 @@ use std::collections::HashMap;
 /// changes.
 pub const STAGE: StageId = StageId {
     name: "grade_nadir",
-    version: "3",
+    version: "4",
 };
 
 /// A correspondence is correct within this distance, aerial pixels.
 pub const CORRECT_TOLERANCE_PX: f64 = 1.0;
+/// The same tolerance on the ground, m: the larger of the two, in pixels of the aerial image at X, applies.
+pub const CORRECT_TOLERANCE_M: f64 = 0.10;
 /// An MM tie point's rays must pass within this distance of the true point, metres.
 pub const MM_CORRECT_TOLERANCE_M: f64 = 0.05;
 
@@ -86,7 +90,7 @@ pub struct NadirGrade {
     pub delivered_correct: usize,
     /// Error (aerial px) of the graded correspondences: median, 90th percentile, largest.
     pub correspondence_error_px: [f64; 3],
-    /// The wrong correspondences (error above [`CORRECT_TOLERANCE_PX`]), largest error first, so a user can
+    /// The wrong correspondences (error above the tolerance), largest error first, so a user can
     /// look at each one (`skytie tool ortho`, the report's registration views).
     pub wrong: Vec<WrongCorrespondence>,
 }
@@ -141,17 +145,21 @@ impl Truth {
         triangulate_rays(&rays, &sigmas).ok().map(|t| t.point_world)
     }
 
-    /// (u, v) minus the true projection of `x_world` into aerial image `aerial_id`, aerial px.
+    /// (u, v) minus the true projection of `x_world` into aerial image `aerial_id`, aerial px, and the
+    /// correctness tolerance there, px ([`CORRECT_TOLERANCE_PX`], or [`CORRECT_TOLERANCE_M`] in pixels of
+    /// the image at `x_world` when that is larger).
     fn aerial_offset_px(
         &self,
         aerial_id: &str,
         x_world: &Vector3<f64>,
         u: f64,
         v: f64,
-    ) -> Option<[f64; 2]> {
+    ) -> Option<([f64; 2], f64)> {
         let cam = FrameCamera::from_aerial(self.aerial.get(aerial_id)?);
         let (pu, pv) = cam.project_world(x_world)?;
-        Some([u - pu, v - pv])
+        let pixel_m = (x_world - cam.center_world).norm() / cam.focal_px;
+        let tolerance_px = CORRECT_TOLERANCE_PX.max(CORRECT_TOLERANCE_M / pixel_m);
+        Some(([u - pu, v - pv], tolerance_px))
     }
 }
 
@@ -192,11 +200,11 @@ pub fn grade_nadir(
             let (u, v) = (m.observation.u_px, m.observation.v_px);
             let err = x.and_then(|x| truth.aerial_offset_px(&r.aerial_id, &x, u, v));
             match err {
-                Some(offset) => {
+                Some((offset, tolerance_px)) => {
                     let e = offset[0].hypot(offset[1]);
                     g.tie_points += 1;
                     errors_px.push(e);
-                    if e <= CORRECT_TOLERANCE_PX {
+                    if e <= tolerance_px {
                         g.correct_tie_points += 1;
                     } else {
                         g.wrong.push(WrongCorrespondence {
@@ -226,11 +234,11 @@ pub fn grade_nadir(
     for c in control {
         let x = truth.true_point(&c.mm);
         for o in &c.aerial {
-            if let Some(off) =
+            if let Some((off, tolerance_px)) =
                 x.and_then(|x| truth.aerial_offset_px(&o.image_id, &x, o.u_px, o.v_px))
             {
                 g.delivered_tie_points += 1;
-                g.delivered_correct += usize::from(off[0].hypot(off[1]) <= CORRECT_TOLERANCE_PX);
+                g.delivered_correct += usize::from(off[0].hypot(off[1]) <= tolerance_px);
             }
         }
     }

@@ -6,7 +6,9 @@
 //! 1. the panorama ray through `mm` and the oblique ray through `oblique_px` pass each other within
 //!    [`CLOSEST_APPROACH_TOLERANCE_M`] = 0.15 m, in front of both cameras; and
 //! 2. the reference point reprojects into the oblique image within [`REPROJECTION_TOLERANCE_PX`] = 1.5 px of
-//!    `oblique_px`.
+//!    `oblique_px`, or within [`REPROJECTION_TOLERANCE_M`] = 0.15 m measured on the ground at the reference
+//!    point when that is more pixels (so the rule means the same on the ground for a frame finer than the
+//!    thesis' ≈ 10 cm obliques: a 2.5 cm frame is allowed 6 px).
 //!
 //! The **reference point** is what the panorama observation depicts:
 //! - with the campaign's scene (`truth/scene.toml` of skytie's generator, [`SceneOracle`]): the first surface
@@ -49,13 +51,15 @@ pub use crate::synth::scene_truth::SceneOracle;
 /// changes.
 pub const STAGE: StageId = StageId {
     name: "grade_oblique",
-    version: "3",
+    version: "4",
 };
 
 /// Largest closest-approach distance of the panorama and oblique rays of a correct correspondence, m.
 pub const CLOSEST_APPROACH_TOLERANCE_M: f64 = 0.15;
 /// Largest reprojection error of the best point in the oblique image of a correct correspondence, px.
 pub const REPROJECTION_TOLERANCE_PX: f64 = 1.5;
+/// The same tolerance on the ground (1.5 px of a 10 cm oblique), m: the larger of the two, in pixels, applies.
+pub const REPROJECTION_TOLERANCE_M: f64 = 0.15;
 
 /// Counts of one street side.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -215,16 +219,29 @@ pub fn grade_match(
 pub struct MatchErrors {
     pub closest_approach_m: f64,
     pub reprojection_px: f64,
+    /// Size of one oblique pixel at the reference point (distance from the camera / focal length), m.
+    pub pixel_m: f64,
     pub matchable: bool,
 }
 
 impl MatchErrors {
+    /// The reprojection tolerance of this correspondence, px: [`REPROJECTION_TOLERANCE_PX`], or
+    /// [`REPROJECTION_TOLERANCE_M`] in pixels at the reference point when that is larger.
+    pub fn tolerance_px(&self) -> f64 {
+        let ground_px = if self.pixel_m > 0.0 {
+            REPROJECTION_TOLERANCE_M / self.pixel_m
+        } else {
+            0.0
+        };
+        REPROJECTION_TOLERANCE_PX.max(ground_px)
+    }
+
     /// The rule of the module doc.
     pub fn verdict(&self) -> Verdict {
         if !self.matchable {
             Verdict::NonMatchable
         } else if self.closest_approach_m <= CLOSEST_APPROACH_TOLERANCE_M
-            && self.reprojection_px <= REPROJECTION_TOLERANCE_PX
+            && self.reprojection_px <= self.tolerance_px()
         {
             Verdict::Correct
         } else {
@@ -270,6 +287,7 @@ pub fn observation_errors(
     let far = MatchErrors {
         closest_approach_m: f64::INFINITY,
         reprojection_px: f64::INFINITY,
+        pixel_m: 0.0,
         matchable: true,
     };
     let surface = match scene {
@@ -305,6 +323,7 @@ pub fn observation_errors(
         reprojection_px: cam
             .project_world(&reference)
             .map_or(f64::INFINITY, |(pu, pv)| (pu - u).hypot(pv - v)),
+        pixel_m: (reference - cam.center_world).norm() / cam.focal_px,
         matchable: true,
     })
 }
