@@ -342,7 +342,8 @@ pub fn build_block(
                 p
             }
         };
-        let kind = if cp.aerial.len() >= 2 {
+        // An orthophoto control point (`map`) is control like a point triangulated from ≥ 2 aerial images.
+        let kind = if cp.aerial.len() >= 2 || cp.map.is_some() {
             PointKind::Control
         } else {
             PointKind::SingleAerial
@@ -351,7 +352,7 @@ pub fn build_block(
             points[p].kind = kind;
         }
         points[p].aerial.extend(aerial.iter().copied());
-        if config.aerial_observations {
+        if config.aerial_observations && cp.map.is_none() {
             let initial = block.points_initial_world[p];
             for &(camera, u, v) in &aerial {
                 if FrameCamera::from_aerial(aerial_rows[camera])
@@ -371,8 +372,16 @@ pub fn build_block(
                 });
             }
             counts.control_as_aerial_observations += usize::from(!aerial.is_empty());
-        } else if let Some(xyz) = cp.point_world.filter(|_| cp.aerial.len() >= 2) {
-            let covariance_m2 = match config.control_weighting {
+        } else if let Some(xyz) = cp
+            .point_world
+            .filter(|_| cp.aerial.len() >= 2 || cp.map.is_some())
+        {
+            // Orthophoto points always carry their stated accuracy (the fixed σ describes aerial triangulation).
+            let weighting = match cp.map {
+                Some(_) => ControlWeighting::Covariance,
+                None => config.control_weighting,
+            };
+            let covariance_m2 = match weighting {
                 ControlWeighting::Fixed => {
                     Matrix3::identity() * (config.control_sigma_m * config.control_sigma_m)
                 }
