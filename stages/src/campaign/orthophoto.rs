@@ -12,7 +12,7 @@ const TOML: &str = "campaign.toml";
 pub const DEFAULT_DTM_SIGMA_M: f64 = 0.25;
 
 /// One GeoTIFF tile and its header.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct RasterFile {
     /// As written in `campaign.toml` (relative to the campaign folder, or absolute).
     pub file: String,

@@ -21,7 +21,7 @@ const SQUARE_TOLERANCE: f64 = 1e-6;
 
 /// A north-up raster's placement: world (easting, northing) of continuous pixel (u, v) is
 /// `(origin_x_m + u·pixel_m, origin_y_m − v·pixel_m)`.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct GeoTransform {
     /// World easting of the image's top-left corner, m.
     pub origin_x_m: f64,
@@ -50,7 +50,7 @@ impl GeoTransform {
 }
 
 /// A georeferenced raster's header: size, placement and CRS code.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct RasterHeader {
     pub width_px: u32,
     pub height_px: u32,
@@ -169,6 +169,34 @@ pub fn read_header(path: &Path) -> Result<RasterHeader, String> {
     })
 }
 
+/// GeoTIFF tags placing a north-up raster by `t` in the projected CRS `EPSG:epsg` (raster type PixelIsArea).
+pub fn geotiff_tags(t: &GeoTransform, epsg: u16) -> GeoTiffTags {
+    const GT_MODEL_TYPE: u16 = 1024;
+    GeoTiffTags {
+        model_pixel_scale: Some(vec![t.pixel_m, t.pixel_m, 0.0]),
+        model_tiepoints: Some(vec![0.0, 0.0, 0.0, t.origin_x_m, t.origin_y_m, 0.0]),
+        geo_key_directory: Some(vec![
+            1,
+            1,
+            0,
+            3,
+            GT_MODEL_TYPE,
+            0,
+            1,
+            1,
+            GT_RASTER_TYPE,
+            0,
+            1,
+            1,
+            PROJECTED_CS_TYPE,
+            0,
+            1,
+            epsg,
+        ]),
+        ..GeoTiffTags::default()
+    }
+}
+
 /// The EPSG code of the horizontal part of a campaign `crs` (`EPSG:28992+5709` → 28992).
 pub fn campaign_epsg(crs: &str) -> Option<u32> {
     let s = crs.trim();
@@ -235,6 +263,18 @@ mod tests {
         assert!(geotransform(&GeoTiffTags::default())
             .unwrap_err()
             .contains("GeoTIFF"));
+    }
+
+    #[test]
+    fn written_tags_read_back_to_the_same_transform() {
+        let t = GeoTransform {
+            origin_x_m: 155_000.25,
+            origin_y_m: 463_100.5,
+            pixel_m: 0.08,
+        };
+        let tags = geotiff_tags(&t, 28992);
+        assert_eq!(geotransform(&tags).unwrap(), t);
+        assert_eq!(epsg_code(&tags), Some(28992));
     }
 
     #[test]

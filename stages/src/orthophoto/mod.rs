@@ -8,12 +8,14 @@
 pub mod control;
 pub mod dtm;
 pub mod register;
+pub mod summary;
 
 pub use crate::campaign::orthophoto::{DtmSource, OrthophotoSource, RasterFile};
 pub use crate::imaging::georef::{GeoTransform, RasterHeader};
 pub use control::{orthophoto_control, OrthophotoControl, OrthophotoInput};
 pub use dtm::{Dtm, DtmTile};
 pub use register::{nominal_transform, register_translation};
+pub use summary::OrthophotoSummary;
 
 use crate::nadir::refine::RefineParams;
 use crate::params::StageId;
