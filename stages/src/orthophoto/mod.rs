@@ -33,6 +33,8 @@ crate::params! {
         /// The largest offset of a recorded position from the orthophoto that the registration searches
         /// (the expected maximum localisation error, thesis 3.4.5.1).
         max_offset_m: f64 = 3.0, unit "m", min 0.1, max 50.0;
+        /// Side of the ortho's central square (the road around the vehicle) registered to the orthophoto.
+        road_template_m: f64 = 12.0, unit "m", min 2.0, max 100.0;
         /// A coarse registration whose correlation peak is below this is rejected.
         min_peak: f64 = 0.05, min 0.0, max 1.0;
         /// Precision of a located tie point in the orthophoto at the working resolution, added to the stated

@@ -1,14 +1,17 @@
 //! The initial transform of a panorama's ground ortho into the orthophoto (the orthophoto's counterpart of
 //! thesis 3.4.5.2). An orthophoto is north-up with a known pixel size, so the ortho is made north-up at the
 //! orthophoto's resolution and the two differ by a translation only — the recording's position error. It is
-//! found by phase correlation of the whole ortho (the vehicle's masked pixels set to the mean) against the
-//! orthophoto sampled on the ortho grid, grown on every side by the largest offset searched. A peak below
+//! found by phase correlation of the ortho's centre — the road around the vehicle, `road_template_m` wide,
+//! without the façades that the ortho-projection smears across the ground (the vehicle's masked pixels set to
+//! the mean) — against the orthophoto sampled on the ortho grid, grown on every side by the largest offset
+//! searched; both Wallis-filtered first. A peak below
 //! `min_peak` or an offset beyond `max_offset_m` rejects the recording, with the reason.
 
 use super::OrthophotoParams;
 use crate::geometry::Similarity2;
 use crate::imaging::georef::GeoTransform;
 use crate::imaging::pyramid::{PyramidError, TileSource};
+use crate::imaging::wallis::{wallis_filter, WallisParams};
 use crate::imaging::GrayImage;
 use crate::matching::phase_correlation::{locate_template, PhaseCorrelationParams};
 use crate::nadir::aerial_patch::AerialWindow;
@@ -22,6 +25,26 @@ pub fn nominal_transform(georef: &OrthoGeoref, photo: &GeoTransform) -> Similari
     let (u0, v0) = photo.world_to_pixel(p0.x, p0.y);
     let (u1, v1) = photo.world_to_pixel(p1.x, p1.y);
     Similarity2::from_ab(u1 - u0, v1 - v0, u0, v0)
+}
+
+/// The central `side × side` pixels of the ortho (the road around the vehicle), masked pixels set to the mean
+/// of the valid ones, Wallis-filtered like the search window; and the crop's top-left ortho pixel.
+fn road_template(ortho: &OrthoImage, side: usize) -> (GrayImage, (usize, usize)) {
+    let filled = filled_template(ortho);
+    let (w, h) = (filled.width, filled.height);
+    let (cw, ch) = (side.min(w), side.min(h));
+    let (x0, y0) = ((w - cw) / 2, (h - ch) / 2);
+    let mut crop = GrayImage::filled(cw, ch, 0.0);
+    for r in 0..ch {
+        let start = (y0 + r) * w + x0;
+        crop.data[r * cw..(r + 1) * cw].copy_from_slice(&filled.data[start..start + cw]);
+    }
+    (wallis_or_same(crop), (x0, y0))
+}
+
+/// The image Wallis-filtered (thesis 3.4.5.2 equalises MM and aerial contrast so), or unchanged if it cannot be.
+fn wallis_or_same(img: GrayImage) -> GrayImage {
+    wallis_filter(&img, &WallisParams::default()).unwrap_or(img)
 }
 
 /// The ortho's grey values with masked pixels set to the mean of the valid ones.
@@ -84,11 +107,16 @@ pub fn register_translation(
             p.max_offset_m
         )));
     }
-    let template = filled_template(ortho);
+    let side = (p.road_template_m / gsd_m).round().max(8.0) as usize;
+    let (template, (x0, y0)) = road_template(ortho, side);
+    let search = wallis_or_same(search);
     let Ok(loc) = locate_template(&template, &search, &PhaseCorrelationParams::default()) else {
         return Ok(reject("phase correlation failed".into()));
     };
-    let (dx, dy) = (loc.u_px - (mf + wf / 2.0), loc.v_px - (mf + hf / 2.0));
+    // The template's centre is at ortho pixel (x0 + tw/2, y0 + th/2), i.e. search pixel m + that.
+    let (tw, th) = (template.width as f64, template.height as f64);
+    let dx = loc.u_px - (mf + x0 as f64 + tw / 2.0);
+    let dy = loc.v_px - (mf + y0 as f64 + th / 2.0);
     let offset_m = dx.hypot(dy) * gsd_m;
     if !(offset_m <= p.max_offset_m) {
         return Ok(reject(format!(
