@@ -161,7 +161,11 @@ pub fn add_nadir(
         )?;
         windows.push(window);
         if let Some(route) = photo_route.as_mut() {
-            control.extend(route.add_recording(b, item, window)?);
+            control.extend(route.add_recording(
+                b,
+                (item.recording, item.row, item.pano_image),
+                window,
+            )?);
         }
         if !on(stage::ORTHO_AERIAL) {
             continue;

@@ -4,7 +4,6 @@
 //! resolution and the `orthophoto` node (registration, tie points, control points), whose control points join
 //! the frames' (when the campaign has both, the adjustment takes both, each with its own σ).
 
-use super::nadir::RecordingItem;
 use super::wf_err;
 use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::campaign::ingest::{ingest_file, IngestedImage};
@@ -16,6 +15,7 @@ use crate::nodes::nadir::orthophoto::{
 };
 use crate::workflow::Workflow;
 use skytie_stages::campaign::orthophoto::{OrthophotoSource, DEFAULT_DTM_SIGMA_M};
+use skytie_stages::campaign::Recording;
 use skytie_stages::nadir::aerial_patch::working_level;
 use skytie_stages::nadir::{MmWindowMatch, OrthoParams, RecordingControl};
 use skytie_stages::orthophoto::{Dtm, OrthophotoControl, OrthophotoParams, OrthophotoSummary};
@@ -55,10 +55,9 @@ impl<'a> OrthophotoRoute<'a> {
         let recs = &snapshot.campaign.recordings;
         let dtm = match (&snapshot.campaign.dtm, recs.is_empty()) {
             (Some(d), false) => {
-                let fold =
-                    |f: fn(f64, f64) -> f64,
-                     pick: fn(&skytie_stages::campaign::Recording) -> f64,
-                     init| { recs.iter().map(pick).fold(init, f) };
+                let fold = |f: fn(f64, f64) -> f64, pick: fn(&Recording) -> f64, init| {
+                    recs.iter().map(pick).fold(init, f)
+                };
                 let area_m = [
                     fold(f64::min, |r| r.x, f64::INFINITY) - DTM_MARGIN_M,
                     fold(f64::min, |r| r.y, f64::INFINITY) - DTM_MARGIN_M,
@@ -90,10 +89,9 @@ impl<'a> OrthophotoRoute<'a> {
     pub fn add_recording(
         &mut self,
         b: &mut DagBuilder,
-        item: &RecordingItem<'_>,
+        (r, row, pano_image): (&Recording, Handle<Recording>, Handle<IngestedImage>),
         window: Handle<MmWindowMatch>,
     ) -> Result<Option<Handle<RecordingControl>>, PipelineError> {
-        let r = item.recording;
         let foot = [r.x, r.y];
         let Some(k) = self
             .source
@@ -126,12 +124,7 @@ impl<'a> OrthophotoRoute<'a> {
             ..self.ortho_base.clone()
         };
         let label = format!("rec {} × {}", r.image_id, tile.file);
-        let ortho = b.add(
-            OrthoProject,
-            &label,
-            ortho_params,
-            (item.row, item.pano_image),
-        )?;
+        let ortho = b.add(OrthoProject, &label, ortho_params, (row, pano_image))?;
         let params = OrthophotoNodeParams {
             route: self.params.clone(),
             tile: tile.clone(),
