@@ -2,6 +2,7 @@
 //! (campaign format + `truth/`) with the named error profile.
 
 use clap::Args;
+use skytie_stages::synth::orthophoto::OrthophotoOptions;
 use skytie_stages::synth::output::{aerial_format_from, parse_size_px};
 use skytie_stages::synth::profile::COMPONENTS;
 use skytie_stages::synth::sizes::SizeOptions;
@@ -56,6 +57,21 @@ pub struct SynthArgs {
     /// Write the campaign at the size it is rendered at (a real-size preset's demo-size twin).
     #[arg(long)]
     pub at_render_size: bool,
+    /// Also write an orthophoto of this GSD, m, and a 1 m DTM (GeoTIFFs under orthophoto/, declared in
+    /// campaign.toml).
+    #[arg(long, value_name = "M")]
+    pub orthophoto_gsd: Option<f64>,
+    /// RMS planimetric error of the orthophoto, m: a known smooth warp (truth/orthophoto.toml).
+    #[arg(
+        long,
+        value_name = "M",
+        default_value_t = 0.0,
+        requires = "orthophoto_gsd"
+    )]
+    pub orthophoto_error: f64,
+    /// Leave the nadir frames out: the orthophoto is the campaign's only nadir source.
+    #[arg(long, requires = "orthophoto_gsd")]
+    pub without_nadir: bool,
 }
 
 /// The size options of the command line.
@@ -105,6 +121,11 @@ pub fn main(a: &SynthArgs) -> i32 {
             return 2;
         }
     };
+    options.orthophoto = a.orthophoto_gsd.map(|gsd_m| OrthophotoOptions {
+        gsd_m,
+        error_m: a.orthophoto_error,
+        without_nadir: a.without_nadir,
+    });
     let run = || generate(&options, out);
     let result = match a.threads {
         Some(n) => match rayon::ThreadPoolBuilder::new()

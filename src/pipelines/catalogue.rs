@@ -21,8 +21,9 @@ use skytie_stages::nadir::OrthoParams;
 use skytie_stages::oblique::facades::FacadeParams;
 use skytie_stages::oblique::patch_registration::PatchParams;
 use skytie_stages::oblique::sparse_cloud::SparseCloudParams;
+use skytie_stages::orthophoto::OrthophotoParams;
 use skytie_stages::params::{ParamSpec, Params, StageId};
-use skytie_stages::{adjustment, nadir, oblique, synth};
+use skytie_stages::{adjustment, nadir, oblique, orthophoto, synth};
 
 /// One workflow table: its name (the stage's), what the stage does, and its parameter type's documentation,
 /// defaults and validation.
@@ -102,6 +103,10 @@ pub fn tables() -> Vec<ParamTable> {
         table::<ControlParams>(
             nadir::control_points::STAGE,
             "triangulate registered road points from the aerial images as control (thesis 3.4.5.4)",
+        ),
+        table::<OrthophotoParams>(
+            orthophoto::STAGE,
+            "register the top-view images with the campaign's orthophoto and take control from it and the DTM",
         ),
         table::<BaselineParams>(
             nadir::baseline::STAGE,

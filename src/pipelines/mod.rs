@@ -6,6 +6,7 @@ pub mod adjust;
 pub mod catalogue;
 pub mod nadir;
 pub mod oblique;
+pub mod orthophoto;
 pub mod shards;
 pub mod skytie;
 pub mod validate;

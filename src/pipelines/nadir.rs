@@ -4,6 +4,7 @@
 //! aerial control points (`control`), then the global `nadir` summary and — on synthetic campaigns with
 //! `truth/` — the evaluation node `grade_nadir`.
 
+use super::orthophoto::OrthophotoRoute;
 use super::{distance_m, missing_upstream, stage, wf_err};
 use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::campaign::aerial::{SelectAerial, SelectAerialParams};
@@ -124,6 +125,10 @@ pub fn add_nadir(
         )));
     };
     let nadir_dir = root.join("aerial/nadir");
+    let mut photo_route = match on(stage::CONTROL) {
+        true => OrthophotoRoute::new(b, wf, variant, root, snapshot, ortho_base)?,
+        false => None,
+    };
 
     let mut aerial_rows: BTreeMap<usize, Handle<AerialImage>> = BTreeMap::new();
     let mut windows = Vec::new();
@@ -155,6 +160,13 @@ pub fn add_nadir(
             ),
         )?;
         windows.push(window);
+        if let Some(route) = photo_route.as_mut() {
+            control.extend(route.add_recording(
+                b,
+                (item.recording, item.row, item.pano_image),
+                window,
+            )?);
+        }
         if !on(stage::ORTHO_AERIAL) {
             continue;
         }
@@ -268,6 +280,9 @@ pub fn add_nadir(
                 (window, optional_all(&rec_refinements), rec_aerials),
             )?);
         }
+    }
+    if let Some(route) = photo_route {
+        route.finish(b)?;
     }
     if on(stage::NADIR) {
         let summary = b.add(

@@ -19,6 +19,7 @@ pub mod import;
 pub mod matching;
 pub mod nadir;
 pub mod oblique;
+pub mod orthophoto;
 pub mod params;
 pub mod rng;
 pub mod synth;

@@ -128,6 +128,8 @@ fn write_valid_campaign(root: &Path) -> Campaign {
         oblique,
         checkpoints,
         observations,
+        orthophoto: None,
+        dtm: None,
     }
 }
 

@@ -92,6 +92,7 @@ fn control() -> Vec<AerialControlPoint> {
     };
     vec![
         AerialControlPoint {
+            map: None,
             tie_point_id: "t 1".into(),
             mm: vec![
                 PanoObservation {
@@ -110,6 +111,7 @@ fn control() -> Vec<AerialControlPoint> {
             covariance_m2: Some([[0.0004, 0.0, 0.0], [0.0, 0.0009, 0.0], [0.0, 0.0, 0.25]]),
         },
         AerialControlPoint {
+            map: None,
             tie_point_id: "t2".into(),
             mm: vec![],
             aerial: vec![aerial("n1", 1.0, 1.0)],

@@ -82,6 +82,7 @@ fn a_shifted_aerial_observation_is_graded_wrong_and_listed() {
     };
     // The control point keeps only the exact observation (as if the consistency check had dropped the other).
     let control = AerialControlPoint {
+        map: None,
         tie_point_id: tie_point.id.clone(),
         mm: tie_point.observations.clone(),
         aerial: vec![exact.matches[0].observation.clone()],

@@ -179,6 +179,7 @@ fn grade_counts_before_and_after_consensus_per_side() {
     // A control point 3 cm east and 4 cm above the true point of point 2.
     let x = s.points[2];
     let control = vec![AerialControlPoint {
+        map: None,
         tie_point_id: s.cloud.points[2].tie.id.clone(),
         mm: s.cloud.points[2].tie.observations.clone(),
         aerial: vec![AerialObservation {

@@ -9,6 +9,7 @@ pub mod mm_match;
 pub mod options;
 pub mod ortho;
 pub mod ortho_aerial;
+pub mod orthophoto;
 pub mod refine;
 pub mod summary;
 pub mod transform;

@@ -226,7 +226,8 @@ pub fn build_block(
                 p
             }
         };
-        let kind = if cp.aerial.len() >= 2 {
+        // An orthophoto control point (`map`) is control like a point triangulated from ≥ 2 aerial images.
+        let kind = if cp.aerial.len() >= 2 || cp.map.is_some() {
             PointKind::Control
         } else {
             PointKind::SingleAerial
@@ -235,9 +236,12 @@ pub fn build_block(
             points[p].kind = kind;
         }
         points[p].aerial.extend(aerial.iter().copied());
-        if config.aerial_observations {
+        if config.aerial_observations && cp.map.is_none() {
             add_aerial_observations(&mut block, &cameras.rows, p, &aerial, &mut counts);
-        } else if let Some(xyz) = cp.point_world.filter(|_| cp.aerial.len() >= 2) {
+        } else if let Some(xyz) = cp
+            .point_world
+            .filter(|_| cp.aerial.len() >= 2 || cp.map.is_some())
+        {
             block.control_points.push(ControlPoint {
                 point: p,
                 position_world: Vector3::from(xyz),
@@ -483,7 +487,12 @@ fn control_covariance(
     cp: &AerialControlPoint,
     owner: &str,
 ) -> Result<Matrix3<f64>, AdjustError> {
-    match config.control_weighting {
+    // Orthophoto points always carry their stated accuracy (the fixed σ describes aerial triangulation).
+    let weighting = match cp.map {
+        Some(_) => ControlWeighting::Covariance,
+        None => config.control_weighting,
+    };
+    match weighting {
         ControlWeighting::Fixed => {
             Ok(Matrix3::identity() * (config.control_sigma_m * config.control_sigma_m))
         }

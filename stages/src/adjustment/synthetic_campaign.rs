@@ -240,6 +240,7 @@ impl SyntheticCampaignSpec {
                 })
                 .flatten();
             control.push(AerialControlPoint {
+                map: None,
                 tie_point_id: format!("t{}", cp.point),
                 mm: pano_obs(cp.point),
                 aerial,

@@ -189,7 +189,9 @@ pub fn verify(
     let mut rays = Vec::new();
     let mut sigmas = Vec::new();
     for cp in control {
-        let (Some(aerial_xyz), true) = (cp.point_world, cp.aerial.len() >= 2) else {
+        // Triangulated from ≥ 2 aerial images, or measured in the orthophoto.
+        let usable = cp.aerial.len() >= 2 || cp.map.is_some();
+        let (Some(aerial_xyz), true) = (cp.point_world, usable) else {
             skipped_single_aerial += 1;
             continue;
         };

@@ -5,6 +5,7 @@ pub mod cameras;
 pub mod check;
 pub mod images;
 pub mod model;
+pub mod orthophoto;
 mod plausibility;
 pub mod problem;
 mod ranges;

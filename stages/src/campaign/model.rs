@@ -178,4 +178,10 @@ pub struct Campaign {
     pub oblique: Vec<AerialImage>,
     pub checkpoints: Vec<CheckPoint>,
     pub observations: Vec<Observation>,
+    /// `campaign.toml` `[orthophoto]`: the orthophoto tiles and their stated accuracy.
+    #[serde(default)]
+    pub orthophoto: Option<super::orthophoto::OrthophotoSource>,
+    /// `campaign.toml` `[dtm]`: the terrain model tiles and their stated accuracy.
+    #[serde(default)]
+    pub dtm: Option<super::orthophoto::DtmSource>,
 }

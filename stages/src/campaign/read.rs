@@ -3,6 +3,7 @@
 //! their existence is checked.
 
 use super::model::{AerialImage, Campaign, Recording};
+use super::orthophoto::read_orthophoto_tables;
 use super::plausibility::{check_checkpoints, check_trajectory, shared_images, ImageUse};
 use super::problem::{Problem, ProblemKind};
 use super::read_aerial::read_aerial_rows;
@@ -17,7 +18,7 @@ use std::path::{Path, PathBuf};
 /// changes.
 pub const STAGE: StageId = StageId {
     name: "load",
-    version: "2",
+    version: "3",
 };
 
 /// The folder holds nothing usable as a campaign.
@@ -74,7 +75,11 @@ pub fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>), Camp
         return Err(CampaignError::NotACampaign(root.to_path_buf()));
     }
     let mut problems = Vec::new();
-    let (name, crs) = read_toml(root, &mut problems);
+    let (name, crs, parsed) = read_toml(root, &mut problems);
+    let (orthophoto, dtm) = match &parsed {
+        Some((text, table)) => read_orthophoto_tables(root, text, table, &crs, &mut problems),
+        None => (None, None),
+    };
 
     let mut recordings = if root.join(RECORDINGS).is_file() {
         read_recording_rows(
@@ -225,6 +230,8 @@ pub fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>), Camp
         oblique,
         checkpoints,
         observations,
+        orthophoto,
+        dtm,
     };
     sort_problems(&mut problems);
     let sourced = SourcedCampaign {
@@ -293,8 +300,12 @@ pub fn sort_problems(problems: &mut [Problem]) {
     });
 }
 
-/// `name` and `crs` of `campaign.toml` (empty strings when missing, with a problem).
-fn read_toml(root: &Path, problems: &mut Vec<Problem>) -> (String, String) {
+/// `name` and `crs` of `campaign.toml` (empty strings when missing, with a problem), and its text and table
+/// when it parses.
+fn read_toml(
+    root: &Path,
+    problems: &mut Vec<Problem>,
+) -> (String, String, Option<(String, toml::Table)>) {
     const HINT: &str = "write campaign.toml with name = \"...\" and crs = \"EPSG:...\"";
     let text = match std::fs::read_to_string(root.join(TOML)) {
         Ok(t) => t,
@@ -303,7 +314,7 @@ fn read_toml(root: &Path, problems: &mut Vec<Problem>) -> (String, String) {
                 Problem::error(TOML, None, None, "does not exist", HINT)
                     .with_kind(ProblemKind::Missing),
             );
-            return (String::new(), String::new());
+            return (String::new(), String::new(), None);
         }
         Err(e) => {
             problems.push(Problem::error(
@@ -313,7 +324,7 @@ fn read_toml(root: &Path, problems: &mut Vec<Problem>) -> (String, String) {
                 format!("cannot be read ({e})"),
                 "save it as UTF-8 text and make it readable",
             ));
-            return (String::new(), String::new());
+            return (String::new(), String::new(), None);
         }
     };
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
@@ -334,7 +345,7 @@ fn read_toml(root: &Path, problems: &mut Vec<Problem>) -> (String, String) {
                 format!("is not valid TOML ({})", e.message()),
                 HINT,
             ));
-            return (String::new(), String::new());
+            return (String::new(), String::new(), None);
         }
     };
     let mut key = |k: &str| -> String {
@@ -366,5 +377,6 @@ fn read_toml(root: &Path, problems: &mut Vec<Problem>) -> (String, String) {
             }
         }
     };
-    (key("name"), key("crs"))
+    let (name, crs) = (key("name"), key("crs"));
+    (name, crs, Some((text.to_string(), table)))
 }

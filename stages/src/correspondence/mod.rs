@@ -61,4 +61,30 @@ pub struct AerialControlPoint {
     pub point_world: Option<[f64; 3]>,
     /// A-priori covariance of `point_world` (σ0 = 1, from the aerial images' `sigma_px`), m², row-major.
     pub covariance_m2: Option<[[f64; 3]; 3]>,
+    /// Set when the point comes from an orthophoto instead of aerial frames (`aerial` is then empty): where it
+    /// was measured and where its height came from. `point_world` and `covariance_m2` are then always set.
+    #[serde(default)]
+    pub map: Option<MapControl>,
+}
+
+/// Where a height came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum HeightSource {
+    /// Interpolated bilinearly in the campaign's DTM.
+    Dtm,
+    /// The mobile-mapping ground estimate (no DTM, or none at the point).
+    MmGround,
+}
+
+/// The orthophoto measurement of a control point.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MapControl {
+    /// The orthophoto tile, as named in `campaign.toml`.
+    pub orthophoto: String,
+    /// Continuous pixel in that tile (full resolution).
+    pub u_px: f64,
+    pub v_px: f64,
+    /// Phase-correlation peak of the match.
+    pub score: f64,
+    pub height: HeightSource,
 }

@@ -65,6 +65,7 @@ mod tests {
     #[test]
     fn one_row_per_observation_panorama_first() {
         let p = AerialControlPoint {
+            map: None,
             tie_point_id: "pano_1#3".into(),
             mm: vec![
                 PanoObservation {

@@ -8,6 +8,7 @@ pub use skytie_util::huge_pages;
 pub mod budget;
 pub mod decode;
 pub mod equirect;
+pub mod georef;
 pub mod image;
 pub mod ingest;
 pub mod io;

@@ -35,7 +35,7 @@ use nalgebra::{Vector2, Vector3};
 /// changes.
 pub const STAGE: StageId = StageId {
     name: "control",
-    version: "1",
+    version: "2",
 };
 
 crate::params! {
@@ -257,6 +257,7 @@ pub fn aerial_control_points(
             },
         };
         out.push(AerialControlPoint {
+            map: None,
             tie_point_id: tp.id.clone(),
             mm: tp.observations.clone(),
             aerial: kept.into_iter().map(|c| c.observation).collect(),

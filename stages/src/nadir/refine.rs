@@ -326,7 +326,30 @@ pub fn refine_in_aerial(
     neighbours: &[NeighbourOrtho],
     p: &RefineParams,
 ) -> Result<AerialRefinement, PyramidError> {
-    let mut result = AerialRefinement::empty(&t.recording_id, &aerial_row.image_id);
+    refine_in_image(
+        mm_ortho,
+        aerial,
+        (&aerial_row.image_id, AerialKind::Nadir),
+        t,
+        window,
+        neighbours,
+        p,
+    )
+}
+
+/// [`refine_in_aerial`] in any nadir raster that `t.ortho_to_aerial` maps the ortho into (an aerial frame or
+/// an orthophoto); the observations carry `image` = (image id, kind).
+pub fn refine_in_image(
+    mm_ortho: &OrthoImage,
+    aerial: &dyn TileSource,
+    image: (&str, AerialKind),
+    t: &InitialTransform,
+    window: &MmWindowMatch,
+    neighbours: &[NeighbourOrtho],
+    p: &RefineParams,
+) -> Result<AerialRefinement, PyramidError> {
+    let (image_id, kind) = image;
+    let mut result = AerialRefinement::empty(&t.recording_id, image_id);
     let tf = t.ortho_to_aerial;
     let transform_ok = [tf.scale, tf.rotation_rad, tf.tx, tf.ty]
         .iter()
@@ -392,8 +415,8 @@ pub fn refine_in_aerial(
             Outcome::Located(AerialMatch {
                 tie_point_id: window.tie_points[i].id.clone(),
                 observation: AerialObservation {
-                    image_id: aerial_row.image_id.clone(),
-                    kind: AerialKind::Nadir,
+                    image_id: image_id.to_string(),
+                    kind,
                     u_px: observed.x,
                     v_px: observed.y,
                     score: peak,

@@ -45,7 +45,7 @@ use crate::params::{Params, StageId};
 /// changes.
 pub const STAGE: StageId = StageId {
     name: "oblique",
-    version: "1",
+    version: "2",
 };
 
 /// What happens to the matches of a set smaller than `min_set_size` (`"keep"` or `"drop"` in a workflow).
@@ -360,6 +360,7 @@ fn control_points(
             stats.single_image_points += 1;
         }
         out.push(AerialControlPoint {
+            map: None,
             tie_point_id: point_id.to_string(),
             mm,
             aerial,

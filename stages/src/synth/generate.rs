@@ -9,6 +9,7 @@
 //! order). Timings are returned in [`SynthSummary`], never written into the folder.
 
 pub use super::options::{RenderIdentity, SynthOptions};
+use super::orthophoto::{self, OrthophotoOptions};
 use super::output::{render_factor, write_aerial_image, write_jpeg};
 pub use super::plan::{plan_campaign, AreaPlan, CampaignPlan};
 
@@ -200,7 +201,10 @@ fn write_error_free(
     }
     let truth = plan.true_tables();
     let path = root.join("campaign.toml");
-    cw::write_campaign_toml(&path, name, "EPSG:28992").map_err(io(path))?;
+    cw::write_campaign_toml(&path, name, "EPSG:28992").map_err(io(path.clone()))?;
+    if let Some(o) = &plan.orthophoto {
+        write_orthophotos(plan, o, root, &path)?;
+    }
     for rel in ["mm/recordings.csv", "truth/recordings.csv"] {
         let path = root.join(rel);
         cw::write_recordings_csv(&path, &truth.recordings).map_err(io(path))?;
@@ -230,6 +234,31 @@ fn write_error_free(
     let path = root.join(SCENE_TRUTH_FILE);
     crate::fsutil::atomic_write(&path, plan.scene_truth.to_toml().as_bytes()).map_err(io(path))?;
     Ok((rays, reused))
+}
+
+/// The orthophoto and DTM of every area, their tables in `campaign.toml` (at `toml`) and `truth/orthophoto.toml`.
+fn write_orthophotos(
+    plan: &CampaignPlan,
+    o: &OrthophotoOptions,
+    root: &Path,
+    toml: &Path,
+) -> Result<(), SynthError> {
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |e: std::io::Error| SynthError::io(&path, e)
+    };
+    let files = plan
+        .areas
+        .iter()
+        .enumerate()
+        .map(|(i, a)| orthophoto::write_area(&a.scene, &a.truth, o, plan.seed, i, root))
+        .collect::<Result<Vec<_>, _>>()?;
+    let text =
+        std::fs::read_to_string(toml).map_err(io(toml))? + &orthophoto::campaign_tables(o, &files);
+    crate::fsutil::atomic_write(toml, text.as_bytes()).map_err(io(toml))?;
+    let path = root.join("truth/orthophoto.toml");
+    let truth = orthophoto::truth_toml(o, plan.seed, plan.areas.len());
+    crate::fsutil::atomic_write(&path, truth.as_bytes()).map_err(io(&path))
 }
 
 static TMP_COUNTER: AtomicU64 = AtomicU64::new(0);

@@ -16,6 +16,7 @@ pub mod control;
 pub mod error;
 pub mod generate;
 pub mod options;
+pub mod orthophoto;
 pub mod output;
 pub mod plan;
 pub mod postprocess;

@@ -1,6 +1,7 @@
 //! What to generate: preset, seed, error profile and the overrides of a preset's knobs, with the checks that
 //! turn bad values into errors naming the option.
 
+use super::orthophoto::OrthophotoOptions;
 use super::preset::{Preset, PresetParams};
 use super::profile::{Profile, RenderOptions};
 use super::sizes::SizeOptions;
@@ -25,6 +26,9 @@ pub struct SynthOptions {
     /// Sensor sizes and image files.
     #[serde(default)]
     pub sizes: SizeOptions,
+    /// Also write an orthophoto and a DTM (`synth::orthophoto`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orthophoto: Option<OrthophotoOptions>,
 }
 
 /// Everything that decides the rendered images (and nothing else): the identity of a rendered folder.
@@ -39,6 +43,8 @@ pub struct RenderIdentity {
     #[serde(default)]
     pub sizes: SizeOptions,
     pub render: RenderOptions,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orthophoto: Option<OrthophotoOptions>,
 }
 
 impl SynthOptions {
@@ -53,6 +59,7 @@ impl SynthOptions {
             panorama_width_px: None,
             max_recordings_per_route: None,
             sizes: SizeOptions::default(),
+            orthophoto: None,
         }
     }
 
@@ -68,6 +75,7 @@ impl SynthOptions {
             panorama_width_px: identity.panorama_width_px,
             max_recordings_per_route: identity.max_recordings_per_route,
             sizes: identity.sizes.clone(),
+            orthophoto: identity.orthophoto.clone(),
         }
     }
 
@@ -82,6 +90,7 @@ impl SynthOptions {
             max_recordings_per_route: self.max_recordings_per_route,
             sizes: self.sizes.clone(),
             render: self.profile.render_options(),
+            orthophoto: self.orthophoto.clone(),
         }
     }
 
@@ -141,6 +150,9 @@ impl SynthOptions {
         p.nadir.corner_distortion_px = render.nadir_corner_distortion_px;
         p.exposure_log_sigma = render.epoch.map_or(0.0, |e| e.exposure_log_sigma);
         self.sizes.apply(&mut p)?;
+        if let Some(o) = &self.orthophoto {
+            o.check()?;
+        }
         Ok(p)
     }
 

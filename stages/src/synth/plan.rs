@@ -35,6 +35,8 @@ pub struct CampaignPlan {
     pub applied: Applied,
     /// What `truth/scene.toml` records (how to rebuild the scenes for evaluation).
     pub scene_truth: SceneTruth,
+    /// The orthophoto and DTM to write, if any.
+    pub orthophoto: Option<super::orthophoto::OrthophotoOptions>,
 }
 
 impl CampaignPlan {
@@ -112,6 +114,9 @@ fn plan_area(
     // An aerial frame that sees none of the panoramas is of no use to the pipeline (and `skytie check` warns
     // about it): the flight plan covers more than the route, so leave those out.
     nadir.retain(|img| sees_any(img, &truth));
+    if options.orthophoto.as_ref().is_some_and(|o| o.without_nadir) {
+        nadir.clear();
+    }
     oblique.retain(|img| sees_any(img, &truth));
     let extension = params.aerial_format.extension();
     for img in nadir.iter_mut().chain(oblique.iter_mut()) {
@@ -163,6 +168,7 @@ pub fn plan_campaign(options: &SynthOptions) -> Result<CampaignPlan, SynthError>
             aerial_changed: false,
         },
         scene_truth,
+        orthophoto: options.orthophoto.clone(),
     };
     plan.applied = options.profile.apply(seed, &plan.true_tables());
     Ok(plan)

@@ -336,8 +336,7 @@ mod tests {
         assert_eq!(Preset::from_name(" Demo ").unwrap(), Preset::Demo);
         let e = Preset::from_name("huge").unwrap_err().to_string();
         assert!(
-            e.contains("huge") && e.contains("tiny, demo, paper, realsize"),
-            e.contains("huge") && e.contains("tiny, demo, paper, street"),
+            e.contains("huge") && e.contains("tiny, demo, paper, realsize, street"),
             "{e}"
         );
     }

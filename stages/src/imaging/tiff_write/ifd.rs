@@ -5,8 +5,10 @@
 /// Field types used here (TIFF 6.0 / BigTIFF).
 #[derive(Clone, Copy, Debug)]
 pub enum FieldType {
+    Ascii = 2,
     Short = 3,
     Long = 4,
+    Double = 12,
     Long8 = 16,
 }
 
@@ -34,6 +36,27 @@ impl Entry {
             field_type: FieldType::Long,
             count: values.len() as u64,
             bytes: values.iter().flat_map(|v| v.to_le_bytes()).collect(),
+        }
+    }
+
+    pub fn doubles(tag: u16, values: &[f64]) -> Self {
+        Self {
+            tag,
+            field_type: FieldType::Double,
+            count: values.len() as u64,
+            bytes: values.iter().flat_map(|v| v.to_le_bytes()).collect(),
+        }
+    }
+
+    /// NUL-terminated ASCII text.
+    pub fn ascii(tag: u16, text: &str) -> Self {
+        let mut bytes = text.as_bytes().to_vec();
+        bytes.push(0);
+        Self {
+            tag,
+            field_type: FieldType::Ascii,
+            count: bytes.len() as u64,
+            bytes,
         }
     }
 

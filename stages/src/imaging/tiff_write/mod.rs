@@ -9,6 +9,7 @@ mod ifd;
 
 pub use compress::TiffCompression;
 
+use crate::imaging::decode::GeoTiffTags;
 use ifd::Entry;
 use rayon::prelude::*;
 use std::fs::{self, File};
@@ -72,6 +73,7 @@ pub struct TiledTiffWriter {
     tmp: PathBuf,
     dest: PathBuf,
     done: bool,
+    geotiff: Vec<Entry>,
 }
 
 impl TiledTiffWriter {
@@ -106,7 +108,13 @@ impl TiledTiffWriter {
             tmp,
             dest: dest.to_path_buf(),
             done: false,
+            geotiff: Vec::new(),
         })
+    }
+
+    /// Writes these GeoTIFF tags (georeference, CRS, no-data) into the directory.
+    pub fn set_geotiff(&mut self, tags: &GeoTiffTags) {
+        self.geotiff = geotiff_entries(tags);
     }
 
     /// Appends one row of 8-bit samples (`width × channels`).
@@ -230,6 +238,7 @@ impl TiledTiffWriter {
             Entry::offsets(325, &self.counts, s.big).ok_or_else(too_big)?,
             Entry::shorts(339, &vec![1; s.channels]),
         ];
+        entries.append(&mut self.geotiff);
         if s.compression.predicts() {
             entries.push(Entry::shorts(317, &[2]));
         }
@@ -253,6 +262,32 @@ impl TiledTiffWriter {
         self.done = true;
         Ok(())
     }
+}
+
+/// The directory entries of GeoTIFF tags (OGC GeoTIFF 1.1 tag numbers; GDAL's no-data 42113).
+pub(crate) fn geotiff_entries(t: &GeoTiffTags) -> Vec<Entry> {
+    let mut out = Vec::new();
+    let doubles = [
+        (33550, &t.model_pixel_scale),
+        (33922, &t.model_tiepoints),
+        (34264, &t.model_transformation),
+        (34736, &t.geo_double_params),
+    ];
+    for (tag, v) in doubles {
+        if let Some(v) = v {
+            out.push(Entry::doubles(tag, v));
+        }
+    }
+    if let Some(keys) = &t.geo_key_directory {
+        out.push(Entry::shorts(34735, keys));
+    }
+    if let Some(text) = &t.geo_ascii_params {
+        out.push(Entry::ascii(34737, text));
+    }
+    if let Some(text) = &t.gdal_nodata {
+        out.push(Entry::ascii(42113, text));
+    }
+    out
 }
 
 impl Drop for TiledTiffWriter {

@@ -127,6 +127,10 @@ pub fn apply_profile_dir(
     };
     let t = &applied.tables;
     write("campaign.toml", &|p| cw::write_campaign_toml(p, name, &crs))?;
+    crate::synth::orthophoto::carry_tables(
+        &rendered.join("campaign.toml"),
+        &out.join("campaign.toml"),
+    )?;
     write("mm/recordings.csv", &|p| {
         cw::write_recordings_csv(p, &t.recordings)
     })?;

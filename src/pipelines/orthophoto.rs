@@ -1,0 +1,156 @@
+//! The orthophoto route in the nadir part of the `skytie` pipeline, for campaigns that declare an orthophoto
+//! (`campaign.toml` `[orthophoto]`): per tile the orthophoto ingested into its pyramid, the DTM tiles loaded
+//! once (cropped to the recordings' area), per recording a north-up ground ortho at the orthophoto's working
+//! resolution and the `orthophoto` node (registration, tie points, control points), whose control points join
+//! the frames' (when the campaign has both, the adjustment takes both, each with its own σ).
+
+use super::wf_err;
+use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
+use crate::nodes::campaign::ingest::{ingest_file, IngestedImage};
+use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::nadir::ortho::OrthoProject;
+use crate::nodes::nadir::orthophoto::{
+    DtmParams, LoadDtm, NoParams, OrthophotoNodeParams, OrthophotoPoints, OrthophotoStage,
+    SummarizeOrthophoto,
+};
+use crate::workflow::Workflow;
+use skytie_stages::campaign::orthophoto::{OrthophotoSource, DEFAULT_DTM_SIGMA_M};
+use skytie_stages::campaign::Recording;
+use skytie_stages::nadir::aerial_patch::working_level;
+use skytie_stages::nadir::{MmWindowMatch, OrthoParams, RecordingControl};
+use skytie_stages::orthophoto::{Dtm, OrthophotoControl, OrthophotoParams, OrthophotoSummary};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Margin around the recordings kept of the DTM, m.
+const DTM_MARGIN_M: f64 = 100.0;
+
+/// The orthophoto route of one variant, built recording by recording.
+pub struct OrthophotoRoute<'a> {
+    root: &'a Path,
+    source: &'a OrthophotoSource,
+    params: OrthophotoParams,
+    ortho_base: OrthoParams,
+    dtm: Option<(Handle<Dtm>, f64)>,
+    tiles: BTreeMap<usize, Handle<IngestedImage>>,
+    results: Vec<Handle<OrthophotoControl>>,
+}
+
+impl<'a> OrthophotoRoute<'a> {
+    /// The route for the campaign of `snapshot`; `None` when it declares no orthophoto.
+    pub fn new(
+        b: &mut DagBuilder,
+        wf: &Workflow,
+        variant: &str,
+        root: &'a Path,
+        snapshot: &'a CampaignSnapshot,
+        ortho_base: &OrthoParams,
+    ) -> Result<Option<Self>, PipelineError> {
+        let Some(source) = snapshot.campaign.orthophoto.as_ref() else {
+            return Ok(None);
+        };
+        let params: OrthophotoParams = wf
+            .params(skytie_stages::orthophoto::STAGE.name, variant)
+            .map_err(wf_err)?;
+        let recs = &snapshot.campaign.recordings;
+        let dtm = match (&snapshot.campaign.dtm, recs.is_empty()) {
+            (Some(d), false) => {
+                let fold = |f: fn(f64, f64) -> f64, pick: fn(&Recording) -> f64, init| {
+                    recs.iter().map(pick).fold(init, f)
+                };
+                let area_m = [
+                    fold(f64::min, |r| r.x, f64::INFINITY) - DTM_MARGIN_M,
+                    fold(f64::min, |r| r.y, f64::INFINITY) - DTM_MARGIN_M,
+                    fold(f64::max, |r| r.x, f64::NEG_INFINITY) + DTM_MARGIN_M,
+                    fold(f64::max, |r| r.y, f64::NEG_INFINITY) + DTM_MARGIN_M,
+                ];
+                let files: Vec<RawFile> = d.tiles.iter().map(|t| RawFile(t.path(root))).collect();
+                let p = DtmParams {
+                    tiles: d.tiles.iter().map(|t| t.file.clone()).collect(),
+                    area_m,
+                };
+                Some((b.add(LoadDtm, "", p, files)?, d.sigma_m))
+            }
+            _ => None,
+        };
+        Ok(Some(Self {
+            root,
+            source,
+            params,
+            ortho_base: ortho_base.clone(),
+            dtm,
+            tiles: BTreeMap::new(),
+            results: Vec::new(),
+        }))
+    }
+
+    /// The route for one recording whose MM matching window is `window`; its control points, or `None` when
+    /// no orthophoto tile covers the recording.
+    pub fn add_recording(
+        &mut self,
+        b: &mut DagBuilder,
+        (r, row, pano_image): (&Recording, Handle<Recording>, Handle<IngestedImage>),
+        window: Handle<MmWindowMatch>,
+    ) -> Result<Option<Handle<RecordingControl>>, PipelineError> {
+        let foot = [r.x, r.y];
+        let Some(k) = self
+            .source
+            .tile_at(foot[0], foot[1], self.params.max_offset_m)
+        else {
+            return Ok(None);
+        };
+        let tile = &self.source.tiles[k];
+        let image = match self.tiles.get(&k) {
+            Some(h) => *h,
+            None => {
+                let h = ingest_file(
+                    b,
+                    &format!("orthophoto {}", tile.file),
+                    tile.path(self.root),
+                )?;
+                self.tiles.insert(k, h);
+                h
+            }
+        };
+        let h = &tile.header;
+        let level = working_level(
+            h.transform.pixel_m,
+            self.ortho_base.registration_gsd_m,
+            (h.width_px, h.height_px),
+        );
+        let ortho_params = OrthoParams {
+            gsd_m: h.transform.pixel_m * (1u64 << level) as f64,
+            rotation_deg: 0.0,
+            ..self.ortho_base.clone()
+        };
+        let label = format!("rec {} × {}", r.image_id, tile.file);
+        let ortho = b.add(OrthoProject, &label, ortho_params, (row, pano_image))?;
+        let params = OrthophotoNodeParams {
+            route: self.params.clone(),
+            tile: tile.clone(),
+            sigma_m: self.source.sigma_m,
+            dtm_sigma_m: self.dtm.map_or(DEFAULT_DTM_SIGMA_M, |d| d.1),
+        };
+        let dtm: Vec<Handle<Dtm>> = self.dtm.iter().map(|d| d.0).collect();
+        let result = b.add(OrthophotoStage, &label, params, (window, ortho, image, dtm))?;
+        self.results.push(result);
+        Ok(Some(b.add(
+            OrthophotoPoints,
+            &label,
+            NoParams::default(),
+            result,
+        )?))
+    }
+
+    /// The route's summary node, with its metrics under `orthophoto`.
+    pub fn finish(self, b: &mut DagBuilder) -> Result<(), PipelineError> {
+        let summary = b.add(
+            SummarizeOrthophoto,
+            "",
+            NoParams::default(),
+            optional_all(&self.results),
+        )?;
+        b.metrics(summary, "orthophoto", |s: &OrthophotoSummary| s.metrics());
+        Ok(())
+    }
+}

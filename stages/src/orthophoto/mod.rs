@@ -1,0 +1,48 @@
+//! The orthophoto route of the nadir registration (thesis chapter 3 with an orthophoto in place of oriented
+//! aerial frames): a georeferenced orthophoto (GeoTIFF) with its stated planimetric accuracy and an optional
+//! DTM take the place of the nadir frames. Each panorama's ground ortho is made north-up at the orthophoto's
+//! resolution, registered to the orthophoto window around it ([`register`]), its tie points are located by
+//! the same phase-correlation refinement as in frames (`nadir::refine`, thesis 3.4.5.3), and each located tie
+//! point becomes a control point whose XY comes from the orthophoto and Z from the DTM ([`control`]).
+
+pub mod control;
+pub mod dtm;
+pub mod register;
+pub mod summary;
+
+pub use crate::campaign::orthophoto::{DtmSource, OrthophotoSource, RasterFile};
+pub use crate::imaging::georef::{GeoTransform, RasterHeader};
+pub use control::{orthophoto_control, OrthophotoControl, OrthophotoInput};
+pub use dtm::{Dtm, DtmTile};
+pub use register::{nominal_transform, register_translation};
+pub use summary::OrthophotoSummary;
+
+use crate::nadir::refine::RefineParams;
+use crate::params::StageId;
+
+/// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
+/// changes.
+pub const STAGE: StageId = StageId {
+    name: "orthophoto",
+    version: "1",
+};
+
+crate::params! {
+    /// Parameters of the orthophoto route (registration, refinement and control points).
+    pub struct OrthophotoParams {
+        /// The largest offset of a recorded position from the orthophoto that the registration searches
+        /// (the expected maximum localisation error, thesis 3.4.5.1).
+        max_offset_m: f64 = 3.0, unit "m", min 0.1, max 50.0;
+        /// Side of the ortho's central square (the road around the vehicle) registered to the orthophoto.
+        road_template_m: f64 = 12.0, unit "m", min 2.0, max 100.0;
+        /// A coarse registration whose correlation peak is below this is rejected.
+        min_peak: f64 = 0.05, min 0.0, max 1.0;
+        /// Precision of a located tie point in the orthophoto at the working resolution, added to the stated
+        /// accuracy of the orthophoto for the control point's planimetric σ.
+        match_sigma_px: f64 = 0.3, unit "px", min 0.0, max 10.0;
+        /// σ of a control point's height taken from the mobile-mapping ground estimate (no DTM, or outside it).
+        mm_height_sigma_m: f64 = 0.5, unit "m", min 0.001, max 100.0;
+        /// The phase-correlation refinement of the tie points in the orthophoto (thesis 3.4.5.3).
+        refine: RefineParams = RefineParams::default(), section;
+    }
+}

@@ -1,0 +1,245 @@
+//! Known-answer tests of the orthophoto route: a ground ortho cut from a textured orthophoto at a known
+//! offset from its recorded placement is registered back (initial transform and tie points), and its control
+//! points get XY from the orthophoto and Z from a planar DTM (or the MM height without one).
+
+use skytie_stages::campaign::orthophoto::RasterFile;
+use skytie_stages::correspondence::{HeightSource, MmTiePoint, PanoObservation};
+use skytie_stages::imaging::border::Border;
+use skytie_stages::imaging::georef::{GeoTransform, RasterHeader};
+use skytie_stages::imaging::pyramid::MemoryPyramid;
+use skytie_stages::imaging::sample::sample_bilinear;
+use skytie_stages::imaging::GrayImage;
+use skytie_stages::nadir::{MmWindowMatch, OrthoGeoref, OrthoImage, TransformOutcome};
+use skytie_stages::orthophoto::{
+    orthophoto_control, Dtm, DtmTile, OrthophotoInput, OrthophotoParams,
+};
+use skytie_stages::rng::SplitMix64;
+
+const GSD_M: f64 = 0.1;
+const PHOTO_PX: usize = 640;
+const ORIGIN: [f64; 2] = [155_000.0, 463_000.0];
+
+/// Smooth random texture with blobs of a few pixels (a road surface with markings is no easier).
+fn texture(seed: u64, n: usize) -> GrayImage {
+    let mut rng = SplitMix64::new(seed);
+    let coarse = n / 4 + 2;
+    let grid: Vec<f32> = (0..coarse * coarse)
+        .map(|_| rng.next_f64() as f32)
+        .collect();
+    let fine: Vec<f32> = (0..n * n).map(|_| 0.15 * rng.next_f64() as f32).collect();
+    let mut img = GrayImage::filled(n, n, 0.0);
+    let at = |c: usize, r: usize| grid[r.min(coarse - 1) * coarse + c.min(coarse - 1)];
+    for r in 0..n {
+        for c in 0..n {
+            let (x, y) = (c as f32 / 4.0, r as f32 / 4.0);
+            let (c0, r0) = (x.floor() as usize, y.floor() as usize);
+            let (ax, ay) = (x - c0 as f32, y - r0 as f32);
+            let v = (1.0 - ay) * ((1.0 - ax) * at(c0, r0) + ax * at(c0 + 1, r0))
+                + ay * ((1.0 - ax) * at(c0, r0 + 1) + ax * at(c0 + 1, r0 + 1));
+            img.set(c, r, v + fine[r * n + c]);
+        }
+    }
+    img
+}
+
+fn photo_tile() -> RasterFile {
+    RasterFile {
+        file: "orthophoto/ortho.tif".into(),
+        header: RasterHeader {
+            width_px: PHOTO_PX as u32,
+            height_px: PHOTO_PX as u32,
+            transform: GeoTransform {
+                origin_x_m: ORIGIN[0],
+                origin_y_m: ORIGIN[1] + PHOTO_PX as f64 * GSD_M,
+                pixel_m: GSD_M,
+            },
+            epsg: Some(28992),
+        },
+    }
+}
+
+/// The ground ortho of a recording whose recorded foot point is `foot`, while the ground it shows lies at
+/// `foot + offset` (the recording's position error is −offset).
+fn ortho_at(photo: &GrayImage, t: &GeoTransform, foot: [f64; 3], offset: [f64; 2]) -> OrthoImage {
+    let n = 200;
+    let georef = OrthoGeoref {
+        foot_world: foot,
+        gsd_m: GSD_M,
+        rotation_deg: 0.0,
+        width_px: n,
+        height_px: n,
+    };
+    let mut image = GrayImage::filled(n, n, 0.0);
+    for r in 0..n {
+        for c in 0..n {
+            let p = georef.pixel_to_world(c as f64 + 0.5, r as f64 + 0.5);
+            let (u, v) = t.world_to_pixel(p.x + offset[0], p.y + offset[1]);
+            image.set(c, r, sample_bilinear(photo, u, v, Border::Reflect));
+        }
+    }
+    let mut valid = vec![1u8; n * n];
+    // The vehicle's footprint in the middle is masked.
+    for r in 90..110 {
+        for c in 92..108 {
+            valid[r * n + c] = 0;
+        }
+    }
+    OrthoImage {
+        image,
+        valid,
+        georef,
+    }
+}
+
+/// A window of tie points on a grid around the foot point (recorded placement), height `z`.
+fn window(foot: [f64; 3]) -> MmWindowMatch {
+    let mut tie_points = Vec::new();
+    let mut ground_world = Vec::new();
+    for (k, (dx, dy)) in [
+        (-5.0, -4.0),
+        (4.0, -5.0),
+        (5.5, 4.5),
+        (-4.5, 5.0),
+        (0.5, -6.0),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let p = [foot[0] + dx, foot[1] + dy, foot[2]];
+        tie_points.push(MmTiePoint {
+            id: format!("r1#{k}"),
+            observations: vec![
+                PanoObservation {
+                    image_id: "r1".into(),
+                    u_px: 100.0,
+                    v_px: 200.0,
+                },
+                PanoObservation {
+                    image_id: "r2".into(),
+                    u_px: 110.0,
+                    v_px: 200.0,
+                },
+            ],
+            point_world: p,
+            covariance_m2: [[0.0; 3]; 3],
+            max_angle_deg: 10.0,
+        });
+        ground_world.push(p);
+    }
+    MmWindowMatch {
+        recording_id: "r1".into(),
+        pairs: Vec::new(),
+        corners_detected: tie_points.len(),
+        neighbour_ground_world: vec![Vec::new(); tie_points.len()],
+        tie_points,
+        ground_world,
+    }
+}
+
+fn planar_dtm() -> Dtm {
+    // z = 2 + 0.01 (x − x0) − 0.02 (y − y0) on a 1 m grid over the tile.
+    let t = GeoTransform {
+        origin_x_m: ORIGIN[0],
+        origin_y_m: ORIGIN[1] + 64.0,
+        pixel_m: 1.0,
+    };
+    let mut heights_m = Vec::new();
+    for r in 0..64 {
+        for c in 0..64 {
+            let [x, y] = t.pixel_to_world(c as f64 + 0.5, r as f64 + 0.5);
+            heights_m.push((2.0 + 0.01 * (x - ORIGIN[0]) - 0.02 * (y - ORIGIN[1])) as f32);
+        }
+    }
+    Dtm {
+        tiles: vec![DtmTile {
+            file: "dtm.tif".into(),
+            transform: t,
+            width_px: 64,
+            height_px: 64,
+            heights_m,
+        }],
+    }
+}
+
+#[test]
+fn a_known_offset_is_recovered_and_control_points_take_xy_from_the_orthophoto_and_z_from_the_dtm() {
+    let photo = texture(7, PHOTO_PX);
+    let tile = photo_tile();
+    let pixels = MemoryPyramid::from_gray(&photo);
+    let foot = [ORIGIN[0] + 31.7, ORIGIN[1] + 30.2, 1.8];
+    let offset = [0.73, -1.21];
+    let ortho = ortho_at(&photo, &tile.header.transform, foot, offset);
+    let dtm = planar_dtm();
+    let input = OrthophotoInput {
+        tile: &tile,
+        pixels: &pixels,
+        sigma_m: 0.04,
+        dtm: Some((&dtm, 0.1)),
+    };
+    let p = OrthophotoParams::default();
+    let w = window(foot);
+    let out = orthophoto_control(&ortho, &w, &input, &p).unwrap();
+    let TransformOutcome::Accepted(t) = &out.transform else {
+        panic!("rejected: {:?}", out.transform);
+    };
+    let [ex, ey] = t.centre_offset_world_m;
+    assert!(
+        (ex - offset[0]).abs() < 0.03 && (ey - offset[1]).abs() < 0.03,
+        "initial offset {ex:.3}, {ey:.3} vs {offset:?}"
+    );
+    assert_eq!(
+        out.control.points.len(),
+        w.tie_points.len(),
+        "{:?}",
+        out.refinement
+    );
+    assert_eq!((out.height_from_dtm, out.height_from_mm), (5, 0));
+    let mut worst = 0.0f64;
+    for (cp, g) in out.control.points.iter().zip(&w.ground_world) {
+        let [x, y, z] = cp.point_world.unwrap();
+        let (tx, ty) = (g[0] + offset[0], g[1] + offset[1]);
+        worst = worst.max((x - tx).hypot(y - ty));
+        let tz = 2.0 + 0.01 * (x - ORIGIN[0]) - 0.02 * (y - ORIGIN[1]);
+        assert!((z - tz).abs() < 1e-3, "z {z} vs {tz}");
+        assert!(cp.aerial.is_empty());
+        let map = cp.map.as_ref().unwrap();
+        assert_eq!(map.height, HeightSource::Dtm);
+        let c = cp.covariance_m2.unwrap();
+        assert!((c[0][0].sqrt() - 0.04f64.hypot(0.3 * GSD_M)).abs() < 1e-9);
+        assert!((c[2][2].sqrt() - 0.1).abs() < 1e-9);
+    }
+    assert!(worst < 0.01, "worst control point error {worst:.4} m");
+}
+
+#[test]
+fn without_a_dtm_the_height_is_the_mm_ground_and_a_far_offset_is_rejected() {
+    let photo = texture(11, PHOTO_PX);
+    let tile = photo_tile();
+    let pixels = MemoryPyramid::from_gray(&photo);
+    let foot = [ORIGIN[0] + 30.0, ORIGIN[1] + 33.0, 1.8];
+    let input = OrthophotoInput {
+        tile: &tile,
+        pixels: &pixels,
+        sigma_m: 0.04,
+        dtm: None,
+    };
+    let p = OrthophotoParams::default();
+    let ortho = ortho_at(&photo, &tile.header.transform, foot, [-0.4, 0.9]);
+    let out = orthophoto_control(&ortho, &window(foot), &input, &p).unwrap();
+    assert!(!out.control.points.is_empty());
+    assert_eq!(out.height_from_dtm, 0);
+    for cp in &out.control.points {
+        assert_eq!(cp.map.as_ref().unwrap().height, HeightSource::MmGround);
+        assert_eq!(cp.point_world.unwrap()[2], foot[2]);
+        assert!((cp.covariance_m2.unwrap()[2][2].sqrt() - p.mm_height_sigma_m).abs() < 1e-12);
+    }
+    // Ground 6 m away from the recorded placement is beyond max_offset_m = 3 m.
+    let far = ortho_at(&photo, &tile.header.transform, foot, [6.0, 0.0]);
+    let out = orthophoto_control(&far, &window(foot), &input, &p).unwrap();
+    assert!(
+        matches!(out.transform, TransformOutcome::Rejected { .. }),
+        "{:?}",
+        out.transform
+    );
+    assert!(out.control.points.is_empty());
+}
