@@ -13,6 +13,7 @@ pub mod pose;
 pub mod report;
 pub mod run;
 mod source_pose;
+pub mod vendor_campaign;
 
 pub use config::ImportConfig;
 pub use report::ImportReport;
