@@ -10,6 +10,7 @@ pub mod export;
 mod metashape;
 pub mod mm;
 pub mod pose;
+pub mod provenance;
 pub mod report;
 pub mod run;
 mod source_pose;
