@@ -7,6 +7,7 @@ use super::config::{AerialKindName, CampaignSection, ImportConfig, MmSource, Tra
 use super::context::ImportContext;
 use super::control::import_control;
 use super::mm::import_mm;
+use super::panorama_tags::import_panorama_tags;
 use super::provenance::{
     write_campaign_toml_with_source, ProvenanceFormat, SourceSection, TrajectoryProvenance,
 };
@@ -42,6 +43,15 @@ pub fn run_import(config: &ImportConfig, out: &Path) -> Result<ImportReport, Imp
         return Err(ImportError::OutputExists(out.to_path_buf()));
     }
     let ctx = ImportContext::new(&config.campaign).map_err(ImportError::Config)?;
+    if config.mm.is_some() && config.panorama_tags.is_some() {
+        return Err(ImportError::Config(Problem::error(
+            "import configuration",
+            None,
+            Some("panorama_tags"),
+            "both [mm] and [panorama_tags] are given",
+            "take the panorama poses from a trajectory ([mm]) or from the images' tags ([panorama_tags]), not both",
+        )));
+    }
     let name = out
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -86,6 +96,17 @@ pub fn run_import(config: &ImportConfig, out: &Path) -> Result<ImportReport, Imp
         }
     }
     let mut panorama_ids = HashSet::new();
+    if let Some(tags) = &config.panorama_tags {
+        let (recordings, r) = import_panorama_tags(tags, &ctx);
+        let dir = partial.join("mm/panoramas");
+        for rec in &recordings {
+            panorama_ids.insert(rec.image_id.clone());
+            link_or_copy(&tags.panoramas.join(&rec.file), &dir.join(&rec.file))?;
+        }
+        let path = partial.join("mm/recordings.csv");
+        cw::write_recordings_csv(&path, &recordings).map_err(io(&path))?;
+        report.sources.push(r);
+    }
     if let Some(mm) = &config.mm {
         let (mut recordings, mut r) = import_mm(mm, &ctx);
         let dir = partial.join("mm/panoramas");

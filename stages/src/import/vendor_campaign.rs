@@ -128,6 +128,7 @@ pub fn export_vendor_campaign(
         campaign: spec.campaign.clone(),
         aerial,
         mm,
+        panorama_tags: None,
         control,
     };
     let text = toml::to_string(&config)
