@@ -16,8 +16,10 @@ use cli::{run_finished, run_ok, skytie};
 use nalgebra::Matrix3;
 use skytie_stages::campaign::{read_campaign, AerialImage, Campaign};
 use skytie_stages::crs::geoid::GeoidGrid;
+use skytie_stages::export::SBET_ADJUSTED;
 use skytie_stages::geometry::{opk_to_matrix, panorama_rotation};
 use skytie_stages::import::config::CampaignSection;
+use skytie_stages::import::provenance::read_source;
 use skytie_stages::import::vendor_campaign::{export_vendor_campaign, VendorExport};
 use std::path::{Path, PathBuf};
 
@@ -263,6 +265,20 @@ fn round_trip(preset: &str, seed: u32, geoid: Geoid, workflow: &str) {
         "the imported campaign's metrics differ:\n{}",
         diffs.join("\n")
     );
+    // The imported campaign knows its SBET; a corrected run delivers it corrected, record for record.
+    let source = read_source(&imported_dir).unwrap().trajectory.unwrap();
+    assert_eq!(source.crs, "EPSG:4937");
+    let sbet_out = dir.join("out-imported").join(SBET_ADJUSTED);
+    assert!(!dir.join("out-original").join(SBET_ADJUSTED).exists());
+    if b["adjust"]["combined"]["verdict"] == "corrected" {
+        let input = std::fs::metadata(vendor.join("sbet.out")).unwrap().len();
+        assert_eq!(std::fs::metadata(&sbet_out).unwrap().len(), input);
+    } else {
+        assert!(
+            !sbet_out.exists(),
+            "an uncorrected run must not deliver a corrected SBET"
+        );
+    }
 }
 
 #[test]
