@@ -14,12 +14,12 @@ mod cli;
 
 use cli::{run_finished, run_ok, skytie};
 use nalgebra::Matrix3;
+use skytie_stages::campaign::source::read_source;
 use skytie_stages::campaign::{read_campaign, AerialImage, Campaign};
 use skytie_stages::crs::geoid::GeoidGrid;
 use skytie_stages::export::SBET_ADJUSTED;
 use skytie_stages::geometry::{opk_to_matrix, panorama_rotation};
 use skytie_stages::import::config::CampaignSection;
-use skytie_stages::import::provenance::read_source;
 use skytie_stages::import::vendor_campaign::{export_vendor_campaign, VendorExport};
 use std::path::{Path, PathBuf};
 

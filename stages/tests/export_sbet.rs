@@ -4,12 +4,12 @@
 //! corrections must be the linear mix of their neighbours, every other SBET field must be copied, and a
 //! record the importer cannot use must pass through unchanged and flagged.
 
+use skytie_stages::campaign::source::read_source;
 use skytie_stages::campaign::{read_campaign, Campaign};
 use skytie_stages::export::corrections::{Correction, CorrectionSeries, SeriesRecording};
 use skytie_stages::export::{write_corrected_sbet, SampleKind, Support, SBET_ADJUSTED};
 use skytie_stages::formats::gps_time::unix_to_gps;
 use skytie_stages::formats::sbet::{read_sbet_records, write_sbet, SbetRecord};
-use skytie_stages::import::provenance::read_source;
 use skytie_stages::import::{run_import, ImportConfig};
 use std::path::Path;
 

@@ -76,7 +76,7 @@ pub fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>), Camp
     let mut problems = Vec::new();
     let (name, crs) = read_toml(root, &mut problems);
     // `[source]` only matters for the corrected SBET of a run: a bad one is a warning.
-    if let Err(p) = crate::import::provenance::read_source(root) {
+    if let Err(p) = crate::campaign::source::read_source(root) {
         problems.push(p);
     }
 

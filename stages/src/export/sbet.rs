@@ -16,6 +16,7 @@
 //! time not increasing) is copied unchanged and flagged `not_corrected`.
 
 use super::corrections::{Correction, CorrectionSeries};
+use crate::campaign::source::{read_source, ProvenanceFormat, TrajectoryProvenance};
 use crate::crs::Ellipsoid;
 use crate::formats::gps_time::gps_to_unix_s;
 use crate::formats::sbet::{read_sbet_records, record_problem, write_sbet, SbetRecord};
@@ -24,7 +25,6 @@ use crate::import::context::ImportContext;
 use crate::import::convert::{Converter, Inverse};
 use crate::import::export::inverse;
 use crate::import::pose::{apply_lever_arm, body_to_ned, remove_lever_arm};
-use crate::import::provenance::{read_source, ProvenanceFormat, TrajectoryProvenance};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::io;

@@ -11,7 +11,6 @@ mod metashape;
 pub mod mm;
 pub mod panorama_tags;
 pub mod pose;
-pub mod provenance;
 pub mod report;
 pub mod run;
 mod source_pose;

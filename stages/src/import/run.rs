@@ -8,10 +8,10 @@ use super::context::ImportContext;
 use super::control::import_control;
 use super::mm::import_mm;
 use super::panorama_tags::import_panorama_tags;
-use super::provenance::{
+use super::report::ImportReport;
+use crate::campaign::source::{
     write_campaign_toml_with_source, ProvenanceFormat, SourceSection, TrajectoryProvenance,
 };
-use super::report::ImportReport;
 use crate::campaign::{self as cw, AerialImage, Problem};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};

@@ -1,5 +1,5 @@
-//! Where an imported campaign's trajectory came from, recorded in `campaign.toml` as `[source.trajectory]`
-//! so that a run can deliver the corrected trajectory in the same form (an SBET with the same record layout
+//! `campaign.toml`'s `[source]` table: where an imported campaign's trajectory came from
+//! (`[source.trajectory]`), so that a run can deliver the corrected trajectory in the same form (an SBET with the same record layout
 //! and time base). The import copies the SBET (and the geoid grid, if one was used) into `mm/trajectory/` of
 //! the campaign, so the folder stays self-contained; paths in the table are relative to the campaign folder.
 //!
@@ -18,7 +18,7 @@
 //! geoid_grid = "mm/trajectory/nlgeo2018.gtx"     # or geoid_separation_m = 43.2, or neither
 //! ```
 
-use crate::campaign::Problem;
+use super::Problem;
 use crate::crs::{Crs, GeoidModel};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
