@@ -1,7 +1,8 @@
 //! `campaign.toml`'s `[source]` table: where an imported campaign's trajectory came from
 //! (`[source.trajectory]`), so that a run can deliver the corrected trajectory in the same form (an SBET with
-//! the same record layout and time base). The import copies the SBET (and the geoid grid, if one was used) into `mm/trajectory/` of
-//! the campaign, so the folder stays self-contained; paths in the table are relative to the campaign folder.
+//! the same record layout and time base). The import copies the SBET (and the geoid grid, if one was used)
+//! into `mm/trajectory/` of the campaign, so the folder stays self-contained; paths in the table are relative
+//! to the campaign folder.
 //!
 //! ```toml
 //! name = "Utrecht 2024"
