@@ -1,7 +1,8 @@
 //! Writing a run's user-facing files into `OUT/` (or `OUT/variants/<name>/` in a sweep) once the adjustment
 //! and verification nodes have produced their values (every file is described in `docs/outputs.md`):
 //! `trajectory_adjusted.csv` (the input recordings file with the adjusted values), `corrections.csv` (the
-//! correction time series), `ground_control/` (control points for OpenSfM/OpenDroneMap, Metashape and as a
+//! correction time series), `sbet_adjusted.out` + `sbet_adjusted_quality.csv` (the corrected SBET of a
+//! campaign imported from one), `ground_control/` (control points for OpenSfM/OpenDroneMap, Metashape and as a
 //! plain list), `skytie.gpkg` (GeoPackage layers for GIS), `trajectory.geojson`, `tie_points.ply`,
 //! `checkpoints.csv`, `verification.csv` and `verification_adjusted.csv`, `correspondences.csv` and a COLMAP
 //! text model in `colmap/`. The encoders live in `skytie_stages::export`; every file is written atomically.
@@ -16,8 +17,8 @@ use skytie_stages::correspondence::AerialControlPoint;
 use skytie_stages::export::gpkg::{run_layers, srs_for, write_geopackage, RunLayers};
 use skytie_stages::export::{
     write_adjusted_trajectory, write_checkpoint_errors_csv, write_colmap_model,
-    write_corrections_csv, write_correspondences_csv, write_ground_control, write_run_geojson,
-    write_tie_points_ply, CorrectionSeries,
+    write_corrected_sbet, write_corrections_csv, write_correspondences_csv, write_ground_control,
+    write_run_geojson, write_tie_points_ply, CorrectionSeries, SBET_ADJUSTED, SBET_QUALITY_CSV,
 };
 use skytie_stages::imaging::io::dimensions;
 use skytie_stages::nadir::RecordingControl;
@@ -132,6 +133,10 @@ fn adjusted_exports(
             "trajectory_adjusted.csv",
             write_adjusted_trajectory(&path, &input, series, run),
         );
+        p.note(
+            SBET_ADJUSTED,
+            write_corrected_sbet(&c.root, &c.crs, series, dir),
+        );
     }
     let path = dir.join("checkpoints.csv");
     p.note("checkpoints.csv", write_checkpoint_errors_csv(&path, rows));
@@ -236,5 +241,13 @@ fn withhold_adjusted_trajectory(dir: &Path, verdict: Verdict, p: &mut Problems) 
             p.note(file, std::fs::remove_file(&path));
         }
         p.warn(file, format!("not written: {why}"));
+    }
+    // A corrected SBET of an earlier run into the same folder must not outlive its verdict.
+    for file in [SBET_ADJUSTED, SBET_QUALITY_CSV] {
+        let path = dir.join(file);
+        if path.exists() {
+            p.note(file, std::fs::remove_file(&path));
+            p.warn(file, format!("removed: {why}"));
+        }
     }
 }

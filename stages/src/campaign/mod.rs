@@ -13,6 +13,7 @@ pub mod read;
 mod read_aerial;
 mod read_control;
 mod read_recordings;
+pub mod source;
 mod table;
 pub mod time;
 mod unique;

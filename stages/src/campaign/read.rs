@@ -80,6 +80,10 @@ pub fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>), Camp
         Some((text, table)) => read_orthophoto_tables(root, text, table, &crs, &mut problems),
         None => (None, None),
     };
+    // `[source]` only matters for the corrected SBET of a run: a bad one is a warning.
+    if let Err(p) = crate::campaign::source::read_source(root) {
+        problems.push(p);
+    }
 
     let mut recordings = if root.join(RECORDINGS).is_file() {
         read_recording_rows(

@@ -7,6 +7,7 @@
 //! Units: geographic coordinates in degrees (latitude, longitude), projected coordinates and heights in
 //! metres, angles of convergence in degrees (`_deg`).
 
+pub mod campaign_frame;
 pub mod definition;
 pub mod ellipsoid;
 pub mod error_budget;
@@ -19,6 +20,7 @@ mod vertical;
 #[cfg(test)]
 mod tests;
 
+pub use campaign_frame::{CampaignFrame, FrameError};
 pub use definition::{Crs, CrsError, HorizontalKind, VerticalDatum};
 pub use ellipsoid::{Ellipsoid, LocalTangentFrame};
 pub use geoid::{GeoidError, GeoidModel};

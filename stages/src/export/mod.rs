@@ -21,6 +21,7 @@ pub mod gcp;
 pub mod geojson;
 pub mod gpkg;
 pub mod ply;
+pub mod sbet;
 pub mod support;
 pub mod trajectory;
 
@@ -37,5 +38,6 @@ pub use ply::{
     write_tie_points_ply, PLY_SOURCE_CONTROL, PLY_SOURCE_RECORDING, PLY_SOURCE_SINGLE_AERIAL,
     PLY_SOURCE_TIE,
 };
+pub use sbet::{write_corrected_sbet, SbetOutput, SBET_ADJUSTED, SBET_QUALITY_CSV};
 pub use support::{recording_support, RecordingSupport, Support};
 pub use trajectory::{adjusted_recordings, write_adjusted_trajectory, TrajectoryExportCounts};

@@ -10,10 +10,9 @@ pub mod angles;
 pub mod camera_model;
 pub mod events;
 pub mod gps_time;
+pub mod image_tags;
 pub mod metashape_xml;
-
 pub mod opk_list;
-
 pub mod pix4d;
 pub mod points;
 pub mod sbet;

@@ -176,3 +176,78 @@ pub fn read_measurements(
     }
     (rows, problems)
 }
+
+/// Write a point list (comma-separated, header `id,x,y,z` plus `sigma_xy`/`sigma_z` where `rows` carry them)
+/// and return the layout that reads it back. `Err` if only some rows carry a σ (one layout cannot hold both).
+pub fn write_points(path: &Path, rows: &[PointRow]) -> std::io::Result<PointFormat> {
+    let all_or_none = |has: &dyn Fn(&PointRow) -> bool, name: &str| {
+        let n = rows.iter().filter(|r| has(r)).count();
+        if n != 0 && n != rows.len() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!(
+                    "{n} of {} points have {name}; give it for all or none",
+                    rows.len()
+                ),
+            ));
+        }
+        Ok(n > 0)
+    };
+    let with_sxy = all_or_none(&|r| r.sigma_xy_m.is_some(), "sigma_xy")?;
+    let with_sz = all_or_none(&|r| r.sigma_z_m.is_some(), "sigma_z")?;
+    let mut out = String::from("id,x,y,z");
+    out.push_str(if with_sxy { ",sigma_xy" } else { "" });
+    out.push_str(if with_sz { ",sigma_z" } else { "" });
+    out.push('\n');
+    for r in rows {
+        out.push_str(&format!("{},{},{},{}", r.id, r.a, r.b, r.z));
+        for s in [r.sigma_xy_m, r.sigma_z_m].into_iter().flatten() {
+            out.push_str(&format!(",{s}"));
+        }
+        out.push('\n');
+    }
+    crate::fsutil::atomic_write(path, out.as_bytes())?;
+    Ok(PointFormat {
+        delimiter: Delimiter::Comma,
+        header: true,
+        id: "id".into(),
+        x: "x".into(),
+        y: "y".into(),
+        z: "z".into(),
+        sigma_xy: with_sxy.then(|| "sigma_xy".into()),
+        sigma_z: with_sz.then(|| "sigma_z".into()),
+    })
+}
+
+/// Write image measurements (comma-separated `point,image,u,v`, `u_px`/`v_px` of `rows` given in skytie's
+/// convention and written with `origin`) and return the layout that reads them back.
+pub fn write_measurements(
+    path: &Path,
+    rows: &[MeasurementRow],
+    origin: PixelOrigin,
+) -> std::io::Result<MeasurementFormat> {
+    let shift = match origin {
+        PixelOrigin::Corner => 0.0,
+        PixelOrigin::FirstPixelCentre => 0.5,
+    };
+    let mut out = String::from("point,image,u,v\n");
+    for r in rows {
+        out.push_str(&format!(
+            "{},{},{},{}\n",
+            r.point,
+            r.image,
+            r.u_px - shift,
+            r.v_px - shift
+        ));
+    }
+    crate::fsutil::atomic_write(path, out.as_bytes())?;
+    Ok(MeasurementFormat {
+        delimiter: Delimiter::Comma,
+        header: true,
+        point: "point".into(),
+        image: "image".into(),
+        u: "u".into(),
+        v: "v".into(),
+        pixel_origin: origin,
+    })
+}

@@ -76,48 +76,60 @@ impl SbetRecord {
     }
 }
 
+/// Every record of an SBET as stored, valid or not; `Err` for a file that cannot be read or whose size is not
+/// a multiple of 136 bytes (not an SBET, or truncated).
+pub fn read_sbet_records(path: &Path) -> Result<Vec<SbetRecord>, Problem> {
+    let bytes = std::fs::read(path).map_err(|e| super::unreadable(path, &e))?;
+    if bytes.is_empty() || bytes.len() % RECORD_BYTES != 0 {
+        return Err(Problem::error(path, None, None, format!("is {} bytes, not a whole number of 136-byte SBET records", bytes.len()), "give the binary SBET (sbet_*.out) itself, not a text export; a truncated copy must be exported again"));
+    }
+    Ok(bytes
+        .chunks_exact(RECORD_BYTES)
+        .map(SbetRecord::from_bytes)
+        .collect())
+}
+
+/// Why a record cannot be used (`None`: it can), given the time of the last usable record before it.
+pub fn record_problem(r: &SbetRecord, last_time_sow_s: f64) -> Option<&'static str> {
+    if ![
+        r.time_sow_s,
+        r.lat_rad,
+        r.lon_rad,
+        r.height_m,
+        r.roll_rad,
+        r.pitch_rad,
+        r.heading_rad,
+    ]
+    .iter()
+    .all(|v| v.is_finite())
+    {
+        Some("has a non-finite time, position or attitude")
+    } else if r.lat_rad.abs() > std::f64::consts::FRAC_PI_2
+        || r.lon_rad.abs() > 2.0 * std::f64::consts::PI
+    {
+        Some("has a latitude/longitude outside ±90°/±360° (not radians?)")
+    } else if !(0.0..=crate::formats::gps_time::WEEK_S + 86_400.0).contains(&r.time_sow_s) {
+        Some("has a time outside the GPS week (0 … 604800 s)")
+    } else if r.time_sow_s <= last_time_sow_s {
+        Some("does not come after the previous record in time")
+    } else {
+        None
+    }
+}
+
 /// Read an SBET. A file whose size is not a multiple of 136 bytes is refused (not an SBET, or truncated);
 /// records with non-finite or out-of-range values, or whose time does not increase, are skipped and
 /// reported as "record N" (1-based) in the problem's row.
 pub fn read_sbet(path: &Path) -> (Vec<SbetRecord>, Vec<Problem>) {
-    let bytes = match std::fs::read(path) {
-        Ok(b) => b,
-        Err(e) => {
-            return (Vec::new(), vec![super::unreadable(path, &e)]);
-        }
+    let all = match read_sbet_records(path) {
+        Ok(r) => r,
+        Err(p) => return (Vec::new(), vec![p]),
     };
-    if bytes.is_empty() || bytes.len() % RECORD_BYTES != 0 {
-        return (Vec::new(), vec![Problem::error(path, None, None, format!("is {} bytes, not a whole number of 136-byte SBET records", bytes.len()), "give the binary SBET (sbet_*.out) itself, not a text export; a truncated copy must be exported again")]);
-    }
-    let mut records = Vec::with_capacity(bytes.len() / RECORD_BYTES);
+    let mut records = Vec::with_capacity(all.len());
     let mut problems = Vec::new();
     let mut last_time = f64::NEG_INFINITY;
-    for (i, chunk) in bytes.chunks_exact(RECORD_BYTES).enumerate() {
-        let r = SbetRecord::from_bytes(chunk);
-        let reason = if ![
-            r.time_sow_s,
-            r.lat_rad,
-            r.lon_rad,
-            r.height_m,
-            r.roll_rad,
-            r.pitch_rad,
-            r.heading_rad,
-        ]
-        .iter()
-        .all(|v| v.is_finite())
-        {
-            Some("has a non-finite time, position or attitude")
-        } else if r.lat_rad.abs() > std::f64::consts::FRAC_PI_2
-            || r.lon_rad.abs() > 2.0 * std::f64::consts::PI
-        {
-            Some("has a latitude/longitude outside ±90°/±360° (not radians?)")
-        } else if !(0.0..=crate::formats::gps_time::WEEK_S + 86_400.0).contains(&r.time_sow_s) {
-            Some("has a time outside the GPS week (0 … 604800 s)")
-        } else if r.time_sow_s <= last_time {
-            Some("does not come after the previous record in time")
-        } else {
-            None
-        };
+    for (i, r) in all.into_iter().enumerate() {
+        let reason = record_problem(&r, last_time);
         match reason {
             Some(reason) => problems.push(Problem::error(
                 path,

@@ -19,8 +19,29 @@ pub struct ImportConfig {
     pub aerial: Vec<AerialSource>,
     #[serde(default)]
     pub mm: Option<MmSource>,
+    /// Panoramas with their pose in EXIF GPS / GPano tags (instead of `[mm]`).
+    #[serde(default)]
+    pub panorama_tags: Option<PanoramaTagSource>,
     #[serde(default)]
     pub control: Option<ControlSource>,
+}
+
+/// `[panorama_tags]`: panoramas whose JPEG files carry their pose (EXIF GPS + GPano XMP).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PanoramaTagSource {
+    /// Folder of the panorama images (every `.jpg`/`.jpeg` in it).
+    pub panoramas: PathBuf,
+    /// Geographic CRS of the GPS tags, e.g. `EPSG:4979` (WGS 84) or `EPSG:4937` (ETRS89).
+    pub crs: String,
+    /// What `GPSAltitude` is: `ellipsoidal`, `campaign` or `EPSG:<vertical>` (devices differ; no default).
+    pub heights: String,
+    /// Height of the panorama centre above the road, m.
+    pub camera_height_m: f64,
+    #[serde(default)]
+    pub sigma_xy_m: Option<f64>,
+    #[serde(default)]
+    pub sigma_z_m: Option<f64>,
 }
 
 /// `[campaign]`.
@@ -270,6 +291,9 @@ impl ImportConfig {
             fix(&mut mm.trajectory);
             fix(&mut mm.events);
             fix(&mut mm.panoramas);
+        }
+        if let Some(t) = &mut self.panorama_tags {
+            fix(&mut t.panoramas);
         }
         if let Some(c) = &mut self.control {
             fix(&mut c.points);

@@ -31,7 +31,11 @@ pub enum ExportError {
     Io(#[from] std::io::Error),
 }
 
-fn inverse(ctx: &ImportContext, crs: &str, heights: &str) -> Result<Inverse, ExportError> {
+pub(crate) fn inverse(
+    ctx: &ImportContext,
+    crs: &str,
+    heights: &str,
+) -> Result<Inverse, ExportError> {
     let parse = |t: &str| Crs::parse(t).map_err(|e| ExportError::Setup(e.to_string()));
     let source = match crs.strip_prefix("geographic:") {
         Some(rest) => parse(rest)?.own_geographic(),

@@ -9,10 +9,12 @@ pub mod convert;
 pub mod export;
 mod metashape;
 pub mod mm;
+pub mod panorama_tags;
 pub mod pose;
 pub mod report;
 pub mod run;
 mod source_pose;
+pub mod vendor_campaign;
 
 pub use config::ImportConfig;
 pub use report::ImportReport;

@@ -3,11 +3,15 @@
 //! when complete, so an interrupted import never leaves a half campaign behind.
 
 use super::aerial::import_aerial;
-use super::config::{AerialKindName, ImportConfig};
+use super::config::{AerialKindName, CampaignSection, ImportConfig, MmSource, TrajectoryFormat};
 use super::context::ImportContext;
 use super::control::import_control;
 use super::mm::import_mm;
+use super::panorama_tags::import_panorama_tags;
 use super::report::ImportReport;
+use crate::campaign::source::{
+    write_campaign_toml_with_source, ProvenanceFormat, SourceSection, TrajectoryProvenance,
+};
 use crate::campaign::{self as cw, AerialImage, Problem};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -39,6 +43,15 @@ pub fn run_import(config: &ImportConfig, out: &Path) -> Result<ImportReport, Imp
         return Err(ImportError::OutputExists(out.to_path_buf()));
     }
     let ctx = ImportContext::new(&config.campaign).map_err(ImportError::Config)?;
+    if config.mm.is_some() && config.panorama_tags.is_some() {
+        return Err(ImportError::Config(Problem::error(
+            "import configuration",
+            None,
+            Some("panorama_tags"),
+            "both [mm] and [panorama_tags] are given",
+            "take the panorama poses from a trajectory ([mm]) or from the images' tags ([panorama_tags]), not both",
+        )));
+    }
     let name = out
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -83,6 +96,17 @@ pub fn run_import(config: &ImportConfig, out: &Path) -> Result<ImportReport, Imp
         }
     }
     let mut panorama_ids = HashSet::new();
+    if let Some(tags) = &config.panorama_tags {
+        let (recordings, r) = import_panorama_tags(tags, &ctx);
+        let dir = partial.join("mm/panoramas");
+        for rec in &recordings {
+            panorama_ids.insert(rec.image_id.clone());
+            link_or_copy(&tags.panoramas.join(&rec.file), &dir.join(&rec.file))?;
+        }
+        let path = partial.join("mm/recordings.csv");
+        cw::write_recordings_csv(&path, &recordings).map_err(io(&path))?;
+        report.sources.push(r);
+    }
     if let Some(mm) = &config.mm {
         let (mut recordings, mut r) = import_mm(mm, &ctx);
         let dir = partial.join("mm/panoramas");
@@ -112,6 +136,19 @@ pub fn run_import(config: &ImportConfig, out: &Path) -> Result<ImportReport, Imp
         cw::write_recordings_csv(&path, &recordings).map_err(io(&path))?;
         report.sources.push(r);
     }
+    let source = match &config.mm {
+        // A trajectory the import could not read (reported above) is not recorded.
+        Some(mm)
+            if mm.format == TrajectoryFormat::Sbet
+                && mm.gps_week.is_some()
+                && mm.trajectory.is_file() =>
+        {
+            SourceSection {
+                trajectory: Some(keep_sbet(mm, &config.campaign, &partial)?),
+            }
+        }
+        _ => SourceSection::default(),
+    };
     if let Some(control) = &config.control {
         let (points, observations, reports) = import_control(control, &ctx, &panorama_ids);
         let dir = partial.join("control");
@@ -125,7 +162,7 @@ pub fn run_import(config: &ImportConfig, out: &Path) -> Result<ImportReport, Imp
         report.sources.extend(reports);
     }
     let toml = partial.join("campaign.toml");
-    cw::write_campaign_toml(&toml, &config.campaign.name, &config.campaign.crs)
+    write_campaign_toml_with_source(&toml, &config.campaign.name, &config.campaign.crs, &source)
         .map_err(io(&toml))?;
     let text = report_text(&report, &ctx);
     let path = partial.join("import_report.txt");
@@ -159,4 +196,34 @@ fn link_or_copy(from: &Path, to: &Path) -> Result<(), ImportError> {
         return Ok(());
     }
     std::fs::copy(from, to).map(|_| ()).map_err(io(from))
+}
+
+/// Copy (or link) the SBET and the geoid grid into `mm/trajectory/` of the campaign being assembled in
+/// `partial` and describe them for `[source.trajectory]`, so a run can write the corrected trajectory back.
+fn keep_sbet(
+    mm: &MmSource,
+    campaign: &CampaignSection,
+    partial: &Path,
+) -> Result<TrajectoryProvenance, ImportError> {
+    let keep = |from: &Path| -> Result<PathBuf, ImportError> {
+        let name = from.file_name().map_or_else(
+            || std::ffi::OsString::from("trajectory"),
+            |n| n.to_os_string(),
+        );
+        let rel = Path::new("mm/trajectory").join(name);
+        link_or_copy(from, &partial.join(&rel))?;
+        Ok(rel)
+    };
+    Ok(TrajectoryProvenance {
+        format: ProvenanceFormat::Sbet,
+        file: keep(&mm.trajectory)?,
+        crs: mm.crs.clone(),
+        heights: mm.heights.clone(),
+        gps_week: mm.gps_week.unwrap_or_default(),
+        leap_seconds: mm.leap_seconds,
+        lever_arm_m: mm.lever_arm_m,
+        boresight_deg: mm.boresight_deg,
+        geoid_grid: campaign.geoid_grid.as_deref().map(keep).transpose()?,
+        geoid_separation_m: campaign.geoid_separation_m,
+    })
 }
