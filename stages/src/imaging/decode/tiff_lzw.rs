@@ -1,7 +1,7 @@
 //! LZW-compressed TIFF strips and tiles, decompressed here instead of by the `tiff` crate: its 0.11 releases
 //! read a tile narrower than its padded width row by row through `weezl` 0.1 with small output buffers,
-//! where the decoder can stop short of the end code ("no lzw end code found", image-tiff issue 395) — every
-//! LZW-tiled image whose width is not a multiple of the tile width fails there. A whole chunk is decoded in
+//! where the decoder can stop short of the end code ("no lzw end code found", reported upstream to image-tiff
+//! as #395) — every LZW-tiled image whose width is not a multiple of the tile width fails there. A whole chunk is decoded in
 //! one call into a buffer of its full size, which does not hit that path; a chunk whose end code is missing
 //! but whose pixels are complete is accepted, as libtiff does.
 
