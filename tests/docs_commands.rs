@@ -450,9 +450,15 @@ fn offending_lines(bad: impl Fn(&str) -> bool) -> Vec<String> {
 #[test]
 fn nothing_refers_to_a_path_outside_the_repository() {
     let found = offending_lines(|line| {
-        ["../shared", "shared/docs/", "shared/reference/", "/work/"]
-            .iter()
-            .any(|needle| line.contains(needle))
+        // `concat!` keeps this file itself free of the path it looks for.
+        [
+            concat!("..", "/shared"),
+            "shared/docs/",
+            "shared/reference/",
+            "/work/",
+        ]
+        .iter()
+        .any(|needle| line.contains(needle))
     });
     assert!(
         found.is_empty(),
@@ -573,8 +579,9 @@ fn the_extraction_knows_the_shell_forms() {
     assert!(has_bare_date("measured 2026-11-24 on"));
     assert!(!has_bare_date("time 2019-06-14T10:31:07Z"));
     assert!(!has_bare_date("EPSG:28992+5709"));
-    assert!(is_history("as issue 6 (b) asked"));
-    assert!(is_history("fixed in this session"));
+    // Built at run time so that this file does not itself carry the words it checks for.
+    assert!(is_history(&format!("as {} 6 (b) asked", "issue")));
+    assert!(is_history(&format!("fixed in this {}", "session")));
     assert!(is_history("measured 2026-11-24"));
     assert!(!is_history("`Session` (staged phases), `Pipeline`"));
     assert!(!is_history("see [cli.md](cli.md#exit-codes) and ## Sweeps"));
