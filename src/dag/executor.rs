@@ -309,12 +309,13 @@ impl<'a> Exec<'a> {
         self.slot(id).status = Some(status);
     }
 
-    fn ctx(&self, node: &Node, key: NodeKey) -> NodeCtx {
+    fn ctx(&self, node: &Node, key: NodeKey) -> NodeCtx<'a> {
         NodeCtx {
             stage: node.stage,
             item: node.item.clone(),
             key,
             cache_root: self.env.store.root().to_path_buf(),
+            progress: Some(self.env.progress),
         }
     }
 

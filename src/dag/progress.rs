@@ -130,6 +130,9 @@ struct Bars {
     model: BarModel,
     overall: Option<ProgressBar>,
     stages: BTreeMap<&'static str, ProgressBar>,
+    /// Single-node stages whose node reports its own steps: their bar counts steps (last printed tenth in
+    /// plain mode).
+    stepped: BTreeMap<&'static str, u64>,
 }
 
 /// Bar template: items done of all, rate and ETA.
@@ -137,12 +140,14 @@ const COUNT_TEMPLATE: &str = "{prefix:>16} [{bar:30}] {pos}/{len} {per_sec} ETA 
 /// Spinner template of a stage with a single node (no count to show, no ETA to estimate).
 const SINGLE_TEMPLATE: &str = "{prefix:>16} {spinner} running for {elapsed}";
 
+fn style(template: &str) -> ProgressStyle {
+    ProgressStyle::with_template(template)
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> ")
+}
+
 fn styled(bar: ProgressBar, template: &str, prefix: &'static str) -> ProgressBar {
-    bar.set_style(
-        ProgressStyle::with_template(template)
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
+    bar.set_style(style(template));
     bar.set_prefix(prefix);
     bar
 }
@@ -171,6 +176,7 @@ impl Progress {
         let mut st = self.state();
         st.model = BarModel::new(totals);
         st.stages.clear();
+        st.stepped.clear();
         st.overall = self.multi.as_ref().map(|m| {
             let total = st.model.overall().1 as u64;
             styled(m.add(ProgressBar::new(total)), COUNT_TEMPLATE, "all nodes")
@@ -226,6 +232,35 @@ impl Progress {
         }
     }
 
+    /// The node of single-node stage `stage` has done `done` of `total` steps; its spinner becomes a bar of
+    /// steps with rate and ETA. Ignored for stages of several nodes (their bar counts nodes).
+    pub fn node_steps(&self, stage: &'static str, done: u64, total: u64) {
+        let mut st = self.state();
+        if st.model.stage(stage).map(|(_, t)| t) != Some(1) || total == 0 {
+            return;
+        }
+        let first = !st.stepped.contains_key(stage);
+        if self.mode == ProgressMode::Plain {
+            let tenth = done * 10 / total;
+            if first || st.stepped.get(stage) != Some(&tenth) {
+                eprintln!("{stage}: {done}/{total}");
+            }
+            st.stepped.insert(stage, tenth);
+            return;
+        }
+        st.stepped.insert(stage, done);
+        let Some(bar) = st.stages.get(stage) else {
+            return;
+        };
+        if first {
+            bar.disable_steady_tick();
+            bar.set_style(style(COUNT_TEMPLATE));
+            bar.reset_eta();
+        }
+        bar.set_length(total);
+        bar.set_position(done);
+    }
+
     /// Print a warning once (the caller deduplicates).
     pub fn warn(&self, message: &str) {
         if self.mode != ProgressMode::Silent {
@@ -259,6 +294,7 @@ impl Progress {
             b.finish_and_clear();
         }
         st.model = BarModel::default();
+        st.stepped.clear();
         if let Some(m) = &self.multi {
             let _ = m.clear();
         }

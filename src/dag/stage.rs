@@ -7,6 +7,7 @@
 use crate::codec::Artifact;
 use crate::dag::error::StageError;
 use crate::dag::inputs::InputSet;
+use crate::dag::progress::Progress;
 use crate::hashing::NodeKey;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
@@ -47,15 +48,25 @@ pub type InputsOf<S> = <<S as Stage>::Inputs as InputSet>::Values;
 /// What `Stage::run` of `S` returns.
 pub type RunResult<S> = Result<<S as Stage>::Output, StageError>;
 
-/// What a running node may know about itself.
-pub struct NodeCtx {
+/// What a running node may know about itself, and where it reports progress within itself.
+pub struct NodeCtx<'a> {
     pub(crate) stage: &'static str,
     pub(crate) item: String,
     pub(crate) key: NodeKey,
     pub(crate) cache_root: PathBuf,
+    pub(crate) progress: Option<&'a Progress>,
 }
 
-impl NodeCtx {
+impl NodeCtx<'_> {
+    /// Reports how far a long node is: `done` of `total` steps (e.g. images rendered). A stage with a single
+    /// node shows it as its bar (items, rate, ETA); for stages of many nodes the bar counts nodes and this is
+    /// ignored.
+    pub fn report_steps(&self, done: u64, total: u64) {
+        if let Some(p) = self.progress {
+            p.node_steps(self.stage, done, total);
+        }
+    }
+
     /// Stage name.
     pub fn stage(&self) -> &'static str {
         self.stage

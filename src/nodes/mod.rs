@@ -3,15 +3,24 @@
 //! The algorithms, their versions and their parameters live in `stages/`; this layer only adds typed inputs and
 //! encoding.
 
-/// Inside `impl Stage for …`: the node's identity (name and version from the algorithm's `StageId`, so
-/// both are defined once, next to the algorithm), its parameters and its output:
-/// `stage_types!(skytie_stages::oblique::facades::STAGE, FacadeParams => TripletFacades);`.
+/// Inside `impl Stage for …`: the node's whole signature in one declaration — its identity (name and version
+/// from the algorithm's `StageId`, so both are defined once, next to the algorithm), its parameters, its output
+/// and its typed inputs:
+/// `stage_types!(skytie_stages::oblique::facades::STAGE, FacadeParams => TripletFacades, inputs: (Handle<A>, Vec<Handle<B>>));`.
+/// A node with no algorithm of its own in `skytie-stages` names itself: `stage_types!(named "probe" version "1", …)`.
 macro_rules! stage_types {
-    ($id:expr, $params:ty => $output:ty) => {
+    (named $name:literal version $version:literal, $params:ty => $output:ty, inputs: $inputs:ty) => {
+        $crate::nodes::stage_types!(
+            skytie_stages::params::StageId::new($name, $version),
+            $params => $output, inputs: $inputs
+        );
+    };
+    ($id:expr, $params:ty => $output:ty, inputs: $inputs:ty) => {
         const NAME: &'static str = $id.name;
         const VERSION: &'static str = $id.version;
         type Params = $params;
         type Output = $output;
+        type Inputs = $inputs;
     };
 }
 pub(crate) use stage_types;

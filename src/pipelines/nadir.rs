@@ -7,7 +7,7 @@
 use super::orthophoto::OrthophotoRoute;
 use super::{distance_m, missing_upstream, stage, wf_err};
 use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
-use crate::nodes::campaign::aerial::{SelectAerial, SelectAerialParams};
+use crate::nodes::campaign::aerial::AerialRowNodes;
 use crate::nodes::campaign::ingest::{ingest_file, IngestedImage};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::summary::SummaryParams;
@@ -22,7 +22,7 @@ use crate::nodes::nadir::summary::SummarizeNadir;
 use crate::nodes::nadir::transform::InitialTransformStage;
 use crate::nodes::nadir::transform_agreement::TransformAgreementStage;
 use crate::workflow::Workflow;
-use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
+use skytie_stages::campaign::{AerialKind, Recording};
 use skytie_stages::nadir::aerial_overlap::overlapping_nadir;
 use skytie_stages::nadir::baseline::BaselineParams;
 use skytie_stages::nadir::control_points::ControlParams;
@@ -34,7 +34,6 @@ use skytie_stages::nadir::summary::NadirSummary;
 use skytie_stages::nadir::{
     AerialRefinement, MmWindowMatch, OrthoImage, OrthoParams, RecordingControl, TransformOutcome,
 };
-use std::collections::BTreeMap;
 use std::path::Path;
 
 /// The stages of the nadir chain, in dependency order.
@@ -130,7 +129,7 @@ pub fn add_nadir(
         false => None,
     };
 
-    let mut aerial_rows: BTreeMap<usize, Handle<AerialImage>> = BTreeMap::new();
+    let mut aerial_rows = AerialRowNodes::new(AerialKind::Nadir, snap);
     let mut windows = Vec::new();
     let mut transforms: Vec<Handle<TransformOutcome>> = Vec::new();
     let mut refinements: Vec<Handle<AerialRefinement>> = Vec::new();
@@ -180,22 +179,7 @@ pub fn add_nadir(
             options.overlap_margin_m,
         ) {
             let row = &snapshot.campaign.nadir[a];
-            let aerial = match aerial_rows.get(&a) {
-                Some(h) => *h,
-                None => {
-                    let h = b.add(
-                        SelectAerial,
-                        &format!("nadir {}", row.image_id),
-                        SelectAerialParams {
-                            image_id: row.image_id.clone(),
-                            kind: AerialKind::Nadir,
-                        },
-                        snap,
-                    )?;
-                    aerial_rows.insert(a, h);
-                    h
-                }
-            };
+            let aerial = aerial_rows.get_or_add(b, a, row)?;
             let pair = pair_label(&item.recording.image_id, &row.image_id);
             let aerial_file = ingest_file(
                 b,

@@ -10,7 +10,7 @@
 use super::nadir::RecordingItem;
 use super::{distance_m, missing_upstream, stage, wf_err};
 use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
-use crate::nodes::campaign::aerial::{SelectAerial, SelectAerialParams};
+use crate::nodes::campaign::aerial::AerialRowNodes;
 use crate::nodes::campaign::ingest::ingest_file;
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::summary::SummaryParams;
@@ -23,13 +23,12 @@ use crate::nodes::oblique::options::ObliqueOptions;
 use crate::nodes::oblique::patches::PatchesStage;
 use crate::nodes::oblique::sparse_cloud::SparseCloudStage;
 use crate::workflow::Workflow;
-use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
+use skytie_stages::campaign::{AerialKind, Recording};
 use skytie_stages::oblique::candidates::candidate_oblique;
 use skytie_stages::oblique::facades::FacadeParams;
 use skytie_stages::oblique::patch_registration::PatchParams;
 use skytie_stages::oblique::sparse_cloud::SparseCloudParams;
 use skytie_stages::oblique::{PatchRegistrationSet, SparseCloud, TripletFacades};
-use std::collections::BTreeMap;
 use std::path::Path;
 
 /// The stages of the oblique chain, in dependency order.
@@ -95,7 +94,7 @@ pub fn add_oblique(
     let oblique_dir = root.join("aerial/oblique");
     let oblique_rows = &snapshot.campaign.oblique;
 
-    let mut aerial_rows: BTreeMap<usize, Handle<AerialImage>> = BTreeMap::new();
+    let mut aerial_rows = AerialRowNodes::new(AerialKind::Oblique, snap);
     let mut all_facades: Vec<Handle<TripletFacades>> = Vec::new();
     let mut sets: Vec<Handle<PatchRegistrationSet>> = Vec::new();
     // Pass 1: the sparse cloud of every triplet (centre item index → cloud).
@@ -155,22 +154,7 @@ pub fn add_oblique(
         let mut aerials = Vec::with_capacity(candidates.len());
         for &a in &candidates {
             let row = &oblique_rows[a];
-            let h = match aerial_rows.get(&a) {
-                Some(h) => *h,
-                None => {
-                    let h = b.add(
-                        SelectAerial,
-                        &format!("oblique {}", row.image_id),
-                        SelectAerialParams {
-                            image_id: row.image_id.clone(),
-                            kind: AerialKind::Oblique,
-                        },
-                        snap,
-                    )?;
-                    aerial_rows.insert(a, h);
-                    h
-                }
-            };
+            let h = aerial_rows.get_or_add(b, a, row)?;
             aerials.push((a, h));
         }
         let facades = b.add(

@@ -8,11 +8,12 @@ use super::wf_err;
 use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::campaign::ingest::{ingest_file, IngestedImage};
 use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::summary::SummaryParams;
+use crate::nodes::nadir::dtm::{DtmParams, LoadDtm};
 use crate::nodes::nadir::ortho::OrthoProject;
-use crate::nodes::nadir::orthophoto::{
-    DtmParams, LoadDtm, NoParams, OrthophotoNodeParams, OrthophotoPoints, OrthophotoStage,
-    SummarizeOrthophoto,
-};
+use crate::nodes::nadir::orthophoto::{OrthophotoNodeParams, OrthophotoStage};
+use crate::nodes::nadir::orthophoto_points::OrthophotoPoints;
+use crate::nodes::nadir::orthophoto_summary::SummarizeOrthophoto;
 use crate::workflow::Workflow;
 use skytie_stages::campaign::orthophoto::{OrthophotoSource, DEFAULT_DTM_SIGMA_M};
 use skytie_stages::campaign::Recording;
@@ -137,7 +138,7 @@ impl<'a> OrthophotoRoute<'a> {
         Ok(Some(b.add(
             OrthophotoPoints,
             &label,
-            NoParams::default(),
+            SummaryParams::default(),
             result,
         )?))
     }
@@ -147,7 +148,7 @@ impl<'a> OrthophotoRoute<'a> {
         let summary = b.add(
             SummarizeOrthophoto,
             "",
-            NoParams::default(),
+            SummaryParams::default(),
             optional_all(&self.results),
         )?;
         b.metrics(summary, "orthophoto", |s: &OrthophotoSummary| s.metrics());

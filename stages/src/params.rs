@@ -44,6 +44,12 @@ pub struct StageId {
     pub version: &'static str,
 }
 
+impl StageId {
+    pub const fn new(name: &'static str, version: &'static str) -> Self {
+        Self { name, version }
+    }
+}
+
 /// The allowed values of a numeric parameter.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Range {

@@ -6,9 +6,7 @@
 use nalgebra::Matrix3;
 use skytie_stages::campaign::{read_campaign, AerialImage, Campaign, CheckPoint, Recording};
 use skytie_stages::crs::geoid::GeoidGrid;
-use skytie_stages::formats::angles::{AngleUnit, AttitudeConvention};
-use skytie_stages::formats::opk_list::{OpkColumns, OpkListFormat};
-use skytie_stages::formats::text_table::Delimiter;
+use skytie_stages::formats::opk_list::OpkListFormat;
 use skytie_stages::geometry::{opk_to_matrix, panorama_rotation};
 use skytie_stages::import::config::CampaignSection;
 use skytie_stages::import::context::ImportContext;
@@ -120,6 +118,16 @@ fn assert_aerial_equal(orig: &[AerialImage], got: &[AerialImage], what: &str) {
     }
 }
 
+/// A scratch folder holding an (empty) image file for every row, as an import expects.
+fn with_images(rows: &[AerialImage]) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    touch_all(
+        &dir.path().join("images"),
+        rows.iter().map(|r| r.file.clone()),
+    );
+    dir
+}
+
 fn context(geoid_separation_m: f64) -> ImportContext {
     ImportContext::new(&CampaignSection {
         name: "t".into(),
@@ -203,11 +211,7 @@ fn metashape_opk_and_generic_lists_round_trip() {
         .collect();
     let camera = "[aerial.camera]\nfocal_px = 10000.5\ncx_px = 3000.25\ncy_px = 2001.75\nwidth_px = 6000\nheight_px = 4000\nk1 = -0.12\nk2 = 0.03\nk3 = 0.004\nk4 = -0.0005\np1 = 2e-4\np2 = -1e-4\nb1 = 0.8\nb2 = -0.3\n";
     // Metashape ω-φ-κ export.
-    let dir = tempfile::tempdir().unwrap();
-    touch_all(
-        &dir.path().join("images"),
-        rows.iter().map(|r| r.file.clone()),
-    );
+    let dir = with_images(&rows);
     export_opk_list(
         &rows,
         &context(43.25),
@@ -219,26 +223,8 @@ fn metashape_opk_and_generic_lists_round_trip() {
     let got = import(dir.path(), &format!("{CAMPAIGN}[[aerial]]\nkind = \"nadir\"\nformat = \"metashape-opk\"\norientations = \"opk.txt\"\nimages = \"images\"\n{camera}"));
     assert_aerial_equal(&rows, &got.nadir, "metashape-opk");
     // A classical AT list: semicolons, no header, gon, yaw-pitch-roll, columns by position.
-    let layout = OpkListFormat {
-        delimiter: Delimiter::Semicolon,
-        header: false,
-        comment_header: false,
-        angle_unit: AngleUnit::Gon,
-        attitude: AttitudeConvention::YawPitchRoll,
-        columns: OpkColumns {
-            image: "1".into(),
-            x: "2".into(),
-            y: "3".into(),
-            z: "4".into(),
-            angles: ["5".into(), "6".into(), "7".into()],
-            matrix: None,
-        },
-    };
-    let dir = tempfile::tempdir().unwrap();
-    touch_all(
-        &dir.path().join("images"),
-        rows.iter().map(|r| r.file.clone()),
-    );
+    let layout = OpkListFormat::at_list();
+    let dir = with_images(&rows);
     export_opk_list(
         &rows,
         &context(43.25),

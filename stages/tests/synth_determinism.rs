@@ -227,7 +227,7 @@ fn table_profiles_share_one_rendering_of_the_images() {
     let dir = tempfile::tempdir().unwrap();
     let rendered = dir.path().join("rendered");
     let thesis = SynthOptions::new(Preset::Tiny, 3);
-    render_campaign(&thesis, &rendered, &dir.path().join("store")).unwrap();
+    render_campaign(&thesis, &rendered, &dir.path().join("store"), &|_, _| {}).unwrap();
     let mut rich = thesis.clone();
     rich.profile = Profile::parse("outage+ins+vertical+aerial").unwrap();
     assert_eq!(rich.render_identity(), thesis.render_identity());

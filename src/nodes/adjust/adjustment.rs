@@ -181,15 +181,8 @@ fn spread(mut values: Vec<f64>) -> serde_json::Value {
 pub struct AdjustStage;
 
 impl Stage for AdjustStage {
-    crate::nodes::stage_types!(skytie_stages::adjustment::from_correspondences::STAGE, AdjustConfig => AdjustReport);
-    type Inputs = (
-        Handle<CampaignSnapshot>,
-        Vec<RawFile>,
-        Vec<Optional<MmWindowMatch>>,
-        Vec<Optional<RecordingControl>>,
-        Vec<Optional<SparseCloud>>,
-        Vec<Optional<ObliqueOutput>>,
-    );
+    crate::nodes::stage_types!(skytie_stages::adjustment::from_correspondences::STAGE, AdjustConfig => AdjustReport,
+        inputs: (Handle<CampaignSnapshot>, Vec<RawFile>, Vec<Optional<MmWindowMatch>>, Vec<Optional<RecordingControl>>, Vec<Optional<SparseCloud>>, Vec<Optional<ObliqueOutput>>));
 
     fn run(&self, config: &AdjustConfig, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (snap, panos, windows, control, clouds, oblique) = inputs;

@@ -30,17 +30,13 @@ impl AdjustGrade {
 
 /// The stage's identity in cache keys (the computation lives in this node); bump the version whenever its
 /// output for the same inputs and parameters changes.
-pub const STAGE: StageId = StageId {
-    name: "grade_adjust",
-    version: "1",
-};
+pub const STAGE: StageId = StageId::new("grade_adjust", "1");
 
 /// The adjustment grading node.
 pub struct GradeAdjust;
 
 impl Stage for GradeAdjust {
-    crate::nodes::stage_types!(STAGE, SummaryParams => AdjustGrade);
-    type Inputs = (RawFile, Handle<AdjustReport>);
+    crate::nodes::stage_types!(STAGE, SummaryParams => AdjustGrade, inputs: (RawFile, Handle<AdjustReport>));
 
     fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (truth_file, report) = inputs;

@@ -39,19 +39,13 @@ pub fn verify_metrics(v: &Verification) -> serde_json::Value {
     })
 }
 
-/// The verification node.
+/// The verification node. Inputs: the campaign, its panoramas, the aerial control points, and no or one
+/// adjustment whose poses replace the recorded ones.
 pub struct VerifyStage;
 
 impl Stage for VerifyStage {
-    crate::nodes::stage_types!(skytie_stages::adjustment::verify::STAGE, VerifyConfig => Verification);
-    /// The campaign, its panoramas, the aerial control points, and no or one adjustment whose poses replace the
-    /// recorded ones.
-    type Inputs = (
-        Handle<CampaignSnapshot>,
-        Vec<RawFile>,
-        Vec<Optional<RecordingControl>>,
-        Vec<Handle<AdjustReport>>,
-    );
+    crate::nodes::stage_types!(skytie_stages::adjustment::verify::STAGE, VerifyConfig => Verification,
+        inputs: (Handle<CampaignSnapshot>, Vec<RawFile>, Vec<Optional<RecordingControl>>, Vec<Handle<AdjustReport>>));
 
     fn run(&self, config: &VerifyConfig, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (snap, panos, control, adjusted) = inputs;

@@ -87,8 +87,8 @@ pub fn listing_hash(root: &Path) -> std::io::Result<String> {
 pub struct LoadCampaign;
 
 impl Stage for LoadCampaign {
-    crate::nodes::stage_types!(skytie_stages::campaign::read::STAGE, LoadCampaignParams => CampaignSnapshot);
-    type Inputs = Vec<RawFile>;
+    crate::nodes::stage_types!(skytie_stages::campaign::read::STAGE, LoadCampaignParams => CampaignSnapshot,
+        inputs: Vec<RawFile>);
 
     fn run(&self, p: &LoadCampaignParams, _files: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (sourced, problems) = read_sourced(Path::new(&p.root))
@@ -107,17 +107,14 @@ skytie_stages::params! {
 
 /// The stage's identity in cache keys (the computation lives in this node); bump the version whenever its
 /// output for the same inputs and parameters changes.
-pub const RECORDING_STAGE: StageId = StageId {
-    name: "recording",
-    version: "1",
-};
+pub const RECORDING_STAGE: StageId = StageId::new("recording", "1");
 
 /// One recording's row of the snapshot.
 pub struct SelectRecording;
 
 impl Stage for SelectRecording {
-    crate::nodes::stage_types!(RECORDING_STAGE, SelectRecordingParams => Recording);
-    type Inputs = Handle<CampaignSnapshot>;
+    crate::nodes::stage_types!(RECORDING_STAGE, SelectRecordingParams => Recording,
+        inputs: Handle<CampaignSnapshot>);
 
     fn run(&self, p: &SelectRecordingParams, snap: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         snap.campaign

@@ -64,17 +64,14 @@ impl CampaignSummary {
 
 /// The stage's identity in cache keys (the computation lives in this node); bump the version whenever its
 /// output for the same inputs and parameters changes.
-pub const STAGE: StageId = StageId {
-    name: "summary",
-    version: "2",
-};
+pub const STAGE: StageId = StageId::new("summary", "2");
 
 /// The summary node.
 pub struct SummarizeCampaign;
 
 impl Stage for SummarizeCampaign {
-    crate::nodes::stage_types!(STAGE, SummaryParams => CampaignSummary);
-    type Inputs = (Handle<CampaignSnapshot>, Vec<Optional<OrthoImage>>);
+    crate::nodes::stage_types!(STAGE, SummaryParams => CampaignSummary,
+        inputs: (Handle<CampaignSnapshot>, Vec<Optional<OrthoImage>>));
 
     fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (snap, orthos) = inputs;

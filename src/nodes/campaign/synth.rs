@@ -203,13 +203,13 @@ pub fn list_files(root: &Path) -> std::io::Result<Vec<(String, u64)>> {
 pub struct RenderCampaign;
 
 impl Stage for RenderCampaign {
-    crate::nodes::stage_types!(RENDER_STAGE, RenderIdentity => GeneratedCampaign);
-    type Inputs = ();
+    crate::nodes::stage_types!(RENDER_STAGE, RenderIdentity => GeneratedCampaign, inputs: ());
 
     fn run(&self, identity: &RenderIdentity, _: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         let options = SynthOptions::rendering(identity);
         let tmp = ctx.output_dir_tmp()?;
-        let (summary, reused) = render_campaign(&options, &tmp.join("campaign"), &ctx.partial_dir())
+        let report = |done: u64, total: u64| ctx.report_steps(done, total);
+        let (summary, reused) = render_campaign(&options, &tmp.join("campaign"), &ctx.partial_dir(), &report)
             .map_err(|e| {
                 StageError::new(format!(
                     "synthetic campaign rendering failed: {e} (the images rendered so far are kept in {}; \
@@ -235,8 +235,7 @@ impl Stage for RenderCampaign {
 pub struct SynthCampaign;
 
 impl Stage for SynthCampaign {
-    crate::nodes::stage_types!(STAGE, SynthParams => GeneratedCampaign);
-    type Inputs = Handle<GeneratedCampaign>;
+    crate::nodes::stage_types!(STAGE, SynthParams => GeneratedCampaign, inputs: Handle<GeneratedCampaign>);
 
     fn run(&self, p: &SynthParams, rendered: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         let options = p

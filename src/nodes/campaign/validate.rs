@@ -23,11 +23,8 @@ crate::serde_artifact!(ImageProbe);
 pub struct ProbeImage;
 
 impl Stage for ProbeImage {
-    const NAME: &'static str = "probe";
-    const VERSION: &'static str = "1";
-    type Params = SummaryParams;
-    type Output = ImageProbe;
-    type Inputs = crate::dag::RawFile;
+    crate::nodes::stage_types!(named "probe" version "1", SummaryParams => ImageProbe,
+        inputs: crate::dag::RawFile);
 
     fn run(&self, _: &SummaryParams, file: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         Ok(ImageProbe {
@@ -40,11 +37,8 @@ impl Stage for ProbeImage {
 pub struct ValidateImages;
 
 impl Stage for ValidateImages {
-    const NAME: &'static str = "validate";
-    const VERSION: &'static str = "1";
-    type Params = SummaryParams;
-    type Output = CampaignSnapshot;
-    type Inputs = (Handle<CampaignSnapshot>, Vec<Handle<ImageProbe>>);
+    crate::nodes::stage_types!(named "validate" version "1", SummaryParams => CampaignSnapshot,
+        inputs: (Handle<CampaignSnapshot>, Vec<Handle<ImageProbe>>));
 
     fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (snap, probes) = inputs;

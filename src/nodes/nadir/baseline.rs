@@ -13,14 +13,8 @@ use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, OrthoImage, Transfor
 pub struct BaselineStage;
 
 impl Stage for BaselineStage {
-    crate::nodes::stage_types!(skytie_stages::nadir::baseline::STAGE, BaselineParams => AerialRefinement);
-    type Inputs = (
-        Handle<OrthoImage>,
-        Handle<IngestedImage>,
-        Handle<AerialImage>,
-        Handle<TransformOutcome>,
-        Handle<MmWindowMatch>,
-    );
+    crate::nodes::stage_types!(skytie_stages::nadir::baseline::STAGE, BaselineParams => AerialRefinement,
+        inputs: (Handle<OrthoImage>, Handle<IngestedImage>, Handle<AerialImage>, Handle<TransformOutcome>, Handle<MmWindowMatch>));
 
     fn run(&self, p: &BaselineParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (ortho, aerial_file, aerial, outcome, window) = inputs;

@@ -13,12 +13,8 @@ crate::serde_artifact!(RecordingControl);
 pub struct ControlStage;
 
 impl Stage for ControlStage {
-    crate::nodes::stage_types!(skytie_stages::nadir::control_points::STAGE, ControlParams => RecordingControl);
-    type Inputs = (
-        Handle<MmWindowMatch>,
-        Vec<Optional<AerialRefinement>>,
-        Vec<Handle<AerialImage>>,
-    );
+    crate::nodes::stage_types!(skytie_stages::nadir::control_points::STAGE, ControlParams => RecordingControl,
+        inputs: (Handle<MmWindowMatch>, Vec<Optional<AerialRefinement>>, Vec<Handle<AerialImage>>));
 
     fn run(&self, p: &ControlParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (window, refinements, aerials) = inputs;

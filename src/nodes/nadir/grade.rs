@@ -109,15 +109,8 @@ pub fn load_truth(
 pub struct GradeNadir;
 
 impl Stage for GradeNadir {
-    crate::nodes::stage_types!(skytie_stages::nadir::grading::STAGE, SummaryParams => NadirGrade);
-    type Inputs = (
-        Handle<CampaignSnapshot>,
-        Vec<RawFile>,
-        Vec<RawFile>,
-        Vec<Handle<MmWindowMatch>>,
-        Vec<Handle<AerialRefinement>>,
-        Vec<Handle<RecordingControl>>,
-    );
+    crate::nodes::stage_types!(skytie_stages::nadir::grading::STAGE, SummaryParams => NadirGrade,
+        inputs: (Handle<CampaignSnapshot>, Vec<RawFile>, Vec<RawFile>, Vec<Handle<MmWindowMatch>>, Vec<Handle<AerialRefinement>>, Vec<Handle<RecordingControl>>));
 
     fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (snap, truth_files, panos, windows, refinements, control) = inputs;

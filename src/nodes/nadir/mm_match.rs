@@ -14,12 +14,8 @@ crate::serde_artifact!(MmWindowMatch);
 pub struct MmMatch;
 
 impl Stage for MmMatch {
-    crate::nodes::stage_types!(skytie_stages::nadir::mm_matching::STAGE, MmMatchParams => MmWindowMatch);
-    type Inputs = (
-        Vec<Handle<Recording>>,
-        Vec<Handle<OrthoImage>>,
-        Vec<RawFile>,
-    );
+    crate::nodes::stage_types!(skytie_stages::nadir::mm_matching::STAGE, MmMatchParams => MmWindowMatch,
+        inputs: (Vec<Handle<Recording>>, Vec<Handle<OrthoImage>>, Vec<RawFile>));
 
     fn run(&self, p: &MmMatchParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (recs, orthos, panos) = inputs;

@@ -4,12 +4,15 @@
 
 pub mod baseline;
 pub mod control;
+pub mod dtm;
 pub mod grade;
 pub mod mm_match;
 pub mod options;
 pub mod ortho;
 pub mod ortho_aerial;
 pub mod orthophoto;
+pub mod orthophoto_points;
+pub mod orthophoto_summary;
 pub mod refine;
 pub mod summary;
 pub mod transform;

@@ -36,8 +36,8 @@ pub fn panorama_for_ortho(
 pub struct OrthoProject;
 
 impl Stage for OrthoProject {
-    crate::nodes::stage_types!(skytie_stages::nadir::ortho::STAGE, OrthoParams => OrthoImage);
-    type Inputs = (Handle<Recording>, Handle<IngestedImage>);
+    crate::nodes::stage_types!(skytie_stages::nadir::ortho::STAGE, OrthoParams => OrthoImage,
+        inputs: (Handle<Recording>, Handle<IngestedImage>));
 
     fn run(&self, p: &OrthoParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (rec, pano) = inputs;

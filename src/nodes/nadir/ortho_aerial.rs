@@ -17,12 +17,8 @@ use skytie_stages::nadir::{ortho_project, OrthoImage, OrthoParams};
 pub struct OrthoForAerial;
 
 impl Stage for OrthoForAerial {
-    crate::nodes::stage_types!(skytie_stages::nadir::aerial_patch::STAGE, OrthoParams => OrthoImage);
-    type Inputs = (
-        Handle<Recording>,
-        Handle<IngestedImage>,
-        Handle<AerialImage>,
-    );
+    crate::nodes::stage_types!(skytie_stages::nadir::aerial_patch::STAGE, OrthoParams => OrthoImage,
+        inputs: (Handle<Recording>, Handle<IngestedImage>, Handle<AerialImage>));
 
     fn run(&self, base: &OrthoParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (rec, pano, aerial) = inputs;

@@ -20,15 +20,8 @@ crate::serde_artifact!(AerialRefinement);
 pub struct RefineStage;
 
 impl Stage for RefineStage {
-    crate::nodes::stage_types!(skytie_stages::nadir::refine::STAGE, RefineParams => AerialRefinement);
-    type Inputs = (
-        Handle<OrthoImage>,
-        Handle<IngestedImage>,
-        Handle<AerialImage>,
-        Handle<TransformOutcome>,
-        Handle<MmWindowMatch>,
-        Vec<Handle<OrthoImage>>,
-    );
+    crate::nodes::stage_types!(skytie_stages::nadir::refine::STAGE, RefineParams => AerialRefinement,
+        inputs: (Handle<OrthoImage>, Handle<IngestedImage>, Handle<AerialImage>, Handle<TransformOutcome>, Handle<MmWindowMatch>, Vec<Handle<OrthoImage>>));
 
     fn run(&self, p: &RefineParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (ortho, aerial_file, aerial, outcome, window, neighbour_orthos) = inputs;

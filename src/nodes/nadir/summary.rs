@@ -13,14 +13,8 @@ crate::serde_artifact!(NadirSummary);
 pub struct SummarizeNadir;
 
 impl Stage for SummarizeNadir {
-    crate::nodes::stage_types!(skytie_stages::nadir::summary::STAGE, SummaryParams => NadirSummary);
-    type Inputs = (
-        Handle<CampaignSnapshot>,
-        Vec<Optional<MmWindowMatch>>,
-        Vec<Optional<TransformOutcome>>,
-        Vec<Optional<AerialRefinement>>,
-        Vec<Optional<RecordingControl>>,
-    );
+    crate::nodes::stage_types!(skytie_stages::nadir::summary::STAGE, SummaryParams => NadirSummary,
+        inputs: (Handle<CampaignSnapshot>, Vec<Optional<MmWindowMatch>>, Vec<Optional<TransformOutcome>>, Vec<Optional<AerialRefinement>>, Vec<Optional<RecordingControl>>));
 
     fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (snap, windows, transforms, refinements, control) = inputs;

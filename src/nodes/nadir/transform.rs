@@ -15,13 +15,8 @@ crate::serde_artifact!(TransformOutcome);
 pub struct InitialTransformStage;
 
 impl Stage for InitialTransformStage {
-    crate::nodes::stage_types!(skytie_stages::nadir::initial_transform::STAGE, TransformParams => TransformOutcome);
-    type Inputs = (
-        Handle<Recording>,
-        Handle<OrthoImage>,
-        Handle<IngestedImage>,
-        Handle<AerialImage>,
-    );
+    crate::nodes::stage_types!(skytie_stages::nadir::initial_transform::STAGE, TransformParams => TransformOutcome,
+        inputs: (Handle<Recording>, Handle<OrthoImage>, Handle<IngestedImage>, Handle<AerialImage>));
 
     fn run(&self, p: &TransformParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (rec, ortho, aerial_file, aerial) = inputs;

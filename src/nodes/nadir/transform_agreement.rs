@@ -11,8 +11,8 @@ use skytie_stages::nadir::TransformOutcome;
 pub struct TransformAgreementStage;
 
 impl Stage for TransformAgreementStage {
-    crate::nodes::stage_types!(skytie_stages::nadir::transform_agreement::STAGE, TransformParams => TransformOutcome);
-    type Inputs = (Handle<TransformOutcome>, Vec<Handle<TransformOutcome>>);
+    crate::nodes::stage_types!(skytie_stages::nadir::transform_agreement::STAGE, TransformParams => TransformOutcome,
+        inputs: (Handle<TransformOutcome>, Vec<Handle<TransformOutcome>>));
 
     fn run(&self, p: &TransformParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (own, all) = inputs;

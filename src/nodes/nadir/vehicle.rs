@@ -64,8 +64,8 @@ impl VehicleDetection {
 pub struct DetectVehicle;
 
 impl Stage for DetectVehicle {
-    crate::nodes::stage_types!(skytie_stages::nadir::vehicle_detect::STAGE, VehicleNodeParams => VehicleDetection);
-    type Inputs = (Handle<CampaignSnapshot>, Vec<Handle<IngestedImage>>);
+    crate::nodes::stage_types!(skytie_stages::nadir::vehicle_detect::STAGE, VehicleNodeParams => VehicleDetection,
+        inputs: (Handle<CampaignSnapshot>, Vec<Handle<IngestedImage>>));
 
     fn run(&self, p: &VehicleNodeParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (snap, panos) = inputs;

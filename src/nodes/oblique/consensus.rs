@@ -23,14 +23,8 @@ crate::serde_artifact!(ObliqueOutput);
 pub struct ConsensusStage;
 
 impl Stage for ConsensusStage {
-    crate::nodes::stage_types!(skytie_stages::oblique::consensus::STAGE, ConsensusParams => ObliqueOutput);
-    type Inputs = (
-        Handle<CampaignSnapshot>,
-        Vec<RawFile>,
-        Vec<Optional<SparseCloud>>,
-        Vec<Optional<TripletFacades>>,
-        Vec<Optional<PatchRegistrationSet>>,
-    );
+    crate::nodes::stage_types!(skytie_stages::oblique::consensus::STAGE, ConsensusParams => ObliqueOutput,
+        inputs: (Handle<CampaignSnapshot>, Vec<RawFile>, Vec<Optional<SparseCloud>>, Vec<Optional<TripletFacades>>, Vec<Optional<PatchRegistrationSet>>));
 
     fn run(&self, p: &ConsensusParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (snap, panos, clouds, facades, sets) = inputs;

@@ -17,12 +17,8 @@ crate::serde_artifact!(TripletFacades);
 pub struct FacadesStage;
 
 impl Stage for FacadesStage {
-    crate::nodes::stage_types!(skytie_stages::oblique::facades::STAGE, FacadeParams => TripletFacades);
-    type Inputs = (
-        Vec<Handle<SparseCloud>>,
-        Vec<Handle<Recording>>,
-        Vec<Handle<AerialImage>>,
-    );
+    crate::nodes::stage_types!(skytie_stages::oblique::facades::STAGE, FacadeParams => TripletFacades,
+        inputs: (Vec<Handle<SparseCloud>>, Vec<Handle<Recording>>, Vec<Handle<AerialImage>>));
 
     fn run(&self, p: &FacadeParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (clouds, recs, oblique) = inputs;

@@ -34,15 +34,8 @@ impl GradeOblique {
 }
 
 impl Stage for GradeOblique {
-    crate::nodes::stage_types!(skytie_stages::oblique::grading::STAGE, SummaryParams => ObliqueGrade);
-    type Inputs = (
-        Handle<CampaignSnapshot>,
-        Vec<RawFile>,
-        Vec<RawFile>,
-        Vec<RawFile>,
-        Vec<Handle<SparseCloud>>,
-        Handle<ObliqueOutput>,
-    );
+    crate::nodes::stage_types!(skytie_stages::oblique::grading::STAGE, SummaryParams => ObliqueGrade,
+        inputs: (Handle<CampaignSnapshot>, Vec<RawFile>, Vec<RawFile>, Vec<RawFile>, Vec<Handle<SparseCloud>>, Handle<ObliqueOutput>));
 
     fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (snap, truth_files, scene_files, panos, clouds, result) = inputs;

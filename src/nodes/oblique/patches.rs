@@ -17,15 +17,8 @@ crate::serde_artifact!(PatchRegistrationSet);
 pub struct PatchesStage;
 
 impl Stage for PatchesStage {
-    crate::nodes::stage_types!(skytie_stages::oblique::patch_registration::STAGE, PatchParams => PatchRegistrationSet);
-    type Inputs = (
-        Handle<Recording>,
-        Handle<IngestedImage>,
-        Handle<AerialImage>,
-        Handle<IngestedImage>,
-        Vec<Handle<SparseCloud>>,
-        Handle<TripletFacades>,
-    );
+    crate::nodes::stage_types!(skytie_stages::oblique::patch_registration::STAGE, PatchParams => PatchRegistrationSet,
+        inputs: (Handle<Recording>, Handle<IngestedImage>, Handle<AerialImage>, Handle<IngestedImage>, Vec<Handle<SparseCloud>>, Handle<TripletFacades>));
 
     fn run(&self, p: &PatchParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (rec, pano, oblique, oblique_file, clouds, facades) = inputs;

@@ -18,8 +18,8 @@ crate::serde_artifact!(SparseCloud);
 pub struct SparseCloudStage;
 
 impl Stage for SparseCloudStage {
-    crate::nodes::stage_types!(skytie_stages::oblique::sparse_cloud::STAGE, SparseCloudParams => SparseCloud);
-    type Inputs = (Vec<Handle<Recording>>, Vec<Handle<IngestedImage>>);
+    crate::nodes::stage_types!(skytie_stages::oblique::sparse_cloud::STAGE, SparseCloudParams => SparseCloud,
+        inputs: (Vec<Handle<Recording>>, Vec<Handle<IngestedImage>>));
 
     fn run(&self, p: &SparseCloudParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (recs, panos) = inputs;

@@ -26,10 +26,7 @@ use std::collections::HashMap;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId {
-    name: "adjust",
-    version: "3",
-};
+pub const STAGE: StageId = StageId::new("adjust", "3");
 
 /// The inputs of one adjustment.
 #[derive(Clone, Copy, Debug)]

@@ -27,10 +27,7 @@ use std::path::Path;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId {
-    name: "verify",
-    version: "4",
-};
+pub const STAGE: StageId = StageId::new("verify", "4");
 
 crate::params! {
     /// Parameters of a verification (the verify node's params).

@@ -16,10 +16,7 @@ use std::path::{Path, PathBuf};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId {
-    name: "load",
-    version: "3",
-};
+pub const STAGE: StageId = StageId::new("load", "3");
 
 /// The folder holds nothing usable as a campaign.
 #[derive(Debug, thiserror::Error)]

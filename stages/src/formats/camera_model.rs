@@ -15,21 +15,31 @@
 
 use crate::campaign::AerialImage;
 
-/// Interior orientation in the campaign's convention.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Interior orientation in the campaign's convention; also the `[aerial.camera]` table of an import
+/// configuration (distortion terms optional, default 0).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CameraModel {
     pub focal_px: f64,
     pub cx_px: f64,
     pub cy_px: f64,
     pub width_px: u32,
     pub height_px: u32,
+    #[serde(default)]
     pub k1: f64,
+    #[serde(default)]
     pub k2: f64,
+    #[serde(default)]
     pub k3: f64,
+    #[serde(default)]
     pub k4: f64,
+    #[serde(default)]
     pub p1: f64,
+    #[serde(default)]
     pub p2: f64,
+    #[serde(default)]
     pub b1: f64,
+    #[serde(default)]
     pub b2: f64,
 }
 

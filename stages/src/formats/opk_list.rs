@@ -71,6 +71,26 @@ impl OpkListFormat {
     }
 
     /// Metashape "Omega Phi Kappa" text export.
+    /// A classical aerial-triangulation list: semicolons, no header, gon, yaw-pitch-roll, columns by
+    /// position (image, X, Y, Z, yaw, pitch, roll).
+    pub fn at_list() -> Self {
+        Self {
+            delimiter: Delimiter::Semicolon,
+            header: false,
+            comment_header: false,
+            angle_unit: AngleUnit::Gon,
+            attitude: AttitudeConvention::YawPitchRoll,
+            columns: OpkColumns {
+                image: "1".into(),
+                x: "2".into(),
+                y: "3".into(),
+                z: "4".into(),
+                angles: ["5".into(), "6".into(), "7".into()],
+                matrix: None,
+            },
+        }
+    }
+
     pub fn metashape() -> Self {
         let r = |i: usize, j: usize| format!("r{i}{j}");
         Self {

@@ -73,24 +73,9 @@ fn read_list(
     layout: &OpkListFormat,
     report: &mut SourceReport,
 ) -> Option<(Vec<SourcePose>, Option<String>)> {
-    let Some(c) = src.camera else {
+    let Some(camera) = src.camera else {
         report.problems.push(missing(&src.orientations, "camera", "give the interior orientation in [aerial.camera] (focal_px, cx_px, cy_px, width_px, height_px, distortion)"));
         return None;
-    };
-    let camera = CameraModel {
-        focal_px: c.focal_px,
-        cx_px: c.cx_px,
-        cy_px: c.cy_px,
-        width_px: c.width_px,
-        height_px: c.height_px,
-        k1: c.k1,
-        k2: c.k2,
-        k3: c.k3,
-        k4: c.k4,
-        p1: c.p1,
-        p2: c.p2,
-        b1: c.b1,
-        b2: c.b2,
     };
     let (rows, problems) = read_opk_list(&src.orientations, layout);
     report.read = rows.len() + problems.iter().filter(|p| p.row.is_some()).count();

@@ -3,6 +3,7 @@
 //! file, boresight and lever arm, and the control points. Paths are relative to the configuration file.
 //! Unknown keys are errors (a misspelt key must not silently fall back to a default).
 
+use crate::formats::camera_model::CameraModel;
 use crate::formats::events::EventFormat;
 use crate::formats::opk_list::OpkListFormat;
 use crate::formats::points::{MeasurementFormat, PointFormat};
@@ -112,37 +113,10 @@ pub struct AerialSource {
     pub layout: Option<OpkListFormat>,
     /// Interior orientation for list formats (campaign convention).
     #[serde(default)]
-    pub camera: Option<CameraSection>,
+    pub camera: Option<CameraModel>,
     /// Image measurement precision, px (default 0.5).
     #[serde(default)]
     pub sigma_px: Option<f64>,
-}
-
-/// `[aerial.camera]`: interior orientation in the campaign's convention (see docs/campaign-format.md).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CameraSection {
-    pub focal_px: f64,
-    pub cx_px: f64,
-    pub cy_px: f64,
-    pub width_px: u32,
-    pub height_px: u32,
-    #[serde(default)]
-    pub k1: f64,
-    #[serde(default)]
-    pub k2: f64,
-    #[serde(default)]
-    pub k3: f64,
-    #[serde(default)]
-    pub k4: f64,
-    #[serde(default)]
-    pub p1: f64,
-    #[serde(default)]
-    pub p2: f64,
-    #[serde(default)]
-    pub b1: f64,
-    #[serde(default)]
-    pub b2: f64,
 }
 
 /// The trajectory file format.

@@ -8,8 +8,8 @@
 //! folders).
 
 use super::config::{
-    AerialFormat, AerialKindName, AerialSource, CameraSection, CampaignSection, ControlSource,
-    ImportConfig, MmSource, PanoramaOrientation, TrajectoryFormat,
+    AerialFormat, AerialKindName, AerialSource, CampaignSection, ControlSource, ImportConfig,
+    MmSource, PanoramaOrientation, TrajectoryFormat,
 };
 use super::context::ImportContext;
 use super::export::{
@@ -17,9 +17,10 @@ use super::export::{
     ExportError, TrajectoryExport,
 };
 use crate::campaign::{AerialImage, Campaign, Recording};
-use crate::formats::angles::{AngleUnit, AttitudeConvention};
+
+use crate::formats::camera_model::CameraModel;
 use crate::formats::events::{EventFormat, TimeSystem};
-use crate::formats::opk_list::{OpkColumns, OpkListFormat};
+use crate::formats::opk_list::OpkListFormat;
 use crate::formats::points::{
     write_measurements, write_points, MeasurementRow, PixelOrigin, PointRow,
 };
@@ -77,7 +78,7 @@ pub fn export_vendor_campaign(
         });
     }
     if !n2.is_empty() {
-        let layout = at_list_layout();
+        let layout = OpkListFormat::at_list();
         let path = dir.join("nadir_at.txt");
         export_opk_list(n2, &ctx, &horizontal, &layout, &path)?;
         aerial.push(AerialSource {
@@ -165,42 +166,9 @@ fn source(
     }
 }
 
-/// A classical AT list: semicolons, no header, gon, yaw-pitch-roll, columns by position.
-fn at_list_layout() -> OpkListFormat {
-    OpkListFormat {
-        delimiter: Delimiter::Semicolon,
-        header: false,
-        comment_header: false,
-        angle_unit: AngleUnit::Gon,
-        attitude: AttitudeConvention::YawPitchRoll,
-        columns: OpkColumns {
-            image: "1".into(),
-            x: "2".into(),
-            y: "3".into(),
-            z: "4".into(),
-            angles: ["5".into(), "6".into(), "7".into()],
-            matrix: None,
-        },
-    }
-}
-
 /// The one interior orientation (and σ) of a block exported as a list; `Err` when the rows differ.
-fn camera_section(rows: &[AerialImage]) -> Result<CameraSection, ExportError> {
-    let of = |a: &AerialImage| CameraSection {
-        focal_px: a.focal_px,
-        cx_px: a.cx_px,
-        cy_px: a.cy_px,
-        width_px: a.width_px,
-        height_px: a.height_px,
-        k1: a.k1,
-        k2: a.k2,
-        k3: a.k3,
-        k4: a.k4,
-        p1: a.p1,
-        p2: a.p2,
-        b1: a.b1,
-        b2: a.b2,
-    };
+fn camera_section(rows: &[AerialImage]) -> Result<CameraModel, ExportError> {
+    let of = CameraModel::of_aerial;
     let first = of(&rows[0]);
     if rows
         .iter()

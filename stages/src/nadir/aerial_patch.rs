@@ -23,10 +23,7 @@ use nalgebra::{Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId {
-    name: "ortho_aerial",
-    version: "4",
-};
+pub const STAGE: StageId = StageId::new("ortho_aerial", "4");
 
 /// Step of the finite differences of the projection Jacobian, metres on the ground.
 const JACOBIAN_STEP_M: f64 = 1.0;

@@ -33,10 +33,7 @@ use nalgebra::{Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId {
-    name: "control",
-    version: "2",
-};
+pub const STAGE: StageId = StageId::new("control", "2");
 
 crate::params! {
     /// Parameters of [`aerial_control_points`].

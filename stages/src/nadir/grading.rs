@@ -22,10 +22,7 @@ use std::collections::HashMap;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId {
-    name: "grade_nadir",
-    version: "4",
-};
+pub const STAGE: StageId = StageId::new("grade_nadir", "4");
 
 /// A correspondence is correct within this distance, aerial pixels.
 pub const CORRECT_TOLERANCE_PX: f64 = 1.0;

@@ -27,10 +27,7 @@ use serde::{Deserialize, Serialize};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId {
-    name: "ortho",
-    version: "4",
-};
+pub const STAGE: StageId = StageId::new("ortho", "4");
 
 crate::params! {
     /// Parameters of one ortho-projection.

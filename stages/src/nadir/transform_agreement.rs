@@ -18,10 +18,7 @@ use crate::params::StageId;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId {
-    name: "transform_agreement",
-    version: "1",
-};
+pub const STAGE: StageId = StageId::new("transform_agreement", "1");
 
 /// The transforms of one recording that agree with each other: `outcome` unchanged, or turned into a
 /// rejection when its implied offset lies farther than `max_disagreement_m` from the median of the offsets

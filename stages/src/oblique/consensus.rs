@@ -43,10 +43,7 @@ use crate::params::{Params, StageId};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId {
-    name: "oblique",
-    version: "2",
-};
+pub const STAGE: StageId = StageId::new("oblique", "2");
 
 /// What happens to the matches of a set smaller than `min_set_size` (`"keep"` or `"drop"` in a workflow).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

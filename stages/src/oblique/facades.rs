@@ -47,10 +47,7 @@ use nalgebra::Vector3;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId {
-    name: "facades",
-    version: "4",
-};
+pub const STAGE: StageId = StageId::new("facades", "4");
 
 /// FNV-1a hash of a string: a stable item id for seeding (independent of platform and run).
 fn stable_hash(s: &str) -> u64 {

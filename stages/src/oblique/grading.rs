@@ -49,10 +49,7 @@ pub use crate::synth::scene_truth::SceneOracle;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId {
-    name: "grade_oblique",
-    version: "4",
-};
+pub const STAGE: StageId = StageId::new("grade_oblique", "4");
 
 /// Largest closest-approach distance of the panorama and oblique rays of a correct correspondence, m.
 pub const CLOSEST_APPROACH_TOLERANCE_M: f64 = 0.15;

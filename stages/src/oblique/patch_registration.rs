@@ -53,10 +53,7 @@ use search::{mi_search, ncc_search, Found};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId {
-    name: "patches",
-    version: "7",
-};
+pub const STAGE: StageId = StageId::new("patches", "7");
 
 /// Stable 64-bit FNV-1a hash of the strings (separated), for per-item seeds.
 fn stable_hash(parts: &[&str]) -> u64 {

@@ -34,10 +34,7 @@ use std::collections::HashMap;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId {
-    name: "sparse_cloud",
-    version: "2",
-};
+pub const STAGE: StageId = StageId::new("sparse_cloud", "2");
 
 /// Corners of one view with their descriptors (row-major, `len` values each).
 struct ViewFeatures {

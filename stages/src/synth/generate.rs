@@ -36,17 +36,11 @@ use std::time::Instant;
 
 /// The identity of the generator stage (the rendered campaign with an error profile applied) in cache keys;
 /// bump the version whenever its output for the same inputs and parameters changes.
-pub const STAGE: StageId = StageId {
-    name: "synth",
-    version: "2",
-};
+pub const STAGE: StageId = StageId::new("synth", "2");
 
 /// The identity of the render stage (the error-free campaign of a [`RenderIdentity`]); bump the version
 /// whenever the generator renders differently (scenes, presets, cameras, looks).
-pub const RENDER_STAGE: StageId = StageId {
-    name: "render",
-    version: "4",
-};
+pub const RENDER_STAGE: StageId = StageId::new("render", "4");
 
 /// What was generated and how long it took.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -162,6 +156,7 @@ fn write_error_free(
     name: &str,
     root: &Path,
     store: &RenderStore,
+    on_image: ImageProgress<'_>,
 ) -> Result<(u64, usize), SynthError> {
     let p = &plan.params;
     let io = |path: PathBuf| move |e: std::io::Error| SynthError::io(&path, e);
@@ -172,15 +167,25 @@ fn write_error_free(
         root.join("aerial/oblique"),
     );
     let mut reused = 0usize;
+    let total = plan
+        .areas
+        .iter()
+        .map(|a| a.truth.len() + a.nadir.len() + a.oblique.len())
+        .sum::<usize>() as u64;
+    let mut done = 0u64;
+    on_image(done, total);
     // One image: taken from the store when an interrupted generation finished it, else rendered and kept.
     let mut image = |rel: String, render: &dyn Fn() -> Result<u64, SynthError>| {
         let path = root.join(&rel);
         if store.fetch(&rel, &path)? {
             reused += 1;
-            return Ok::<(), SynthError>(());
+        } else {
+            rays += render()?;
+            store.keep(&rel, &path)?;
         }
-        rays += render()?;
-        store.keep(&rel, &path)
+        done += 1;
+        on_image(done, total);
+        Ok::<(), SynthError>(())
     };
     for area in &plan.areas {
         for rec in &area.truth {
@@ -330,7 +335,7 @@ pub fn generate_resumable(
     let start = Instant::now();
     check_replaceable(out)?;
     let rendered = sibling(out, "rendered");
-    let (mut summary, reused) = render_campaign(options, &rendered, store_dir)?;
+    let (mut summary, reused) = render_campaign(options, &rendered, store_dir, &|_, _| {})?;
     let applied = apply_profile(&rendered, options, out);
     let _ = std::fs::remove_dir_all(&rendered);
     applied?;
@@ -372,14 +377,19 @@ fn check_replaceable(out: &Path) -> Result<(), SynthError> {
     Ok(())
 }
 
+/// Called after each image of a rendering with (images done, images in all), and once with 0 before the first.
+pub type ImageProgress<'a> = &'a dyn Fn(u64, u64);
+
 /// Render the error-free campaign of `options` (its images depend only on [`SynthOptions::render_identity`];
 /// the tables hold the true values, `truth/README.md` says so) into the folder `out`, created or replacing a
 /// previous synthetic campaign. Finished images are kept in the render store at `store_dir` until the folder
-/// is installed; returns the summary and how many images were taken from the store.
+/// is installed; `on_image` hears of each finished image. Returns the summary and how many images were taken
+/// from the store.
 pub fn render_campaign(
     options: &SynthOptions,
     out: &Path,
     store_dir: &Path,
+    on_image: ImageProgress<'_>,
 ) -> Result<(SynthSummary, usize), SynthError> {
     let start = Instant::now();
     check_replaceable(out)?;
@@ -396,7 +406,7 @@ pub fn render_campaign(
     }
     .campaign_name();
     let render_start = Instant::now();
-    let written = write_error_free(&plan, &name, &tmp, &store);
+    let written = write_error_free(&plan, &name, &tmp, &store, on_image);
     let render_seconds = render_start.elapsed().as_secs_f64();
     let (rays, reused) = match written.and_then(|w| install(&tmp, out).map(|_| w)) {
         Ok(w) => w,

@@ -36,10 +36,7 @@ use rayon::prelude::*;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId {
-    name: "mm_match",
-    version: "2",
-};
+pub const STAGE: StageId = StageId::new("mm_match", "2");
 
 /// One recording as the matcher sees it: its recorded pose, its 3 cm north-up ortho image, the panorama size.
 #[derive(Clone, Copy, Debug)]

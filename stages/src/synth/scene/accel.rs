@@ -3,7 +3,7 @@
 //! bounds and walked cell by cell (2-D DDA, Amanatides–Woo) in front-to-back order.
 
 use super::objects::Object;
-use super::shapes::Aabb;
+use super::shapes::{Aabb, Ray};
 use nalgebra::Vector3;
 
 #[derive(Clone, Debug)]
@@ -101,13 +101,12 @@ impl Grid {
     #[inline]
     pub fn walk(
         &self,
-        o: &Vector3<f64>,
-        d: &Vector3<f64>,
-        inv_d: &Vector3<f64>,
+        ray: &Ray,
         t_min: f64,
         t_max: f64,
         mut visit: impl FnMut(&[u32], f64) -> bool,
     ) {
+        let (o, d, inv_d) = (&ray.o, &ray.d, &ray.inv_d);
         if self.nx == 0 {
             return;
         }

@@ -27,6 +27,7 @@ use ground::{Ground, GroundClass};
 use markings::{StreetAxis, StreetMarkingInput, StreetMarkings};
 use nalgebra::Vector3;
 use objects::{Material, Object, Shape, IN_AERIAL, IN_BOTH, IN_MM};
+use shapes::Ray;
 
 pub use epoch_changes::{EpochChangeSpec, Roadworks};
 pub use layout::{Building, Car};
@@ -381,22 +382,22 @@ impl Scene {
                 },
             });
         }
-        let inv_d = Vector3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+        let ray = Ray::new(*o, *d);
         let bit = epoch.bit();
         let mut best_obj: Option<(u32, f64, Vector3<f64>)> = None;
-        self.grid.walk(o, d, &inv_d, 0.0, best_t, |cell, t_exit| {
+        self.grid.walk(&ray, 0.0, best_t, |cell, t_exit| {
             for &k in cell {
                 let obj = &self.objects[k as usize];
                 if obj.epochs & bit == 0 {
                     continue;
                 }
                 let end = obj.children_end.max(k + 1);
-                if end > k + 1 && obj.bounds.clip(o, &inv_d, 0.0, best_t).is_none() {
+                if end > k + 1 && obj.bounds.clip(o, &ray.inv_d, 0.0, best_t).is_none() {
                     continue; // misses the compound's envelope
                 }
                 for j in k..end {
                     let part = &self.objects[j as usize];
-                    if let Some((t, n)) = part.hit(o, d, &inv_d, 0.0, best_t) {
+                    if let Some((t, n)) = part.hit(&ray, 0.0, best_t) {
                         best_t = t;
                         best_obj = Some((j, t, n));
                     }
@@ -421,22 +422,22 @@ impl Scene {
         if let Some(_g) = self.ground.intersect(o, d, 0.0, 30.0) {
             return true;
         }
-        let inv_d = Vector3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+        let ray = Ray::new(*o, *d);
         let bit = epoch.bit();
         let mut blocked = false;
-        self.grid.walk(o, d, &inv_d, 0.0, f64::INFINITY, |cell, _| {
+        self.grid.walk(&ray, 0.0, f64::INFINITY, |cell, _| {
             for &k in cell {
                 let obj = &self.objects[k as usize];
                 if obj.epochs & bit == 0 || matches!(obj.material, Material::Marker { .. }) {
                     continue;
                 }
                 let end = obj.children_end.max(k + 1);
-                if end > k + 1 && obj.bounds.clip(o, &inv_d, 0.0, f64::INFINITY).is_none() {
+                if end > k + 1 && obj.bounds.clip(o, &ray.inv_d, 0.0, f64::INFINITY).is_none() {
                     continue;
                 }
                 for j in k..end {
                     if self.objects[j as usize]
-                        .hit(o, d, &inv_d, 0.0, f64::INFINITY)
+                        .hit(&ray, 0.0, f64::INFINITY)
                         .is_some()
                     {
                         blocked = true;

@@ -3,7 +3,7 @@
 //! tree crowns.
 
 use super::shapes::{
-    cylinder_hit, ellipsoid_normal, ellipsoid_roots, sphere_hit, Aabb, ConvexPrism,
+    cylinder_hit, ellipsoid_normal, ellipsoid_roots, sphere_hit, Aabb, ConvexPrism, Ray,
 };
 use crate::synth::noise::value3;
 use nalgebra::Vector3;
@@ -152,17 +152,11 @@ impl Object {
 
     /// Nearest hit (t, normal facing the ray's origin side) in (t_min, t_max).
     #[inline]
-    pub fn hit(
-        &self,
-        o: &Vector3<f64>,
-        d: &Vector3<f64>,
-        inv_d: &Vector3<f64>,
-        t_min: f64,
-        t_max: f64,
-    ) -> Option<(f64, Vector3<f64>)> {
+    pub fn hit(&self, ray: &Ray, t_min: f64, t_max: f64) -> Option<(f64, Vector3<f64>)> {
+        let (o, d) = (&ray.o, &ray.d);
         match &self.shape {
-            Shape::Box(b) => b.hit(o, d, inv_d, t_min, t_max),
-            Shape::Prism(p) => p.hit(o, d, t_min, t_max),
+            Shape::Box(b) => b.hit(ray, t_min, t_max),
+            Shape::Prism(p) => p.hit(ray, t_min, t_max),
             Shape::Crown {
                 centre,
                 inv_r,

@@ -4,6 +4,21 @@
 
 use nalgebra::Vector3;
 
+/// A ray in the local frame with its component-wise reciprocal direction (±inf allowed) for slab tests.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    pub o: Vector3<f64>,
+    pub d: Vector3<f64>,
+    pub inv_d: Vector3<f64>,
+}
+
+impl Ray {
+    pub fn new(o: Vector3<f64>, d: Vector3<f64>) -> Self {
+        let inv_d = Vector3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+        Self { o, d, inv_d }
+    }
+}
+
 /// Axis-aligned box.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
@@ -59,14 +74,8 @@ impl Aabb {
 
     /// Nearest surface hit (t, outward normal) in (t_min, t_max), ray starting outside.
     #[inline]
-    pub fn hit(
-        &self,
-        o: &Vector3<f64>,
-        d: &Vector3<f64>,
-        inv_d: &Vector3<f64>,
-        t_min: f64,
-        t_max: f64,
-    ) -> Option<(f64, Vector3<f64>)> {
+    pub fn hit(&self, ray: &Ray, t_min: f64, t_max: f64) -> Option<(f64, Vector3<f64>)> {
+        let (o, d, inv_d) = (&ray.o, &ray.d, &ray.inv_d);
         let mut t_enter = f64::NEG_INFINITY;
         let mut axis = 0;
         let mut t_exit = f64::INFINITY;
@@ -144,13 +153,8 @@ impl ConvexPrism {
 
     /// Nearest hit from outside (Kay–Kajiya).
     #[inline]
-    pub fn hit(
-        &self,
-        o: &Vector3<f64>,
-        d: &Vector3<f64>,
-        t_min: f64,
-        t_max: f64,
-    ) -> Option<(f64, Vector3<f64>)> {
+    pub fn hit(&self, ray: &Ray, t_min: f64, t_max: f64) -> Option<(f64, Vector3<f64>)> {
+        let (o, d) = (&ray.o, &ray.d);
         let mut t_enter = f64::NEG_INFINITY;
         let mut n_enter = Vector3::zeros();
         let mut t_exit = f64::INFINITY;
@@ -289,20 +293,16 @@ pub fn cylinder_hit(
 mod tests {
     use super::*;
 
-    fn inv(d: &Vector3<f64>) -> Vector3<f64> {
-        Vector3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z)
-    }
-
     #[test]
     fn box_hit_distance_and_normal() {
         let b = Aabb::new(Vector3::new(1.0, -1.0, 0.0), Vector3::new(3.0, 1.0, 2.0));
         let o = Vector3::new(0.0, 0.0, 1.0);
         let d = Vector3::new(1.0, 0.0, 0.0);
-        let (t, n) = b.hit(&o, &d, &inv(&d), 0.0, f64::INFINITY).unwrap();
+        let (t, n) = b.hit(&Ray::new(o, d), 0.0, f64::INFINITY).unwrap();
         assert!((t - 1.0).abs() < 1e-12);
         assert_eq!(n, Vector3::new(-1.0, 0.0, 0.0));
         let d = Vector3::new(0.0, 1.0, 0.0);
-        assert!(b.hit(&o, &d, &inv(&d), 0.0, f64::INFINITY).is_none());
+        assert!(b.hit(&Ray::new(o, d), 0.0, f64::INFINITY).is_none());
     }
 
     #[test]
@@ -311,21 +311,28 @@ mod tests {
         // straight down over the ridge line (y = 4) hits at z = 13
         let o = Vector3::new(5.0, 4.0, 50.0);
         let (t, _) = g
-            .hit(&o, &Vector3::new(0.0, 0.0, -1.0), 0.0, f64::INFINITY)
+            .hit(
+                &Ray::new(o, Vector3::new(0.0, 0.0, -1.0)),
+                0.0,
+                f64::INFINITY,
+            )
             .unwrap();
         assert!((50.0 - t - 13.0).abs() < 1e-9);
         // at y = 2 (half-way down the slope) z = 11.5, normal tilted towards −y
         let o = Vector3::new(5.0, 2.0, 50.0);
         let (t, n) = g
-            .hit(&o, &Vector3::new(0.0, 0.0, -1.0), 0.0, f64::INFINITY)
+            .hit(
+                &Ray::new(o, Vector3::new(0.0, 0.0, -1.0)),
+                0.0,
+                f64::INFINITY,
+            )
             .unwrap();
         assert!((50.0 - t - 11.5).abs() < 1e-9);
         assert!(n.y < -0.5 && n.z > 0.5);
         // outside the footprint: miss
         assert!(g
             .hit(
-                &Vector3::new(11.0, 2.0, 50.0),
-                &Vector3::new(0.0, 0.0, -1.0),
+                &Ray::new(Vector3::new(11.0, 2.0, 50.0), Vector3::new(0.0, 0.0, -1.0)),
                 0.0,
                 f64::INFINITY
             )
