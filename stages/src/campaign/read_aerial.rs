@@ -5,7 +5,7 @@ use super::model::AerialImage;
 use super::problem::Problem;
 use super::ranges;
 use super::read_recordings::check_file_exists;
-use super::table::read_table;
+use super::table::read_rows;
 use super::unique::Sourced;
 use std::path::Path;
 
@@ -22,13 +22,8 @@ pub(crate) fn read_aerial_rows(
     check_files: bool,
     problems: &mut Vec<Problem>,
 ) -> Vec<Sourced<AerialImage>> {
-    let Some(table) = read_table(root, rel, AERIAL_COLUMNS, problems) else {
-        return Vec::new();
-    };
     let dir = rel.parent().unwrap_or(Path::new(""));
-    let mut rows = Vec::with_capacity(table.records.len());
-    for record in &table.records {
-        let mut f = table.fields(record, problems);
+    let rows = read_rows(root, rel, AERIAL_COLUMNS, problems, |f| {
         let image_id = f.text("image_id");
         let file = f.text("file");
         let (x, y, z) = (f.number("x"), f.number("y"), f.number("z"));
@@ -60,50 +55,43 @@ pub(crate) fn read_aerial_rows(
                 );
             }
         }
-        ranges::coordinates(&mut f, x, y, z);
-        ranges::angle(&mut f, "kappa", kappa_deg, -360.0, 360.0);
-        ranges::frame_camera(&mut f, focal_px, width_px, height_px);
+        ranges::coordinates(f, x, y, z);
+        ranges::angle(f, "kappa", kappa_deg, -360.0, 360.0);
+        ranges::frame_camera(f, focal_px, width_px, height_px);
         for (column, c, size) in [("cx", cx_px, width_px), ("cy", cy_px, height_px)] {
             if size > 0 && !(0.0..=f64::from(size)).contains(&c) {
                 f.error(column, format!("principal point {c} px lies outside the image (0..{size} px)"), "give the principal point in continuous pixel coordinates of this image (centre = size/2)");
             }
         }
-        ranges::sigma_px(&mut f, sigma_px);
+        ranges::sigma_px(f, sigma_px);
         if check_files && !file.is_empty() {
-            check_file_exists(&mut f, root, dir, &file);
+            check_file_exists(f, root, dir, &file);
         }
-        if f.ok {
-            let item = AerialImage {
-                image_id,
-                file,
-                x,
-                y,
-                z,
-                omega_deg,
-                phi_deg,
-                kappa_deg,
-                focal_px,
-                cx_px,
-                cy_px,
-                width_px,
-                height_px,
-                k1,
-                k2,
-                p1,
-                p2,
-                k3,
-                k4,
-                b1,
-                b2,
-                sigma_px,
-            };
-            rows.push(Sourced {
-                item,
-                file: rel.to_path_buf(),
-                row: record.row,
-            });
-        }
-    }
+        Some(AerialImage {
+            image_id,
+            file,
+            x,
+            y,
+            z,
+            omega_deg,
+            phi_deg,
+            kappa_deg,
+            focal_px,
+            cx_px,
+            cy_px,
+            width_px,
+            height_px,
+            k1,
+            k2,
+            p1,
+            p2,
+            k3,
+            k4,
+            b1,
+            b2,
+            sigma_px,
+        })
+    });
     rows
 }
 

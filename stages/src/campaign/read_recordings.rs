@@ -4,7 +4,7 @@
 use super::model::Recording;
 use super::problem::{Problem, ProblemKind};
 use super::ranges;
-use super::table::read_table;
+use super::table::read_rows;
 use super::time::parse_time_s;
 use super::unique::{keep_unique, Sourced};
 use std::path::Path;
@@ -32,12 +32,7 @@ pub(crate) fn read_recording_rows(
     images_dir: Option<&Path>,
     problems: &mut Vec<Problem>,
 ) -> Vec<Sourced<Recording>> {
-    let Some(table) = read_table(root, rel, RECORDING_COLUMNS, problems) else {
-        return Vec::new();
-    };
-    let mut rows = Vec::with_capacity(table.records.len());
-    for record in &table.records {
-        let mut f = table.fields(record, problems);
+    let rows = read_rows(root, rel, RECORDING_COLUMNS, problems, |f| {
         let image_id = f.text("image_id");
         let file = f.text("file");
         let time = f.text("time");
@@ -74,43 +69,36 @@ pub(crate) fn read_recording_rows(
                 "check the column and its unit (metres)",
             );
         }
-        ranges::coordinates(&mut f, x, y, z);
-        ranges::angle(&mut f, "heading", heading_deg, -180.0, 360.0);
-        ranges::angle(&mut f, "yaw", yaw_deg, -360.0, 360.0);
-        ranges::sigma_m(&mut f, "sigma_xy", sigma_xy_m);
-        ranges::sigma_m(&mut f, "sigma_z", sigma_z_m);
+        ranges::coordinates(f, x, y, z);
+        ranges::angle(f, "heading", heading_deg, -180.0, 360.0);
+        ranges::angle(f, "yaw", yaw_deg, -360.0, 360.0);
+        ranges::sigma_m(f, "sigma_xy", sigma_xy_m);
+        ranges::sigma_m(f, "sigma_z", sigma_z_m);
         for (column, angle) in [("pitch", pitch_deg), ("roll", roll_deg)] {
             if angle.abs() > 90.0 {
                 f.error(column, format!("{angle}° is beyond ±90°"), "the residual tilt of a levelled panorama is a few degrees; check the column and its unit (degrees)");
             }
         }
         if let (Some(dir), false) = (images_dir, file.is_empty()) {
-            check_file_exists(&mut f, root, dir, &file);
+            check_file_exists(f, root, dir, &file);
         }
-        if f.ok {
-            let item = Recording {
-                image_id,
-                file,
-                time,
-                time_s,
-                x,
-                y,
-                z,
-                heading_deg,
-                camera_height_m,
-                sigma_xy_m,
-                sigma_z_m,
-                yaw_deg,
-                pitch_deg,
-                roll_deg,
-            };
-            rows.push(Sourced {
-                item,
-                file: rel.to_path_buf(),
-                row: record.row,
-            });
-        }
-    }
+        Some(Recording {
+            image_id,
+            file,
+            time,
+            time_s,
+            x,
+            y,
+            z,
+            heading_deg,
+            camera_height_m,
+            sigma_xy_m,
+            sigma_z_m,
+            yaw_deg,
+            pitch_deg,
+            roll_deg,
+        })
+    });
     let rows = keep_unique(
         rows,
         |r| r.image_id.clone(),

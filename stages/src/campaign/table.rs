@@ -8,6 +8,7 @@
 //! just the first), so a caller can skip the row and still report everything at once.
 
 use super::problem::{Problem, ProblemKind};
+use super::unique::Sourced;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -230,6 +231,34 @@ fn is_known(key: &str, required: &[&str]) -> bool {
 const OPTIONAL_COLUMNS: &[&str] = &[
     "sigma_xy", "sigma_z", "yaw", "pitch", "roll", "k1", "k2", "p1", "p2", "sigma_px",
 ];
+
+/// The rows of the table `root/rel` (which must have the `required` columns), each made by `row` from its
+/// fields, in file order with their row numbers: a row is kept when `row` returns it and none of its fields had
+/// an error. A missing or unreadable table gives no rows; every problem goes to `problems`.
+pub(crate) fn read_rows<T>(
+    root: &Path,
+    rel: &Path,
+    required: &[&str],
+    problems: &mut Vec<Problem>,
+    mut row: impl FnMut(&mut Fields<'_>) -> Option<T>,
+) -> Vec<Sourced<T>> {
+    let Some(table) = read_table(root, rel, required, problems) else {
+        return Vec::new();
+    };
+    let mut rows = Vec::with_capacity(table.records.len());
+    for record in &table.records {
+        let mut f = table.fields(record, problems);
+        let item = row(&mut f);
+        if let (true, Some(item)) = (f.ok, item) {
+            rows.push(Sourced {
+                item,
+                file: rel.to_path_buf(),
+                row: record.row,
+            });
+        }
+    }
+    rows
+}
 
 impl Table {
     /// Typed access to one row; problems go to `problems`.

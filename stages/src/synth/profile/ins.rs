@@ -5,7 +5,7 @@
 //! inertial unit) get the errors, exactly as a provider who north-aligns panoramas with a biased heading
 //! delivers them.
 
-use super::{signed_draw, Routes, Tables};
+use super::{signed_draw, Draw, Tables};
 use crate::synth::rng::{hash_str, Stream};
 
 crate::params! {
@@ -33,13 +33,12 @@ impl InsParams {
     }
 
     /// Add the orientation errors to the recorded yaw, pitch, roll and heading; returns the README lines.
-    pub fn apply(
-        &self,
-        seed: u64,
-        truth: &Tables,
-        routes: &Routes,
-        out: &mut Tables,
-    ) -> Vec<String> {
+    pub fn apply(&self, on: &Draw<'_>, out: &mut Tables) -> Vec<String> {
+        let Draw {
+            seed,
+            truth,
+            routes,
+        } = *on;
         let mut notes = Vec::new();
         for (route, members) in routes.members.iter().enumerate() {
             let bias = self.bias_deg(seed, route);

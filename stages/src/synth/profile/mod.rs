@@ -30,7 +30,7 @@ pub use ins::InsParams;
 pub use lens::LensParams;
 pub use outage::{Outage, OutageParams};
 pub use position::ThesisParams;
-pub use routes::Routes;
+pub use routes::{Draw, Routes};
 pub use vertical::VerticalParams;
 
 use super::rng::Stream;
@@ -290,12 +290,17 @@ impl Profile {
         let mut out = truth.clone();
         let mut notes = Vec::new();
         let p = &self.params;
+        let on = Draw {
+            seed,
+            truth,
+            routes: &routes,
+        };
         for c in &self.components {
             notes.extend(match c {
                 Component::Thesis => p.thesis.apply(seed, truth, &mut out),
-                Component::Outage => p.outage.apply(seed, truth, &routes, &mut out),
-                Component::Ins => p.ins.apply(seed, truth, &routes, &mut out),
-                Component::Vertical => p.vertical.apply(seed, truth, &routes, &mut out),
+                Component::Outage => p.outage.apply(&on, &mut out),
+                Component::Ins => p.ins.apply(&on, &mut out),
+                Component::Vertical => p.vertical.apply(&on, &mut out),
                 Component::Aerial => p.aerial.apply(seed, truth, &mut out),
                 Component::Lens => p.lens.given_note(),
                 Component::LensUnknown => p.lens.hide(&mut out),

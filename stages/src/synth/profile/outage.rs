@@ -5,7 +5,7 @@
 //! the vehicle frame (an along- and cross-track drift), so its direction in the world turns with the vehicle
 //! through a bend, and a random walk is added on top. Outside the outages positions keep centimetre noise.
 
-use super::{Routes, Tables};
+use super::{Draw, Tables};
 use crate::synth::rng::{hash_str, Stream};
 use std::f64::consts::PI;
 
@@ -72,13 +72,12 @@ impl OutageParams {
     }
 
     /// Add the outage errors to the recorded positions; returns the README lines.
-    pub fn apply(
-        &self,
-        seed: u64,
-        truth: &Tables,
-        routes: &Routes,
-        out: &mut Tables,
-    ) -> Vec<String> {
+    pub fn apply(&self, on: &Draw<'_>, out: &mut Tables) -> Vec<String> {
+        let Draw {
+            seed,
+            truth,
+            routes,
+        } = *on;
         let mut notes = Vec::new();
         for (route, members) in routes.members.iter().enumerate() {
             let o = self.draw(seed, route, routes.length_m[route]);

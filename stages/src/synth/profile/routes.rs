@@ -4,12 +4,22 @@
 //! Works from the true recordings alone (time order, positions, headings), so a profile can be applied to any
 //! error-free campaign in the campaign format, not only to the generator's plan.
 
+use super::Tables;
 use crate::campaign::Recording;
 
 /// A new route starts where consecutive recordings (in time order) are more than this apart in time, s.
 pub const ROUTE_TIME_GAP_S: f64 = 60.0;
 /// … or more than this apart in space, m.
 pub const ROUTE_DISTANCE_GAP_M: f64 = 50.0;
+
+/// What the route-based components (outage, INS, vertical) draw their errors from: the seed, the true tables
+/// and where each recording lies on its route.
+#[derive(Clone, Copy, Debug)]
+pub struct Draw<'a> {
+    pub seed: u64,
+    pub truth: &'a Tables,
+    pub routes: &'a Routes,
+}
 
 /// Where each recording lies on its route (indices refer to the table as given, not to time order).
 #[derive(Clone, Debug, PartialEq)]

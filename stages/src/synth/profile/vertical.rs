@@ -3,7 +3,7 @@
 //! the road (a mis-measured mounting, the suspension): a constant per campaign plus a little noise. The camera
 //! height sets the scale of every ortho image, so its error reaches the nadir registration directly.
 
-use super::{signed_draw, Routes, Tables};
+use super::{signed_draw, Draw, Tables};
 use crate::synth::rng::{hash_str, Stream};
 
 crate::params! {
@@ -27,13 +27,12 @@ crate::params! {
 
 impl VerticalParams {
     /// Add the height and camera-height errors; returns the README lines.
-    pub fn apply(
-        &self,
-        seed: u64,
-        truth: &Tables,
-        routes: &Routes,
-        out: &mut Tables,
-    ) -> Vec<String> {
+    pub fn apply(&self, on: &Draw<'_>, out: &mut Tables) -> Vec<String> {
+        let Draw {
+            seed,
+            truth,
+            routes,
+        } = *on;
         let mut notes = Vec::new();
         let camera_bias = signed_draw(
             &mut Stream::new(&[seed, hash_str("camera-height-bias")]),
