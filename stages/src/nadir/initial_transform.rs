@@ -20,7 +20,7 @@
 //! Option (thesis 3.4.5.2, last paragraph): [`reuse_neighbour`] adapts a neighbouring recording's transform to
 //! this recording through the recorded relative pose.
 
-use super::aerial_patch::{aerial_ground_similarity, extract_patch, level_of_scale};
+use super::aerial_patch::{aerial_ground_similarity, extract_patch, level_of_scale, AerialPatch};
 use super::ortho::{OrthoGeoref, OrthoImage};
 use super::registration::{InitialTransform, TransformOutcome};
 use super::translation_consensus::{false_alarms, translation_consensus};
@@ -310,43 +310,165 @@ pub fn initial_transform(
     ))
 }
 
+/// Why a transform was rejected, with the matches and inliers it had got to by then.
+struct Rejection {
+    reason: String,
+    matches: usize,
+    inliers: usize,
+}
+
+fn rejected(reason: impl Into<String>, matches: usize, inliers: usize) -> Rejection {
+    Rejection {
+        reason: reason.into(),
+        matches,
+        inliers,
+    }
+}
+
 /// [`initial_transform`] once the aerial patch is read (`None`: the footprint misses the image).
 fn transform_with_patch(
     rec: &Recording,
     mm_ortho: &OrthoImage,
-    (aerial_w, aerial_h): (usize, usize),
-    patch: Option<&super::aerial_patch::AerialPatch>,
+    aerial_size_px: (usize, usize),
+    patch: Option<&AerialPatch>,
     aerial_row: &AerialImage,
     p: &TransformParams,
 ) -> TransformOutcome {
-    let reject = |reason: String, matches: usize, inliers: usize| TransformOutcome::Rejected {
+    match find_transform(rec, mm_ortho, aerial_size_px, patch, aerial_row, p) {
+        Ok(t) => TransformOutcome::Accepted(t),
+        Err(r) => TransformOutcome::Rejected {
+            recording_id: rec.image_id.clone(),
+            aerial_id: aerial_row.image_id.clone(),
+            reason: r.reason,
+            matches: r.matches,
+            inliers: r.inliers,
+        },
+    }
+}
+
+/// Steps 2–6 of the module documentation.
+fn find_transform(
+    rec: &Recording,
+    mm_ortho: &OrthoImage,
+    aerial_size_px: (usize, usize),
+    patch: Option<&AerialPatch>,
+    aerial_row: &AerialImage,
+    p: &TransformParams,
+) -> Result<InitialTransform, Rejection> {
+    check_inputs(rec, mm_ortho, aerial_size_px, aerial_row, p)?;
+    let georef = &mm_ortho.georef;
+    let cam = FrameCamera::from_aerial(aerial_row);
+    let max_err_m = p.max_localisation_error_m;
+    let nominal = nominal_transform(georef, &cam).ok_or_else(|| {
+        rejected(
+            "the ortho footprint does not project into the aerial image",
+            0,
+            0,
+        )
+    })?;
+    let patch = patch.ok_or_else(|| {
+        rejected(
+            "the ortho footprint (plus the localisation error) does not overlap the aerial image",
+            0,
+            0,
+        )
+    })?;
+    let aerial_gsd_m = aerial_ground_similarity(&cam, georef.foot_world)
+        .map(|(gsd, _)| gsd)
+        .unwrap_or_else(|| cam.gsd_at(&Vector3::from(georef.foot_world)));
+    if !(aerial_gsd_m.is_finite() && aerial_gsd_m > 0.0) {
+        return Err(rejected(
+            "the aerial GSD at the foot point is not positive",
+            0,
+            0,
+        ));
+    }
+    // The matching window in patch pixels (the patch is at the working level: `scale` full pixels each).
+    let window_px = max_err_m / (aerial_gsd_m * patch.scale);
+    let pairs = matched_keypoints(mm_ortho, patch, &cam, p, window_px)?;
+    let n_matches = pairs.len();
+    let (model, n_inliers) = if p.estimate_shape {
+        similarity_by_ransac(&pairs, &nominal, patch.scale, rec, aerial_row, p)?
+    } else {
+        similarity_by_translation_consensus(&pairs, &nominal, patch.scale, window_px, p)?
+    };
+    if n_inliers < p.min_inliers {
+        return Err(rejected(
+            format!(
+                "{n_matches} matches, RANSAC found {n_inliers} inliers < {}",
+                p.min_inliers
+            ),
+            n_matches,
+            n_inliers,
+        ));
+    }
+    if (n_inliers as f64) < p.min_inlier_ratio * n_matches as f64 {
+        return Err(rejected(
+            format!(
+                "{n_matches} matches, {n_inliers} inliers < {} of the matches",
+                p.min_inlier_ratio
+            ),
+            n_matches,
+            n_inliers,
+        ));
+    }
+    // Plausibility (thesis 3.4.5.2): the projected MM image centre must lie within the expected error.
+    let offset = centre_offset_world(&model, georef, &cam).ok_or_else(|| {
+        rejected(
+            "the transformed ortho centre does not meet the ground plane",
+            n_matches,
+            n_inliers,
+        )
+    })?;
+    let centre_offset_m = offset[0].hypot(offset[1]);
+    if !(centre_offset_m <= max_err_m) {
+        return Err(rejected(
+            format!("centre offset {centre_offset_m:.2} m > {max_err_m} m"),
+            n_matches,
+            n_inliers,
+        ));
+    }
+    Ok(InitialTransform {
         recording_id: rec.image_id.clone(),
         aerial_id: aerial_row.image_id.clone(),
-        reason,
-        matches,
-        inliers,
-    };
+        ortho_to_aerial: model,
+        matches: n_matches,
+        inliers: n_inliers,
+        centre_offset_m,
+        centre_offset_world_m: offset,
+        reused_from: None,
+    })
+}
+
+/// The parameters, the aerial image's size against its row and the ortho against its georeference.
+fn check_inputs(
+    rec: &Recording,
+    mm_ortho: &OrthoImage,
+    (aerial_w, aerial_h): (usize, usize),
+    aerial_row: &AerialImage,
+    p: &TransformParams,
+) -> Result<(), Rejection> {
     if let Err(errs) = p.validate() {
-        return reject(
+        return Err(rejected(
             format!("invalid transform parameters: {}", describe(&errs)),
             0,
             0,
-        );
+        ));
     }
     if aerial_w != aerial_row.width_px as usize || aerial_h != aerial_row.height_px as usize {
-        return reject(
+        return Err(rejected(
             format!(
                 "aerial image {} is {}×{} px but aerial/nadir/cameras.csv says {}×{}; fix the width/height columns",
                 aerial_row.file, aerial_w, aerial_h, aerial_row.width_px, aerial_row.height_px
             ),
             0,
             0,
-        );
+        ));
     }
     let georef = &mm_ortho.georef;
     let (w, h) = (mm_ortho.image.width, mm_ortho.image.height);
     if w != georef.width_px || h != georef.height_px || mm_ortho.valid.len() != w * h {
-        return reject(
+        return Err(rejected(
             format!(
                 "ortho image of {} is inconsistent: {w}×{h} px, georeference {}×{}, {} mask values",
                 rec.image_id,
@@ -356,75 +478,50 @@ fn transform_with_patch(
             ),
             0,
             0,
-        );
+        ));
     }
-    let cam = FrameCamera::from_aerial(aerial_row);
-    let max_err_m = p.max_localisation_error_m;
-    let Some(nominal) = nominal_transform(georef, &cam) else {
-        return reject(
-            "the ortho footprint does not project into the aerial image".into(),
-            0,
-            0,
-        );
-    };
-    let Some(patch) = patch else {
-        return reject(
-            "the ortho footprint (plus the localisation error) does not overlap the aerial image"
-                .into(),
-            0,
-            0,
-        );
-    };
-    let aerial_gsd_m = aerial_ground_similarity(&cam, georef.foot_world)
-        .map(|(gsd, _)| gsd)
-        .unwrap_or_else(|| cam.gsd_at(&Vector3::from(georef.foot_world)));
-    if !(aerial_gsd_m.is_finite() && aerial_gsd_m > 0.0) {
-        return reject(
-            "the aerial GSD at the foot point is not positive".into(),
-            0,
-            0,
-        );
-    }
-    // The matching window in patch pixels (the patch is at the working level: `scale` full pixels each).
-    let window_px = max_err_m / (aerial_gsd_m * patch.scale);
+    Ok(())
+}
 
-    // Wallis + two KAZE detector instances, one descriptor configuration (thesis 3.4.5.2).
-    let mm_features = match wallis_kaze(
+/// Steps 2–4: Wallis + two KAZE detector instances with one descriptor configuration, then every MM keypoint off
+/// the mask → ortho plane (world) → aerial patch pixel, matched inside ± `window_px` of that prediction. Returns
+/// the matches as (ortho px, full aerial px) pairs; too few is a rejection.
+fn matched_keypoints(
+    mm_ortho: &OrthoImage,
+    patch: &AerialPatch,
+    cam: &FrameCamera,
+    p: &TransformParams,
+    window_px: f64,
+) -> Result<Vec<PointPair>, Rejection> {
+    let mm_features = wallis_kaze(
         &fill_masked(mm_ortho),
         p,
         p.kaze_threshold_mm,
         "MM ortho image",
-    ) {
-        Ok(f) => f,
-        Err(e) => return reject(e, 0, 0),
-    };
-    let aerial_features =
-        match wallis_kaze(&patch.image, p, p.kaze_threshold_aerial, "aerial patch") {
-            Ok(f) => f,
-            Err(e) => return reject(e, 0, 0),
-        };
-    if mm_features.is_empty() {
-        return reject(
-            format!(
-                "no KAZE keypoints in the MM ortho image (threshold {})",
-                p.kaze_threshold_mm
-            ),
-            0,
-            0,
-        );
+    )
+    .map_err(|e| rejected(e, 0, 0))?;
+    let aerial_features = wallis_kaze(&patch.image, p, p.kaze_threshold_aerial, "aerial patch")
+        .map_err(|e| rejected(e, 0, 0))?;
+    for (features, what, threshold) in [
+        (&mm_features, "the MM ortho image", p.kaze_threshold_mm),
+        (
+            &aerial_features,
+            "the aerial patch",
+            p.kaze_threshold_aerial,
+        ),
+    ] {
+        if features.is_empty() {
+            return Err(rejected(
+                format!("no KAZE keypoints in {what} (threshold {threshold})"),
+                0,
+                0,
+            ));
+        }
     }
-    if aerial_features.is_empty() {
-        return reject(
-            format!(
-                "no KAZE keypoints in the aerial patch (threshold {})",
-                p.kaze_threshold_aerial
-            ),
-            0,
-            0,
-        );
-    }
-
-    // MM keypoints off the mask → ortho plane (world) → aerial patch pixel.
+    let (georef, (w, h)) = (
+        &mm_ortho.georef,
+        (mm_ortho.image.width, mm_ortho.image.height),
+    );
     let len = mm_features.descriptor_len;
     let mut query_idx: Vec<usize> = Vec::with_capacity(mm_features.len());
     let mut predicted: Vec<[f64; 2]> = Vec::with_capacity(mm_features.len());
@@ -448,7 +545,7 @@ fn transform_with_patch(
         .iter()
         .map(|k| [f64::from(k.u_px), f64::from(k.v_px)])
         .collect();
-    let matched = match match_windowed(
+    let matched = match_windowed(
         &query,
         &predicted,
         &aerial_features.descriptors,
@@ -456,10 +553,8 @@ fn transform_with_patch(
         len,
         window_px,
         p.match_ratio,
-    ) {
-        Ok(m) => m,
-        Err(e) => return reject(format!("descriptor matching failed: {e}"), 0, 0),
-    };
+    )
+    .map_err(|e| rejected(format!("descriptor matching failed: {e}"), 0, 0))?;
     let pairs: Vec<PointPair> = matched
         .iter()
         .flatten()
@@ -471,7 +566,7 @@ fn transform_with_patch(
         .collect();
     let n_matches = pairs.len();
     if n_matches < p.min_inliers {
-        return reject(
+        return Err(rejected(
             format!(
                 "{n_matches} descriptor matches in the ±{window_px:.1} px windows < {} required ({} MM, {} aerial keypoints)",
                 p.min_inliers,
@@ -480,111 +575,87 @@ fn transform_with_patch(
             ),
             n_matches,
             0,
-        );
+        ));
     }
+    Ok(pairs)
+}
 
-    let (model, n_inliers) = if p.estimate_shape {
-        // RANSAC similarity; only hypotheses close to the recorded-pose scale and rotation.
-        let ransac = RansacParams {
-            seed: pair_seed(p.seed, &rec.image_id, &aerial_row.image_id),
-            threshold: p.ransac_threshold_px * patch.scale,
-            ..p.ransac()
-        };
-        let shape_ok = |m: &Similarity2| {
-            (m.scale / nominal.scale - 1.0).abs() <= p.max_scale_deviation
-                && wrap_deg((m.rotation_rad - nominal.rotation_rad).to_degrees()).abs()
-                    <= p.max_rotation_deg
-        };
-        let Some(fit) = ransac_filtered::<Similarity2>(&pairs, &ransac, shape_ok) else {
-            return reject(
-                format!("{n_matches} matches, RANSAC found no similarity within the scale/rotation tolerances"),
-                n_matches,
-                0,
-            );
-        };
-        (fit.model, fit.inliers.len())
-    } else {
-        // Scale and rotation from the recorded pose, translation by exhaustive consensus.
-        let Some(c) = translation_consensus(&pairs, &nominal, p.ransac_threshold_px * patch.scale)
-        else {
-            return reject(
+/// Step 5: a RANSAC similarity, considering only hypotheses close to the recorded-pose scale and rotation.
+/// Returns the model and its inlier count.
+fn similarity_by_ransac(
+    pairs: &[PointPair],
+    nominal: &Similarity2,
+    patch_scale: f64,
+    rec: &Recording,
+    aerial_row: &AerialImage,
+    p: &TransformParams,
+) -> Result<(Similarity2, usize), Rejection> {
+    let ransac = RansacParams {
+        seed: pair_seed(p.seed, &rec.image_id, &aerial_row.image_id),
+        threshold: p.ransac_threshold_px * patch_scale,
+        ..p.ransac()
+    };
+    let shape_ok = |m: &Similarity2| {
+        (m.scale / nominal.scale - 1.0).abs() <= p.max_scale_deviation
+            && wrap_deg((m.rotation_rad - nominal.rotation_rad).to_degrees()).abs()
+                <= p.max_rotation_deg
+    };
+    let fit = ransac_filtered::<Similarity2>(pairs, &ransac, shape_ok).ok_or_else(|| {
+        rejected(
+            format!(
+                "{} matches, RANSAC found no similarity within the scale/rotation tolerances",
+                pairs.len()
+            ),
+            pairs.len(),
+            0,
+        )
+    })?;
+    Ok((fit.model, fit.inliers.len()))
+}
+
+/// Step 5 without estimating the shape: scale and rotation from the recorded pose, the translation by exhaustive
+/// consensus, accepted only when it clearly beats the runner-up and is not what chance gives (a-contrario).
+fn similarity_by_translation_consensus(
+    pairs: &[PointPair],
+    nominal: &Similarity2,
+    patch_scale: f64,
+    window_px: f64,
+    p: &TransformParams,
+) -> Result<(Similarity2, usize), Rejection> {
+    let n_matches = pairs.len();
+    let c = translation_consensus(pairs, nominal, p.ransac_threshold_px * patch_scale).ok_or_else(
+        || {
+            rejected(
                 format!("{n_matches} matches, no translation consensus"),
                 n_matches,
                 0,
-            );
-        };
-        let n = c.inliers.len();
-        if (n as f64) < p.min_consensus_margin * c.runner_up as f64 {
-            return reject(
-                format!(
-                    "{n_matches} matches: ambiguous translation ({n} inliers, a competing one has {})",
-                    c.runner_up
-                ),
-                n_matches,
-                n,
-            );
-        }
-        let nfa = false_alarms(n_matches, n, p.ransac_threshold_px, window_px);
-        if nfa > p.max_false_alarms {
-            return reject(
-                format!(
-                    "{n_matches} matches: a consensus of {n} is what chance gives (expected {nfa:.2} among \
-                     random matches > {})",
-                    p.max_false_alarms
-                ),
-                n_matches,
-                n,
-            );
-        }
-        (c.model, n)
-    };
-    if n_inliers < p.min_inliers {
-        return reject(
+            )
+        },
+    )?;
+    let n = c.inliers.len();
+    if (n as f64) < p.min_consensus_margin * c.runner_up as f64 {
+        return Err(rejected(
             format!(
-                "{n_matches} matches, RANSAC found {n_inliers} inliers < {}",
-                p.min_inliers
+                "{n_matches} matches: ambiguous translation ({n} inliers, a competing one has {})",
+                c.runner_up
             ),
             n_matches,
-            n_inliers,
-        );
+            n,
+        ));
     }
-    if (n_inliers as f64) < p.min_inlier_ratio * n_matches as f64 {
-        return reject(
+    let nfa = false_alarms(n_matches, n, p.ransac_threshold_px, window_px);
+    if nfa > p.max_false_alarms {
+        return Err(rejected(
             format!(
-                "{n_matches} matches, {n_inliers} inliers < {} of the matches",
-                p.min_inlier_ratio
+                "{n_matches} matches: a consensus of {n} is what chance gives (expected {nfa:.2} among \
+                 random matches > {})",
+                p.max_false_alarms
             ),
             n_matches,
-            n_inliers,
-        );
+            n,
+        ));
     }
-
-    // Plausibility (thesis 3.4.5.2): the projected MM image centre must lie within the expected error.
-    let Some(offset) = centre_offset_world(&model, georef, &cam) else {
-        return reject(
-            "the transformed ortho centre does not meet the ground plane".into(),
-            n_matches,
-            n_inliers,
-        );
-    };
-    let centre_offset_m = offset[0].hypot(offset[1]);
-    if !(centre_offset_m <= max_err_m) {
-        return reject(
-            format!("centre offset {centre_offset_m:.2} m > {max_err_m} m"),
-            n_matches,
-            n_inliers,
-        );
-    }
-    TransformOutcome::Accepted(InitialTransform {
-        recording_id: rec.image_id.clone(),
-        aerial_id: aerial_row.image_id.clone(),
-        ortho_to_aerial: model,
-        matches: n_matches,
-        inliers: n_inliers,
-        centre_offset_m,
-        centre_offset_world_m: offset,
-        reused_from: None,
-    })
+    Ok((c.model, n))
 }
 
 /// The option "re-use a neighbour's transform" (thesis 3.4.5.2, last paragraph): the relative orientation along the
