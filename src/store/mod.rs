@@ -238,7 +238,11 @@ impl Store {
 
     /// On a local miss: the entry downloaded from the remote, verified and installed at `path`, opened; or
     /// what the load returns instead (a miss, or the report of a damaged remote copy).
-    fn fetch_remote<T>(&self, key: &NodeKey, path: &Path) -> Result<Result<File, Loaded<T>>, StoreError> {
+    fn fetch_remote<T>(
+        &self,
+        key: &NodeKey,
+        path: &Path,
+    ) -> Result<Result<File, Loaded<T>>, StoreError> {
         let Some(remote) = &self.remote else {
             return Ok(Err(Loaded::Miss));
         };

@@ -47,7 +47,8 @@ pub(crate) fn put(
 ) -> Result<Vec<u8>, StoreError> {
     let path = record_path(records, namespace, name)?;
     let out = encode(name, bytes);
-    skytie_util::fsutil::atomic_write(&path, &out).map_err(StoreError::io("write record", &path))?;
+    skytie_util::fsutil::atomic_write(&path, &out)
+        .map_err(StoreError::io("write record", &path))?;
     Ok(out)
 }
 
@@ -98,7 +99,8 @@ pub(crate) fn install(
         return Ok(None);
     };
     let path = record_path(records, namespace, name)?;
-    skytie_util::fsutil::atomic_write(&path, file).map_err(StoreError::io("write record", &path))?;
+    skytie_util::fsutil::atomic_write(&path, file)
+        .map_err(StoreError::io("write record", &path))?;
     Ok(Some(payload.to_vec()))
 }
 

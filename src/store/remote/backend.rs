@@ -117,8 +117,8 @@ impl Remote {
             RemoteUrl::File { root } => {
                 std::fs::create_dir_all(root)
                     .map_err(StoreError::io("create remote cache folder", root))?;
-                let local = object_store::local::LocalFileSystem::new_with_prefix(root)
-                    .map_err(|e| {
+                let local =
+                    object_store::local::LocalFileSystem::new_with_prefix(root).map_err(|e| {
                         StoreError::RemoteUrl(format!(
                             "cache remote `{raw_url}`: cannot use {} as an object store: {e}",
                             root.display()
@@ -139,7 +139,11 @@ impl Remote {
         Ok(Remote {
             url: raw_url.trim().to_string(),
             store,
-            prefix: prefix.split('/').filter(|s| !s.is_empty()).map(String::from).collect(),
+            prefix: prefix
+                .split('/')
+                .filter(|s| !s.is_empty())
+                .map(String::from)
+                .collect(),
             runtime,
         })
     }
@@ -195,15 +199,28 @@ impl Remote {
 
     /// Uploads `bytes` as `name`: with `create`, only if there is no object of that name yet (a conditional
     /// PUT); otherwise replacing it.
-    pub(crate) fn put_bytes(&self, name: &str, bytes: Vec<u8>, create: bool) -> Result<Put, StoreError> {
+    pub(crate) fn put_bytes(
+        &self,
+        name: &str,
+        bytes: Vec<u8>,
+        create: bool,
+    ) -> Result<Put, StoreError> {
         let path = self.path(name);
-        let mode = if create { PutMode::Create } else { PutMode::Overwrite };
+        let mode = if create {
+            PutMode::Create
+        } else {
+            PutMode::Overwrite
+        };
         let opts = PutOptions {
             mode,
             ..PutOptions::default()
         };
         self.runtime.block_on(async {
-            match self.store.put_opts(&path, PutPayload::from(bytes), opts).await {
+            match self
+                .store
+                .put_opts(&path, PutPayload::from(bytes), opts)
+                .await
+            {
                 Ok(_) => Ok(Put::Created),
                 Err(object_store::Error::AlreadyExists { .. }) => Ok(Put::AlreadyThere),
                 Err(e) => Err(self.err("upload", name, e)),
@@ -214,7 +231,12 @@ impl Remote {
     /// Uploads the file `local` as `name` (conditionally with `create`, see [`Remote::put_bytes`]). Files above
     /// 64 MiB go up in parts, streamed from disk: with `create`, one existence check first (a multipart upload
     /// cannot be conditional everywhere; two writers of one content-addressed name upload the same bytes).
-    pub(crate) fn put_file(&self, name: &str, local: &Path, create: bool) -> Result<Put, StoreError> {
+    pub(crate) fn put_file(
+        &self,
+        name: &str,
+        local: &Path,
+        create: bool,
+    ) -> Result<Put, StoreError> {
         let mut file =
             std::fs::File::open(local).map_err(StoreError::io("open for upload", local))?;
         let len = file

@@ -5,7 +5,8 @@
 use std::path::PathBuf;
 
 /// What every URL error message ends with: the accepted forms.
-const FORMS: &str = "use s3://BUCKET/PREFIX (S3 or MinIO; credentials and endpoint from the AWS_* environment \
+const FORMS: &str =
+    "use s3://BUCKET/PREFIX (S3 or MinIO; credentials and endpoint from the AWS_* environment \
                      variables), file:///ABSOLUTE/PATH or memory://NAME (tests only)";
 
 /// A parsed remote cache location.
@@ -66,9 +67,9 @@ pub fn parse(url: &str) -> Result<RemoteUrl, UrlError> {
             }
             let valid_bucket = bucket.len() >= 3
                 && bucket.len() <= 63
-                && bucket
-                    .bytes()
-                    .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'-' || b == b'.');
+                && bucket.bytes().all(|b| {
+                    b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'-' || b == b'.'
+                });
             if !valid_bucket {
                 return Err(err(
                     url,
@@ -158,13 +159,19 @@ mod tests {
     #[test]
     fn errors_say_what_to_write() {
         let e = parse("s3://").unwrap_err().to_string();
-        assert!(e.contains("no bucket") && e.contains("s3://BUCKET/PREFIX"), "{e}");
+        assert!(
+            e.contains("no bucket") && e.contains("s3://BUCKET/PREFIX"),
+            "{e}"
+        );
         let e = parse("s3:///prefix").unwrap_err().to_string();
         assert!(e.contains("no bucket"), "{e}");
         let e = parse("s3://Bad_Bucket/x").unwrap_err().to_string();
         assert!(e.contains("not a valid bucket name"), "{e}");
         let e = parse("gs://bucket/x").unwrap_err().to_string();
-        assert!(e.contains("unknown scheme `gs://`") && e.contains("s3://BUCKET/PREFIX"), "{e}");
+        assert!(
+            e.contains("unknown scheme `gs://`") && e.contains("s3://BUCKET/PREFIX"),
+            "{e}"
+        );
         let e = parse("/srv/cache").unwrap_err().to_string();
         assert!(e.contains("not a URL") && e.contains("--cache DIR"), "{e}");
         let e = parse("file://srv/cache").unwrap_err().to_string();

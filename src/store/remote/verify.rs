@@ -40,10 +40,7 @@ fn check_entry(
     name: &str,
     scratch: &Path,
 ) -> Result<Option<String>, StoreError> {
-    let tmp = scratch.join(format!(
-        ".verify-{key}-{}.tmp",
-        std::process::id()
-    ));
+    let tmp = scratch.join(format!(".verify-{key}-{}.tmp", std::process::id()));
     let result = (|| {
         let mut file = File::options()
             .read(true)
@@ -74,12 +71,14 @@ pub(crate) fn run(remote: &Remote, scratch: &Path) -> Result<RemoteVerifyReport,
         .par_iter()
         .filter_map(|o| entries::key_of(&o.name).map(|k| (k, o)))
         .map(|(key, o)| {
-            Ok(check_entry(remote, &key, &o.name, scratch)?.map(|reason| BadRemoteObject {
-                key,
-                name: o.name.clone(),
-                reason,
-                removed: false,
-            }))
+            Ok(
+                check_entry(remote, &key, &o.name, scratch)?.map(|reason| BadRemoteObject {
+                    key,
+                    name: o.name.clone(),
+                    reason,
+                    removed: false,
+                }),
+            )
         })
         .collect();
     let folder_results: Vec<Result<Option<BadRemoteObject>, StoreError>> = manifests
@@ -92,17 +91,22 @@ pub(crate) fn run(remote: &Remote, scratch: &Path) -> Result<RemoteVerifyReport,
             let Some(manifest) = remote.get_bytes(&o.name)? else {
                 return Ok(None);
             };
-            Ok(dirs::check(remote, &key, &manifest, scratch)?.map(|reason| BadRemoteObject {
-                key,
-                name: o.name.clone(),
-                reason: format!("generated folder: {reason}"),
-                removed: false,
-            }))
+            Ok(
+                dirs::check(remote, &key, &manifest, scratch)?.map(|reason| BadRemoteObject {
+                    key,
+                    name: o.name.clone(),
+                    reason: format!("generated folder: {reason}"),
+                    removed: false,
+                }),
+            )
         })
         .collect();
     let mut report = RemoteVerifyReport {
         url: remote.url().to_string(),
-        entries_checked: objects.iter().filter(|o| entries::key_of(&o.name).is_some()).count() as u64,
+        entries_checked: objects
+            .iter()
+            .filter(|o| entries::key_of(&o.name).is_some())
+            .count() as u64,
         folders_checked: manifests.len() as u64,
         bytes_checked: objects.iter().map(|o| o.bytes).sum(),
         bad: Vec::new(),
