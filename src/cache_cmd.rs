@@ -202,9 +202,17 @@ pub fn verify(store: &Store) -> (String, bool) {
     (out, all_ok)
 }
 
+/// `skytie cache gc --max-size SIZE`: [`gc_with`] with the default `--remote-min-age` of one hour.
+pub fn gc(store: &Store, max_size: &str) -> Result<String, String> {
+    gc_with(store, max_size, DEFAULT_REMOTE_MIN_AGE)
+}
+
+/// Default of `--remote-min-age`.
+pub const DEFAULT_REMOTE_MIN_AGE: &str = "1h";
+
 /// `skytie cache gc --max-size SIZE [--remote-min-age AGE]`: removes least-recently-used entries until the
 /// cache folder fits in SIZE; with a remote, then removes the remote results no node record points to.
-pub fn gc(store: &Store, max_size: &str, remote_min_age: &str) -> Result<String, String> {
+pub fn gc_with(store: &Store, max_size: &str, remote_min_age: &str) -> Result<String, String> {
     let max_bytes = parse_size(max_size)?;
     let min_age = parse_age(remote_min_age)?;
     let report = store.gc(max_bytes).map_err(|e| e.to_string())?;

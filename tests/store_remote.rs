@@ -27,7 +27,7 @@ fn exec(store: &Store, dag: &skytie::dag::Dag) -> Outcome {
     let stat = StatCache::open(store.root());
     let progress = Progress::new(ProgressMode::Silent);
     let env = Env {
-        store: store,
+        store,
         stat_cache: &stat,
         progress: &progress,
     };

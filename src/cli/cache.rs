@@ -27,7 +27,7 @@ pub enum CacheAction {
         max_size: String,
         /// With a remote: keep unreachable remote objects younger than this (runs on other hosts upload an
         /// entry just before its node record), e.g. 30m, 6h, 2d, 0.
-        #[arg(long, value_name = "AGE", default_value = "1h")]
+        #[arg(long, value_name = "AGE", default_value = crate::cache_cmd::DEFAULT_REMOTE_MIN_AGE)]
         remote_min_age: String,
     },
 }
@@ -57,7 +57,7 @@ pub fn main(args: &CacheArgs) -> i32 {
         CacheAction::Gc {
             max_size,
             remote_min_age,
-        } => match crate::cache_cmd::gc(&store, max_size, remote_min_age) {
+        } => match crate::cache_cmd::gc_with(&store, max_size, remote_min_age) {
             Ok(text) => {
                 print!("{text}");
                 0

@@ -14,7 +14,7 @@ use crate::hashing::NodeKey;
 use crate::store::error::StoreError;
 use crate::store::records;
 
-/// Outcome of [`run`].
+/// Outcome of a remote collection (`Store::gc_remote`).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct RemoteGcReport {
     pub url: String,

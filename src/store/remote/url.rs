@@ -1,6 +1,6 @@
 //! The remote cache's URL: `s3://BUCKET/PREFIX` (S3 and S3-compatible stores such as MinIO), `file:///PATH` (a
 //! folder, through object_store's local file system backend) and `memory://NAME` (an in-process store for
-//! tests). Parsing only; opening is in [`super::backend`].
+//! tests). Parsing only; [`super::Remote::open`] opens it.
 
 use std::path::PathBuf;
 

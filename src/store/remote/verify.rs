@@ -23,7 +23,7 @@ pub struct BadRemoteObject {
     pub removed: bool,
 }
 
-/// Outcome of [`run`].
+/// Outcome of a remote verification (`Store::verify_remote`).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct RemoteVerifyReport {
     pub url: String,
