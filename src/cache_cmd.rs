@@ -1,9 +1,39 @@
 //! Bodies of the `skytie cache stats | verify | gc` commands (the CLI wires them in): human-readable tables
-//! built from [`Store::stats`], [`Store::verify`] and [`Store::gc`], and size parsing for `--max-size`.
+//! built from [`Store::stats`], [`Store::verify`] and [`Store::gc`] (and, with a remote, [`Store::verify_remote`]
+//! and [`Store::gc_remote`]), and size and age parsing for `--max-size` and `--remote-min-age`.
 
 use std::fmt::Write;
+use std::time::Duration;
 
+use crate::dag::record::{NodeRecord, NODES_NS, OUTPUT_NS};
+use crate::hashing::{ContentHash, NodeKey};
 use crate::store::Store;
+
+/// Parses an age such as `0`, `90s`, `30m`, `6h`, `2d` (a number without unit is seconds).
+pub fn parse_age(text: &str) -> Result<Duration, String> {
+    let t = text.trim();
+    let split = t.find(|c: char| !c.is_ascii_digit()).unwrap_or(t.len());
+    let (number, unit) = t.split_at(split);
+    let seconds_per = match unit.trim() {
+        "" | "s" => 1,
+        "m" => 60,
+        "h" => 3600,
+        "d" => 86_400,
+        _ => 0,
+    };
+    match number.parse::<u64>() {
+        Ok(n) if seconds_per > 0 => Ok(Duration::from_secs(n.saturating_mul(seconds_per))),
+        _ => Err(format!(
+            "invalid age `{text}`: write a whole number with an optional unit s, m, h or d (e.g. 30m, 6h, 2d, 0)"
+        )),
+    }
+}
+
+/// The key a node record (JSON) names: the roots of the remote collection.
+fn record_key(payload: &[u8]) -> Option<NodeKey> {
+    let record: NodeRecord = serde_json::from_slice(payload).ok()?;
+    ContentHash::from_hex(&record.key).ok()
+}
 
 /// Parses a size such as `10G`, `500M`, `1.5GiB`, `64k`, `0` or `123456` (bytes). Suffixes K, M, G, T are
 /// binary multiples (1K = 1024 bytes); an optional `B`/`iB` after them is accepted; case does not matter.
@@ -135,18 +165,56 @@ pub fn verify(store: &Store) -> (String, bool) {
             report.temp_files_removed
         );
     }
-    if !report.all_ok() {
+    let mut all_ok = report.all_ok();
+    match store.verify_remote() {
+        None => {}
+        Some(Err(e)) => {
+            let _ = writeln!(out, "remote: {e}");
+            all_ok = false;
+        }
+        Some(Ok(remote)) => {
+            let _ = writeln!(
+                out,
+                "remote {}: checked {} entries ({}) and {} generated folders: {} bad",
+                remote.url,
+                remote.entries_checked,
+                format_bytes(remote.bytes_checked),
+                remote.folders_checked,
+                remote.bad.len()
+            );
+            for bad in &remote.bad {
+                let action = if bad.removed {
+                    "deleted from the remote"
+                } else {
+                    "could NOT be deleted"
+                };
+                let _ = writeln!(out, "  {}  {} — {action}", bad.name, bad.reason);
+            }
+            all_ok &= remote.bad.is_empty();
+        }
+    }
+    if !all_ok {
         let _ = writeln!(
             out,
             "bad entries will be recomputed by the next `skytie run`"
         );
     }
-    (out, report.all_ok())
+    (out, all_ok)
 }
 
-/// `skytie cache gc --max-size SIZE`: removes least-recently-used entries until the cache fits in SIZE.
+/// `skytie cache gc --max-size SIZE`: [`gc_with`] with the default `--remote-min-age` of one hour.
 pub fn gc(store: &Store, max_size: &str) -> Result<String, String> {
+    gc_with(store, max_size, DEFAULT_REMOTE_MIN_AGE)
+}
+
+/// Default of `--remote-min-age`.
+pub const DEFAULT_REMOTE_MIN_AGE: &str = "1h";
+
+/// `skytie cache gc --max-size SIZE [--remote-min-age AGE]`: removes least-recently-used entries until the
+/// cache folder fits in SIZE; with a remote, then removes the remote results no node record points to.
+pub fn gc_with(store: &Store, max_size: &str, remote_min_age: &str) -> Result<String, String> {
     let max_bytes = parse_size(max_size)?;
+    let min_age = parse_age(remote_min_age)?;
     let report = store.gc(max_bytes).map_err(|e| e.to_string())?;
     let mut out = String::new();
     let _ = writeln!(out, "{:<22} {:>10} {:>12}", "", "entries", "size");
@@ -202,6 +270,33 @@ pub fn gc(store: &Store, max_size: &str) -> Result<String, String> {
     for failure in &report.failures {
         let _ = writeln!(out, "warning: {failure}");
     }
+    if let Some(remote) = store.gc_remote(NODES_NS, &record_key, OUTPUT_NS, min_age) {
+        let r = remote.map_err(|e| e.to_string())?;
+        let _ = writeln!(out, "remote {}:", r.url);
+        row(&mut out, "before", r.entries_before, r.bytes_before);
+        row(
+            &mut out,
+            "removed (unreachable)",
+            r.removed_keys.len() as u64,
+            r.removed_bytes,
+        );
+        row(&mut out, "after", r.kept_entries, r.kept_bytes);
+        let _ = writeln!(
+            out,
+            "roots: {} node records{}; {} unreachable entries younger than {} s kept; {} folders and {} output \
+             records removed",
+            r.roots,
+            if r.unreadable_roots > 0 {
+                format!(" ({} unreadable)", r.unreadable_roots)
+            } else {
+                String::new()
+            },
+            r.young_entries,
+            r.min_age.as_secs(),
+            r.removed_folders,
+            r.removed_records
+        );
+    }
     Ok(out)
 }
 
@@ -225,6 +320,19 @@ mod tests {
                 e.contains("invalid size") && e.contains("10G"),
                 "{bad}: {e}"
             );
+        }
+    }
+
+    #[test]
+    fn ages_parse_with_units_and_clear_errors() {
+        assert_eq!(parse_age("0"), Ok(Duration::ZERO));
+        assert_eq!(parse_age("90s"), Ok(Duration::from_secs(90)));
+        assert_eq!(parse_age("30m"), Ok(Duration::from_secs(1800)));
+        assert_eq!(parse_age(" 6h"), Ok(Duration::from_secs(6 * 3600)));
+        assert_eq!(parse_age("2d"), Ok(Duration::from_secs(2 * 86_400)));
+        for bad in ["", "h", "1.5h", "3w", "-1h"] {
+            let e = parse_age(bad).unwrap_err();
+            assert!(e.contains("invalid age") && e.contains("30m"), "{bad}: {e}");
         }
     }
 

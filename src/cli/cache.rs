@@ -1,5 +1,5 @@
 //! `skytie cache stats|verify|gc --max-size SIZE`: the store maintenance commands (bodies in
-//! `crate::cache_cmd`).
+//! `crate::cache_cmd`); with `--cache-remote URL`, `verify` and `gc` work on the remote too.
 
 use crate::cli::common::CacheOpt;
 use clap::{Args, Subcommand};
@@ -16,13 +16,19 @@ pub struct CacheArgs {
 pub enum CacheAction {
     /// Entries and bytes, per stage.
     Stats,
-    /// Re-hash every entry; remove and list bad ones (exit 1 if any).
+    /// Re-hash every entry; remove and list bad ones (exit 1 if any). With a remote, also download and
+    /// check every remote entry and generated folder.
     Verify,
-    /// Remove least-recently-used entries until the cache fits (never entries of a running run).
+    /// Remove least-recently-used entries until the cache fits (never entries of a running run). With a
+    /// remote, also remove the remote results no node record points to any more.
     Gc {
-        /// Size limit, e.g. 10G, 500M, 0.
+        /// Size limit of the local cache folder, e.g. 10G, 500M, 0.
         #[arg(long, value_name = "SIZE")]
         max_size: String,
+        /// With a remote: keep unreachable remote objects younger than this (runs on other hosts upload an
+        /// entry just before its node record), e.g. 30m, 6h, 2d, 0.
+        #[arg(long, value_name = "AGE", default_value = crate::cache_cmd::DEFAULT_REMOTE_MIN_AGE)]
+        remote_min_age: String,
     },
 }
 
@@ -48,7 +54,10 @@ pub fn main(args: &CacheArgs) -> i32 {
                 1
             }
         }
-        CacheAction::Gc { max_size } => match crate::cache_cmd::gc(&store, max_size) {
+        CacheAction::Gc {
+            max_size,
+            remote_min_age,
+        } => match crate::cache_cmd::gc_with(&store, max_size, remote_min_age) {
             Ok(text) => {
                 print!("{text}");
                 0

@@ -10,12 +10,17 @@ use std::path::{Path, PathBuf};
 /// The workflow `skytie run` runs when none is named (built in, see [`super::builtin_workflows`]).
 pub const DEFAULT_WORKFLOW: &str = "default";
 
-/// `--cache DIR` (default: `$SKYTIE_CACHE`, else `cache/` in the working directory).
+/// `--cache DIR` (default: `$SKYTIE_CACHE`, else `cache/` in the working directory) and `--cache-remote URL`
+/// (default: `$SKYTIE_CACHE_REMOTE`, else none).
 #[derive(Args, Debug, Clone, Default)]
 pub struct CacheOpt {
     /// Cache folder (default: $SKYTIE_CACHE, else ./cache).
     #[arg(long, value_name = "DIR", global = true)]
     pub cache: Option<PathBuf>,
+    /// Remote cache behind the cache folder: s3://BUCKET/PREFIX (S3, MinIO; AWS_* variables) or
+    /// file:///PATH (default: $SKYTIE_CACHE_REMOTE, else none). See docs/cache.md.
+    #[arg(long, value_name = "URL", global = true)]
+    pub cache_remote: Option<String>,
 }
 
 impl CacheOpt {
@@ -30,10 +35,20 @@ impl CacheOpt {
         }
     }
 
+    /// The remote cache URL to use, if any.
+    pub fn remote(&self) -> Option<String> {
+        if let Some(r) = &self.cache_remote {
+            return Some(r.clone());
+        }
+        std::env::var("SKYTIE_CACHE_REMOTE")
+            .ok()
+            .filter(|v| !v.trim().is_empty())
+    }
+
     /// Open the store, or print why not.
     pub fn open(&self) -> Result<Store, String> {
         let root = self.root();
-        Store::open(&root).map_err(|e| {
+        Store::open_with_remote(&root, self.remote().as_deref()).map_err(|e| {
             format!(
                 "cannot open the cache at {}: {e} (use --cache DIR)",
                 root.display()

@@ -105,7 +105,8 @@ fn run(args: &SlurmArgs) -> Result<(), (i32, String)> {
     if args.cache.cache.is_none() && std::env::var_os("SKYTIE_CACHE").is_none() {
         return Err((
             2,
-            "give the shared cache folder with --cache DIR (or SKYTIE_CACHE): every job must see the same cache"
+            "give the shared cache folder with --cache DIR (or SKYTIE_CACHE): every job must see the same cache \
+             (with --cache-remote, a node-local folder at the same path on every node)"
                 .into(),
         ));
     }
@@ -139,6 +140,9 @@ fn run(args: &SlurmArgs) -> Result<(), (i32, String)> {
     );
     if let Some(c) = &args.campaign {
         command.push_str(&format!(" --campaign {}", quoted(&absolute(c))));
+    }
+    if let Some(remote) = args.cache.remote() {
+        command.push_str(&format!(" --cache-remote {}", quoted(Path::new(&remote))));
     }
     let dir = out.join("slurm");
     let plan = Plan {

@@ -24,6 +24,20 @@ pub enum StoreError {
          starting with '.'"
     )]
     InvalidNamespace(String),
+    /// A request to the remote cache failed.
+    #[error(
+        "cache remote {url}: cannot {action} {name}: {message} (check the URL, the AWS_* credentials and endpoint, and \
+         the network; without --cache-remote and SKYTIE_CACHE_REMOTE the local cache is used alone)"
+    )]
+    Remote {
+        action: &'static str,
+        url: String,
+        name: String,
+        message: String,
+    },
+    /// The remote cache URL is invalid or the remote cannot be set up (the message says what to do).
+    #[error("{0}")]
+    RemoteUrl(String),
     /// Entry metadata too large for the entry header.
     #[error("cache: metadata of entry {key} is {len} bytes, more than the {max}-byte limit (shorten the item name)")]
     MetaTooLarge { key: String, len: usize, max: usize },

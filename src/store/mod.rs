@@ -6,6 +6,10 @@
 //! damaged entry is reported once, deleted and recomputed by the caller — never trusted. Last use of an entry
 //! is its file modification time (set on every load hit and save, and by `contains` during a run), which
 //! `gc` sorts by; live runs hold a [`RunLease`] so `gc` never removes what they used.
+//!
+//! Optionally a remote object store stands behind the folder ([`Store::open_with_remote`], [`remote`]): the
+//! folder is then the local cache in front of it — loads that miss locally download, verify and install the
+//! remote entry; saves and side records are uploaded too. Without a remote nothing of this costs anything.
 
 mod entry;
 mod error;
@@ -13,6 +17,7 @@ mod gc;
 mod lease;
 mod objects;
 mod records;
+pub mod remote;
 mod stats;
 mod stream;
 mod verify;
@@ -29,6 +34,7 @@ pub use entry::{EntryMeta, STORE_FORMAT_VERSION};
 pub use error::StoreError;
 pub use gc::GcReport;
 pub use lease::{LiveRun, RunLease};
+pub use remote::{Remote, RemoteGcReport, RemoteVerifyReport};
 pub use stats::{StageStats, StoreStats};
 pub use verify::{BadEntry, VerifyReport};
 
@@ -86,11 +92,20 @@ pub struct Store {
     reported: Mutex<HashSet<NodeKey>>,
     /// Leases taken through this handle and not yet dropped.
     active_leases: Arc<AtomicUsize>,
+    /// The remote object store behind this folder, if any.
+    remote: Option<Remote>,
 }
 
 impl Store {
     /// Opens (creating as needed) the store at `root`, with its `objects/`, `records/` and `runs/` folders.
     pub fn open(root: &Path) -> Result<Store, StoreError> {
+        Store::open_with_remote(root, None)
+    }
+
+    /// Opens the store at `root` as the local cache in front of the remote at `remote_url` (see [`remote`]
+    /// for the URL forms); `None` is [`Store::open`].
+    pub fn open_with_remote(root: &Path, remote_url: Option<&str>) -> Result<Store, StoreError> {
+        let remote = remote_url.map(Remote::open).transpose()?;
         let store = Store {
             root: root.to_path_buf(),
             objects: root.join("objects"),
@@ -99,6 +114,7 @@ impl Store {
             other_format_noticed: AtomicBool::new(false),
             reported: Mutex::new(HashSet::new()),
             active_leases: Arc::new(AtomicUsize::new(0)),
+            remote,
         };
         for dir in [&store.root, &store.objects, &store.records, &store.runs] {
             fs::create_dir_all(dir).map_err(StoreError::io("create cache folder", dir))?;
@@ -109,6 +125,17 @@ impl Store {
     /// The cache folder.
     pub fn root(&self) -> &Path {
         &self.root
+    }
+
+    /// The URL of the remote behind this cache, if any.
+    pub fn remote_url(&self) -> Option<&str> {
+        self.remote.as_ref().map(Remote::url)
+    }
+
+    /// `<root>/dirs`: where nodes' generated folders live (`<root>/dirs/<key>/`); they travel to and from the
+    /// remote with their entries.
+    fn dirs_root(&self) -> PathBuf {
+        self.root.join("dirs")
     }
 
     /// Path of the entry file of `key`.
@@ -161,7 +188,10 @@ impl Store {
         let path = self.object_path(key);
         let mut file = match File::open(&path) {
             Ok(f) => f,
-            Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Loaded::Miss),
+            Err(e) if e.kind() == io::ErrorKind::NotFound => match self.fetch_remote(key, &path)? {
+                Ok(f) => f,
+                Err(outcome) => return Ok(outcome),
+            },
             // The entry itself is unusable: report and remove it.
             Err(e)
                 if matches!(
@@ -203,6 +233,34 @@ impl Store {
             Err(EntryFault::Unreadable(e)) => {
                 Ok(self.corrupt(key, &path, Some(&file), &format!("read error: {e}")))
             }
+        }
+    }
+
+    /// On a local miss: the entry downloaded from the remote, verified and installed at `path`, opened; or
+    /// what the load returns instead (a miss, or the report of a damaged remote copy).
+    fn fetch_remote<T>(
+        &self,
+        key: &NodeKey,
+        path: &Path,
+    ) -> Result<Result<File, Loaded<T>>, StoreError> {
+        let Some(remote) = &self.remote else {
+            return Ok(Err(Loaded::Miss));
+        };
+        match remote::entries::fetch(remote, key, path, &self.dirs_root())? {
+            remote::entries::Fetched::Installed => match File::open(path) {
+                Ok(f) => Ok(Ok(f)),
+                // Removed meanwhile (a concurrent gc): a miss like any other.
+                Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(Err(Loaded::Miss)),
+                Err(e) => Err(StoreError::io("open cache entry", path)(e)),
+            },
+            remote::entries::Fetched::Absent => Ok(Err(Loaded::Miss)),
+            remote::entries::Fetched::Damaged(reason) => Ok(Err(Loaded::Corrupt {
+                message: format!(
+                    "cache entry {key} on the remote {} is corrupt: {reason}; deleted from the remote, the node will \
+                     be recomputed",
+                    remote.url()
+                ),
+            })),
         }
     }
 
@@ -279,6 +337,13 @@ impl Store {
             file.seek(SeekFrom::End(0)).map(|_| ())
         })
         .map_err(StoreError::io("write cache entry", &path))?;
+        if let Some(remote) = &self.remote {
+            if let Err(e) = remote::entries::upload(remote, key, &path, &self.dirs_root()) {
+                // Not kept locally either: a later run finds it missing, computes and uploads it again.
+                let _ = fs::remove_file(&path);
+                return Err(e);
+            }
+        }
         Ok(content_hash)
     }
 
@@ -306,18 +371,38 @@ impl Store {
     }
 
     /// Atomically stores a small side record `bytes` under `<root>/records/<namespace>/<blake3(name)>`.
+    /// With a remote, the record is uploaded too (replacing the remote one: records are mutable, the last
+    /// writer wins).
     pub fn put_record(&self, namespace: &str, name: &str, bytes: &[u8]) -> Result<(), StoreError> {
-        records::put(&self.records, namespace, name, bytes)
+        let file = records::put(&self.records, namespace, name, bytes)?;
+        if let Some(remote) = &self.remote {
+            let remote_name = format!("records/{}", records::file_name(namespace, name)?);
+            remote.put_bytes(&remote_name, file, false)?;
+        }
+        Ok(())
     }
 
-    /// The record stored under (`namespace`, `name`); `None` if absent, unreadable or corrupt.
+    /// The record stored under (`namespace`, `name`); `None` if absent, unreadable or corrupt. The local copy
+    /// is preferred; with a remote, a record absent locally is downloaded, checked and kept locally. A remote
+    /// that cannot be reached reads as absent.
     pub fn get_record(&self, namespace: &str, name: &str) -> Option<Vec<u8>> {
-        records::get(&self.records, namespace, name)
+        if let Some(payload) = records::get(&self.records, namespace, name) {
+            return Some(payload);
+        }
+        let remote = self.remote.as_ref()?;
+        let remote_name = format!("records/{}", records::file_name(namespace, name).ok()?);
+        let file = remote.get_bytes(&remote_name).ok()??;
+        records::install(&self.records, namespace, name, &file).ok()?
     }
 
-    /// Removes the record (`namespace`, `name`) if there is one; returns whether there was.
+    /// Removes the record (`namespace`, `name`) if there is one (locally and on the remote); returns whether
+    /// there was one locally.
     pub fn remove_record(&self, namespace: &str, name: &str) -> Result<bool, StoreError> {
-        records::remove(&self.records, namespace, name)
+        let removed = records::remove(&self.records, namespace, name)?;
+        if let Some(remote) = &self.remote {
+            remote.delete(&format!("records/{}", records::file_name(namespace, name)?))?;
+        }
+        Ok(removed)
     }
 
     /// Registers this process as a live run until the returned lease is dropped. Entries it loads or saves are
@@ -345,5 +430,32 @@ impl Store {
     /// used since the start of a live run.
     pub fn gc(&self, max_bytes: u64) -> Result<GcReport, StoreError> {
         gc::run(self, max_bytes)
+    }
+
+    /// With a remote: removes the remote entries no record of `roots_namespace` points to (`root_key` reads
+    /// the key a record names), with their generated folders and their records in `outputs_namespace`;
+    /// unreachable objects younger than `min_age` are kept (see [`remote::gc`]). `None` without a remote.
+    pub fn gc_remote(
+        &self,
+        roots_namespace: &str,
+        root_key: &dyn Fn(&[u8]) -> Option<NodeKey>,
+        outputs_namespace: &str,
+        min_age: std::time::Duration,
+    ) -> Option<Result<RemoteGcReport, StoreError>> {
+        let remote = self.remote.as_ref()?;
+        Some(remote::gc::run(
+            remote,
+            roots_namespace,
+            root_key,
+            outputs_namespace,
+            min_age,
+        ))
+    }
+
+    /// With a remote: downloads and verifies every remote entry and generated folder, deleting damaged ones
+    /// from the remote (see [`remote::verify`]). `None` without a remote.
+    pub fn verify_remote(&self) -> Option<Result<RemoteVerifyReport, StoreError>> {
+        let remote = self.remote.as_ref()?;
+        Some(remote::verify::run(remote, &self.objects))
     }
 }

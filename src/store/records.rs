@@ -23,22 +23,37 @@ fn valid_namespace(namespace: &str) -> bool {
             .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-' || b == b'.')
 }
 
-fn record_path(records: &Path, namespace: &str, name: &str) -> Result<PathBuf, StoreError> {
+/// `<namespace>/<blake3(name) hex>`: the record's file below `records/` (locally and on a remote).
+pub(crate) fn file_name(namespace: &str, name: &str) -> Result<String, StoreError> {
     if !valid_namespace(namespace) {
         return Err(StoreError::InvalidNamespace(namespace.to_string()));
     }
-    Ok(records
-        .join(namespace)
-        .join(blake3::hash(name.as_bytes()).to_hex().as_str()))
+    Ok(format!(
+        "{namespace}/{}",
+        blake3::hash(name.as_bytes()).to_hex()
+    ))
 }
 
+fn record_path(records: &Path, namespace: &str, name: &str) -> Result<PathBuf, StoreError> {
+    Ok(records.join(file_name(namespace, name)?))
+}
+
+/// Writes a record; returns the file's bytes (what a remote stores too).
 pub(crate) fn put(
     records: &Path,
     namespace: &str,
     name: &str,
     bytes: &[u8],
-) -> Result<(), StoreError> {
+) -> Result<Vec<u8>, StoreError> {
     let path = record_path(records, namespace, name)?;
+    let out = encode(name, bytes);
+    skytie_util::fsutil::atomic_write(&path, &out)
+        .map_err(StoreError::io("write record", &path))?;
+    Ok(out)
+}
+
+/// The bytes of the record file of (`name`, `bytes`).
+fn encode(name: &str, bytes: &[u8]) -> Vec<u8> {
     let mut out = Vec::with_capacity(MAGIC.len() + 1 + 4 + name.len() + 8 + 32 + bytes.len());
     out.extend_from_slice(MAGIC);
     out.push(VERSION);
@@ -47,10 +62,16 @@ pub(crate) fn put(
     out.extend_from_slice(&(bytes.len() as u64).to_le_bytes());
     out.extend_from_slice(hash_bytes(bytes).as_bytes());
     out.extend_from_slice(bytes);
-    skytie_util::fsutil::atomic_write(&path, &out).map_err(StoreError::io("write record", &path))
+    out
 }
 
-fn parse<'a>(file: &'a [u8], name: &str) -> Option<&'a [u8]> {
+/// The payload of the record file `file` if it is intact and holds the record `name`.
+pub(crate) fn parse<'a>(file: &'a [u8], name: &str) -> Option<&'a [u8]> {
+    parse_any(file).and_then(|(n, payload)| (n == name.as_bytes()).then_some(payload))
+}
+
+/// The name and payload of the record file `file` if it is intact.
+pub(crate) fn parse_any(file: &[u8]) -> Option<(&[u8], &[u8])> {
     let rest = file.strip_prefix(MAGIC.as_slice())?;
     let (&version, rest) = rest.split_first()?;
     if version != VERSION {
@@ -58,15 +79,29 @@ fn parse<'a>(file: &'a [u8], name: &str) -> Option<&'a [u8]> {
     }
     let name_len = u32::from_le_bytes(rest.get(..4)?.try_into().ok()?) as usize;
     let rest = &rest[4..];
-    if rest.get(..name_len)? != name.as_bytes() {
-        return None;
-    }
+    let name = rest.get(..name_len)?;
     let rest = &rest[name_len..];
     let payload_len = u64::from_le_bytes(rest.get(..8)?.try_into().ok()?);
     let hash = rest.get(8..40)?;
     let payload = &rest[40..];
     (payload.len() as u64 == payload_len && hash_bytes(payload).as_bytes() == hash)
-        .then_some(payload)
+        .then_some((name, payload))
+}
+
+/// Installs the record file `file` (checked to hold record `name`) fetched from a remote; returns its payload.
+pub(crate) fn install(
+    records: &Path,
+    namespace: &str,
+    name: &str,
+    file: &[u8],
+) -> Result<Option<Vec<u8>>, StoreError> {
+    let Some(payload) = parse(file, name) else {
+        return Ok(None);
+    };
+    let path = record_path(records, namespace, name)?;
+    skytie_util::fsutil::atomic_write(&path, file)
+        .map_err(StoreError::io("write record", &path))?;
+    Ok(Some(payload.to_vec()))
 }
 
 pub(crate) fn get(records: &Path, namespace: &str, name: &str) -> Option<Vec<u8>> {
