@@ -1,12 +1,13 @@
 //! Windows of campaign images shared by all pages of one report: the variants of a sweep draw the same map
 //! backgrounds and registration views, whose image windows are decoded once per report instead of once per
 //! variant. A window is read at the pyramid level its figure needs
-//! (`skytie_stages::imaging::pyramid::PartialPyramid`: the file decoded once, only the tiles under the
+//! (`skytie_stages::imaging::partial::PartialPyramid`: the file decoded once, only the tiles under the
 //! window kept), so memory follows the figures' sizes, not the images'. The cache holds at most a quarter of
 //! the memory budget (`skytie_stages::imaging::budget`); the least recently used windows leave first.
 
 use skytie_stages::imaging::budget;
-use skytie_stages::imaging::pyramid::{PartialPyramid, Region, ScaledWindow};
+use skytie_stages::imaging::partial::{PartialPyramid, Region};
+use skytie_stages::imaging::pyramid::ScaledWindow;
 use std::collections::{HashMap, VecDeque};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};

@@ -30,10 +30,9 @@ use skytie_stages::geometry::{FrameCamera, PanoramaCamera};
 use skytie_stages::imaging::equirect::PanoramaLevels;
 use skytie_stages::imaging::image::RgbImage;
 use skytie_stages::imaging::io::{dimensions, save_rgb};
+use skytie_stages::imaging::partial::{PartialPyramid, Region};
 use skytie_stages::imaging::pyramid::layout::MAX_LEVELS;
-use skytie_stages::imaging::pyramid::{
-    footprint_level, PartialPyramid, PyramidLayout, Region, ScaledWindow, TileSource,
-};
+use skytie_stages::imaging::pyramid::{footprint_level, PyramidLayout, ScaledWindow, TileSource};
 use skytie_stages::nadir::ortho::panorama_bands;
 use skytie_stages::nadir::{ortho_project, OrthoGeoref, OrthoImage, OrthoParams};
 use skytie_stages::oblique::grading::Truth as StageTruth;

@@ -13,14 +13,12 @@
 pub mod builder;
 pub mod layout;
 pub mod memory;
-pub mod partial;
 pub mod reader;
 pub mod sample;
 
 pub use builder::{PyramidBuilder, PyramidSummary};
 pub use layout::{PixelRect, PyramidLayout, SampleDepth, DEFAULT_TILE_SIDE};
 pub use memory::MemoryPyramid;
-pub use partial::{PartialPyramid, Region};
 pub use reader::{read_window, PyramidError, TileId, TileSource, TiledPyramid};
 
 use crate::imaging::GrayImage;

@@ -1,12 +1,12 @@
 //! A pyramid decoded from an image file straight into memory, keeping only the tiles under the regions the
 //! caller will read: views of a whole campaign image at a coarse level, or a window of it, in memory bounded
 //! by what is kept (plus the decoder's own buffers), never by the image's size. The tiles are the ones
-//! ingestion writes ([`super::PyramidBuilder`]: same decoder, same levels), so a window read from it equals
-//! the window a stage reads from the ingested pyramid.
+//! ingestion writes ([`super::pyramid::PyramidBuilder`]: same decoder, same levels), so a window read from it
+//! equals the window a stage reads from the ingested pyramid.
 
-use super::builder::{Chain, TileSink};
-use super::layout::{PyramidLayout, SampleDepth, DEFAULT_TILE_SIDE};
-use super::reader::{PyramidError, TileId, TileSource};
+use super::pyramid::builder::{Chain, TileSink};
+use super::pyramid::layout::{PyramidLayout, SampleDepth, DEFAULT_TILE_SIDE};
+use super::pyramid::reader::{PyramidError, TileId, TileSource};
 use crate::imaging::decode::{decode_grey, limits, GreyInfo, GreyRowSink};
 use crate::imaging::io_error::ImageIoError;
 use std::collections::HashMap;
