@@ -3,6 +3,7 @@
 //! (0.5, 0.5)) as everywhere in skytie.
 
 use skytie_stages::imaging::image::{GrayImage, RgbImage};
+use skytie_stages::imaging::pyramid::ScaledWindow;
 
 pub type Rgb = [f32; 3];
 pub const GREEN: Rgb = [0.0, 0.85, 0.2];
@@ -10,9 +11,72 @@ pub const RED: Rgb = [1.0, 0.1, 0.1];
 pub const YELLOW: Rgb = [1.0, 0.85, 0.0];
 pub const BLUE: Rgb = [0.15, 0.45, 1.0];
 
+/// A grey raster sampled bilinearly at array coordinates of its full-resolution pixels (pixel centres at
+/// integers), 0 outside it: a whole image, or a window of an image's pyramid level that covers every position
+/// asked for.
+pub trait Raster {
+    fn bilinear(&self, x: f64, y: f64) -> f32;
+}
+
+/// A raster that is black everywhere (an image a view misses entirely).
+pub struct Black;
+
+impl Raster for Black {
+    fn bilinear(&self, _x: f64, _y: f64) -> f32 {
+        0.0
+    }
+}
+
+impl Raster for GrayImage {
+    fn bilinear(&self, x: f64, y: f64) -> f32 {
+        bilinear(self, x, y)
+    }
+}
+
+impl Raster for ScaledWindow {
+    /// Samples the window's level at the full-resolution array position (x, y); 0 outside the whole image
+    /// at that level. Level pixels outside the window repeat its nearest edge pixel (the window is read to
+    /// cover the positions asked for, so this happens only at the image's own edges, as for a whole image).
+    fn bilinear(&self, x: f64, y: f64) -> f32 {
+        let s = self.scale();
+        // Level 0 as given (the same arithmetic as for a whole image).
+        let (lx, ly) = if self.level == 0 {
+            (x, y)
+        } else {
+            ((x + 0.5) / s - 0.5, (y + 0.5) / s - 0.5)
+        };
+        let (lw, lh) = self.level_size;
+        let img = &self.image;
+        if img.width == 0 || img.height == 0 {
+            return 0.0;
+        }
+        if !(lx >= 0.0 && ly >= 0.0) || lx > (lw - 1) as f64 || ly > (lh - 1) as f64 {
+            return 0.0;
+        }
+        let (x0, y0) = (lx.floor() as usize, ly.floor() as usize);
+        let (x1, y1) = ((x0 + 1).min(lw - 1), (y0 + 1).min(lh - 1));
+        let (fx, fy) = ((lx - x0 as f64) as f32, (ly - y0 as f64) as f32);
+        let at = |c: usize, r: usize| {
+            let wc = (c as i64 - self.rect.x0).clamp(0, img.width as i64 - 1) as usize;
+            let wr = (r as i64 - self.rect.y0).clamp(0, img.height as i64 - 1) as usize;
+            img.get(wc, wr)
+        };
+        let top = at(x0, y0) * (1.0 - fx) + at(x1, y0) * fx;
+        let bottom = at(x0, y1) * (1.0 - fx) + at(x1, y1) * fx;
+        top * (1.0 - fy) + bottom * fy
+    }
+}
+
 /// A crop of `img` with top-left corner (x0, y0) and size (w, h) source pixels, scaled by `scale` with
 /// bilinear sampling; outside the source is black. Returns the RGB image.
-pub fn crop_scaled(img: &GrayImage, x0: f64, y0: f64, w: f64, h: f64, scale: f64) -> RgbImage {
+pub fn crop_scaled<R: Raster + ?Sized>(
+    img: &R,
+    x0: f64,
+    y0: f64,
+    w: f64,
+    h: f64,
+    scale: f64,
+) -> RgbImage {
     let (ow, oh) = (
         ((w * scale).round() as usize).max(1),
         ((h * scale).round() as usize).max(1),
@@ -22,7 +86,7 @@ pub fn crop_scaled(img: &GrayImage, x0: f64, y0: f64, w: f64, h: f64, scale: f64
         let sy = y0 + (row as f64 + 0.5) / scale - 0.5;
         for col in 0..ow {
             let sx = x0 + (col as f64 + 0.5) / scale - 0.5;
-            let v = bilinear(img, sx, sy);
+            let v = img.bilinear(sx, sy);
             out.set(col, row, [v, v, v]);
         }
     }
@@ -31,8 +95,8 @@ pub fn crop_scaled(img: &GrayImage, x0: f64, y0: f64, w: f64, h: f64, scale: f64
 
 /// A `w × h` image whose pixel (col, row) samples `img` at `source(col + 0.5, row + 0.5)` (continuous pixel
 /// coordinates, centres at +0.5) bilinearly; black where `source` is `None` or outside `img`.
-pub fn resample_on_ground(
-    img: &GrayImage,
+pub fn resample_on_ground<R: Raster + ?Sized>(
+    img: &R,
     w: usize,
     h: usize,
     source: impl Fn(f64, f64) -> Option<(f64, f64)>,
@@ -41,7 +105,7 @@ pub fn resample_on_ground(
     for row in 0..h {
         for col in 0..w {
             if let Some((u, v)) = source(col as f64 + 0.5, row as f64 + 0.5) {
-                let s = bilinear(img, u - 0.5, v - 0.5);
+                let s = img.bilinear(u - 0.5, v - 0.5);
                 out.set(col, row, [s, s, s]);
             }
         }
@@ -138,6 +202,36 @@ mod tests {
         }
         let outside = crop_scaled(&g, 10.0, 10.0, 2.0, 2.0, 1.0);
         assert_eq!(outside.get(0, 0), [0.0; 3]);
+    }
+
+    #[test]
+    fn a_window_samples_like_the_whole_image() {
+        let mut g = GrayImage::filled(40, 30, 0.0);
+        for row in 0..30 {
+            for col in 0..40 {
+                g.set(col, row, ((col * 7 + row * 11) % 17) as f32 / 17.0);
+            }
+        }
+        let window = ScaledWindow {
+            image: GrayImage::from_vec(
+                20,
+                12,
+                (0..12)
+                    .flat_map(|r| (0..20).map(move |c| (c + 15, r + 10)))
+                    .map(|(c, r)| g.get(c, r))
+                    .collect(),
+            )
+            .unwrap(),
+            level: 0,
+            rect: skytie_stages::imaging::pyramid::PixelRect::new(15, 10, 20, 12),
+            level_size: (40, 30),
+            full_size: (40, 30),
+        };
+        for (x, y) in [(16.25, 11.5), (20.0, 15.75), (33.9, 20.1)] {
+            assert_eq!(Raster::bilinear(&window, x, y), Raster::bilinear(&g, x, y));
+        }
+        assert_eq!(Raster::bilinear(&window, -0.5, 3.0), 0.0);
+        assert_eq!(Raster::bilinear(&window, 39.5, 3.0), 0.0);
     }
 
     #[test]

@@ -5,7 +5,8 @@
 //! (`truth` module: nadir and oblique rules). Nadir: the recording's north-up MM ortho image (recorded pose,
 //! `ortho_project` at 3 cm) beside the aerial nadir image resampled onto the same north-up ground grid (so both
 //! halves share orientation and scale). Oblique: the
-//! panorama crop around the observations beside the oblique image crop around them. Inputs:
+//! panorama crop around the observations beside the oblique image crop around them. Each image is read at the
+//! pyramid level matching the view's resolution, only over the part the view shows. Inputs:
 //! `correspondences.csv` of the result folder, the campaign's images and (optionally) `truth/`.
 
 pub mod canvas;
@@ -17,7 +18,7 @@ use super::inputs::{read_csv_opt, CsvTable, ResultSet};
 use super::tables::{fmt_count, Origin, Table};
 use super::{slug, Builder};
 use canvas::{
-    crop_scaled, line, resample_on_ground, ring, side_by_side, Rgb, BLUE, GREEN, RED, YELLOW,
+    crop_scaled, line, resample_on_ground, ring, side_by_side, Black, Rgb, BLUE, GREEN, RED, YELLOW,
 };
 use nalgebra::Vector3;
 use skytie_stages::campaign::read_aerial_csv;
@@ -26,9 +27,14 @@ use skytie_stages::campaign::{
 };
 use skytie_stages::correspondence::PanoObservation;
 use skytie_stages::geometry::{FrameCamera, PanoramaCamera};
+use skytie_stages::imaging::equirect::PanoramaLevels;
 use skytie_stages::imaging::image::RgbImage;
 use skytie_stages::imaging::io::{dimensions, save_rgb};
-use skytie_stages::nadir::{ortho_project_whole, OrthoParams};
+use skytie_stages::imaging::partial::{PartialPyramid, Region};
+use skytie_stages::imaging::pyramid::layout::MAX_LEVELS;
+use skytie_stages::imaging::pyramid::{footprint_level, PyramidLayout, ScaledWindow, TileSource};
+use skytie_stages::nadir::ortho::panorama_bands;
+use skytie_stages::nadir::{ortho_project, OrthoGeoref, OrthoImage, OrthoParams};
 use skytie_stages::oblique::grading::Truth as StageTruth;
 use skytie_stages::synth::scene_truth::{SceneOracle, SceneTruth, SCENE_TRUTH_FILE};
 use std::collections::{BTreeMap, HashMap};
@@ -447,10 +453,8 @@ fn nadir_view(
     let aerial = ctx
         .aerial("nadir", &aerial_id)
         .ok_or_else(|| format!("nadir image {aerial_id} is not in the campaign"))?;
-    let pano = ctx
-        .images
-        .gray(&ctx.campaign.root.join("mm/panoramas").join(&rec.file))?;
-    let ortho = ortho_project_whole(&pano, rec, &OrthoParams::default());
+    let (ortho, pano_size) =
+        ortho_of_panorama(&ctx.campaign.root.join("mm/panoramas").join(&rec.file), rec)?;
     let g = &ortho.georef;
     let left = crop_scaled(
         &ortho.image,
@@ -465,14 +469,16 @@ fn nadir_view(
         .ok_or("the recording is not in front of the aerial camera")?;
     // The aerial side on the same north-up ground grid as the ortho image (each pixel's ground point projected
     // into the aerial image), so both halves share orientation and scale and the lines run side to side.
-    let aerial_img = ctx.images.gray(&ctx.aerial_path("nadir", aerial))?;
-    let right = resample_on_ground(&aerial_img, g.width_px, g.height_px, |c, r| {
-        cam.project_world(&g.pixel_to_world(c, r))
-    });
+    let project = |c: f64, r: f64| cam.project_world(&g.pixel_to_world(c, r));
+    let aerial_path = ctx.aerial_path("nadir", aerial);
+    let right = match ground_window(ctx.images, &aerial_path, aerial, g, &project)? {
+        Some(window) => resample_on_ground(window.as_ref(), g.width_px, g.height_px, project),
+        None => resample_on_ground(&Black, g.width_px, g.height_px, project),
+    };
     let gap = 12;
     let mut img = side_by_side(&left, &right, gap);
     let x_off = (left.width + gap) as f64;
-    let pano_cam = PanoramaCamera::from_recording(rec, pano.width as u32, pano.height as u32);
+    let pano_cam = PanoramaCamera::from_recording(rec, pano_size.0 as u32, pano_size.1 as u32);
     let ground_z = rec.z - rec.camera_height_m;
     let mut counts = ViewCounts::default();
     for p in points {
@@ -508,6 +514,92 @@ fn nadir_view(
     }
     save(out, &img)?;
     Ok((aerial_id, counts))
+}
+
+/// The recording's north-up ortho image at the default ortho parameters, from the bands of the panorama at
+/// `path` that the projection samples (the panorama is decoded once; only those bands are kept), and the
+/// panorama's size in pixels.
+fn ortho_of_panorama(path: &Path, rec: &Recording) -> Result<(OrthoImage, (usize, usize)), String> {
+    let params = OrthoParams::default();
+    let bands_of = |layout: &PyramidLayout| {
+        panorama_bands(
+            rec,
+            &params,
+            (layout.width, layout.height),
+            layout.levels() - 1,
+        )
+    };
+    let pyramid = PartialPyramid::decode(path, |layout| {
+        bands_of(layout)
+            .into_iter()
+            .map(|(level, (v0, v1))| Region::window(level, [0.0, v0, layout.width as f64, v1]))
+            .collect()
+    })
+    .map_err(|e| e.to_string())?;
+    let layout = pyramid.layout();
+    let panorama = PanoramaLevels::read_bands(&pyramid, &bands_of(layout))
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    let size = (layout.width, layout.height);
+    drop(pyramid);
+    Ok((ortho_project(&panorama, rec, &params), size))
+}
+
+/// The window of the aerial image at `path` that the ground grid `g` projects into (`project`: ortho pixel
+/// centre → full-resolution aerial pixel), at the pyramid level matching an ortho pixel's footprint in the
+/// aerial image; `None` when the grid misses the image.
+fn ground_window(
+    images: &ImageCache,
+    path: &Path,
+    aerial: &AerialImage,
+    g: &OrthoGeoref,
+    project: &dyn Fn(f64, f64) -> Option<(f64, f64)>,
+) -> Result<Option<Arc<ScaledWindow>>, String> {
+    let (cx, cy) = (g.width_px as f64 / 2.0, g.height_px as f64 / 2.0);
+    let footprint_px = match (project(cx, cy), project(cx + 1.0, cy)) {
+        (Some(a), Some(b)) => (b.0 - a.0).hypot(b.1 - a.1),
+        _ => 1.0,
+    };
+    let level = footprint_level(1.0, footprint_px, MAX_LEVELS);
+    let margin = 2.0 * (1u64 << level) as f64;
+    let (w, h) = (aerial.width_px as f64, aerial.height_px as f64);
+    let mut b: Option<[f64; 4]> = None;
+    for r in 0..g.height_px {
+        for c in 0..g.width_px {
+            let Some((u, v)) = project(c as f64 + 0.5, r as f64 + 0.5) else {
+                continue;
+            };
+            if u < -margin || v < -margin || u > w + margin || v > h + margin {
+                continue;
+            }
+            let x = b.get_or_insert([u, v, u, v]);
+            *x = [x[0].min(u), x[1].min(v), x[2].max(u), x[3].max(v)];
+        }
+    }
+    let Some([u0, v0, u1, v1]) = b else {
+        return Ok(None);
+    };
+    images.window(
+        path,
+        level,
+        [u0 - margin, v0 - margin, u1 + margin, v1 + margin],
+    )
+}
+
+/// The crop (x0, y0, w, h) of the image at `path` scaled by `scale` ([`crop_scaled`]), read at the pyramid
+/// level matching an output pixel's footprint.
+fn crop_of(
+    images: &ImageCache,
+    path: &Path,
+    (x0, y0, w, h): (f64, f64, f64, f64),
+    scale: f64,
+) -> Result<RgbImage, String> {
+    let level = footprint_level(1.0, 1.0 / scale, MAX_LEVELS);
+    let margin = 2.0 * (1u64 << level) as f64;
+    let b = [x0 - margin, y0 - margin, x0 + w + margin, y0 + h + margin];
+    Ok(match images.window(path, level, b)? {
+        Some(window) => crop_scaled(window.as_ref(), x0, y0, w, h, scale),
+        None => crop_scaled(&Black, x0, y0, w, h, scale),
+    })
 }
 
 /// Bounding box (x0, y0, w, h) of observations, padded, at least `min` pixels wide and high.
@@ -551,10 +643,6 @@ fn oblique_view(
     if pairs.is_empty() {
         return Err("no control point seen in both images".into());
     }
-    let pano = ctx
-        .images
-        .gray(&ctx.campaign.root.join("mm/panoramas").join(&rec.file))?;
-    let aerial_img = ctx.images.gray(&ctx.aerial_path("oblique", aerial))?;
     let lb = bbox(
         &pairs
             .iter()
@@ -572,8 +660,9 @@ fn oblique_view(
         120.0,
     );
     let (ls, rs) = (HEIGHT / lb.3, HEIGHT / rb.3);
-    let left = crop_scaled(&pano, lb.0, lb.1, lb.2, lb.3, ls);
-    let right = crop_scaled(&aerial_img, rb.0, rb.1, rb.2, rb.3, rs);
+    let pano_path = ctx.campaign.root.join("mm/panoramas").join(&rec.file);
+    let left = crop_of(ctx.images, &pano_path, lb, ls)?;
+    let right = crop_of(ctx.images, &ctx.aerial_path("oblique", aerial), rb, rs)?;
     let gap = 12;
     let mut img = side_by_side(&left, &right, gap);
     let x_off = (left.width + gap) as f64;

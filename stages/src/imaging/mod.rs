@@ -13,6 +13,7 @@ pub mod image;
 pub mod ingest;
 pub mod io;
 pub mod io_error;
+pub mod partial;
 pub mod probe;
 pub mod pyramid;
 pub mod tiff_write;
