@@ -23,7 +23,7 @@ use crate::nodes::nadir::transform::InitialTransformStage;
 use crate::nodes::nadir::transform_agreement::TransformAgreementStage;
 use crate::workflow::Workflow;
 use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
-use skytie_stages::nadir::aerial_overlap::overlapping_nadir;
+use skytie_stages::nadir::aerial_overlap::NadirOverlap;
 use skytie_stages::nadir::baseline::BaselineParams;
 use skytie_stages::nadir::control_points::ControlParams;
 use skytie_stages::nadir::grading::NadirGrade;
@@ -131,6 +131,7 @@ pub fn add_nadir(
     };
 
     let mut aerial_rows: BTreeMap<usize, Handle<AerialImage>> = BTreeMap::new();
+    let overlap = NadirOverlap::new(&snapshot.campaign.nadir, &snapshot.campaign.recordings);
     let mut windows = Vec::new();
     let mut transforms: Vec<Handle<TransformOutcome>> = Vec::new();
     let mut refinements: Vec<Handle<AerialRefinement>> = Vec::new();
@@ -174,11 +175,7 @@ pub fn add_nadir(
         let mut rec_aerials = Vec::new();
         // Per overlapping nadir image: (aerial handle, file, pair label, ortho, transform outcome, aerial image_id).
         let mut pairs = Vec::new();
-        for a in overlapping_nadir(
-            item.recording,
-            &snapshot.campaign.nadir,
-            options.overlap_margin_m,
-        ) {
+        for a in overlap.overlapping(item.recording, options.overlap_margin_m) {
             let row = &snapshot.campaign.nadir[a];
             let aerial = match aerial_rows.get(&a) {
                 Some(h) => *h,

@@ -12,7 +12,7 @@
 //! Sources: `metrics.json` (`adjust.*`, `verify.*`), `corrections.csv` (rows of kind `recording`),
 //! `verification.csv` and `verification_adjusted.csv`.
 
-use super::inputs::{num_at, obj_at, read_csv_opt, CsvTable};
+use super::inputs::{num_at, obj_at, read_csv_opt, read_csv_where, CsvTable};
 use serde_json::Value;
 use skytie_stages::export::Support;
 use std::path::Path;
@@ -180,7 +180,8 @@ impl Headline {
             std::fs::read(&path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
         let m: Value = serde_json::from_slice(&bytes)
             .map_err(|e| format!("{}: not valid JSON ({e})", path.display()))?;
-        let corrections = read_csv_opt(&dir.join("corrections.csv"))?;
+        // Only the recordings' rows: the series between them is most of a long campaign's file.
+        let corrections = read_csv_where(&dir.join("corrections.csv"), "kind", "recording")?;
         let before = read_csv_opt(&dir.join("verification.csv"))?;
         let after = read_csv_opt(&dir.join("verification_adjusted.csv"))?;
         Ok(Self::from_parts(

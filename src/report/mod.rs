@@ -18,6 +18,7 @@ pub mod inputs;
 pub mod interactive_map;
 pub mod map_background;
 pub mod map_data;
+pub mod map_thinning;
 pub mod plots;
 pub mod reasons;
 pub mod registration;
