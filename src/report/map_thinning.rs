@@ -7,7 +7,7 @@
 //! campaign's length. Campaigns within the limit keep every recording.
 
 /// Most recordings the map carries besides the flagged ones and the ends of status runs.
-pub const MAP_DETAIL_LIMIT: usize = 5000;
+pub const MAP_DETAIL_LIMIT: usize = 10_000;
 
 /// A run of consecutive recordings (indices `from..=to` in trajectory order) whose verification segments have
 /// the same status.
