@@ -33,7 +33,11 @@ fn thinned_map_of_a_large_output_keeps_every_flagged_recording_within_the_bounds
     let mut lines = ver.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    let ids: Vec<&str> = synth.recordings.iter().map(|r| r.image_id.as_str()).collect();
+    let ids: Vec<&str> = synth
+        .recordings
+        .iter()
+        .map(|r| r.image_id.as_str())
+        .collect();
     let position = |id: &str| ids.iter().position(|x| *x == id).unwrap();
     let mut flagged = Vec::new();
     for l in lines {
@@ -66,7 +70,10 @@ fn thinned_map_of_a_large_output_keeps_every_flagged_recording_within_the_bounds
         .map(|v| v.as_str().unwrap())
         .collect();
     for id in &flagged {
-        assert!(shown.contains(id.as_str()), "flagged {id} is not on the map");
+        assert!(
+            shown.contains(id.as_str()),
+            "flagged {id} is not on the map"
+        );
     }
     assert!(shown.len() < n, "the map is thinned");
     assert!(shown.len() <= MAP_DETAIL_LIMIT + flagged.len() + 2 * 200);
@@ -83,12 +90,26 @@ fn thinned_map_of_a_large_output_keeps_every_flagged_recording_within_the_bounds
         "{} bytes",
         size(&data_path)
     );
-    assert!(size(&summary.index) <= INDEX_MAX_BYTES, "{} bytes", size(&summary.index));
+    assert!(
+        size(&summary.index) <= INDEX_MAX_BYTES,
+        "{} bytes",
+        size(&summary.index)
+    );
     let html = std::fs::read_to_string(&summary.index).unwrap();
-    assert!(html.contains("rows shown (failed segments first"), "long tables are cut");
-    assert!(html.contains(&format!("of the {n} recordings")), "the map says it is thinned");
+    assert!(
+        html.contains("rows shown (failed segments first"),
+        "long tables are cut"
+    );
+    assert!(
+        html.contains(&format!("of the {n} recordings")),
+        "the map says it is thinned"
+    );
     let figure = out.join("report/figures/trajectory.svg");
-    assert!(size(&figure) <= STATIC_MAP_MAX_BYTES, "{} bytes", size(&figure));
+    assert!(
+        size(&figure) <= STATIC_MAP_MAX_BYTES,
+        "{} bytes",
+        size(&figure)
+    );
     // Every row stays in the table files.
     let table = std::fs::read_to_string(out.join("report/tables/verification.csv")).unwrap();
     assert_eq!(

@@ -93,6 +93,12 @@ impl VerificationSummary {
     }
 }
 
+/// The recordings' rows of `dir/corrections.csv` (`None` without the file), streamed past the series between
+/// them.
+pub fn corrections_of_recordings(dir: &Path) -> Result<Option<CsvTable>, String> {
+    read_csv_where(&dir.join("corrections.csv"), "kind", "recording")
+}
+
 /// Whether the run's output can be used as an adjusted trajectory.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Status {
@@ -175,18 +181,24 @@ impl Headline {
     /// Reads the headline of the result folder `dir` (`OUT`, or `OUT/variants/<name>` of a sweep). Err when
     /// `metrics.json` or one of the CSV files is unreadable (the message names the file).
     pub fn from_dir(dir: &Path) -> Result<Self, String> {
+        // Only the recordings' rows: the series between them is most of a long campaign's file.
+        let corrections = corrections_of_recordings(dir)?;
+        Self::from_dir_with(dir, corrections.as_ref())
+    }
+
+    /// [`Self::from_dir`] with the recordings' rows of `corrections.csv` already read
+    /// ([`corrections_of_recordings`]).
+    pub fn from_dir_with(dir: &Path, corrections: Option<&CsvTable>) -> Result<Self, String> {
         let path = dir.join("metrics.json");
         let bytes =
             std::fs::read(&path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
         let m: Value = serde_json::from_slice(&bytes)
             .map_err(|e| format!("{}: not valid JSON ({e})", path.display()))?;
-        // Only the recordings' rows: the series between them is most of a long campaign's file.
-        let corrections = read_csv_where(&dir.join("corrections.csv"), "kind", "recording")?;
         let before = read_csv_opt(&dir.join("verification.csv"))?;
         let after = read_csv_opt(&dir.join("verification_adjusted.csv"))?;
         Ok(Self::from_parts(
             &m,
-            corrections.as_ref(),
+            corrections,
             before.as_ref(),
             after.as_ref(),
         ))

@@ -2,7 +2,7 @@
 //! numbers the terminal can print), the sign convention, and the verification of the adjusted trajectory per
 //! segment.
 
-use super::headline::{Headline, SegmentLine, Status};
+use super::headline::{SegmentLine, Status};
 use super::html::{escape, Page};
 use super::inputs::ResultSet;
 use super::tables::{fmt_num, Origin, Table};
@@ -88,7 +88,7 @@ pub fn headline_section(
     prefix: &str,
 ) -> Result<(), String> {
     page.heading(&format!("{prefix}answer"), "Result");
-    let h = match Headline::from_dir(&set.dir) {
+    let h = match b.cache.headline(&set.dir) {
         Ok(h) => h,
         Err(e) => {
             b.note(page, format!("no result summary: {e}"));
@@ -142,7 +142,7 @@ pub fn adjusted_verification_table(
     set: &ResultSet,
     prefix: &str,
 ) -> Result<(), String> {
-    let Ok(h) = Headline::from_dir(&set.dir) else {
+    let Ok(h) = b.cache.headline(&set.dir) else {
         return Ok(());
     };
     if let Some(v) = &h.verification_after {

@@ -7,9 +7,9 @@
 //! (world coordinates of ~10⁵ m would cost precision in the browser's pixel arithmetic).
 
 use super::html::{escape, Page};
-use super::inputs::{for_each_row, read_csv_opt, read_csv_where, CsvTable, ResultSet};
+use super::inputs::{for_each_row, read_csv_opt, CsvTable, ResultSet};
 use super::map_background::nadir_background;
-use super::map_data::{read_map_data, MapData, AREA_GAP_M};
+use super::map_data::{MapData, AREA_GAP_M};
 use super::map_thinning::{kept_position, kept_recordings, status_runs, MAP_DETAIL_LIMIT};
 use super::Builder;
 use serde_json::{json, Value};
@@ -121,12 +121,10 @@ struct CorrectionRow {
     sigma_enu_m: [Option<f64>; 3],
 }
 
-/// The recordings' rows of `corrections.csv` by id (the last row of an id wins), streamed past the series
-/// between them; `None` without the file.
-fn correction_rows(set_dir: &Path) -> Result<Option<HashMap<String, CorrectionRow>>, String> {
-    let Some(t) = read_csv_where(&set_dir.join("corrections.csv"), "kind", "recording")? else {
-        return Ok(None);
-    };
+/// The recordings' rows of `corrections.csv` (`t`) by id (the last row of an id wins); `None` without the
+/// file.
+fn correction_rows(t: Option<&CsvTable>) -> Option<HashMap<String, CorrectionRow>> {
+    let t = t?;
     let mut out = HashMap::with_capacity(t.rows.len());
     for r in &t.rows {
         out.insert(
@@ -140,7 +138,7 @@ fn correction_rows(set_dir: &Path) -> Result<Option<HashMap<String, CorrectionRo
             },
         );
     }
-    Ok(Some(out))
+    Some(out)
 }
 
 /// Per recording id in `wanted`: the number of distinct control points (source, point id) it observes, from
@@ -192,9 +190,10 @@ fn kept_segments(
 fn map_json(
     data: &MapData,
     set_dir: &Path,
+    corrections: Option<&CsvTable>,
     views: &HashMap<String, Vec<(String, String)>>,
 ) -> Result<Value, String> {
-    let corrections = correction_rows(set_dir)?;
+    let corrections = correction_rows(corrections);
     let row = |id: &str| corrections.as_ref().and_then(|c| c.get(id));
     let (ox, oy) = {
         let r0 = data.recordings.first().map_or([0.0, 0.0], |r| r.recorded);
@@ -314,7 +313,7 @@ fn map_json(
 
 /// Backgrounds per area of the map (nadir images resampled onto the ground), as `{href, x0, y0, x1, y1}`
 /// relative to the map origin.
-fn backgrounds(b: &mut Builder, data: MapData, prefix: &str, origin: [f64; 2]) -> Vec<Value> {
+fn backgrounds(b: &mut Builder, data: &MapData, prefix: &str, origin: [f64; 2]) -> Vec<Value> {
     let Some(root) = b.campaign.clone() else {
         return Vec::new();
     };
@@ -335,8 +334,8 @@ fn backgrounds(b: &mut Builder, data: MapData, prefix: &str, origin: [f64; 2]) -
         .map(|r| (r.image_id.as_str(), r.z - r.camera_height_m))
         .collect();
     let mut out = Vec::new();
-    let ids = data.ids.clone();
-    for (k, area) in data.areas(AREA_GAP_M).into_iter().enumerate() {
+    let ids = &data.ids;
+    for (k, area) in data.clone().areas(AREA_GAP_M).into_iter().enumerate() {
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for r in &area.recordings {
             for d in 0..2 {
@@ -400,20 +399,21 @@ pub fn map_section(
 ) -> Result<(), String> {
     page.heading(&format!("{prefix}map"), "Map");
     let campaign = b.campaign.clone();
-    let Some(data) = read_map_data(&set.dir, campaign.as_deref())? else {
+    let Some(data) = b.cache.map_data(&set.dir, campaign.as_deref())? else {
         b.note(
             page,
             format!("{}: no recorded positions found: no map", set.dir.display()),
         );
         return Ok(());
     };
-    let doc = map_json(&data, &set.dir, views)?;
+    let corrections = b.cache.corrections(&set.dir)?;
+    let doc = map_json(&data, &set.dir, corrections.as_deref(), views)?;
     let origin = [
         doc["origin"][0].as_f64().unwrap_or(0.0),
         doc["origin"][1].as_f64().unwrap_or(0.0),
     ];
     let mut doc = doc;
-    doc["backgrounds"] = Value::Array(backgrounds(b, data, prefix, origin));
+    doc["backgrounds"] = Value::Array(backgrounds(b, &data, prefix, origin));
     let id = if prefix.is_empty() {
         "run".to_string()
     } else {

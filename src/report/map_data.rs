@@ -49,7 +49,10 @@ impl<'de> serde::Deserialize<'de> for Coordinates {
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
                 f.write_str("GeoJSON coordinates")
             }
-            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Coordinates, A::Error> {
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<Coordinates, A::Error> {
                 let mut out = Vec::new();
                 while let Some(v) = seq.next_element::<NumberOrSkip>()? {
                     if let Some(x) = v.0 {
@@ -84,7 +87,10 @@ impl<'de> serde::Deserialize<'de> for NumberOrSkip {
             fn visit_u64<E>(self, v: u64) -> Result<NumberOrSkip, E> {
                 Ok(NumberOrSkip(Some(v as f64)))
             }
-            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<NumberOrSkip, A::Error> {
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<NumberOrSkip, A::Error> {
                 while seq.next_element::<IgnoredAny>()?.is_some() {}
                 Ok(NumberOrSkip(None))
             }
@@ -118,7 +124,10 @@ impl GeoPoints {
                 continue;
             }
             let c = &g.coordinates.0;
-            out.layers.entry(layer).or_default().insert(id, [c[0], c[1]]);
+            out.layers
+                .entry(layer)
+                .or_default()
+                .insert(id, [c[0], c[1]]);
         }
         Ok(out)
     }
@@ -192,6 +201,7 @@ fn positions_csv(path: &Path) -> Result<BTreeMap<String, [f64; 2]>, String> {
 }
 
 /// Everything the map needs, plus the recording order (ids) for other sections.
+#[derive(Clone)]
 pub struct MapData {
     pub ids: Vec<String>,
     pub recordings: Vec<MapRecording>,
@@ -342,7 +352,11 @@ fn linked_pairs(points: &[[f64; 2]], gap_m: f64) -> Vec<(usize, usize)> {
     }
     // Points with non-finite coordinates: tested against every point, as before (none in a valid output).
     for &i in &loose {
-        pairs.extend((0..points.len()).filter(|&j| j != i && close(i, j)).map(|j| (i, j)));
+        pairs.extend(
+            (0..points.len())
+                .filter(|&j| j != i && close(i, j))
+                .map(|j| (i, j)),
+        );
     }
     pairs
 }
@@ -479,7 +493,11 @@ mod tests {
                     }
                 }
             }
-            assert_eq!(groups(linked_pairs(&pts, gap)), groups(every), "round {round}");
+            assert_eq!(
+                groups(linked_pairs(&pts, gap)),
+                groups(every),
+                "round {round}"
+            );
         }
     }
 

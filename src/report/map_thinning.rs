@@ -75,7 +75,10 @@ mod tests {
 
     #[test]
     fn small_campaigns_keep_everything() {
-        assert_eq!(kept_recordings(5, &[false; 5], &[], 10), vec![0, 1, 2, 3, 4]);
+        assert_eq!(
+            kept_recordings(5, &[false; 5], &[], 10),
+            vec![0, 1, 2, 3, 4]
+        );
     }
 
     #[test]

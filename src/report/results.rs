@@ -6,7 +6,7 @@
 use super::headline_section::{headline_section, rank_segments, RANKED_SEGMENTS};
 use super::html::Page;
 use super::inputs::{num_at, obj_at, read_csv_opt, ResultSet, RunOutputs};
-use super::map_data::{read_map_data, AREA_GAP_M};
+use super::map_data::{MapData, AREA_GAP_M};
 use super::plots::histogram::{histogram, HistSeries};
 use super::plots::trajectory::{trajectory_map, trim, MapRecording};
 use super::plots::{GREY, VERMILLION};
@@ -62,7 +62,7 @@ fn map_section(
         "Trajectory map (static figure)",
     );
     let campaign = b.campaign.clone();
-    let Some(data) = read_map_data(&set.dir, campaign.as_deref())? else {
+    let Some(data) = b.cache.map_data(&set.dir, campaign.as_deref())? else {
         b.note(
             page,
             format!(
@@ -72,7 +72,7 @@ fn map_section(
         );
         return Ok(());
     };
-    let areas = data.areas(AREA_GAP_M);
+    let areas = MapData::clone(&data).areas(AREA_GAP_M);
     let n_areas = areas.len();
     if n_areas > 1 {
         page.raw(&format!(
@@ -93,17 +93,7 @@ fn map_section(
         // A static figure of a city's recordings would be tens of megabytes of circles drawn over each other:
         // beyond STATIC_MAP_LIMIT recordings every k-th is drawn (the interactive map keeps the flagged ones).
         let stride = area.recordings.len().div_ceil(STATIC_MAP_LIMIT).max(1);
-        let drawn: Vec<MapRecording> = area
-            .recordings
-            .iter()
-            .step_by(stride)
-            .map(|r| MapRecording {
-                recorded: r.recorded,
-                adjusted: r.adjusted,
-                truth: r.truth,
-                kind: r.kind,
-            })
-            .collect();
+        let drawn: Vec<MapRecording> = area.recordings.iter().step_by(stride).copied().collect();
         let scales = trajectory_map(
             &path,
             &format!("Recordings and check points{title_suffix}{which}"),

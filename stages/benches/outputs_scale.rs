@@ -31,7 +31,10 @@ const FACADE_M: (f64, f64) = (20.0, 15.0);
 const MARGIN_M: f64 = 1.5;
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).filter(|a| a != "--bench").collect();
+    let args: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| a != "--bench")
+        .collect();
     let (Some(n), Some(out), Some(step)) = (
         args.first().and_then(|a| a.parse::<usize>().ok()),
         args.get(1).map(PathBuf::from),
@@ -58,7 +61,10 @@ fn main() {
         "generate" => 0,
         "overlap" => {
             let index = NadirOverlap::new(&s.nadir, &s.recordings);
-            s.recordings.iter().map(|r| index.overlapping(r, MARGIN_M).len()).sum()
+            s.recordings
+                .iter()
+                .map(|r| index.overlapping(r, MARGIN_M).len())
+                .sum()
         }
         "overlap-linear" => s
             .recordings
@@ -80,7 +86,8 @@ fn main() {
             v.segments.len() + va.segments.len()
         }
         "exports" => {
-            let times = write_outputs(&s, &out.join("campaign"), &out.join("out")).expect("exports");
+            let times =
+                write_outputs(&s, &out.join("campaign"), &out.join("out")).expect("exports");
             for (name, secs) in &times {
                 println!("  {name}: {secs:.2} s");
             }

@@ -9,9 +9,9 @@
 //! recordings generate in seconds. [`write_outputs`] writes a run's output folder from it with the real
 //! export writers.
 
+use super::from_correspondences::AerialImageRef;
 use super::synthetic_streets::route::{drive, recorded_positions, CAMERA_HEIGHT_M};
 use super::verify::{verify, write_verification_csv, Verification, VerifyConfig};
-use super::from_correspondences::AerialImageRef;
 use super::{AdjustConfig, AdjustmentRun, BlockPoint, PointKind, RunPoint, RunRecording};
 use crate::campaign::{
     format_time_iso, write_recordings_csv, AerialImage, AerialKind, Campaign, CheckPoint, Recording,
@@ -107,7 +107,13 @@ fn aerial_block(centers: &[Vector3<f64>]) -> (Vec<AerialImage>, Vec<AerialImage>
         while x <= hi[0] + 40.0 {
             let k = nadir.len();
             let id = format!("nadir_{k:06}");
-            nadir.push(AerialImage::ideal(&id, [x, y, z], [0.0, 0.0, 0.0], 4000.0, [1600, 1200]));
+            nadir.push(AerialImage::ideal(
+                &id,
+                [x, y, z],
+                [0.0, 0.0, 0.0],
+                4000.0,
+                [1600, 1200],
+            ));
             if (k + row_k) % 2 == 0 {
                 let look = (k / 2) % 4;
                 // ω tilts the view north (look 0), κ turns it: the ground point seen is ~450 m ahead.
@@ -174,7 +180,11 @@ impl OutputsSpec {
             let mut pano = Vec::new();
             for r in i - 1..=i + 1 {
                 if let Some((u, v)) = true_camera(r).project_world(&p) {
-                    pano.push((r, u + 0.3 * rng.next_gaussian(), v + 0.3 * rng.next_gaussian()));
+                    pano.push((
+                        r,
+                        u + 0.3 * rng.next_gaussian(),
+                        v + 0.3 * rng.next_gaussian(),
+                    ));
                 }
             }
             let mut aerial = Vec::new();
@@ -187,7 +197,8 @@ impl OutputsSpec {
                     break;
                 }
             }
-            let point_world = p + Vector3::new(rng.next_gaussian(), rng.next_gaussian(), 0.0) * 0.03;
+            let point_world =
+                p + Vector3::new(rng.next_gaussian(), rng.next_gaussian(), 0.0) * 0.03;
             let tie_id = format!("{}#0", id(i));
             control.push(AerialControlPoint {
                 tie_point_id: tie_id.clone(),
@@ -210,8 +221,11 @@ impl OutputsSpec {
                     })
                     .collect(),
                 point_world: (aerial.len() >= 2).then(|| point_world.into()),
-                covariance_m2: (aerial.len() >= 2)
-                    .then_some([[0.0025, 0.0, 0.0], [0.0, 0.0025, 0.0], [0.0, 0.0, 0.04]]),
+                covariance_m2: (aerial.len() >= 2).then_some([
+                    [0.0025, 0.0, 0.0],
+                    [0.0, 0.0025, 0.0],
+                    [0.0, 0.0, 0.04],
+                ]),
                 map: None,
             });
             points.push(RunPoint {
@@ -370,7 +384,10 @@ pub fn write_outputs(s: &SyntheticOutputs, campaign: &Path, out: &Path) -> io::R
         verification_adjusted = Some(s.verification(true).map_err(io::Error::other)?);
         Ok(())
     })?;
-    let (v, va) = (verification.expect("set"), verification_adjusted.expect("set"));
+    let (v, va) = (
+        verification.expect("set"),
+        verification_adjusted.expect("set"),
+    );
     let groups: [(&str, &[AerialControlPoint]); 2] = [("nadir", &s.control), ("oblique", &[])];
     timed("correspondences.csv", &mut || {
         write_correspondences_csv(&out.join("correspondences.csv"), &groups)
@@ -390,8 +407,13 @@ pub fn write_outputs(s: &SyntheticOutputs, campaign: &Path, out: &Path) -> io::R
     })?;
     let series = series.expect("set");
     timed("trajectory_adjusted.csv", &mut || {
-        write_adjusted_trajectory(&out.join("trajectory_adjusted.csv"), &input, &series, &s.run)
-            .map(|_| ())
+        write_adjusted_trajectory(
+            &out.join("trajectory_adjusted.csv"),
+            &input,
+            &series,
+            &s.run,
+        )
+        .map(|_| ())
     })?;
     timed("checkpoints.csv", &mut || {
         write_checkpoint_errors_csv(&out.join("checkpoints.csv"), &s.checkpoint_rows)
@@ -465,16 +487,19 @@ fn metrics(s: &SyntheticOutputs, v: &Verification, va: &Verification) -> serde_j
         (e.iter().sum::<f64>() / e.len().max(1) as f64).sqrt()
     };
     let side = |after: bool| {
-        let f = move |r: &CheckPointRow| {
-            if after { r.after } else { r.before }.map(|e| e.error_m)
-        };
+        let f = move |r: &CheckPointRow| if after { r.after } else { r.before }.map(|e| e.error_m);
         serde_json::json!({
             "count": s.checkpoint_rows.len(),
             "x": rms(&f, &[0]), "y": rms(&f, &[1]), "z": rms(&f, &[2]),
             "2d": rms(&f, &[0, 1]), "3d": rms(&f, &[0, 1, 2]),
         })
     };
-    let failed = |v: &Verification| v.segments.iter().filter(|s| s.status.label() == "fail").count();
+    let failed = |v: &Verification| {
+        v.segments
+            .iter()
+            .filter(|s| s.status.label() == "fail")
+            .count()
+    };
     serde_json::json!({
         "campaign": {
             "name": format!("synthetic city, {} recordings", s.recordings.len()),

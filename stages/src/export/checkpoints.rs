@@ -85,10 +85,11 @@ pub fn checkpoint_rows(c: &CheckPointComparison) -> Vec<CheckPointRow> {
     let (before_at, after_at) = (index(&c.before), index(&c.after));
     (0..c.ids.len())
         .map(|i| {
-            let find = |e: &crate::adjustment::CheckPointEvaluation,
-                        at: &(HashMap<usize, usize>, HashMap<usize, usize>)| {
-                at.0.get(&i).map(|&j| AxisErrors::from_point(&e.points[j]))
-            };
+            let find =
+                |e: &crate::adjustment::CheckPointEvaluation,
+                 at: &(HashMap<usize, usize>, HashMap<usize, usize>)| {
+                    at.0.get(&i).map(|&j| AxisErrors::from_point(&e.points[j]))
+                };
             let reason = |e: &crate::adjustment::CheckPointEvaluation,
                           at: &(HashMap<usize, usize>, HashMap<usize, usize>),
                           when: &str| {

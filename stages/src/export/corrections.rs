@@ -246,7 +246,8 @@ impl CorrectionSeries {
                         .filter(move |&t| t > t0)
                         .map(move |t| (None, self.interpolate(r, next, t)))
                 });
-            std::iter::once((Some(r.image_id.as_str()), r.correction)).chain(between.into_iter().flatten())
+            std::iter::once((Some(r.image_id.as_str()), r.correction))
+                .chain(between.into_iter().flatten())
         })
     }
 }

@@ -140,7 +140,12 @@ mod tests {
         for i in 0..100 {
             let (gx, gy) = ((i % 10) as f64, (i / 10) as f64);
             let id = format!("n{:03}", (i * 37) % 100);
-            imgs.push(nadir(&id, 1000.0 + 40.0 * gx, 2000.0 + 40.0 * gy, 30.0 * (i % 4) as f64));
+            imgs.push(nadir(
+                &id,
+                1000.0 + 40.0 * gx,
+                2000.0 + 40.0 * gy,
+                30.0 * (i % 4) as f64,
+            ));
         }
         let recs: Vec<Recording> = (0..300)
             .map(|k| rec(990.0 + 1.37 * k as f64, 1995.0 + 1.21 * k as f64))

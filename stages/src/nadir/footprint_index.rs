@@ -57,7 +57,12 @@ fn ideal_box(cam: &FrameCamera) -> Option<[f64; 4]> {
         PAD_FRACTION * (hi[0] - lo[0]),
         PAD_FRACTION * (hi[1] - lo[1]),
     ];
-    let b = [lo[0] - pad[0], lo[1] - pad[1], hi[0] + pad[0], hi[1] + pad[1]];
+    let b = [
+        lo[0] - pad[0],
+        lo[1] - pad[1],
+        hi[0] + pad[0],
+        hi[1] + pad[1],
+    ];
     b.iter().all(|v| v.is_finite()).then_some(b)
 }
 
@@ -92,8 +97,8 @@ impl FootprintIndex {
     pub fn new(images: &[AerialImage], z_range_world: [f64; 2]) -> Self {
         let mut entries = Vec::with_capacity(images.len());
         let mut unbounded = Vec::new();
-        let finite_range = z_range_world.iter().all(|z| z.is_finite())
-            && z_range_world[0] <= z_range_world[1];
+        let finite_range =
+            z_range_world.iter().all(|z| z.is_finite()) && z_range_world[0] <= z_range_world[1];
         for (i, img) in images.iter().enumerate() {
             match ground_box(img, z_range_world).filter(|_| finite_range) {
                 Some([x0, y0, x1, y1]) => {
@@ -167,9 +172,17 @@ mod tests {
                 300.0 + rng.next_f64() * 700.0,
             ];
             let opk = if oblique {
-                [45.0 * (rng.next_f64() - 0.5) * 2.0, 0.0, rng.next_f64() * 360.0]
+                [
+                    45.0 * (rng.next_f64() - 0.5) * 2.0,
+                    0.0,
+                    rng.next_f64() * 360.0,
+                ]
             } else {
-                [rng.next_f64() * 4.0 - 2.0, rng.next_f64() * 4.0 - 2.0, rng.next_f64() * 360.0]
+                [
+                    rng.next_f64() * 4.0 - 2.0,
+                    rng.next_f64() * 4.0 - 2.0,
+                    rng.next_f64() * 360.0,
+                ]
             };
             let mut img = AerialImage::ideal(&format!("a{i}"), centre, opk, 4000.0, [1200, 900]);
             if i % 2 == 0 {
@@ -189,15 +202,24 @@ mod tests {
             );
             let cand = index.candidates([p.x, p.y], [p.x, p.y], [p.z, p.z]);
             for (i, cam) in cams.iter().enumerate() {
-                if cam.project_world(&p).is_some_and(|(u, v)| cam.contains(u, v)) {
+                if cam
+                    .project_world(&p)
+                    .is_some_and(|(u, v)| cam.contains(u, v))
+                {
                     seen += 1;
                     assert!(cand.binary_search(&i).is_ok(), "image {i} sees {p:?}");
                 }
             }
-            assert!(cand.len() < images.len() / 2, "the index narrows the search");
+            assert!(
+                cand.len() < images.len() / 2,
+                "the index narrows the search"
+            );
         }
         assert!(seen > 1000, "{seen}");
         // Outside the indexed heights: every image.
-        assert_eq!(index.candidates([0.0; 2], [1.0; 2], [50.0, 50.0]).len(), 200);
+        assert_eq!(
+            index.candidates([0.0; 2], [1.0; 2], [50.0, 50.0]).len(),
+            200
+        );
     }
 }

@@ -14,8 +14,8 @@
 //! [`FootprintIndex`] (O(log n) per recording); [`candidate_oblique`] tests every image (one recording).
 
 use crate::campaign::{AerialImage, Recording};
-use crate::nadir::footprint_index::FootprintIndex;
 use crate::geometry::FrameCamera;
+use crate::nadir::footprint_index::FootprintIndex;
 use nalgebra::Vector3;
 
 /// Probe points of a recording's street façades (see the module documentation), world frame, metres.
@@ -180,12 +180,24 @@ mod tests {
     fn the_index_selects_what_testing_every_image_selects() {
         // Obliques looking north along a 2 km street, one every 50 m; recordings every 7 m with varying heading.
         let imgs: Vec<AerialImage> = (0..40)
-            .map(|i| looking_north_at(&format!("o{:02}", (i * 13) % 40), 1000.0 + 50.0 * i as f64, 2000.0))
+            .map(|i| {
+                looking_north_at(
+                    &format!("o{:02}", (i * 13) % 40),
+                    1000.0 + 50.0 * i as f64,
+                    2000.0,
+                )
+            })
             .collect();
         let recs: Vec<Recording> = (0..300)
             .map(|k| Recording {
                 time: "2019-06-14T10:00:00Z".into(),
-                ..Recording::new("r", 0.0, [990.0 + 7.0 * k as f64, 2000.0, 2.2], (k * 17 % 360) as f64, 2.2)
+                ..Recording::new(
+                    "r",
+                    0.0,
+                    [990.0 + 7.0 * k as f64, 2000.0, 2.2],
+                    (k * 17 % 360) as f64,
+                    2.2,
+                )
             })
             .collect();
         let index = ObliqueCandidates::new(&imgs, &recs, 10.0, 12.0);
