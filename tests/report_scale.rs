@@ -2,7 +2,11 @@
 //! (`skytie_stages::adjustment::synthetic_outputs`, written with the real export writers) give an interactive
 //! map that carries every flagged recording (those in failed segments of the adjusted trajectory's
 //! verification, or not corrected) but not every recording, a map data file under 3 MB, an `index.html` under
-//! 1 MB with the per-segment tables cut to their worst rows, and a static trajectory figure under 2 MB.
+//! 1 MB with the per-segment tables cut to their worst rows, and a static trajectory figure under 2 MB. With
+//! `chromium` on PATH the thinned map must initialise and show a flagged recording selected by `#select=<id>`.
+
+#[path = "support/report_check.rs"]
+mod report_check;
 
 use skytie::report::map_thinning::MAP_DETAIL_LIMIT;
 use skytie::report::{build_report, ReportOptions};
@@ -110,6 +114,23 @@ fn thinned_map_of_a_large_output_keeps_every_flagged_recording_within_the_bounds
         "{} bytes",
         size(&figure)
     );
+    if let Some(chromium) = report_check::find_chromium() {
+        let profile = tmp.path().join("chromium-profile");
+        let fragment = format!("#select={}", flagged[0]);
+        let dom = report_check::dump_dom_fragment(&chromium, &summary.index, &fragment, &profile);
+        let attr = |id: &str, a: &str| report_check::element_attr(&dom, id, a);
+        assert_eq!(attr("map-run", "data-ready").as_deref(), Some("1"));
+        assert_eq!(
+            attr("map-run", "data-recordings"),
+            Some(shown.len().to_string())
+        );
+        assert_eq!(
+            attr("panel-run", "data-selected").as_deref(),
+            Some(flagged[0].as_str())
+        );
+    } else {
+        println!("SKIPPED the browser check: chromium not installed (apt-get install -y chromium)");
+    }
     // Every row stays in the table files.
     let table = std::fs::read_to_string(out.join("report/tables/verification.csv")).unwrap();
     assert_eq!(
