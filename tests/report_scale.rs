@@ -1,5 +1,5 @@
 //! The report of a city-scale output folder stays bounded: 30 000 image-free synthetic recordings
-//! (`skytie_stages::adjustment::synthetic_outputs`, written with the real export writers) give an interactive
+//! (`skytie_stages::export::synthetic_outputs`, written with the real export writers) give an interactive
 //! map that carries every flagged recording (those in failed segments of the adjusted trajectory's
 //! verification, or not corrected) but not every recording, a map data file under 3 MB, an `index.html` under
 //! 1 MB with the per-segment tables cut to their worst rows, and a static trajectory figure under 2 MB. With
@@ -10,7 +10,7 @@ mod report_check;
 
 use skytie::report::map_thinning::MAP_DETAIL_LIMIT;
 use skytie::report::{build_report, ReportOptions};
-use skytie_stages::adjustment::synthetic_outputs::{write_outputs, OutputsSpec};
+use skytie_stages::export::synthetic_outputs::{write_outputs, OutputsSpec};
 use std::collections::HashSet;
 
 /// The bounds the report keeps for a campaign whose flagged recordings and status-run ends number ≤ 10⁴.

@@ -100,13 +100,14 @@ impl CsvColumns {
 }
 
 /// Streams the rows of a CSV file with a header line to `f` (one record buffer, reused), without holding the
-/// file: `Ok(false)` when it does not exist. Errors name the file, and the row for malformed lines.
+/// file; returns the header, `Ok(None)` when the file does not exist. Errors name the file, and the row for
+/// malformed lines.
 pub fn for_each_row(
     path: &Path,
     mut f: impl FnMut(&CsvColumns, &csv::StringRecord),
-) -> Result<bool, String> {
+) -> Result<Option<CsvColumns>, String> {
     if !path.exists() {
-        return Ok(false);
+        return Ok(None);
     }
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(true)
@@ -131,28 +132,24 @@ pub fn for_each_row(
         }
         row += 1;
     }
-    Ok(true)
+    Ok(Some(columns))
 }
 
 /// Reads the rows of an optional CSV file whose `column` holds `value` (e.g. the `recording` rows of
 /// `corrections.csv`, a few of every ten), streaming past the others: Ok(None) when the file does not exist.
 pub fn read_csv_where(path: &Path, column: &str, value: &str) -> Result<Option<CsvTable>, String> {
-    let mut table = CsvTable::default();
+    let mut rows = Vec::new();
     let mut at = None;
-    let found = for_each_row(path, |cols, rec| {
-        if table.header.is_empty() {
-            table.header = cols.header.clone();
-            at = cols.col(column);
-        }
-        if at.and_then(|i| rec.get(i)) == Some(value) {
-            table.rows.push(rec.iter().map(|s| s.to_string()).collect());
+    let columns = for_each_row(path, |cols, rec| {
+        let i = *at.get_or_insert_with(|| cols.col(column));
+        if i.and_then(|i| rec.get(i)) == Some(value) {
+            rows.push(rec.iter().map(|s| s.to_string()).collect());
         }
     })?;
-    if found && table.header.is_empty() {
-        // No rows: the header alone.
-        return read_csv(path).map(Some);
-    }
-    Ok(found.then_some(table))
+    Ok(columns.map(|c| CsvTable {
+        header: c.header,
+        rows,
+    }))
 }
 
 /// Reads an optional CSV file: Ok(None) when it does not exist.

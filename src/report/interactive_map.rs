@@ -162,7 +162,7 @@ fn control_counts(
             points[slot].insert((cell(s).to_string(), cell(p).to_string()));
         }
     })?;
-    Ok(found.then(|| points.iter().map(|p| p.len()).collect()))
+    Ok(found.map(|_| points.iter().map(|p| p.len()).collect()))
 }
 
 /// Status segments of the map in the kept recordings' positions: every segment when nothing was left out,

@@ -1,5 +1,5 @@
 //! City-scale benchmark of a run's searches and output writers on image-free synthetic results
-//! ([`skytie_stages::adjustment::synthetic_outputs`]): `outputs_scale N OUT STEP` generates N recordings with
+//! ([`skytie_stages::export::synthetic_outputs`]): `outputs_scale N OUT STEP` generates N recordings with
 //! their aerial images, control and check points and adjustment result, then runs one step and prints its
 //! time and the process' peak resident memory (VmHWM, generation included):
 //! `generate` (nothing more), `overlap` (the nadir images overlapping every recording), `oblique` (the
@@ -8,7 +8,7 @@
 //! `oblique-linear` run the per-image scans the indexes replace, for comparison. Run through
 //! `benches/outputs_scale.sh` for the 10⁴ / 10⁵ table.
 
-use skytie_stages::adjustment::synthetic_outputs::{write_outputs, OutputsSpec};
+use skytie_stages::export::synthetic_outputs::{write_outputs, OutputsSpec};
 use skytie_stages::nadir::aerial_overlap::{overlapping_nadir, NadirOverlap};
 use skytie_stages::oblique::candidates::{candidate_oblique, ObliqueCandidates};
 use std::path::PathBuf;

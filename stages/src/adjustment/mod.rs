@@ -39,7 +39,6 @@ pub mod solver;
 pub mod sparse;
 pub mod synthetic_block;
 pub mod synthetic_campaign;
-pub mod synthetic_outputs;
 pub mod synthetic_streets;
 pub mod trajectory_errors;
 pub mod verify;

@@ -229,14 +229,20 @@ pub fn verify(
     }
     // Members of every segment in one pass over the recordings and one over the points (in their order).
     let mut span: Vec<Option<(usize, usize, usize)>> = vec![None; n_segments];
+    // (A non-finite position makes a later recording's index fall back to 0: segments are those up to the
+    // last recording's, as they always were.)
     for (i, &s) in segment_of.iter().enumerate() {
-        let e = span[s].get_or_insert((0, i, i));
-        e.0 += 1;
-        e.2 = i;
+        if let Some(slot) = span.get_mut(s) {
+            let e = slot.get_or_insert((0, i, i));
+            e.0 += 1;
+            e.2 = i;
+        }
     }
     let mut members: Vec<Vec<&VerifiedPoint>> = vec![Vec::new(); n_segments];
     for p in &points {
-        members[p.segment].push(p);
+        if let Some(m) = members.get_mut(p.segment) {
+            m.push(p);
+        }
     }
     let segments: Vec<VerificationSegment> = span
         .iter()

@@ -1,5 +1,6 @@
 //! Image-free synthetic run results at city scale, for benchmarks and tests of the searches, the export
-//! writers and the report: recordings every 5 m along the street grid of [`super::synthetic_streets::route`]
+//! writers and the report: recordings every 5 m along the street grid of
+//! [`crate::adjustment::synthetic_streets::route`]
 //! with a slowly varying GNSS bias, a block of nadir images over the area and oblique images looking along the
 //! four directions, aerial control points beside the road observed in three panoramas and the nadir images that
 //! see them (found through [`crate::nadir::footprint_index`]), tie points, check points, and an adjustment
@@ -9,21 +10,23 @@
 //! recordings generate in seconds. [`write_outputs`] writes a run's output folder from it with the real
 //! export writers.
 
-use super::from_correspondences::AerialImageRef;
-use super::synthetic_streets::route::{drive, recorded_positions, CAMERA_HEIGHT_M};
-use super::verify::{verify, write_verification_csv, Verification, VerifyConfig};
-use super::{AdjustConfig, AdjustmentRun, BlockPoint, PointKind, RunPoint, RunRecording};
-use crate::campaign::{
-    format_time_iso, write_recordings_csv, AerialImage, AerialKind, Campaign, CheckPoint, Recording,
-};
-use crate::correspondence::{AerialControlPoint, AerialObservation, PanoObservation};
-use crate::export::checkpoints::AxisErrors;
-use crate::export::gpkg::{run_layers, srs_for, write_geopackage, RunLayers};
-use crate::export::{
+use super::checkpoints::AxisErrors;
+use super::gpkg::{run_layers, srs_for, write_geopackage, RunLayers};
+use super::{
     write_adjusted_trajectory, write_checkpoint_errors_csv, write_colmap_model,
     write_corrections_csv, write_correspondences_csv, write_ground_control, write_run_geojson,
     write_tie_points_ply, CheckPointRow, CorrectionSeries,
 };
+use crate::adjustment::from_correspondences::AerialImageRef;
+use crate::adjustment::synthetic_streets::route::{drive, recorded_positions, CAMERA_HEIGHT_M};
+use crate::adjustment::verify::{verify, write_verification_csv, Verification, VerifyConfig};
+use crate::adjustment::{
+    AdjustConfig, AdjustmentRun, BlockPoint, PointKind, RunPoint, RunRecording,
+};
+use crate::campaign::{
+    format_time_iso, write_recordings_csv, AerialImage, AerialKind, Campaign, CheckPoint, Recording,
+};
+use crate::correspondence::{AerialControlPoint, AerialObservation, PanoObservation};
 use crate::geometry::{FrameCamera, PanoramaCamera};
 use crate::nadir::footprint_index::FootprintIndex;
 use crate::rng::SplitMix64;
