@@ -23,7 +23,7 @@ use crate::nodes::nadir::transform::InitialTransformStage;
 use crate::nodes::nadir::transform_agreement::TransformAgreementStage;
 use crate::workflow::Workflow;
 use skytie_stages::campaign::{AerialKind, Recording};
-use skytie_stages::nadir::aerial_overlap::overlapping_nadir;
+use skytie_stages::nadir::aerial_overlap::NadirOverlap;
 use skytie_stages::nadir::baseline::BaselineParams;
 use skytie_stages::nadir::control_points::ControlParams;
 use skytie_stages::nadir::grading::NadirGrade;
@@ -130,6 +130,7 @@ pub fn add_nadir(
     };
 
     let mut aerial_rows = AerialRowNodes::new(AerialKind::Nadir, snap);
+    let overlap = NadirOverlap::new(&snapshot.campaign.nadir, &snapshot.campaign.recordings);
     let mut windows = Vec::new();
     let mut transforms: Vec<Handle<TransformOutcome>> = Vec::new();
     let mut refinements: Vec<Handle<AerialRefinement>> = Vec::new();
@@ -173,11 +174,7 @@ pub fn add_nadir(
         let mut rec_aerials = Vec::new();
         // Per overlapping nadir image: (aerial handle, file, pair label, ortho, transform outcome, aerial image_id).
         let mut pairs = Vec::new();
-        for a in overlapping_nadir(
-            item.recording,
-            &snapshot.campaign.nadir,
-            options.overlap_margin_m,
-        ) {
+        for a in overlap.overlapping(item.recording, options.overlap_margin_m) {
             let row = &snapshot.campaign.nadir[a];
             let aerial = aerial_rows.get_or_add(b, a, row)?;
             let pair = pair_label(&item.recording.image_id, &row.image_id);

@@ -24,7 +24,7 @@ use crate::nodes::oblique::patches::PatchesStage;
 use crate::nodes::oblique::sparse_cloud::SparseCloudStage;
 use crate::workflow::Workflow;
 use skytie_stages::campaign::{AerialKind, Recording};
-use skytie_stages::oblique::candidates::candidate_oblique;
+use skytie_stages::oblique::candidates::ObliqueCandidates;
 use skytie_stages::oblique::facades::FacadeParams;
 use skytie_stages::oblique::patch_registration::PatchParams;
 use skytie_stages::oblique::sparse_cloud::SparseCloudParams;
@@ -93,6 +93,12 @@ pub fn add_oblique(
     let patch_params: PatchParams = wf.params(stage::PATCHES, variant).map_err(wf_err)?;
     let oblique_dir = root.join("aerial/oblique");
     let oblique_rows = &snapshot.campaign.oblique;
+    let candidate_index = ObliqueCandidates::new(
+        oblique_rows,
+        &snapshot.campaign.recordings,
+        options.max_facade_distance_m,
+        options.max_facade_height_m,
+    );
 
     let mut aerial_rows = AerialRowNodes::new(AerialKind::Oblique, snap);
     let mut all_facades: Vec<Handle<TripletFacades>> = Vec::new();
@@ -145,12 +151,7 @@ pub fn add_oblique(
                     .map(|(_, c)| *c),
             )
             .collect();
-        let candidates = candidate_oblique(
-            centre.recording,
-            oblique_rows,
-            options.max_facade_distance_m,
-            options.max_facade_height_m,
-        );
+        let candidates = candidate_index.candidates(centre.recording);
         let mut aerials = Vec::with_capacity(candidates.len());
         for &a in &candidates {
             let row = &oblique_rows[a];

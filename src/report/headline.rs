@@ -12,7 +12,7 @@
 //! Sources: `metrics.json` (`adjust.*`, `verify.*`), `corrections.csv` (rows of kind `recording`),
 //! `verification.csv` and `verification_adjusted.csv`.
 
-use super::inputs::{num_at, obj_at, read_csv_opt, CsvTable};
+use super::inputs::{num_at, obj_at, read_csv_opt, read_csv_where, CsvTable};
 use serde_json::Value;
 use skytie_stages::export::Support;
 use std::path::Path;
@@ -91,6 +91,12 @@ impl VerificationSummary {
     pub fn count(&self, status: &str) -> usize {
         self.segments.iter().filter(|s| s.status == status).count()
     }
+}
+
+/// The recordings' rows of `dir/corrections.csv` (`None` without the file), streamed past the series between
+/// them.
+pub fn corrections_of_recordings(dir: &Path) -> Result<Option<CsvTable>, String> {
+    read_csv_where(&dir.join("corrections.csv"), "kind", "recording")
 }
 
 /// Whether the run's output can be used as an adjusted trajectory.
@@ -175,17 +181,24 @@ impl Headline {
     /// Reads the headline of the result folder `dir` (`OUT`, or `OUT/variants/<name>` of a sweep). Err when
     /// `metrics.json` or one of the CSV files is unreadable (the message names the file).
     pub fn from_dir(dir: &Path) -> Result<Self, String> {
+        // Only the recordings' rows: the series between them is most of a long campaign's file.
+        let corrections = corrections_of_recordings(dir)?;
+        Self::from_dir_with(dir, corrections.as_ref())
+    }
+
+    /// [`Self::from_dir`] with the recordings' rows of `corrections.csv` already read
+    /// ([`corrections_of_recordings`]).
+    pub fn from_dir_with(dir: &Path, corrections: Option<&CsvTable>) -> Result<Self, String> {
         let path = dir.join("metrics.json");
         let bytes =
             std::fs::read(&path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
         let m: Value = serde_json::from_slice(&bytes)
             .map_err(|e| format!("{}: not valid JSON ({e})", path.display()))?;
-        let corrections = read_csv_opt(&dir.join("corrections.csv"))?;
         let before = read_csv_opt(&dir.join("verification.csv"))?;
         let after = read_csv_opt(&dir.join("verification_adjusted.csv"))?;
         Ok(Self::from_parts(
             &m,
-            corrections.as_ref(),
+            corrections,
             before.as_ref(),
             after.as_ref(),
         ))

@@ -2,7 +2,7 @@
 //! numbers the terminal can print), the sign convention, and the verification of the adjusted trajectory per
 //! segment.
 
-use super::headline::{Headline, SegmentLine, Status};
+use super::headline::{SegmentLine, Status};
 use super::html::{escape, Page};
 use super::inputs::ResultSet;
 use super::tables::{fmt_num, Origin, Table};
@@ -12,6 +12,36 @@ use super::Builder;
 pub const SIGN_CONVENTION: &str = "Sign convention everywhere: a correction is adjusted − recorded position; a \
     verification offset is MM − aerial (the control point triangulated from the panoramas with the given poses \
     minus its aerial triangulation: how far the trajectory is off); a check-point error is estimated − surveyed.";
+
+/// Row indices of verification segments, most interesting first, for the page of a long table: the overall
+/// row (label `all`), then failed segments, segments with too few points, passed ones; within each by
+/// decreasing horizontal offset (missing offsets last), ties in table order.
+pub fn rank_segments(rows: &[(&str, &str, Option<f64>)]) -> Vec<usize> {
+    let class = |label: &str, status: &str| match (label, status) {
+        ("all", _) => 0,
+        (_, "fail") => 1,
+        (_, "insufficient") => 2,
+        (_, "pass") => 4,
+        _ => 3,
+    };
+    let mut order: Vec<usize> = (0..rows.len()).collect();
+    order.sort_by(|&a, &b| {
+        let (la, sa, oa) = rows[a];
+        let (lb, sb, ob) = rows[b];
+        class(la, &sa.to_lowercase())
+            .cmp(&class(lb, &sb.to_lowercase()))
+            .then_with(|| {
+                ob.unwrap_or(f64::NEG_INFINITY)
+                    .total_cmp(&oa.unwrap_or(f64::NEG_INFINITY))
+            })
+            .then(a.cmp(&b))
+    });
+    order
+}
+
+/// What [`rank_segments`] shows first, for the line under a long table.
+pub const RANKED_SEGMENTS: &str =
+    "failed segments first, then those with too few points, each by decreasing offset";
 
 fn segment_table(id: &str, title: &str, segments: &[SegmentLine]) -> Table {
     let mut t = Table::new(
@@ -27,6 +57,11 @@ fn segment_table(id: &str, title: &str, segments: &[SegmentLine]) -> Table {
             "verdict",
         ],
     );
+    let keys: Vec<(&str, &str, Option<f64>)> = segments
+        .iter()
+        .map(|s| (s.label.as_str(), s.status.as_str(), s.offset_2d_m))
+        .collect();
+    let ranked = rank_segments(&keys);
     for s in segments {
         t.push(vec![
             s.label.clone(),
@@ -42,7 +77,7 @@ fn segment_table(id: &str, title: &str, segments: &[SegmentLine]) -> Table {
             },
         ]);
     }
-    t
+    t.rank_for_html(ranked, RANKED_SEGMENTS)
 }
 
 /// Appends the headline of `set` to `page`.
@@ -53,7 +88,7 @@ pub fn headline_section(
     prefix: &str,
 ) -> Result<(), String> {
     page.heading(&format!("{prefix}answer"), "Result");
-    let h = match Headline::from_dir(&set.dir) {
+    let h = match b.cache.headline(&set.dir) {
         Ok(h) => h,
         Err(e) => {
             b.note(page, format!("no result summary: {e}"));
@@ -107,7 +142,7 @@ pub fn adjusted_verification_table(
     set: &ResultSet,
     prefix: &str,
 ) -> Result<(), String> {
-    let Ok(h) = Headline::from_dir(&set.dir) else {
+    let Ok(h) = b.cache.headline(&set.dir) else {
         return Ok(());
     };
     if let Some(v) = &h.verification_after {

@@ -87,6 +87,71 @@ pub fn read_csv(path: &Path) -> Result<CsvTable, String> {
     Ok(CsvTable { header, rows })
 }
 
+/// The header of a CSV file being streamed by [`for_each_row`]: cells of a row by column name.
+pub struct CsvColumns {
+    pub header: Vec<String>,
+}
+
+impl CsvColumns {
+    /// Index of a column.
+    pub fn col(&self, name: &str) -> Option<usize> {
+        self.header.iter().position(|h| h == name)
+    }
+}
+
+/// Streams the rows of a CSV file with a header line to `f` (one record buffer, reused), without holding the
+/// file; returns the header, `Ok(None)` when the file does not exist. Errors name the file, and the row for
+/// malformed lines.
+pub fn for_each_row(
+    path: &Path,
+    mut f: impl FnMut(&CsvColumns, &csv::StringRecord),
+) -> Result<Option<CsvColumns>, String> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .flexible(true)
+        .from_path(path)
+        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    let columns = CsvColumns {
+        header: reader
+            .headers()
+            .map_err(|e| format!("{}: bad header: {e}", path.display()))?
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
+    };
+    let mut rec = csv::StringRecord::new();
+    let mut row = 2;
+    loop {
+        match reader.read_record(&mut rec) {
+            Ok(true) => f(&columns, &rec),
+            Ok(false) => break,
+            Err(e) => return Err(format!("{}: row {row}: {e}", path.display())),
+        }
+        row += 1;
+    }
+    Ok(Some(columns))
+}
+
+/// Reads the rows of an optional CSV file whose `column` holds `value` (e.g. the `recording` rows of
+/// `corrections.csv`, a few of every ten), streaming past the others: Ok(None) when the file does not exist.
+pub fn read_csv_where(path: &Path, column: &str, value: &str) -> Result<Option<CsvTable>, String> {
+    let mut rows = Vec::new();
+    let mut at = None;
+    let columns = for_each_row(path, |cols, rec| {
+        let i = *at.get_or_insert_with(|| cols.col(column));
+        if i.and_then(|i| rec.get(i)) == Some(value) {
+            rows.push(rec.iter().map(|s| s.to_string()).collect());
+        }
+    })?;
+    Ok(columns.map(|c| CsvTable {
+        header: c.header,
+        rows,
+    }))
+}
+
 /// Reads an optional CSV file: Ok(None) when it does not exist.
 pub fn read_csv_opt(path: &Path) -> Result<Option<CsvTable>, String> {
     if !path.exists() {
@@ -231,6 +296,22 @@ mod tests {
         let d = tempfile::tempdir().unwrap();
         let e = RunOutputs::read(d.path()).unwrap_err();
         assert!(e.contains("metrics.json") && e.contains("--out"), "{e}");
+    }
+
+    #[test]
+    fn filtered_rows_stream_past_the_others() {
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join("c.csv");
+        std::fs::write(&p, "id,kind\na,recording\n,between\nb,recording\n").unwrap();
+        let t = read_csv_where(&p, "kind", "recording").unwrap().unwrap();
+        assert_eq!(t.header, ["id", "kind"]);
+        assert_eq!(t.rows.len(), 2);
+        assert_eq!(t.text(&t.rows[1], "id"), "b");
+        let empty = read_csv_where(&p, "kind", "nothing").unwrap().unwrap();
+        assert!(empty.rows.is_empty() && empty.header.len() == 2);
+        assert!(read_csv_where(&d.path().join("no.csv"), "kind", "x")
+            .unwrap()
+            .is_none());
     }
 
     #[test]

@@ -7,9 +7,10 @@
 //! (world coordinates of ~10⁵ m would cost precision in the browser's pixel arithmetic).
 
 use super::html::{escape, Page};
-use super::inputs::{read_csv_opt, CsvTable, ResultSet};
+use super::inputs::{for_each_row, read_csv_opt, CsvTable, ResultSet};
 use super::map_background::nadir_background;
-use super::map_data::{read_map_data, MapData, AREA_GAP_M};
+use super::map_data::{MapData, AREA_GAP_M};
+use super::map_thinning::{kept_position, kept_recordings, status_runs, MAP_DETAIL_LIMIT};
 use super::Builder;
 use serde_json::{json, Value};
 use skytie_stages::campaign::read_campaign;
@@ -111,23 +112,89 @@ fn segment_status(
     (status, spans)
 }
 
-/// The map's data document.
+/// One recording's row of `corrections.csv` (the columns the map shows).
+struct CorrectionRow {
+    time: String,
+    support: String,
+    du_m: Option<f64>,
+    dyaw_deg: Option<f64>,
+    sigma_enu_m: [Option<f64>; 3],
+}
+
+/// The recordings' rows of `corrections.csv` (`t`) by id (the last row of an id wins); `None` without the
+/// file.
+fn correction_rows(t: Option<&CsvTable>) -> Option<HashMap<String, CorrectionRow>> {
+    let t = t?;
+    let mut out = HashMap::with_capacity(t.rows.len());
+    for r in &t.rows {
+        out.insert(
+            t.text(r, "image_id").to_string(),
+            CorrectionRow {
+                time: t.text(r, "time").to_string(),
+                support: t.text(r, "support").to_string(),
+                du_m: t.num(r, "du_m"),
+                dyaw_deg: t.num(r, "dyaw_deg"),
+                sigma_enu_m: ["sigma_e_m", "sigma_n_m", "sigma_u_m"].map(|c| t.num(r, c)),
+            },
+        );
+    }
+    Some(out)
+}
+
+/// Per recording id in `wanted`: the number of distinct control points (source, point id) it observes, from
+/// `correspondences.csv` (streamed); `None` without the file.
+fn control_counts(
+    set_dir: &Path,
+    wanted: &HashMap<&str, usize>,
+) -> Result<Option<Vec<usize>>, String> {
+    let mut points: Vec<std::collections::BTreeSet<(String, String)>> =
+        vec![Default::default(); wanted.len()];
+    let mut cols = None;
+    let found = for_each_row(&set_dir.join("correspondences.csv"), |c, r| {
+        let [k, i, s, p] = *cols.get_or_insert_with(|| {
+            ["image_kind", "image_id", "source", "point_id"].map(|n| c.col(n).unwrap_or(usize::MAX))
+        });
+        let cell = |j: usize| r.get(j).unwrap_or("");
+        if cell(k) != "panorama" {
+            return;
+        }
+        if let Some(&slot) = wanted.get(cell(i)) {
+            points[slot].insert((cell(s).to_string(), cell(p).to_string()));
+        }
+    })?;
+    Ok(found.map(|_| points.iter().map(|p| p.len()).collect()))
+}
+
+/// Status segments of the map in the kept recordings' positions: every segment when nothing was left out,
+/// else the runs of equal status (their ends are kept).
+fn kept_segments(
+    spans: &[(usize, usize, String)],
+    kept: &[usize],
+    thinned: bool,
+) -> Vec<(usize, usize, String)> {
+    if !thinned {
+        return spans.to_vec();
+    }
+    status_runs(spans)
+        .into_iter()
+        .filter_map(|r| {
+            let a = kept_position(kept, r.from, true)?;
+            let b = kept_position(kept, r.to, false)?;
+            (a <= b).then_some((a, b, r.status))
+        })
+        .collect()
+}
+
+/// The map's data document: every recording of a campaign within [`MAP_DETAIL_LIMIT`], else the thinned set
+/// of [`super::map_thinning`].
 fn map_json(
     data: &MapData,
     set_dir: &Path,
+    corrections: Option<&CsvTable>,
     views: &HashMap<String, Vec<(String, String)>>,
 ) -> Result<Value, String> {
-    let corrections = read_csv_opt(&set_dir.join("corrections.csv"))?;
-    let mut by_id: HashMap<String, Vec<String>> = HashMap::new();
-    if let Some(t) = &corrections {
-        for r in t.rows.iter().filter(|r| t.text(r, "kind") == "recording") {
-            by_id.insert(t.text(r, "image_id").to_string(), r.clone());
-        }
-    }
-    let num = |id: &str, col: &str| -> Option<f64> {
-        let t = corrections.as_ref()?;
-        t.num(by_id.get(id)?, col)
-    };
+    let corrections = correction_rows(corrections);
+    let row = |id: &str| corrections.as_ref().and_then(|c| c.get(id));
     let (ox, oy) = {
         let r0 = data.recordings.first().map_or([0.0, 0.0], |r| r.recorded);
         (
@@ -136,58 +203,90 @@ fn map_json(
         )
     };
     let round = |v: f64| (v * 1e4).round() / 1e4;
+    let ids = &data.ids;
+    let n = ids.len();
+    let before = read_csv_opt(&set_dir.join("verification.csv"))?;
+    let after = read_csv_opt(&set_dir.join("verification_adjusted.csv"))?;
+    let (status_before, spans_before) = segment_status(ids, before.as_ref());
+    let (status_after, spans_after) = segment_status(ids, after.as_ref());
+    let support_of = |id: &str| support_code(row(id).map_or("", |r| r.support.as_str()));
+    // Flagged: not corrected (when there is a correction file), or in a failed segment of the adjusted
+    // trajectory's verification (else the recorded one's).
+    let shown_status = if after.is_some() {
+        &status_after
+    } else {
+        &status_before
+    };
+    let flagged: Vec<bool> = (0..n)
+        .map(|i| {
+            (corrections.is_some() && support_of(&ids[i]) == 3)
+                || shown_status[i].as_str() == Some("fail")
+        })
+        .collect();
+    let run_ends: Vec<usize> = status_runs(&spans_before)
+        .iter()
+        .chain(&status_runs(&spans_after))
+        .flat_map(|r| [r.from, r.to])
+        .collect();
+    let kept = kept_recordings(n, &flagged, &run_ends, MAP_DETAIL_LIMIT);
+    let thinned = kept.len() < n;
     let (mut rx, mut ry, mut ax, mut ay) = (vec![], vec![], vec![], vec![]);
-    let (mut dz, mut dyaw, mut sx, mut sy, mut sz, mut support, mut control, mut time) = (
-        vec![],
-        vec![],
-        vec![],
-        vec![],
-        vec![],
-        vec![],
-        vec![],
-        vec![],
-    );
+    let (mut dz, mut dyaw, mut sx, mut sy, mut sz, mut support, mut time) =
+        (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
+    let (mut kept_ids, mut before_k, mut after_k) = (vec![], vec![], vec![]);
     let mut moved = Vec::new();
-    for (id, r) in data.ids.iter().zip(&data.recordings) {
+    for &i in &kept {
+        let (id, r) = (&ids[i], &data.recordings[i]);
         let adjusted = r.adjusted.unwrap_or(r.recorded);
         rx.push(round(r.recorded[0] - ox));
         ry.push(round(r.recorded[1] - oy));
         ax.push(round(adjusted[0] - ox));
         ay.push(round(adjusted[1] - oy));
         moved.push((adjusted[0] - r.recorded[0]).hypot(adjusted[1] - r.recorded[1]));
-        dz.push(num(id, "du_m"));
-        dyaw.push(num(id, "dyaw_deg"));
-        sx.push(num(id, "sigma_e_m"));
-        sy.push(num(id, "sigma_n_m"));
-        sz.push(num(id, "sigma_u_m"));
-        let sup = corrections
-            .as_ref()
-            .and_then(|t| by_id.get(id).map(|row| t.text(row, "support").to_string()))
-            .unwrap_or_default();
-        support.push(support_code(&sup));
-        control.push(Value::Null);
-        time.push(Value::Null);
+        let c = row(id);
+        dz.push(c.and_then(|c| c.du_m));
+        dyaw.push(c.and_then(|c| c.dyaw_deg));
+        sx.push(c.and_then(|c| c.sigma_enu_m[0]));
+        sy.push(c.and_then(|c| c.sigma_enu_m[1]));
+        sz.push(c.and_then(|c| c.sigma_enu_m[2]));
+        support.push(support_of(id));
+        time.push(c.map_or(Value::Null, |c| json!(c.time)));
+        kept_ids.push(id.clone());
+        before_k.push(status_before[i].clone());
+        after_k.push(status_after[i].clone());
     }
-    let ids = &data.ids;
-    let before = read_csv_opt(&set_dir.join("verification.csv"))?;
-    let after = read_csv_opt(&set_dir.join("verification_adjusted.csv"))?;
-    let (status_before, spans_before) = segment_status(ids, before.as_ref());
-    let (status_after, spans_after) = segment_status(ids, after.as_ref());
-    let segments: Vec<Value> = spans_before
+    let position: HashMap<&str, usize> = kept_ids
+        .iter()
+        .enumerate()
+        .map(|(k, s)| (s.as_str(), k))
+        .collect();
+    let control: Vec<Value> = match control_counts(set_dir, &position)? {
+        Some(counts) => counts.into_iter().map(|c| json!(c)).collect(),
+        None => vec![Value::Null; kept_ids.len()],
+    };
+    let segments: Vec<Value> = kept_segments(&spans_before, &kept, thinned)
         .iter()
         .map(|s| ("recorded", s))
-        .chain(spans_after.iter().map(|s| ("adjusted", s)))
+        .chain(
+            kept_segments(&spans_after, &kept, thinned)
+                .iter()
+                .map(|s| ("adjusted", s)),
+        )
         .map(|(t, (a, b, s))| json!({"trajectory": t, "from": a, "to": b, "status": s}))
         .collect();
     let cps = &data.checkpoints;
     let err = |e: Option<[f64; 2]>, k: usize| e.map(|v| round(v[k]));
-    Ok(json!({
+    let views: HashMap<&String, &Vec<(String, String)>> = views
+        .iter()
+        .filter(|(id, _)| position.contains_key(id.as_str()))
+        .collect();
+    let mut doc = json!({
         "origin": [ox, oy],
         "exaggeration": exaggeration(&moved, 25.0),
         "recordings": {
-            "id": ids, "time": time, "rx": rx, "ry": ry, "ax": ax, "ay": ay, "dz": dz, "dyaw": dyaw,
+            "id": kept_ids, "time": time, "rx": rx, "ry": ry, "ax": ax, "ay": ay, "dz": dz, "dyaw": dyaw,
             "sx": sx, "sy": sy, "sz": sz, "support": support, "control": control,
-            "before": status_before, "after": status_after,
+            "before": before_k, "after": after_k,
         },
         "checkpoints": {
             "id": (0..cps.len()).collect::<Vec<_>>(),
@@ -201,55 +300,20 @@ fn map_json(
         "segments": segments,
         "views": views,
         "backgrounds": [],
-    }))
-}
-
-/// Fills `time` and `control` of the recordings from `trajectory_adjusted.csv` / `ground_control/` when
-/// present (the numbers the click panel shows).
-fn add_recording_details(doc: &mut Value, set_dir: &Path) -> Result<(), String> {
-    let ids: Vec<String> = doc["recordings"]["id"]
-        .as_array()
-        .map(|a| {
-            a.iter()
-                .filter_map(|v| v.as_str().map(str::to_string))
-                .collect()
-        })
-        .unwrap_or_default();
-    let index: HashMap<&str, usize> = ids
-        .iter()
-        .enumerate()
-        .map(|(i, s)| (s.as_str(), i))
-        .collect();
-    if let Some(t) = read_csv_opt(&set_dir.join("corrections.csv"))? {
-        for r in t.rows.iter().filter(|r| t.text(r, "kind") == "recording") {
-            if let Some(&i) = index.get(t.text(r, "image_id")) {
-                doc["recordings"]["time"][i] = json!(t.text(r, "time"));
-            }
-        }
+    });
+    if thinned {
+        doc["thinned"] = json!({
+            "recordings": n,
+            "shown": kept.len(),
+            "flagged": flagged.iter().filter(|f| **f).count(),
+        });
     }
-    if let Some(t) = read_csv_opt(&set_dir.join("correspondences.csv"))? {
-        let mut points: HashMap<&str, std::collections::BTreeSet<(String, String)>> =
-            HashMap::new();
-        for r in t
-            .rows
-            .iter()
-            .filter(|r| t.text(r, "image_kind") == "panorama")
-        {
-            points.entry(t.text(r, "image_id")).or_default().insert((
-                t.text(r, "source").to_string(),
-                t.text(r, "point_id").to_string(),
-            ));
-        }
-        for (id, i) in &index {
-            doc["recordings"]["control"][*i] = json!(points.get(id).map_or(0, |p| p.len()));
-        }
-    }
-    Ok(())
+    Ok(doc)
 }
 
 /// Backgrounds per area of the map (nadir images resampled onto the ground), as `{href, x0, y0, x1, y1}`
 /// relative to the map origin.
-fn backgrounds(b: &mut Builder, data: MapData, prefix: &str, origin: [f64; 2]) -> Vec<Value> {
+fn backgrounds(b: &mut Builder, data: &MapData, prefix: &str, origin: [f64; 2]) -> Vec<Value> {
     let Some(root) = b.campaign.clone() else {
         return Vec::new();
     };
@@ -270,8 +334,8 @@ fn backgrounds(b: &mut Builder, data: MapData, prefix: &str, origin: [f64; 2]) -
         .map(|r| (r.image_id.as_str(), r.z - r.camera_height_m))
         .collect();
     let mut out = Vec::new();
-    let ids = data.ids.clone();
-    for (k, area) in data.areas(AREA_GAP_M).into_iter().enumerate() {
+    let ids = &data.ids;
+    for (k, area) in data.clone().areas(AREA_GAP_M).into_iter().enumerate() {
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for r in &area.recordings {
             for d in 0..2 {
@@ -335,20 +399,21 @@ pub fn map_section(
 ) -> Result<(), String> {
     page.heading(&format!("{prefix}map"), "Map");
     let campaign = b.campaign.clone();
-    let Some(data) = read_map_data(&set.dir, campaign.as_deref())? else {
+    let Some(data) = b.cache.map_data(&set.dir, campaign.as_deref())? else {
         b.note(
             page,
             format!("{}: no recorded positions found: no map", set.dir.display()),
         );
         return Ok(());
     };
-    let mut doc = map_json(&data, &set.dir, views)?;
-    add_recording_details(&mut doc, &set.dir)?;
+    let corrections = b.cache.corrections(&set.dir)?;
+    let doc = map_json(&data, &set.dir, corrections.as_deref(), views)?;
     let origin = [
         doc["origin"][0].as_f64().unwrap_or(0.0),
         doc["origin"][1].as_f64().unwrap_or(0.0),
     ];
-    doc["backgrounds"] = Value::Array(backgrounds(b, data, prefix, origin));
+    let mut doc = doc;
+    doc["backgrounds"] = Value::Array(backgrounds(b, &data, prefix, origin));
     let id = if prefix.is_empty() {
         "run".to_string()
     } else {
@@ -365,6 +430,15 @@ pub fn map_section(
         .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
     b.wrote_figure(path);
     page.head(&head_html());
+    if let Some(t) = doc.get("thinned") {
+        page.raw(&format!(
+            "<p class=\"note\">The map carries {} of the {} recordings: every flagged one ({} not corrected or \
+             in a failed verification segment), the ends of every stretch of equal verification status, and \
+             recordings at an even spacing along the trajectory; every recording is in trajectory_adjusted.csv \
+             and corrections.csv.</p>\n",
+            t["shown"], t["recordings"], t["flagged"]
+        ));
+    }
     let e = doc["exaggeration"].as_f64().unwrap_or(1.0);
     page.raw(&format!(
         "<p class=\"note\">Drag to pan, scroll to zoom, click a recording for its numbers and registration views. \

@@ -18,10 +18,12 @@ pub mod inputs;
 pub mod interactive_map;
 pub mod map_background;
 pub mod map_data;
+pub mod map_thinning;
 pub mod plots;
 pub mod reasons;
 pub mod registration;
 pub mod results;
+pub mod set_cache;
 pub mod summary;
 pub mod sweep;
 pub mod tables;
@@ -88,6 +90,8 @@ pub struct Builder {
     pub views: std::sync::Arc<registration::SharedViews>,
     /// Registration views of the current result set per recording id: (href, caption), for the map's panel.
     pub recording_views: std::collections::HashMap<String, Vec<(String, String)>>,
+    /// Files of the result sets read once for all sections.
+    pub cache: set_cache::SetCache,
 }
 
 /// Folder names inside `OUT/report/`.
@@ -147,6 +151,7 @@ impl Builder {
             images: std::sync::Arc::clone(&self.images),
             views: std::sync::Arc::clone(&self.views),
             recording_views: Default::default(),
+            cache: Default::default(),
         }
     }
 
@@ -220,6 +225,7 @@ pub fn build_report(out_dir: &Path, options: &ReportOptions) -> Result<ReportSum
         images: Default::default(),
         views: Default::default(),
         recording_views: Default::default(),
+        cache: Default::default(),
     };
     interactive_map::write_assets(&report_dir)?;
     if b.campaign.is_none() {

@@ -3,12 +3,12 @@
 //! before/after, Tables 5-2/5-4/5-9's structure), the check-point residual histogram, verification
 //! (Table 5-13's structure) and the registration views.
 
-use super::headline_section::headline_section;
+use super::headline_section::{headline_section, rank_segments, RANKED_SEGMENTS};
 use super::html::Page;
 use super::inputs::{num_at, obj_at, read_csv_opt, ResultSet, RunOutputs};
-use super::map_data::{read_map_data, AREA_GAP_M};
+use super::map_data::{MapData, AREA_GAP_M};
 use super::plots::histogram::{histogram, HistSeries};
-use super::plots::trajectory::{trajectory_map, trim};
+use super::plots::trajectory::{trajectory_map, trim, MapRecording};
 use super::plots::{GREY, VERMILLION};
 use super::tables::{fmt_count, fmt_num, fmt_percent, Origin, Table};
 use super::{interactive_map, registration, slug, thesis_values, Builder};
@@ -47,6 +47,9 @@ pub fn results_sections(
     Ok(())
 }
 
+/// Most recordings drawn in one static trajectory figure.
+pub const STATIC_MAP_LIMIT: usize = 3000;
+
 fn map_section(
     b: &mut Builder,
     page: &mut Page,
@@ -59,7 +62,7 @@ fn map_section(
         "Trajectory map (static figure)",
     );
     let campaign = b.campaign.clone();
-    let Some(data) = read_map_data(&set.dir, campaign.as_deref())? else {
+    let Some(data) = b.cache.map_data(&set.dir, campaign.as_deref())? else {
         b.note(
             page,
             format!(
@@ -69,7 +72,7 @@ fn map_section(
         );
         return Ok(());
     };
-    let areas = data.areas(AREA_GAP_M);
+    let areas = MapData::clone(&data).areas(AREA_GAP_M);
     let n_areas = areas.len();
     if n_areas > 1 {
         page.raw(&format!(
@@ -87,10 +90,14 @@ fn map_section(
             (format!("{prefix}trajectory.svg"), String::new())
         };
         let (path, href) = b.figure_path(&file);
+        // A static figure of a city's recordings would be tens of megabytes of circles drawn over each other:
+        // beyond STATIC_MAP_LIMIT recordings every k-th is drawn (the interactive map keeps the flagged ones).
+        let stride = area.recordings.len().div_ceil(STATIC_MAP_LIMIT).max(1);
+        let drawn: Vec<MapRecording> = area.recordings.iter().step_by(stride).copied().collect();
         let scales = trajectory_map(
             &path,
             &format!("Recordings and check points{title_suffix}{which}"),
-            &area.recordings,
+            &drawn,
             &area.checkpoints,
         )?;
         b.wrote_figure(path);
@@ -107,7 +114,11 @@ fn map_section(
                  {} check points with horizontal error vectors (estimated − true) before (grey) and after (red) \
                  the adjustment, drawn {}× longer than they are; scale bar {} m.",
                 if n_areas > 1 { format!("Area {} of {n_areas}: ", k + 1) } else { String::new() },
-                area.recordings.len(),
+                if stride > 1 {
+                    format!("every {stride}th of {}", area.recordings.len())
+                } else {
+                    area.recordings.len().to_string()
+                },
                 area.checkpoints.len(),
                 trim(scales.exaggeration),
                 trim(scales.scale_bar_m)
@@ -447,6 +458,18 @@ fn verification_section(
             ],
         )
         .with_note("Same structure as thesis Table 5-13 (mean and SD of the differences), one row per segment.");
+        let keys: Vec<(&str, &str, Option<f64>)> = v
+            .rows
+            .iter()
+            .map(|r| {
+                let offset = match (v.num(r, "mean_x"), v.num(r, "mean_y")) {
+                    (Some(x), Some(y)) => Some(x.hypot(y)),
+                    _ => None,
+                };
+                (v.text(r, "segment"), v.text(r, "status"), offset)
+            })
+            .collect();
+        let ranked = rank_segments(&keys);
         for r in &v.rows {
             let n = |k: &str| fmt_num(v.num(r, k), 3);
             t.push(vec![
@@ -466,7 +489,7 @@ fn verification_section(
                 v.text(r, "status").to_uppercase(),
             ]);
         }
-        b.table(page, t);
+        b.table(page, t.rank_for_html(ranked, RANKED_SEGMENTS));
     }
     if prefix.is_empty() {
         b.table(page, thesis_values::table_5_13());

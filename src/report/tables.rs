@@ -1,9 +1,15 @@
 //! Report tables: one [`Table`] is rendered as HTML (in the page), CSV and Markdown (files in
 //! `OUT/report/tables/<id>.{csv,md}`). Cells are pre-formatted strings so that the three renderings show
-//! exactly the same numbers and a rebuild from the same OUT is byte-identical.
+//! exactly the same numbers and a rebuild from the same OUT is byte-identical. A table longer than
+//! [`HTML_ROW_LIMIT`] rows (per-segment tables of a city campaign have thousands) shows only that many rows in
+//! the page — the worst first when the table was given a ranking ([`Table::rank_for_html`]), else the first
+//! ones — with a line saying so; its CSV and Markdown files always hold every row.
 
 use super::html::escape;
 use std::fmt::Write as _;
+
+/// Most rows a table shows in the HTML page; every row stays in its CSV and Markdown files.
+pub const HTML_ROW_LIMIT: usize = 40;
 
 /// Who a table's values come from: this run, or the thesis' published Rotterdam results (never mixed).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,6 +40,9 @@ pub struct Table {
     pub rows: Vec<Vec<String>>,
     /// One sentence under the table (units, what "before/after" means…); may be empty.
     pub note: String,
+    /// The rows the page shows when the table is longer than [`HTML_ROW_LIMIT`] (indices, in display order)
+    /// and what they are ("the segments with the largest offsets"); `None`: the first rows.
+    html_ranking: Option<(Vec<usize>, String)>,
 }
 
 impl Table {
@@ -45,7 +54,42 @@ impl Table {
             header: header.iter().map(|s| s.to_string()).collect(),
             rows: Vec::new(),
             note: String::new(),
+            html_ranking: None,
         }
+    }
+
+    /// Rows in order of interest (most interesting first) and what the first ones are, for a table longer than
+    /// [`HTML_ROW_LIMIT`]: the page shows the first [`HTML_ROW_LIMIT`] of `ranked`, in table order.
+    pub fn rank_for_html(mut self, ranked: Vec<usize>, what: &str) -> Self {
+        self.html_ranking = Some((ranked, what.to_string()));
+        self
+    }
+
+    /// The rows the page shows (indices in table order) and the sentence saying which, when not all.
+    fn html_rows(&self) -> (Vec<usize>, Option<String>) {
+        let n = self.rows.len();
+        if n <= HTML_ROW_LIMIT {
+            return ((0..n).collect(), None);
+        }
+        let (mut shown, what) = match &self.html_ranking {
+            Some((ranked, what)) => (
+                ranked
+                    .iter()
+                    .copied()
+                    .filter(|&i| i < n)
+                    .take(HTML_ROW_LIMIT)
+                    .collect::<Vec<_>>(),
+                what.clone(),
+            ),
+            None => ((0..HTML_ROW_LIMIT).collect(), "the first ones".to_string()),
+        };
+        shown.sort_unstable();
+        shown.dedup();
+        let line = format!(
+            "{} of {n} rows shown ({what}); the CSV and MD files hold all of them.",
+            shown.len()
+        );
+        (shown, Some(line))
     }
 
     pub fn with_note(mut self, note: &str) -> Self {
@@ -110,7 +154,8 @@ impl Table {
             let _ = write!(s, "<th>{}</th>", escape(h));
         }
         s.push_str("</tr></thead>\n<tbody>\n");
-        for r in &self.rows {
+        let (shown, cut) = self.html_rows();
+        for r in shown.iter().map(|&i| &self.rows[i]) {
             s.push_str("<tr>");
             for c in r {
                 let _ = write!(s, "<td>{}</td>", escape(c));
@@ -118,6 +163,9 @@ impl Table {
             s.push_str("</tr>\n");
         }
         s.push_str("</tbody>\n</table>\n");
+        if let Some(cut) = cut {
+            let _ = writeln!(s, "<p class=\"note\">{}</p>", escape(&cut));
+        }
         if !self.note.is_empty() {
             let _ = writeln!(s, "<p class=\"note\">{}</p>", escape(&self.note));
         }
@@ -194,6 +242,24 @@ mod tests {
         assert!(h.contains("RMSE &lt;m&gt;"));
         assert!(h.contains("<td>q&quot;uote</td>"));
         assert!(h.contains("href=\"tables/t1.csv\""));
+    }
+
+    #[test]
+    fn long_tables_show_the_ranked_rows_in_the_page_and_all_rows_in_the_files() {
+        let mut t = Table::new("long", "long", Origin::Skytie, &["i"]);
+        for i in 0..1000 {
+            t.push(vec![format!("row{i}")]);
+        }
+        let plain = t.to_html("tables");
+        assert_eq!(plain.matches("<tr><td>").count(), HTML_ROW_LIMIT);
+        assert!(plain.contains("40 of 1000 rows shown (the first ones)"));
+        let ranked = t.rank_for_html((0..1000).rev().collect(), "the last ones");
+        let h = ranked.to_html("tables");
+        assert_eq!(h.matches("<tr><td>").count(), HTML_ROW_LIMIT);
+        assert!(h.contains("<td>row999</td>") && !h.contains("<td>row0</td>"));
+        // Table order in the page: row960 before row999.
+        assert!(h.find("row960").unwrap() < h.find("row999").unwrap());
+        assert_eq!(ranked.to_csv().lines().count(), 1001);
     }
 
     #[test]

@@ -52,6 +52,7 @@ impl CorrespondenceKind {
 }
 
 /// One recording on the map (world metres).
+#[derive(Clone, Copy)]
 pub struct MapRecording {
     pub recorded: [f64; 2],
     pub adjusted: Option<[f64; 2]>,
@@ -60,6 +61,7 @@ pub struct MapRecording {
 }
 
 /// One check point with its horizontal error vectors (estimated − true, metres).
+#[derive(Clone, Copy)]
 pub struct MapCheckPoint {
     pub position: [f64; 2],
     pub error_before: Option<[f64; 2]>,

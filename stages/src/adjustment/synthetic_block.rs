@@ -281,10 +281,28 @@ impl SyntheticBlockSpec {
         let mut check_points = Vec::new();
         let mut check_observations = Vec::new();
         let every = self.check_point_every.max(1);
+        // Cameras by centre, so each check point visits only the nearby ones (in recording order, as a scan
+        // over all cameras would; the index's radius is a little larger than the exact test's).
+        let centres = rstar::RTree::bulk_load(
+            true_cameras
+                .iter()
+                .enumerate()
+                .map(|(r, cam)| {
+                    let c = cam.center_world;
+                    rstar::primitives::GeomWithData::new([c.x, c.y, c.z], r)
+                })
+                .collect(),
+        );
         for i in (every / 2..n).step_by(every) {
             let cp = true_centers[i] + Vector3::new(-0.3, 5.0, -CAMERA_HEIGHT_M);
             let id = check_points.len();
-            for (r, cam) in true_cameras.iter().enumerate() {
+            let mut near: Vec<usize> = centres
+                .locate_within_distance([cp.x, cp.y, cp.z], 21.0 * 21.0)
+                .map(|e| e.data)
+                .collect();
+            near.sort_unstable();
+            for r in near {
+                let cam = &true_cameras[r];
                 if (cam.center_world - cp).norm() <= 20.0 {
                     let (u, v) = cam.project_world(&cp).expect("check point off centre");
                     check_observations.push(CheckObservation {

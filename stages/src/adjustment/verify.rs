@@ -224,26 +224,35 @@ pub fn verify(
             mm_views: rays.len(),
         });
     }
-    let segment_recordings = |s: usize| -> (usize, String, String) {
-        let members: Vec<usize> = (0..recordings.len())
-            .filter(|&i| segment_of[i] == s)
-            .collect();
-        match (members.first(), members.last()) {
-            (Some(&a), Some(&b)) => (
-                members.len(),
+    // Members of every segment in one pass over the recordings and one over the points (in their order).
+    let mut span: Vec<Option<(usize, usize, usize)>> = vec![None; n_segments];
+    // (A non-finite position makes a later recording's index fall back to 0: segments are those up to the
+    // last recording's, as they always were.)
+    for (i, &s) in segment_of.iter().enumerate() {
+        if let Some(slot) = span.get_mut(s) {
+            let e = slot.get_or_insert((0, i, i));
+            e.0 += 1;
+            e.2 = i;
+        }
+    }
+    let mut members: Vec<Vec<&VerifiedPoint>> = vec![Vec::new(); n_segments];
+    for p in &points {
+        if let Some(m) = members.get_mut(p.segment) {
+            m.push(p);
+        }
+    }
+    let segments: Vec<VerificationSegment> = span
+        .iter()
+        .zip(&members)
+        .enumerate()
+        .filter_map(|(s, (span, members))| {
+            let &(n_rec, a, b) = span.as_ref()?;
+            let (first, last) = (
                 recordings[a].image_id.clone(),
                 recordings[b].image_id.clone(),
-            ),
-            _ => (0, String::new(), String::new()),
-        }
-    };
-    let segments: Vec<VerificationSegment> = (0..n_segments)
-        .map(|s| {
-            let (n_rec, first, last) = segment_recordings(s);
-            let members: Vec<&VerifiedPoint> = points.iter().filter(|p| p.segment == s).collect();
-            statistics(s, n_rec, first, last, &members, config)
+            );
+            Some(statistics(s, n_rec, first, last, members, config))
         })
-        .filter(|s| s.recordings > 0)
         .collect();
     let all: Vec<&VerifiedPoint> = points.iter().collect();
     let overall = statistics(

@@ -6,6 +6,7 @@ use crate::adjustment::campaign_checkpoints::CheckPointComparison;
 use crate::adjustment::CheckPointError;
 use crate::fsutil::atomic_write_with;
 use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
 use std::io::{self, Write};
 use std::path::Path;
 
@@ -67,27 +68,43 @@ pub struct CheckPointRow {
 
 /// The rows of a comparison, in check-point order.
 pub fn checkpoint_rows(c: &CheckPointComparison) -> Vec<CheckPointRow> {
+    // First evaluated point and first failure of each check point (as a linear search would find them).
+    let first_of = |keys: &mut dyn Iterator<Item = usize>| -> HashMap<usize, usize> {
+        let mut m = HashMap::new();
+        for (j, k) in keys.enumerate() {
+            m.entry(k).or_insert(j);
+        }
+        m
+    };
+    let index = |e: &crate::adjustment::CheckPointEvaluation| {
+        (
+            first_of(&mut e.points.iter().map(|p| p.check_point)),
+            first_of(&mut e.failed.iter().map(|(k, _)| *k)),
+        )
+    };
+    let (before_at, after_at) = (index(&c.before), index(&c.after));
     (0..c.ids.len())
         .map(|i| {
-            let find = |e: &crate::adjustment::CheckPointEvaluation| {
-                e.points
-                    .iter()
-                    .find(|p| p.check_point == i)
-                    .map(AxisErrors::from_point)
+            let find =
+                |e: &crate::adjustment::CheckPointEvaluation,
+                 at: &(HashMap<usize, usize>, HashMap<usize, usize>)| {
+                    at.0.get(&i).map(|&j| AxisErrors::from_point(&e.points[j]))
+                };
+            let reason = |e: &crate::adjustment::CheckPointEvaluation,
+                          at: &(HashMap<usize, usize>, HashMap<usize, usize>),
+                          when: &str| {
+                at.1.get(&i).map(|&j| format!("{when}: {}", e.failed[j].1))
             };
-            let reason = |e: &crate::adjustment::CheckPointEvaluation, when: &str| {
-                e.failed
-                    .iter()
-                    .find(|(k, _)| *k == i)
-                    .map(|(_, why)| format!("{when}: {why}"))
-            };
-            let note = [reason(&c.before, "before"), reason(&c.after, "after")]
-                .into_iter()
-                .flatten()
-                .collect::<Vec<_>>()
-                .join("; ");
-            let before = find(&c.before);
-            let after = find(&c.after);
+            let note = [
+                reason(&c.before, &before_at, "before"),
+                reason(&c.after, &after_at, "after"),
+            ]
+            .into_iter()
+            .flatten()
+            .collect::<Vec<_>>()
+            .join("; ");
+            let before = find(&c.before, &before_at);
+            let after = find(&c.after, &after_at);
             let note = if before.is_none() && after.is_none() && note.is_empty() {
                 "no observations".to_string()
             } else {

@@ -20,7 +20,7 @@ use crate::campaign::{AerialImage, AerialKind, Recording};
 use crate::fsutil::atomic_write_with;
 use crate::geometry::{FrameCamera, PanoramaCamera};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::io::{self, Write};
 use std::path::Path;
 
@@ -110,14 +110,18 @@ pub fn write_colmap_model(
     let mut aerial_cams: Vec<FrameCamera> = Vec::with_capacity(run.aerial_images.len());
     let mut aerial_names: Vec<String> = Vec::with_capacity(run.aerial_images.len());
     let mut aerial_camera_id: Vec<usize> = Vec::with_capacity(run.aerial_images.len());
+    // First row of each id per kind (as a linear search would find it).
+    let mut row_of: HashMap<(bool, &str), &AerialImage> = HashMap::new();
+    for (is_nadir, rows) in [(true, nadir), (false, oblique)] {
+        for r in rows {
+            row_of.entry((is_nadir, r.image_id.as_str())).or_insert(r);
+        }
+    }
     for a in &run.aerial_images {
-        let rows = match a.kind {
-            AerialKind::Nadir => nadir,
-            AerialKind::Oblique => oblique,
-        };
-        let row = rows
-            .iter()
-            .find(|r| r.image_id == a.image_id)
+        let is_nadir = matches!(a.kind, AerialKind::Nadir);
+        let row = row_of
+            .get(&(is_nadir, a.image_id.as_str()))
+            .copied()
             .ok_or_else(|| {
                 invalid(format!(
                     "aerial image '{}' of the adjustment is not among the aerial rows passed",

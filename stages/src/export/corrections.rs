@@ -229,28 +229,26 @@ impl CorrectionSeries {
 
     /// The rows of `corrections.csv`: every recording, and between two linked recordings the interpolated
     /// values at the multiples of `step_s` strictly between them (none across a gap: its two ends suffice).
-    /// Each row with the recording's id (empty between recordings).
-    pub fn rows(&self, step_s: f64) -> Vec<(Option<&str>, Correction)> {
-        let mut out = Vec::new();
-        for (i, r) in self.recordings.iter().enumerate() {
-            out.push((Some(r.image_id.as_str()), r.correction));
-            let Some(next) = self.recordings.get(i + 1) else {
-                continue;
-            };
-            if !r.linked_to_next || !(step_s > 0.0) {
-                continue;
-            }
-            let (t0, t1) = (r.correction.time_s, next.correction.time_s);
-            let mut k = (t0 / step_s).floor() + 1.0;
-            while k * step_s < t1 {
-                let t = k * step_s;
-                if t > t0 {
-                    out.push((None, self.interpolate(r, next, t)));
-                }
-                k += 1.0;
-            }
-        }
-        out
+    /// Each row with the recording's id (empty between recordings). Made one at a time as they are read, so
+    /// a long campaign's 10 Hz series is never held whole.
+    pub fn rows(&self, step_s: f64) -> impl Iterator<Item = (Option<&str>, Correction)> + '_ {
+        self.recordings.iter().enumerate().flat_map(move |(i, r)| {
+            let between = self
+                .recordings
+                .get(i + 1)
+                .filter(|_| r.linked_to_next && step_s > 0.0)
+                .map(|next| {
+                    let (t0, t1) = (r.correction.time_s, next.correction.time_s);
+                    let first = (t0 / step_s).floor() + 1.0;
+                    (0u64..)
+                        .map(move |j| (first + j as f64) * step_s)
+                        .take_while(move |&t| t < t1)
+                        .filter(move |&t| t > t0)
+                        .map(move |t| (None, self.interpolate(r, next, t)))
+                });
+            std::iter::once((Some(r.image_id.as_str()), r.correction))
+                .chain(between.into_iter().flatten())
+        })
     }
 }
 
@@ -352,7 +350,7 @@ pub(crate) mod tests {
         assert!((e.sigma_enu_m[0] - (0.02f64.powi(2) + 0.045).sqrt()).abs() < 1e-12);
         assert!(s.at(f64::NAN).is_none());
         // Rows: every recording plus 0.1 s steps inside linked intervals, none across the gap.
-        let rows = s.rows(0.1);
+        let rows: Vec<_> = s.rows(0.1).collect();
         let between = rows.iter().filter(|(id, _)| id.is_none()).count();
         assert_eq!(rows.len() - between, 4);
         assert_eq!(

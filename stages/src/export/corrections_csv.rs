@@ -36,10 +36,9 @@ pub const CORRECTIONS_CSV_HEADER: [&str; 13] = [
 
 /// Writes `corrections.csv` atomically.
 pub fn write_corrections_csv(path: &Path, series: &CorrectionSeries) -> io::Result<()> {
-    let rows = series.rows(CORRECTION_STEP_S);
     atomic_write_with(path, |w| {
         writeln!(w, "{}", CORRECTIONS_CSV_HEADER.join(","))?;
-        for (id, c) in &rows {
+        for (id, c) in series.rows(CORRECTION_STEP_S) {
             let time = format_time_iso(c.time_s).unwrap_or_default();
             let [de, dn, du] = c.delta_enu_m;
             let [se, sn, su] = c.sigma_enu_m;

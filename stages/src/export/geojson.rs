@@ -12,7 +12,7 @@ use crate::campaign::{
     write_trajectory_geojson, CheckPoint, GeoJsonLayer, GeoJsonPoint, Recording,
 };
 use serde_json::{json, Value};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::io;
 use std::path::Path;
 
@@ -26,14 +26,15 @@ fn props(pairs: impl IntoIterator<Item = (&'static str, Value)>) -> BTreeMap<Str
 /// Verification status per recording index (from the segments' first/last image ids).
 fn status_per_recording(recordings: &[Recording], v: &Verification) -> Vec<Option<&'static str>> {
     let mut out = vec![None; recordings.len()];
+    // First row of each id (as a linear search would find it).
+    let mut index: HashMap<&str, usize> = HashMap::with_capacity(recordings.len());
+    for (i, r) in recordings.iter().enumerate() {
+        index.entry(r.image_id.as_str()).or_insert(i);
+    }
     for s in &v.segments {
-        let first = recordings
-            .iter()
-            .position(|r| r.image_id == s.first_image_id);
-        let last = recordings
-            .iter()
-            .position(|r| r.image_id == s.last_image_id);
-        if let (Some(a), Some(b)) = (first, last) {
+        let first = index.get(s.first_image_id.as_str());
+        let last = index.get(s.last_image_id.as_str());
+        if let (Some(&a), Some(&b)) = (first, last) {
             for slot in out.iter_mut().take(b + 1).skip(a) {
                 *slot = Some(s.status.label());
             }
@@ -105,6 +106,10 @@ pub fn write_run_geojson(
         line: true,
     };
     let mut layers = vec![recorded_layer, adjusted_layer];
+    let mut row_of: HashMap<&str, &CheckPointRow> = HashMap::with_capacity(rows.len());
+    for r in rows {
+        row_of.entry(r.point_id.as_str()).or_insert(r);
+    }
     if !checkpoints.is_empty() {
         layers.push(GeoJsonLayer {
             name: "checkpoints".to_string(),
@@ -112,7 +117,7 @@ pub fn write_run_geojson(
             points: checkpoints
                 .iter()
                 .map(|c| {
-                    let row = rows.iter().find(|r| r.point_id == c.point_id);
+                    let row = row_of.get(c.point_id.as_str());
                     let before = row.and_then(|r| r.before).map(|e| e.d2());
                     let after = row.and_then(|r| r.after).map(|e| e.d2());
                     let improved = match (before, after) {

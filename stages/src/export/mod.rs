@@ -23,6 +23,7 @@ pub mod gpkg;
 pub mod ply;
 pub mod sbet;
 pub mod support;
+pub mod synthetic_outputs;
 pub mod trajectory;
 
 pub use checkpoints::{

@@ -9,8 +9,10 @@
 //! may leave the frame; the aerial patch is then clipped to the image ([`super::aerial_patch::extract_patch`]).
 //!
 //! The result lists indices into `nadir`, ordered by `image_id` (ties by index), so it does not depend on the row
-//! order of `cameras.csv`.
+//! order of `cameras.csv`. [`NadirOverlap`] answers the question for every recording of a campaign through a
+//! [`FootprintIndex`] (O(log n) per recording); [`overlapping_nadir`] tests every image (one recording).
 
+use super::footprint_index::FootprintIndex;
 use crate::campaign::{AerialImage, Recording};
 use crate::geometry::FrameCamera;
 use nalgebra::Vector3;
@@ -39,14 +41,52 @@ pub fn overlapping_nadir(rec: &Recording, nadir: &[AerialImage], margin_m: f64) 
     if !foot.iter().all(|c| c.is_finite()) || !margin_m.is_finite() {
         return Vec::new();
     }
-    let mut hits: Vec<usize> = nadir
-        .iter()
-        .enumerate()
-        .filter(|(_, img)| frame_contains_foot(&FrameCamera::from_aerial(img), foot, margin_m))
-        .map(|(i, _)| i)
+    select(nadir, 0..nadir.len(), foot, margin_m)
+}
+
+/// The images among `candidates` whose frame contains the foot square, ordered by `image_id` then index.
+fn select(
+    nadir: &[AerialImage],
+    candidates: impl IntoIterator<Item = usize>,
+    foot: [f64; 3],
+    margin_m: f64,
+) -> Vec<usize> {
+    let mut hits: Vec<usize> = candidates
+        .into_iter()
+        .filter(|&i| frame_contains_foot(&FrameCamera::from_aerial(&nadir[i]), foot, margin_m))
         .collect();
     hits.sort_by(|&a, &b| nadir[a].image_id.cmp(&nadir[b].image_id).then(a.cmp(&b)));
     hits
+}
+
+/// The nadir images of a campaign indexed by footprint at the recordings' foot heights: the same answer as
+/// [`overlapping_nadir`] for each recording, without testing every image.
+pub struct NadirOverlap<'a> {
+    nadir: &'a [AerialImage],
+    index: FootprintIndex,
+}
+
+impl<'a> NadirOverlap<'a> {
+    /// Indexes `nadir` for the foot points of `recordings`.
+    pub fn new(nadir: &'a [AerialImage], recordings: &[Recording]) -> Self {
+        let z = FootprintIndex::height_range(recordings.iter().map(|r| foot_point_world(r)[2]));
+        Self {
+            nadir,
+            index: FootprintIndex::new(nadir, z),
+        }
+    }
+
+    /// [`overlapping_nadir`] of `rec`.
+    pub fn overlapping(&self, rec: &Recording, margin_m: f64) -> Vec<usize> {
+        let foot = foot_point_world(rec);
+        if !foot.iter().all(|c| c.is_finite()) || !margin_m.is_finite() {
+            return Vec::new();
+        }
+        // Every accepted image contains the centre of the square, so the centre alone narrows the search.
+        let centre = [foot[0], foot[1]];
+        let candidates = self.index.candidates(centre, centre, [foot[2], foot[2]]);
+        select(self.nadir, candidates, foot, margin_m)
+    }
 }
 
 #[cfg(test)]
@@ -91,5 +131,34 @@ mod tests {
             vec![1, 2, 0]
         );
         assert!(overlapping_nadir(&rec(f64::NAN, 2000.0), &imgs, 1.5).is_empty());
+    }
+
+    #[test]
+    fn the_index_selects_what_testing_every_image_selects() {
+        // A 10 × 10 grid of nadir images 40 m apart, some rotated; recordings along a diagonal street.
+        let mut imgs = Vec::new();
+        for i in 0..100 {
+            let (gx, gy) = ((i % 10) as f64, (i / 10) as f64);
+            let id = format!("n{:03}", (i * 37) % 100);
+            imgs.push(nadir(
+                &id,
+                1000.0 + 40.0 * gx,
+                2000.0 + 40.0 * gy,
+                30.0 * (i % 4) as f64,
+            ));
+        }
+        let recs: Vec<Recording> = (0..300)
+            .map(|k| rec(990.0 + 1.37 * k as f64, 1995.0 + 1.21 * k as f64))
+            .collect();
+        let overlap = NadirOverlap::new(&imgs, &recs);
+        let mut total = 0;
+        for r in &recs {
+            for margin in [0.0, 1.5, 5.0] {
+                let want = overlapping_nadir(r, &imgs, margin);
+                total += want.len();
+                assert_eq!(overlap.overlapping(r, margin), want);
+            }
+        }
+        assert!(total > 300, "{total}");
     }
 }

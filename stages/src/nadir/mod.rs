@@ -5,6 +5,7 @@ pub mod aerial_overlap;
 pub mod aerial_patch;
 pub mod baseline;
 pub mod control_points;
+pub mod footprint_index;
 pub mod grading;
 pub mod initial_transform;
 pub mod mm_matching;
