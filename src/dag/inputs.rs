@@ -98,9 +98,13 @@ pub enum InputValue {
 /// The input hash standing for an [`Optional`] input whose node failed or was skipped: a consumer that ran
 /// without it has a key of its own, and runs again once the input is produced.
 pub fn absent_hash() -> ContentHash {
-    ContentHash(
-        *blake3::hash(b"skytie: optional input absent (its node failed or was skipped)").as_bytes(),
-    )
+    static ABSENT: std::sync::OnceLock<ContentHash> = std::sync::OnceLock::new();
+    *ABSENT.get_or_init(|| {
+        ContentHash(
+            *blake3::hash(b"skytie: optional input absent (its node failed or was skipped)")
+                .as_bytes(),
+        )
+    })
 }
 
 /// An input the consumer can do without: when its node fails or is skipped, the consumer still runs and
