@@ -32,7 +32,7 @@ pub fn provenance(
                 entry
                     .1
                     .entry(v.clone())
-                    .or_insert_with(|| node.params_json.clone());
+                    .or_insert_with(|| (*node.params_json).clone());
             }
             for input in &phase.inputs(report.id) {
                 if let Some(path) = input.source.strip_prefix("file ") {

@@ -976,7 +976,7 @@ impl<'a> Exec<'a> {
                 variant: variant.clone(),
                 key: key.to_string(),
                 stage_version: node.version.to_string(),
-                params: node.params_json.clone(),
+                params: (*node.params_json).clone(),
                 inputs: inputs.clone(),
                 output_hash: hash.to_string(),
                 seconds,

@@ -32,7 +32,7 @@ pub fn save_failures(store: &Store, dag: &Dag, reports: &[NodeReport]) -> Result
                 .unwrap_or_else(|| "default".to_string()),
             key: report.key.map(|k| k.to_string()).unwrap_or_default(),
             stage_version: node.version.to_string(),
-            params: node.params_json.clone(),
+            params: (*node.params_json).clone(),
             inputs: recorded_inputs(dag, reports, report.id),
             error: error.clone(),
             recorded_unix_s: now,
