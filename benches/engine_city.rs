@@ -58,6 +58,7 @@ fn measure(role: &str, dir: &Path, recordings: usize) {
     build_city(&mut b, recordings, 1, &mut seeds).expect("build the city DAG");
     let dag = b.build();
     let build_s = t.elapsed().as_secs_f64();
+    let graph_bytes = status_bytes("VmRSS").saturating_sub(baseline);
     let mode = if role == "plan" { Mode::Plan } else { Mode::Run };
     let o = execute(&dag, &env, mode);
     let (wall, cpu) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
@@ -69,7 +70,7 @@ fn measure(role: &str, dir: &Path, recordings: usize) {
     }
     assert!(o.warnings.is_empty(), "warnings: {:?}", o.warnings);
     println!(
-        "RESULT {role} {nodes} {wall:.6} {cpu:.6} {build_s:.6} {peak} {} {}",
+        "RESULT {role} {nodes} {wall:.6} {cpu:.6} {build_s:.6} {peak} {graph_bytes} {} {}",
         o.executed(),
         o.cached()
     );
@@ -82,6 +83,7 @@ struct Row {
     cpu: f64,
     build: f64,
     peak: u64,
+    graph: u64,
 }
 
 fn child(role: &str, dir: &Path, recordings: usize) -> Row {
@@ -110,6 +112,7 @@ fn child(role: &str, dir: &Path, recordings: usize) -> Row {
         cpu: f[4].parse().expect("cpu"),
         build: f[5].parse().expect("build"),
         peak: f[6].parse().expect("peak"),
+        graph: f[7].parse().expect("graph"),
     }
 }
 
@@ -147,18 +150,22 @@ fn main() {
         rows[0].nodes,
         rayon::current_num_threads()
     );
-    println!("| measurement | wall s | µs/node (wall) | µs/node (CPU) | of which build µs/node | peak bytes/node |");
-    println!("|---|---|---|---|---|---|");
+    println!(
+        "| measurement | wall s | µs/node (wall) | µs/node (CPU) | of which build µs/node (wall) | \
+         peak bytes/node | of which graph bytes/node |"
+    );
+    println!("|---|---|---|---|---|---|---|");
     for r in &rows {
         let n = r.nodes as f64;
         println!(
-            "| {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.0} |",
+            "| {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.0} | {:.0} |",
             r.role,
             r.wall,
             r.wall * 1e6 / n,
             r.cpu * 1e6 / n,
             r.build * 1e6 / n,
-            r.peak as f64 / n
+            r.peak as f64 / n,
+            r.graph as f64 / n
         );
     }
 }

@@ -56,6 +56,8 @@ pub struct DagBuilder {
     by_identity: HashKeyed<u64, NodeId>,
     /// The same for the rare identities whose hash is already taken by another identity.
     by_identity_overflow: HashMap<(String, String), NodeId>,
+    /// Input labels, shared by every node that has them.
+    labels: HashMap<String, Arc<str>>,
     /// blake3(stage, canonical params) → the shared bytes and JSON of those params.
     params: HashKeyed<[u8; 32], (Arc<[u8]>, Arc<serde_json::Value>)>,
     variant: String,
@@ -75,6 +77,7 @@ impl DagBuilder {
             by_structure: HashKeyed::default(),
             by_identity: HashKeyed::default(),
             by_identity_overflow: HashMap::new(),
+            labels: HashMap::new(),
             params: HashKeyed::default(),
             variant: "default".to_string(),
             sinks: Vec::new(),
@@ -131,7 +134,10 @@ impl DagBuilder {
         }
         let (params_bytes, params_json) = self.shared_params(S::NAME, params_bytes, &params)?;
         let id = self.nodes.len();
-        refs.shrink_to_fit();
+        let inputs_list: Vec<(Arc<str>, InputRef)> = refs
+            .into_iter()
+            .map(|(label, r)| (self.shared_label(label), r))
+            .collect();
         self.nodes.push(Node {
             stage: S::NAME,
             version: S::VERSION,
@@ -139,7 +145,7 @@ impl DagBuilder {
             variants: vec![self.variant.clone()],
             params_bytes,
             params_json,
-            inputs: refs,
+            inputs: inputs_list,
             erased: Box::new(TypedNode {
                 stage,
                 params,
@@ -150,6 +156,16 @@ impl DagBuilder {
         self.by_structure.insert(structure, id);
         self.set_identity_node(S::NAME, item, id);
         Ok(Handle::new(id))
+    }
+
+    /// `label`, shared with every node that has an input of that label.
+    fn shared_label(&mut self, label: String) -> Arc<str> {
+        if let Some(shared) = self.labels.get(&label) {
+            return shared.clone();
+        }
+        let shared: Arc<str> = Arc::from(label.as_str());
+        self.labels.insert(label, shared.clone());
+        shared
     }
 
     /// The canonical bytes and JSON of `params` of stage `stage`, shared with every node that has equal ones.

@@ -114,7 +114,7 @@ fn recorded_with(
                 }
             };
             RecordedInput {
-                label: label.clone(),
+                label: label.to_string(),
                 source,
                 hash,
             }
@@ -270,10 +270,12 @@ pub fn execute(dag: &Dag, env: &Env<'_>, mode: Mode) -> Outcome {
         env.progress.end();
         ex.commit_records();
     }
+    // The index is not needed any more: free it before the reports are built (peak memory).
+    let Exec { slots, warnings, .. } = ex;
     let mut values = HashMap::new();
     let mut reports = Vec::with_capacity(dag.nodes.len());
-    for (id, node) in dag.nodes.iter().enumerate() {
-        let mut s = ex.slot(id);
+    for ((id, node), slot) in dag.nodes.iter().enumerate().zip(slots) {
+        let mut s = slot.into_inner().unwrap_or_else(|e| e.into_inner());
         if node.requested {
             if let Some(v) = s.value.take() {
                 values.insert(id, v);
@@ -291,7 +293,7 @@ pub fn execute(dag: &Dag, env: &Env<'_>, mode: Mode) -> Outcome {
             key: s.key,
             output_hash: s.hash,
             seconds: s.seconds,
-            file_hashes: std::mem::take(&mut s.file_hashes),
+            file_hashes: s.file_hashes,
         });
     }
     let mut metrics = Vec::new();
@@ -302,11 +304,7 @@ pub fn execute(dag: &Dag, env: &Env<'_>, mode: Mode) -> Outcome {
             }
         }
     }
-    let warnings = ex
-        .warnings
-        .into_inner()
-        .unwrap_or_else(|e| e.into_inner())
-        .0;
+    let warnings = warnings.into_inner().unwrap_or_else(|e| e.into_inner()).0;
     Outcome {
         reports,
         values,
@@ -881,7 +879,7 @@ impl<'a> Exec<'a> {
                         .hash_file(p)
                         .map_err(|e| format!("cannot read input file {}: {e}", p.display()))?;
                     values.push(InputValue::File(RawFileValue {
-                        path: p.clone(),
+                        path: p.to_path_buf(),
                         hash: h,
                     }));
                     hashes.push(h);

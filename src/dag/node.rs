@@ -71,8 +71,8 @@ pub struct Node {
     pub params_bytes: Arc<[u8]>,
     /// The same params as JSON, to tell which field changed.
     pub params_json: Arc<serde_json::Value>,
-    /// Labelled input edges, in the order the stage receives them.
-    pub inputs: Vec<(String, InputRef)>,
+    /// Labelled input edges, in the order the stage receives them (labels are shared between nodes).
+    pub inputs: Vec<(Arc<str>, InputRef)>,
     pub(crate) erased: Box<dyn ErasedStage>,
     /// The caller wants this node's value after the run.
     pub requested: bool,

@@ -125,14 +125,26 @@ fn packs_dir(store: &Store) -> PathBuf {
     store.root().join("records").join("packs")
 }
 
-/// The loaded index of every pack: the latest record of each node name, and the output hash of each key.
+/// The loaded index of every pack: the latest record of each node name, and the output hash of each key. The
+/// packs' index sections are kept as read (100 bytes an entry); two maps of 8-byte hashes to entry ordinals
+/// find them.
 #[derive(Default)]
 pub struct RecordIndex {
-    entries: Vec<Entry>,
+    /// Each pack's entries, as read.
+    bodies: Vec<Vec<u8>>,
+    /// Ordinal of each pack's first entry.
+    bases: Vec<u32>,
+    /// Name hash → ordinal of its latest entry.
     by_name: HashKeyed<u64, u32>,
-    by_key: HashKeyed<NodeKey, u32>,
+    /// First 8 bytes of a key → ordinal of an entry of that key (checked against the whole key on use).
+    by_key: HashKeyed<u64, u32>,
     /// `.rec` file of each pack.
     packs: Vec<PathBuf>,
+    len: u32,
+}
+
+fn key_prefix(key: &NodeKey) -> u64 {
+    u64::from_le_bytes(key.0[..8].try_into().expect("8 bytes"))
 }
 
 impl RecordIndex {
@@ -155,56 +167,72 @@ impl RecordIndex {
     }
 
     fn add_pack(&mut self, dir: &Path, stem: &str) {
-        let Ok(bytes) = fs::read(dir.join(format!("{stem}.idx"))) else {
+        let Ok(mut bytes) = fs::read(dir.join(format!("{stem}.idx"))) else {
             return;
         };
-        let Some(body) = verified_body(&bytes) else {
+        let Some(range) = verified_body(&bytes) else {
             return;
         };
-        let pack = self.packs.len() as u32;
-        self.packs.push(dir.join(format!("{stem}.rec")));
-        self.entries.reserve(body.len() / ENTRY_BYTES);
-        for chunk in body.chunks_exact(ENTRY_BYTES) {
-            let e = Entry::decode(chunk, pack);
-            let at = self.entries.len() as u32;
-            self.entries.push(e);
+        bytes.truncate(range.end);
+        bytes.drain(..range.start);
+        bytes.shrink_to_fit();
+        let count = (bytes.len() / ENTRY_BYTES) as u32;
+        let Some(end) = self.len.checked_add(count) else {
+            return;
+        };
+        self.by_name.reserve(count as usize);
+        self.by_key.reserve(count as usize);
+        for (i, chunk) in bytes.chunks_exact(ENTRY_BYTES).enumerate() {
+            let e = Entry::decode(chunk, 0);
+            let at = self.len + i as u32;
             self.by_name.insert(e.name, at);
-            self.by_key.insert(e.key, at);
+            self.by_key.insert(key_prefix(&e.key), at);
         }
+        self.bases.push(self.len);
+        self.len = end;
+        self.bodies.push(bytes);
+        self.packs.push(dir.join(format!("{stem}.rec")));
+    }
+
+    /// The entry of ordinal `at`.
+    fn entry(&self, at: u32) -> Entry {
+        let pack = self.bases.partition_point(|&b| b <= at) - 1;
+        let i = (at - self.bases[pack]) as usize * ENTRY_BYTES;
+        Entry::decode(&self.bodies[pack][i..i + ENTRY_BYTES], pack as u32)
     }
 
     /// Number of entries loaded.
     pub fn len(&self) -> usize {
-        self.entries.len()
+        self.len as usize
     }
 
     /// True when no pack was loaded.
     pub fn is_empty(&self) -> bool {
-        self.entries.is_empty()
+        self.len == 0
     }
 
     /// The key and output hash of the latest record of node name hash `name`.
     pub fn latest(&self, name: u64) -> Option<(NodeKey, ContentHash)> {
-        let e = &self.entries[*self.by_name.get(&name)? as usize];
+        let e = self.entry(*self.by_name.get(&name)?);
         Some((e.key, e.output))
     }
 
-    /// The position of `key`'s entry in the index (see [`crate::dag::objects_listing`]).
+    /// The ordinal of an entry of `key` (see [`crate::dag::objects_listing`]).
     pub fn position_of(&self, key: &NodeKey) -> Option<u32> {
-        self.by_key.get(key).copied()
+        let at = *self.by_key.get(&key_prefix(key))?;
+        (self.entry(at).key == *key).then_some(at)
     }
 
     /// The output hash recorded for `key` by any node.
     pub fn output_of(&self, key: &NodeKey) -> Option<ContentHash> {
-        Some(self.entries[*self.by_key.get(key)? as usize].output)
+        Some(self.entry(self.position_of(key)?).output)
     }
 
-    /// The latest record of `record_name` (`identity@variant`, see [`crate::dag::record::record_name`]), read
-    /// from its pack and checked.
+    /// The latest record of node `stage_item` (`stage[item]`) in `variant`, read from its pack and checked.
     pub fn record(&self, stage_item: &str, variant: &str) -> Option<NodeRecord> {
         let (stage, item) = split_identity(stage_item);
-        let e = &self.entries[*self.by_name.get(&name_hash(stage, item, variant))? as usize];
-        let bytes = read_record(&self.packs[e.pack as usize], e)?;
+        let e = self.entry(*self.by_name.get(&name_hash(stage, item, variant))?);
+        let bytes = read_record(&self.packs[e.pack as usize], &e)?;
         let rec: NodeRecord = serde_json::from_slice(&bytes).ok()?;
         (rec.identity == stage_item && rec.variant == variant).then_some(rec)
     }
@@ -215,8 +243,8 @@ impl RecordIndex {
         latest.sort_unstable();
         let mut writer = PackWriter::create(dir)?;
         for &at in &latest {
-            let e = &self.entries[at as usize];
-            if let Some(bytes) = read_record(&self.packs[e.pack as usize], e) {
+            let e = self.entry(at);
+            if let Some(bytes) = read_record(&self.packs[e.pack as usize], &e) {
                 writer.push_raw(e.name, e.key, e.output, &bytes)?;
             }
         }
@@ -241,8 +269,8 @@ fn split_identity(identity: &str) -> (&str, &str) {
     }
 }
 
-/// The entries of a pack's index file after checking its magic, format, length and checksum.
-fn verified_body(bytes: &[u8]) -> Option<&[u8]> {
+/// Where the entries of a pack's index file are, after checking its magic, format, length and checksum.
+fn verified_body(bytes: &[u8]) -> Option<std::ops::Range<usize>> {
     if bytes.len() < HEAD_BYTES + 32 || &bytes[..8] != MAGIC || bytes[8] != FORMAT {
         return None;
     }
@@ -251,7 +279,7 @@ fn verified_body(bytes: &[u8]) -> Option<&[u8]> {
     if bytes.len() != end + 32 || blake3::hash(&bytes[..end]).as_bytes() != &bytes[end..] {
         return None;
     }
-    Some(&bytes[HEAD_BYTES..end])
+    Some(HEAD_BYTES..end)
 }
 
 fn read_record(rec_file: &Path, e: &Entry) -> Option<Vec<u8>> {
