@@ -134,10 +134,11 @@ impl DagBuilder {
         }
         let (params_bytes, params_json) = self.shared_params(S::NAME, params_bytes, &params)?;
         let id = self.nodes.len();
-        let inputs_list: Vec<(Arc<str>, InputRef)> = refs
-            .into_iter()
-            .map(|(label, r)| (self.shared_label(label), r))
-            .collect();
+        // Exactly as long as needed (collecting in place would keep the growth capacity of `refs`).
+        let mut inputs_list: Vec<(Arc<str>, InputRef)> = Vec::with_capacity(refs.len());
+        for (label, r) in refs {
+            inputs_list.push((self.shared_label(label), r));
+        }
         self.nodes.push(Node {
             stage: S::NAME,
             version: S::VERSION,
@@ -295,7 +296,8 @@ impl DagBuilder {
     }
 
     /// Finish building.
-    pub fn build(self) -> Dag {
+    pub fn build(mut self) -> Dag {
+        self.nodes.shrink_to_fit();
         Dag {
             nodes: self.nodes,
             sinks: self.sinks,

@@ -183,7 +183,7 @@ struct Slot {
     value: Option<AnyValue>,
     seconds: f64,
     file_hashes: Vec<ContentHash>,
-    consumers_left: usize,
+    consumers_left: u32,
 }
 
 enum Check {
@@ -271,10 +271,24 @@ pub fn execute(dag: &Dag, env: &Env<'_>, mode: Mode) -> Outcome {
         ex.commit_records();
     }
     // The index is not needed any more: free it before the reports are built (peak memory).
-    let Exec { slots, warnings, .. } = ex;
+    let Exec {
+        slots,
+        warnings,
+        index,
+        present,
+        ..
+    } = ex;
+    drop((index, present));
     let mut values = HashMap::new();
     let mut reports = Vec::with_capacity(dag.nodes.len());
-    for ((id, node), slot) in dag.nodes.iter().enumerate().zip(slots) {
+    // Last node first, giving the slots' memory back as the reports take it (peak memory of a large graph).
+    let mut slots = slots;
+    while let Some(slot) = slots.pop() {
+        let id = slots.len();
+        let node = &dag.nodes[id];
+        if id % 4096 == 0 && slots.capacity() > slots.len() + slots.len() / 8 {
+            slots.shrink_to_fit();
+        }
         let mut s = slot.into_inner().unwrap_or_else(|e| e.into_inner());
         if node.requested {
             if let Some(v) = s.value.take() {
@@ -296,6 +310,7 @@ pub fn execute(dag: &Dag, env: &Env<'_>, mode: Mode) -> Outcome {
             file_hashes: s.file_hashes,
         });
     }
+    reports.reverse();
     let mut metrics = Vec::new();
     for sink in &dag.sinks {
         if let Some(v) = values.get(&sink.node) {

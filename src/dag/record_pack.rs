@@ -125,22 +125,21 @@ fn packs_dir(store: &Store) -> PathBuf {
     store.root().join("records").join("packs")
 }
 
-/// The loaded index of every pack: the latest record of each node name, and the output hash of each key. The
-/// packs' index sections are kept as read (100 bytes an entry); two maps of 8-byte hashes to entry ordinals
-/// find them.
+/// The loaded index of every pack: the latest record of each node name, and the output hash of each key. Only
+/// each entry's key and output hash stay in memory (64 bytes), found by two maps of 8-byte hashes to entry
+/// ordinals; where a record lies in its pack is read again from the index file when a record is wanted.
 #[derive(Default)]
 pub struct RecordIndex {
-    /// Each pack's entries, as read.
-    bodies: Vec<Vec<u8>>,
+    /// Key and output hash of every entry, by ordinal.
+    outputs: Vec<(NodeKey, ContentHash)>,
     /// Ordinal of each pack's first entry.
     bases: Vec<u32>,
     /// Name hash → ordinal of its latest entry.
     by_name: HashKeyed<u64, u32>,
     /// First 8 bytes of a key → ordinal of an entry of that key (checked against the whole key on use).
     by_key: HashKeyed<u64, u32>,
-    /// `.rec` file of each pack.
+    /// Index file (stem) of each pack.
     packs: Vec<PathBuf>,
-    len: u32,
 }
 
 fn key_prefix(key: &NodeKey) -> u64 {
@@ -167,72 +166,82 @@ impl RecordIndex {
     }
 
     fn add_pack(&mut self, dir: &Path, stem: &str) {
-        let Ok(mut bytes) = fs::read(dir.join(format!("{stem}.idx"))) else {
+        let path = dir.join(format!("{stem}.idx"));
+        let Ok(bytes) = fs::read(&path) else {
             return;
         };
         let Some(range) = verified_body(&bytes) else {
             return;
         };
-        bytes.truncate(range.end);
-        bytes.drain(..range.start);
-        bytes.shrink_to_fit();
-        let count = (bytes.len() / ENTRY_BYTES) as u32;
-        let Some(end) = self.len.checked_add(count) else {
+        let body = &bytes[range];
+        let count = body.len() / ENTRY_BYTES;
+        let base = self.outputs.len();
+        if u32::try_from(base + count).is_err() {
             return;
-        };
-        self.by_name.reserve(count as usize);
-        self.by_key.reserve(count as usize);
-        for (i, chunk) in bytes.chunks_exact(ENTRY_BYTES).enumerate() {
+        }
+        self.outputs.reserve_exact(count);
+        self.by_name.reserve(count);
+        self.by_key.reserve(count);
+        for (i, chunk) in body.chunks_exact(ENTRY_BYTES).enumerate() {
             let e = Entry::decode(chunk, 0);
-            let at = self.len + i as u32;
+            let at = (base + i) as u32;
             self.by_name.insert(e.name, at);
             self.by_key.insert(key_prefix(&e.key), at);
+            self.outputs.push((e.key, e.output));
         }
-        self.bases.push(self.len);
-        self.len = end;
-        self.bodies.push(bytes);
-        self.packs.push(dir.join(format!("{stem}.rec")));
+        self.bases.push(base as u32);
+        self.packs.push(path);
     }
 
-    /// The entry of ordinal `at`.
-    fn entry(&self, at: u32) -> Entry {
-        let pack = self.bases.partition_point(|&b| b <= at) - 1;
-        let i = (at - self.bases[pack]) as usize * ENTRY_BYTES;
-        Entry::decode(&self.bodies[pack][i..i + ENTRY_BYTES], pack as u32)
+    /// The whole entry of ordinal `at`, read again from its pack's index file (and checked against memory).
+    fn entry(&self, at: u32) -> Option<Entry> {
+        let pack = self.bases.partition_point(|&b| b <= at).checked_sub(1)?;
+        let i = (at - self.bases[pack]) as u64;
+        let mut f = File::open(&self.packs[pack]).ok()?;
+        f.seek(SeekFrom::Start(HEAD_BYTES as u64 + i * ENTRY_BYTES as u64))
+            .ok()?;
+        let mut b = [0u8; ENTRY_BYTES];
+        f.read_exact(&mut b).ok()?;
+        let e = Entry::decode(&b, pack as u32);
+        (self.outputs.get(at as usize) == Some(&(e.key, e.output))).then_some(e)
+    }
+
+    /// The `.rec` file of pack `pack`.
+    fn rec_file(&self, pack: u32) -> PathBuf {
+        self.packs[pack as usize].with_extension("rec")
     }
 
     /// Number of entries loaded.
     pub fn len(&self) -> usize {
-        self.len as usize
+        self.outputs.len()
     }
 
     /// True when no pack was loaded.
     pub fn is_empty(&self) -> bool {
-        self.len == 0
+        self.outputs.is_empty()
     }
 
     /// The key and output hash of the latest record of node name hash `name`.
     pub fn latest(&self, name: u64) -> Option<(NodeKey, ContentHash)> {
-        let e = self.entry(*self.by_name.get(&name)?);
-        Some((e.key, e.output))
+        self.outputs.get(*self.by_name.get(&name)? as usize).copied()
     }
 
     /// The ordinal of an entry of `key` (see [`crate::dag::objects_listing`]).
     pub fn position_of(&self, key: &NodeKey) -> Option<u32> {
         let at = *self.by_key.get(&key_prefix(key))?;
-        (self.entry(at).key == *key).then_some(at)
+        (self.outputs.get(at as usize)?.0 == *key).then_some(at)
     }
 
     /// The output hash recorded for `key` by any node.
     pub fn output_of(&self, key: &NodeKey) -> Option<ContentHash> {
-        Some(self.entry(self.position_of(key)?).output)
+        Some(self.outputs[self.position_of(key)? as usize].1)
     }
 
     /// The latest record of node `stage_item` (`stage[item]`) in `variant`, read from its pack and checked.
     pub fn record(&self, stage_item: &str, variant: &str) -> Option<NodeRecord> {
         let (stage, item) = split_identity(stage_item);
-        let e = self.entry(*self.by_name.get(&name_hash(stage, item, variant))?);
-        let bytes = read_record(&self.packs[e.pack as usize], &e)?;
+        let e = self.entry(*self.by_name.get(&name_hash(stage, item, variant))?)?;
+        let bytes = read_record(&self.rec_file(e.pack), &e)?;
         let rec: NodeRecord = serde_json::from_slice(&bytes).ok()?;
         (rec.identity == stage_item && rec.variant == variant).then_some(rec)
     }
@@ -243,8 +252,8 @@ impl RecordIndex {
         latest.sort_unstable();
         let mut writer = PackWriter::create(dir)?;
         for &at in &latest {
-            let e = self.entry(at);
-            if let Some(bytes) = read_record(&self.packs[e.pack as usize], &e) {
+            let Some(e) = self.entry(at) else { continue };
+            if let Some(bytes) = read_record(&self.rec_file(e.pack), &e) {
                 writer.push_raw(e.name, e.key, e.output, &bytes)?;
             }
         }
