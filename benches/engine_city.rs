@@ -59,7 +59,11 @@ fn measure(role: &str, dir: &Path, recordings: usize) {
     let dag = b.build();
     let build_s = t.elapsed().as_secs_f64();
     let graph_bytes = status_bytes("VmRSS").saturating_sub(baseline);
-    let mode = if role == "plan" { Mode::Plan } else { Mode::Run };
+    let mode = if role == "plan" {
+        Mode::Plan
+    } else {
+        Mode::Run
+    };
     let o = execute(&dag, &env, mode);
     let (wall, cpu) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
     let peak = status_bytes("VmHWM").saturating_sub(baseline);

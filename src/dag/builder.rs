@@ -194,7 +194,9 @@ impl DagBuilder {
 
     /// The node identity `stage[item]` denotes in the current variant, if any.
     fn identity_node(&self, stage: &str, item: &str) -> Option<NodeId> {
-        let id = *self.by_identity.get(&name_hash(stage, item, &self.variant))?;
+        let id = *self
+            .by_identity
+            .get(&name_hash(stage, item, &self.variant))?;
         let n = &self.nodes[id];
         if n.stage == stage && n.item == item && n.variants.contains(&self.variant) {
             return Some(id);
@@ -370,7 +372,12 @@ impl Dag {
     pub fn consumers(&self, id: NodeId) -> Vec<NodeId> {
         // Consumers come after their inputs.
         (id + 1..self.nodes.len())
-            .filter(|&c| self.nodes[c].inputs.iter().any(|(_, r)| r.node() == Some(id)))
+            .filter(|&c| {
+                self.nodes[c]
+                    .inputs
+                    .iter()
+                    .any(|(_, r)| r.node() == Some(id))
+            })
             .collect()
     }
     /// Topological waves: wave k holds the nodes whose longest upstream chain has k nodes. Nodes of one

@@ -106,7 +106,9 @@ fn recorded_with(
                 ),
                 InputRef::Node(u) | InputRef::OptionalNode(u) => {
                     let hash = match (upstream(*u), r) {
-                        (Some(Upstream::Unavailable), InputRef::OptionalNode(_)) => ABSENT.to_string(),
+                        (Some(Upstream::Unavailable), InputRef::OptionalNode(_)) => {
+                            ABSENT.to_string()
+                        }
                         (Some(Upstream::Hash(h)), _) => h.to_string(),
                         _ => String::new(),
                     };
@@ -216,6 +218,8 @@ struct Exec<'a> {
     pack: Mutex<Option<PackWriter>>,
     /// Whether any failure record exists (only then does a success remove the node's failure record).
     failures_recorded: bool,
+    /// Run mode: marks cached entries used.
+    marker: crate::dag::objects_listing::EntryMarker,
 }
 
 /// Execute (or plan) `dag`. Never panics on stage errors/panics or store trouble; those become node
@@ -245,6 +249,7 @@ pub fn execute(dag: &Dag, env: &Env<'_>, mode: Mode) -> Outcome {
         present,
         pack: Mutex::new(None),
         failures_recorded: record::any_failure_recorded(env.store),
+        marker: crate::dag::objects_listing::EntryMarker::new(env.store),
     };
     let mut totals: BTreeMap<&'static str, usize> = BTreeMap::new();
     for n in &dag.nodes {
@@ -541,7 +546,9 @@ impl<'a> Exec<'a> {
         recorded_with(self.dag, &self.dag.nodes[id], &files, |u| {
             let s = self.slot(u);
             Some(match (&s.status, s.hash) {
-                (Some(NodeStatus::Failed(_) | NodeStatus::Skipped { .. }), _) => Upstream::Unavailable,
+                (Some(NodeStatus::Failed(_) | NodeStatus::Skipped { .. }), _) => {
+                    Upstream::Unavailable
+                }
                 (Some(NodeStatus::WillRun { .. }), _) => Upstream::Unknown,
                 (_, Some(h)) => Upstream::Hash(h),
                 _ => Upstream::Unknown,
@@ -621,7 +628,9 @@ impl<'a> Exec<'a> {
             return Check::WillRun(self.upstream_running_reasons(id, variant));
         }
         let key = node_key(node, &hashes);
-        let latest = self.index.latest(name_hash(node.stage, &node.item, variant));
+        let latest = self
+            .index
+            .latest(name_hash(node.stage, &node.item, variant));
         let (known_hash, record_stale) = match latest {
             Some((k, h)) if k == key => (Some(h), false),
             _ => (self.index.output_of(&key), true),
@@ -675,7 +684,12 @@ impl<'a> Exec<'a> {
                     }
                 }
             }
-            let mut list = running.iter().take(SHOWN).cloned().collect::<Vec<_>>().join(", ");
+            let mut list = running
+                .iter()
+                .take(SHOWN)
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", ");
             if running.len() > SHOWN {
                 list.push_str(&format!(" and {} more", running.len() - SHOWN));
             }
@@ -698,7 +712,10 @@ impl<'a> Exec<'a> {
         match (self.mode, &self.present) {
             (Mode::Plan, Some(present)) => present.contains(&self.index, key),
             (Mode::Plan, None) => self.env.store.object_path(key).is_file(),
-            (Mode::Run, _) => touch_entry(self.env.store, key),
+            (Mode::Run, _) => self
+                .marker
+                .mark(key)
+                .unwrap_or_else(|| touch_entry(self.env.store, key)),
         }
     }
 

@@ -54,6 +54,63 @@ impl Present {
     }
 }
 
+/// Marks entries used in a run (their modification time, which `cache gc` reads as last use) through open
+/// handles on the store's 256 entry folders: one `utimensat` that resolves a single name inside an open folder
+/// instead of the whole path from the root, and that tells at the same time whether the entry exists.
+pub struct EntryMarker {
+    objects: Option<PathBuf>,
+    #[cfg(unix)]
+    dirs: Vec<std::sync::OnceLock<Option<std::fs::File>>>,
+}
+
+impl EntryMarker {
+    /// A marker for the entries of `store` (folders are opened on first use).
+    pub fn new(store: &Store) -> EntryMarker {
+        EntryMarker {
+            objects: objects_dir(store),
+            #[cfg(unix)]
+            dirs: (0..256).map(|_| std::sync::OnceLock::new()).collect(),
+        }
+    }
+
+    /// Whether the entry of `key` exists, marking it used now if so; `None` when this cannot tell (no such
+    /// folder handle, or the entry may not be modified, e.g. a read-only shared cache): ask another way.
+    pub fn mark(&self, key: &NodeKey) -> Option<bool> {
+        #[cfg(unix)]
+        {
+            use std::os::unix::io::AsRawFd;
+            let objects = self.objects.as_ref()?;
+            let dir = self.dirs[key.0[0] as usize].get_or_init(|| {
+                std::fs::File::open(objects.join(format!("{:02x}", key.0[0]))).ok()
+            });
+            let Some(dir) = dir else {
+                // No folder: no entry of this prefix (yet).
+                return Some(false);
+            };
+            let hex = key.to_string();
+            let mut name = [0u8; 63];
+            name[..62].copy_from_slice(&hex.as_bytes()[2..]);
+            // SAFETY: `dir` is an open folder, `name` a NUL-terminated file name inside it; a null `times`
+            // pointer means "now" for both access and modification time (POSIX utimensat).
+            let rc = unsafe {
+                libc::utimensat(dir.as_raw_fd(), name.as_ptr().cast(), std::ptr::null(), 0)
+            };
+            if rc == 0 {
+                return Some(true);
+            }
+            match std::io::Error::last_os_error().kind() {
+                std::io::ErrorKind::NotFound => Some(false),
+                _ => None,
+            }
+        }
+        #[cfg(not(unix))]
+        {
+            let _ = (key, &self.objects);
+            None
+        }
+    }
+}
+
 /// The store's `objects/` folder (the grandparent of an entry path).
 fn objects_dir(store: &Store) -> Option<PathBuf> {
     let sample = store.object_path(&ContentHash::default());

@@ -223,7 +223,9 @@ impl RecordIndex {
 
     /// The key and output hash of the latest record of node name hash `name`.
     pub fn latest(&self, name: u64) -> Option<(NodeKey, ContentHash)> {
-        self.outputs.get(*self.by_name.get(&name)? as usize).copied()
+        self.outputs
+            .get(*self.by_name.get(&name)? as usize)
+            .copied()
     }
 
     /// The ordinal of an entry of `key` (see [`crate::dag::objects_listing`]).
@@ -367,13 +369,26 @@ impl PackWriter {
     }
 
     /// Adds a node record (its output key and hash come from the record).
-    pub fn push(&mut self, name: u64, key: NodeKey, output: ContentHash, rec: &NodeRecord) -> io::Result<()> {
+    pub fn push(
+        &mut self,
+        name: u64,
+        key: NodeKey,
+        output: ContentHash,
+        rec: &NodeRecord,
+    ) -> io::Result<()> {
         let bytes = serde_json::to_vec(rec).map_err(io::Error::other)?;
         self.push_raw(name, key, output, &bytes)
     }
 
-    fn push_raw(&mut self, name: u64, key: NodeKey, output: ContentHash, bytes: &[u8]) -> io::Result<()> {
-        let len = u32::try_from(bytes.len()).map_err(|_| io::Error::other("node record over 4 GiB"))?;
+    fn push_raw(
+        &mut self,
+        name: u64,
+        key: NodeKey,
+        output: ContentHash,
+        bytes: &[u8],
+    ) -> io::Result<()> {
+        let len =
+            u32::try_from(bytes.len()).map_err(|_| io::Error::other("node record over 4 GiB"))?;
         self.rec.write_all(bytes)?;
         let e = Entry {
             name,
@@ -382,7 +397,9 @@ impl PackWriter {
             pack: 0,
             offset: self.offset,
             len,
-            check: blake3::hash(bytes).as_bytes()[..16].try_into().expect("16 bytes"),
+            check: blake3::hash(bytes).as_bytes()[..16]
+                .try_into()
+                .expect("16 bytes"),
         };
         e.encode(&mut self.index);
         self.offset += bytes.len() as u64;
@@ -450,7 +467,12 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let store = Store::open(dir.path()).unwrap();
         let name = name_hash("s", "a", "default");
-        let (k1, k2, o1, o2) = (hash_bytes(b"k1"), hash_bytes(b"k2"), hash_bytes(b"o1"), hash_bytes(b"o2"));
+        let (k1, k2, o1, o2) = (
+            hash_bytes(b"k1"),
+            hash_bytes(b"k2"),
+            hash_bytes(b"o1"),
+            hash_bytes(b"o2"),
+        );
         for (k, o) in [(k1, o1), (k2, o2)] {
             let mut w = PackWriter::open(&store).unwrap();
             w.push(name, k, o, &record("s[a]", k, o)).unwrap();
@@ -480,6 +502,9 @@ mod tests {
         assert_eq!(list_stems(&dir_p).len(), 1);
         let last = hash_bytes(&[MAX_PACKS as u8]);
         assert_eq!(merged.latest(name), Some((last, o1)));
-        assert_eq!(merged.record("s[a]", "default").unwrap().key, last.to_string());
+        assert_eq!(
+            merged.record("s[a]", "default").unwrap().key,
+            last.to_string()
+        );
     }
 }

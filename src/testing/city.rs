@@ -67,7 +67,8 @@ impl Digest for Option<Arc<u64>> {
 }
 impl<T: Digest> Digest for Vec<T> {
     fn fold(&self, acc: u64) -> u64 {
-        self.iter().fold(mix(acc ^ self.len() as u64), |a, v| v.fold(a))
+        self.iter()
+            .fold(mix(acc ^ self.len() as u64), |a, v| v.fold(a))
     }
 }
 impl<A: Digest, B: Digest> Digest for (A, B) {
