@@ -701,8 +701,7 @@ impl<'a> Exec<'a> {
     /// The node's last record (for the reasons it will run).
     fn load_record(&self, node: &Node, variant: &str) -> Option<NodeRecord> {
         let identity = node.identity();
-        self.index
-            .record(&identity, variant)
+        record::record_in(&self.index, &identity, variant)
             .or_else(|| record::load_record_file(self.env.store, &identity, variant))
     }
 
@@ -1014,7 +1013,10 @@ impl<'a> Exec<'a> {
                 skytie_version: env!("CARGO_PKG_VERSION").to_string(),
             };
             let name = name_hash(node.stage, &node.item, variant);
-            if let Err(e) = writer.push(name, key, hash, &rec) {
+            let pushed = serde_json::to_vec(&rec)
+                .map_err(std::io::Error::other)
+                .and_then(|bytes| writer.push(name, key, hash, &bytes));
+            if let Err(e) = pushed {
                 drop(pack);
                 self.warn(format!("could not write the run's records: {e}"));
                 return;

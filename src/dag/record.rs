@@ -88,9 +88,22 @@ pub fn record_name(identity: &str, variant: &str) -> String {
 /// The last record of node `identity` in `variant`: from the record packs (where runs keep them, see
 /// [`crate::dag::record_pack`]), else a record of its own (as [`save_record`] writes).
 pub fn load_record(store: &Store, identity: &str, variant: &str) -> Option<NodeRecord> {
-    crate::dag::record_pack::RecordIndex::load(store)
-        .record(identity, variant)
-        .or_else(|| load_record_file(store, identity, variant))
+    record_in(
+        &crate::dag::record_pack::RecordIndex::load(store),
+        identity,
+        variant,
+    )
+    .or_else(|| load_record_file(store, identity, variant))
+}
+
+/// The record of node `identity` in `variant` from the loaded record packs, if it is there and names it.
+pub fn record_in(
+    index: &crate::dag::record_pack::RecordIndex,
+    identity: &str,
+    variant: &str,
+) -> Option<NodeRecord> {
+    let rec: NodeRecord = serde_json::from_slice(&index.record_bytes(identity, variant)?).ok()?;
+    (rec.identity == identity && rec.variant == variant).then_some(rec)
 }
 
 /// A record of its own of node `identity` in `variant` (as [`save_record`] writes, and earlier versions did
