@@ -48,6 +48,9 @@ pub(crate) struct MetricsSink {
     pub to_json: MetricsFn,
 }
 
+/// The canonical bytes and JSON of one set of parameters, shared by the nodes that have them.
+type SharedParams = (Arc<[u8]>, Arc<serde_json::Value>);
+
 /// Collects nodes; see the module documentation.
 pub struct DagBuilder {
     nodes: Vec<Node>,
@@ -59,7 +62,7 @@ pub struct DagBuilder {
     /// Input labels, shared by every node that has them.
     labels: HashMap<String, Arc<str>>,
     /// blake3(stage, canonical params) → the shared bytes and JSON of those params.
-    params: HashKeyed<[u8; 32], (Arc<[u8]>, Arc<serde_json::Value>)>,
+    params: HashKeyed<[u8; 32], SharedParams>,
     variant: String,
     sinks: Vec<MetricsSink>,
 }
@@ -175,7 +178,7 @@ impl DagBuilder {
         stage: &str,
         bytes: Vec<u8>,
         params: &P,
-    ) -> Result<(Arc<[u8]>, Arc<serde_json::Value>), BuildError> {
+    ) -> Result<SharedParams, BuildError> {
         let mut h = blake3::Hasher::new();
         h.update(&(stage.len() as u64).to_le_bytes());
         h.update(stage.as_bytes());

@@ -164,7 +164,7 @@ mod tests {
     fn entry_names_parse_back_to_their_keys() {
         let key = crate::hashing::hash_bytes(b"k");
         let hex = key.to_string();
-        assert_eq!(key_of(key.0[0], hex[2..].as_bytes()), Some(key));
+        assert_eq!(key_of(key.0[0], &hex.as_bytes()[2..]), Some(key));
         assert_eq!(key_of(key.0[0], b"zz"), None);
         assert_eq!(key_of(key.0[0], &hex.as_bytes()[1..]), None);
     }
