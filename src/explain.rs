@@ -38,10 +38,10 @@ pub fn explain(session: &Session<'_>, query: &str) -> Result<String, String> {
         let _ = writeln!(out, "phase     {}", phase.name);
         let _ = writeln!(out, "stage     {} (version {})", node.stage, node.version);
         let _ = writeln!(out, "variants  {}", node.variants.join(", "));
-        let params = serde_json::to_string_pretty(&node.params_json).unwrap_or_default();
+        let params = serde_json::to_string_pretty(&*node.params_json).unwrap_or_default();
         let _ = writeln!(out, "params    {}", params.replace('\n', "\n          "));
         let _ = writeln!(out, "inputs");
-        for i in &r.inputs {
+        for i in &phase.inputs(id) {
             let h = if i.hash.is_empty() {
                 "(not computed yet)"
             } else {

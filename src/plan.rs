@@ -51,7 +51,7 @@ pub fn will_run_reasons(session: &Session<'_>, phase: &Phase, report: &NodeRepor
         return reasons.clone();
     };
     let upstream = |w: &String| w.starts_with("upstream will run");
-    let inputs: &[RecordedInput] = &report.inputs;
+    let inputs: &[RecordedInput] = &phase.inputs(report.id);
     let mut why: Vec<String> =
         record::failure_reasons(&failure, node.version, &node.params_json, inputs)
             .into_iter()

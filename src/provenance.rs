@@ -32,9 +32,9 @@ pub fn provenance(
                 entry
                     .1
                     .entry(v.clone())
-                    .or_insert_with(|| node.params_json.clone());
+                    .or_insert_with(|| (*node.params_json).clone());
             }
-            for input in &report.inputs {
+            for input in &phase.inputs(report.id) {
                 if let Some(path) = input.source.strip_prefix("file ") {
                     raw.insert(path.to_string(), input.hash.clone());
                 }

@@ -288,11 +288,22 @@ fn a_run_killed_mid_way_is_resumed_with_finished_nodes_reused() {
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    // Wait until a few nodes have finished, then SIGKILL.
-    let records = t.cache().join("records/outputs");
+    // Wait until a few nodes have stored their results, then SIGKILL.
+    let objects = t.cache().join("objects");
+    let stored = || -> usize {
+        let Ok(folders) = std::fs::read_dir(&objects) else {
+            return 0;
+        };
+        folders
+            .flatten()
+            .filter_map(|f| std::fs::read_dir(f.path()).ok())
+            .flat_map(|d| d.flatten())
+            .filter(|e| !e.file_name().to_string_lossy().starts_with('.'))
+            .count()
+    };
     let start = Instant::now();
     loop {
-        let done = std::fs::read_dir(&records).map(|d| d.count()).unwrap_or(0);
+        let done = stored();
         if done >= 3 || start.elapsed() > Duration::from_secs(20) {
             break;
         }

@@ -78,7 +78,7 @@ fn tuple_inputs_arrive_in_order_with_position_labels() {
     let labels: Vec<(String, bool)> = dag.nodes()[3]
         .inputs
         .iter()
-        .map(|(l, r)| (l.clone(), matches!(r, InputRef::File(_))))
+        .map(|(l, r)| (l.to_string(), matches!(r, InputRef::File(_))))
         .collect();
     assert_eq!(
         labels,

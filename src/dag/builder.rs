@@ -2,9 +2,11 @@
 //!
 //! Nodes are deduplicated at build time: adding a node whose stage, version, params, item and inputs equal
 //! those of an existing node returns the existing handle (this is how the variants of a sweep share their
-//! common prefix: built bottom-up, shared nodes merge and run once). The graph itself is a petgraph
-//! `DiGraph` (edge upstream → consumer); handles only refer to existing nodes, so insertion order is a
-//! topological order.
+//! common prefix: built bottom-up, shared nodes merge and run once). The graph is the nodes' input lists
+//! (no separate edge structure: a million-node graph keeps one copy of its edges); handles only refer to
+//! existing nodes, so insertion order is a topological order. Equal parameters of many nodes are stored once
+//! (their canonical bytes and JSON are shared), and the maps that find equal nodes and identities are keyed by
+//! hashes, so a node costs a few hundred bytes.
 //!
 //! A node's identity `stage[item]` names it in plans, records (`identity@variant`) and `explain`, so within one
 //! variant an identity must denote one node: adding the same `stage[item]` again in a variant that already
@@ -14,8 +16,8 @@
 use crate::codec::encode_params;
 use crate::dag::inputs::{Handle, InputRef, InputSet, NodeId};
 use crate::dag::node::{Node, TypedNode};
+use crate::dag::record_pack::{name_hash, HashKeyed};
 use crate::dag::stage::Stage;
-use petgraph::graph::{DiGraph, NodeIndex};
 use std::collections::HashMap;
 use std::fmt;
 use std::sync::Arc;
@@ -46,13 +48,21 @@ pub(crate) struct MetricsSink {
     pub to_json: MetricsFn,
 }
 
+/// The canonical bytes and JSON of one set of parameters, shared by the nodes that have them.
+type SharedParams = (Arc<[u8]>, Arc<serde_json::Value>);
+
 /// Collects nodes; see the module documentation.
 pub struct DagBuilder {
     nodes: Vec<Node>,
-    graph: DiGraph<NodeId, ()>,
-    by_structure: HashMap<[u8; 32], NodeId>,
-    /// (identity `stage[item]`, variant) → the node that identity denotes in that variant.
-    by_identity: HashMap<(String, String), NodeId>,
+    by_structure: HashKeyed<[u8; 32], NodeId>,
+    /// Hash of (identity `stage[item]`, variant) → the node that identity denotes in that variant.
+    by_identity: HashKeyed<u64, NodeId>,
+    /// The same for the rare identities whose hash is already taken by another identity.
+    by_identity_overflow: HashMap<(String, String), NodeId>,
+    /// Input labels, shared by every node that has them.
+    labels: HashMap<String, Arc<str>>,
+    /// blake3(stage, canonical params) → the shared bytes and JSON of those params.
+    params: HashKeyed<[u8; 32], SharedParams>,
     variant: String,
     sinks: Vec<MetricsSink>,
 }
@@ -67,9 +77,11 @@ impl DagBuilder {
     pub fn new() -> Self {
         DagBuilder {
             nodes: Vec::new(),
-            graph: DiGraph::new(),
-            by_structure: HashMap::new(),
-            by_identity: HashMap::new(),
+            by_structure: HashKeyed::default(),
+            by_identity: HashKeyed::default(),
+            by_identity_overflow: HashMap::new(),
+            labels: HashMap::new(),
+            params: HashKeyed::default(),
             variant: "default".to_string(),
             sinks: Vec::new(),
         }
@@ -91,9 +103,6 @@ impl DagBuilder {
         let params_bytes = encode_params(&params).map_err(|e| BuildError {
             message: format!("stage {}: cannot encode params: {e}", S::NAME),
         })?;
-        let params_json = serde_json::to_value(&params).map_err(|e| BuildError {
-            message: format!("stage {}: cannot describe params: {e}", S::NAME),
-        })?;
         let mut refs = Vec::new();
         inputs.collect_refs("", &mut refs);
         for (label, r) in &refs {
@@ -110,28 +119,28 @@ impl DagBuilder {
         }
         let structure = structural_hash(S::NAME, S::VERSION, item, &params_bytes, &refs);
         let existing = self.by_structure.get(&structure).copied();
-        let identity_key = (identity_of(S::NAME, item), self.variant.clone());
-        if let Some(&other) = self.by_identity.get(&identity_key) {
+        let identity = self.identity_node(S::NAME, item);
+        if let Some(other) = identity {
             if Some(other) != existing {
-                return Err(self.identity_clash(other, S::NAME, item, &params_json));
+                let json = serde_json::to_value(&params).unwrap_or_default();
+                return Err(self.identity_clash(other, S::NAME, item, &json));
             }
         }
         if let Some(id) = existing {
-            let node = &mut self.nodes[id];
-            if !node.variants.contains(&self.variant) {
-                node.variants.push(self.variant.clone());
+            if !self.nodes[id].variants.contains(&self.variant) {
+                self.nodes[id].variants.push(self.variant.clone());
             }
-            self.by_identity.insert(identity_key, id);
+            if identity.is_none() {
+                self.set_identity_node(S::NAME, item, id);
+            }
             return Ok(Handle::new(id));
         }
+        let (params_bytes, params_json) = self.shared_params(S::NAME, params_bytes, &params)?;
         let id = self.nodes.len();
-        let gid = self.graph.add_node(id);
-        debug_assert_eq!(gid.index(), id);
-        let mut upstream: Vec<NodeId> = refs.iter().filter_map(|(_, r)| r.node()).collect();
-        upstream.sort_unstable();
-        upstream.dedup();
-        for u in upstream {
-            self.graph.add_edge(NodeIndex::new(u), gid, ());
+        // Exactly as long as needed (collecting in place would keep the growth capacity of `refs`).
+        let mut inputs_list: Vec<(Arc<str>, InputRef)> = Vec::with_capacity(refs.len());
+        for (label, r) in refs {
+            inputs_list.push((self.shared_label(label), r));
         }
         self.nodes.push(Node {
             stage: S::NAME,
@@ -140,7 +149,7 @@ impl DagBuilder {
             variants: vec![self.variant.clone()],
             params_bytes,
             params_json,
-            inputs: refs,
+            inputs: inputs_list,
             erased: Box::new(TypedNode {
                 stage,
                 params,
@@ -149,8 +158,77 @@ impl DagBuilder {
             requested: false,
         });
         self.by_structure.insert(structure, id);
-        self.by_identity.insert(identity_key, id);
+        self.set_identity_node(S::NAME, item, id);
         Ok(Handle::new(id))
+    }
+
+    /// `label`, shared with every node that has an input of that label.
+    fn shared_label(&mut self, label: String) -> Arc<str> {
+        if let Some(shared) = self.labels.get(&label) {
+            return shared.clone();
+        }
+        let shared: Arc<str> = Arc::from(label.as_str());
+        self.labels.insert(label, shared.clone());
+        shared
+    }
+
+    /// The canonical bytes and JSON of `params` of stage `stage`, shared with every node that has equal ones.
+    fn shared_params<P: serde::Serialize>(
+        &mut self,
+        stage: &str,
+        bytes: Vec<u8>,
+        params: &P,
+    ) -> Result<SharedParams, BuildError> {
+        let mut h = blake3::Hasher::new();
+        h.update(&(stage.len() as u64).to_le_bytes());
+        h.update(stage.as_bytes());
+        h.update(&bytes);
+        let id = *h.finalize().as_bytes();
+        if let Some(shared) = self.params.get(&id) {
+            return Ok(shared.clone());
+        }
+        let json = serde_json::to_value(params).map_err(|e| BuildError {
+            message: format!("stage {stage}: cannot describe params: {e}"),
+        })?;
+        let shared = (Arc::<[u8]>::from(bytes), Arc::new(json));
+        self.params.insert(id, shared.clone());
+        Ok(shared)
+    }
+
+    /// The node identity `stage[item]` denotes in the current variant, if any.
+    fn identity_node(&self, stage: &str, item: &str) -> Option<NodeId> {
+        let id = *self
+            .by_identity
+            .get(&name_hash(stage, item, &self.variant))?;
+        let n = &self.nodes[id];
+        if n.stage == stage && n.item == item && n.variants.contains(&self.variant) {
+            return Some(id);
+        }
+        // The hash belongs to another identity.
+        self.by_identity_overflow
+            .get(&(identity_of(stage, item), self.variant.clone()))
+            .copied()
+    }
+
+    fn set_identity_node(&mut self, stage: &str, item: &str, id: NodeId) {
+        let hash = name_hash(stage, item, &self.variant);
+        match self.by_identity.get(&hash) {
+            Some(&other) if other != id && self.identity_is(other, stage, item) => {}
+            Some(&other) if other != id => {
+                self.by_identity_overflow
+                    .insert((identity_of(stage, item), self.variant.clone()), id);
+                return;
+            }
+            _ => {}
+        }
+        self.by_identity.insert(hash, id);
+    }
+
+    /// Whether node `id` has identity `stage[item]` in some other variant than the current one (its hash slot
+    /// may then be taken over: identities are looked up together with the variant).
+    fn identity_is(&self, id: NodeId, stage: &str, item: &str) -> bool {
+        let n = &self.nodes[id];
+        n.stage == stage && n.item == item
     }
 
     /// The error for a second, different node of identity `stage[item]` in the current variant; `other` is
@@ -223,10 +301,10 @@ impl DagBuilder {
     }
 
     /// Finish building.
-    pub fn build(self) -> Dag {
+    pub fn build(mut self) -> Dag {
+        self.nodes.shrink_to_fit();
         Dag {
             nodes: self.nodes,
-            graph: self.graph,
             sinks: self.sinks,
         }
     }
@@ -280,7 +358,6 @@ fn structural_hash(
 /// A finished graph, ready for `plan` or `execute`.
 pub struct Dag {
     pub(crate) nodes: Vec<Node>,
-    pub(crate) graph: DiGraph<NodeId, ()>,
     pub(crate) sinks: Vec<MetricsSink>,
 }
 
@@ -296,13 +373,15 @@ impl Dag {
     }
     /// Ids of the nodes that read node `id`.
     pub fn consumers(&self, id: NodeId) -> Vec<NodeId> {
-        let mut c: Vec<NodeId> = self
-            .graph
-            .neighbors_directed(NodeIndex::new(id), petgraph::Direction::Outgoing)
-            .map(|n| n.index())
-            .collect();
-        c.sort_unstable();
-        c
+        // Consumers come after their inputs.
+        (id + 1..self.nodes.len())
+            .filter(|&c| {
+                self.nodes[c]
+                    .inputs
+                    .iter()
+                    .any(|(_, r)| r.node() == Some(id))
+            })
+            .collect()
     }
     /// Topological waves: wave k holds the nodes whose longest upstream chain has k nodes. Nodes of one
     /// wave are independent and run in parallel.

@@ -3,14 +3,18 @@
 //! Nodes run in topological waves on the rayon pool; every parallel step collects in node order, so results
 //! and records are identical for 1 or N threads. For each wave:
 //! 1. check (parallel): skip nodes whose upstream failed; hash raw-file inputs (stat cache); compute the key
-//!    from the inputs' content hashes (early cutoff); a key whose output hash is known (node record or
-//!    output record) and whose entry exists is CACHED without reading the artifact; otherwise `Store::load`
-//!    (Hit ⇒ cached; Corrupt ⇒ one warning, recompute; Miss ⇒ run).
+//!    from the inputs' content hashes (early cutoff); a key whose output hash is known (the record packs'
+//!    index, loaded once per execution) and whose entry exists is CACHED without reading the artifact
+//!    (existence: one listing of the store in plan mode, one call marking the entry used in run mode);
+//!    otherwise `Store::load` (Hit ⇒ cached; Corrupt ⇒ one warning, recompute; Miss ⇒ run).
 //! 2. load (parallel, each value once) the inputs the nodes to run need; an input that turns out corrupt or
 //!    missing is recomputed first (recursively).
 //! 3. run (parallel) inside `catch_unwind`: an error or panic marks the node FAILED and nothing is stored;
 //!    success is encoded, saved, then recorded (output record, node record).
 //! 4. account (sequential): statuses, progress, release values no consumer needs any more.
+//!
+//! The records of the nodes that ran (or were found under a key their record did not have) go into one record
+//! pack per execution, and the store is flushed once at the end.
 //!
 //! No lock is ever held while a stage runs or the store is called (rayon work stealing could otherwise
 //! re-enter the lock on the same thread).
@@ -21,6 +25,7 @@ use crate::dag::key::node_key;
 use crate::dag::node::{AnyValue, Node};
 use crate::dag::progress::Progress;
 use crate::dag::record::{self, NodeRecord, RecordedInput};
+use crate::dag::record_pack::{name_hash, PackWriter, RecordIndex};
 use crate::dag::stage::{dirs_root, tmp_dir_for, NodeCtx};
 pub use crate::dag::status::NodeStatus;
 use crate::hashing::{ContentHash, NodeKey, StatCache};
@@ -54,8 +59,69 @@ pub struct NodeReport {
     pub output_hash: Option<ContentHash>,
     /// Seconds the stage ran in this run (0 when cached).
     pub seconds: f64,
-    /// The node's inputs with their sources and hashes (empty hash: not known yet, plan mode).
-    pub inputs: Vec<RecordedInput>,
+    /// Content hashes of the node's raw-file inputs, in input order (the other inputs' hashes are their
+    /// upstream nodes' output hashes: [`recorded_inputs`] puts them together).
+    pub file_hashes: Vec<ContentHash>,
+}
+
+/// The inputs of node `id` of `dag` with their sources and hashes, from the reports of its execution: an
+/// upstream's output hash, [`ABSENT`] for an optional input whose node failed or was skipped, an empty hash
+/// when not known yet (plan mode: the upstream will run).
+pub fn recorded_inputs(dag: &Dag, reports: &[NodeReport], id: NodeId) -> Vec<RecordedInput> {
+    let Some(node) = dag.nodes.get(id) else {
+        return Vec::new();
+    };
+    let files = reports.get(id).map_or(&[][..], |r| &r.file_hashes[..]);
+    recorded_with(dag, node, files, |u| {
+        let r = reports.get(u)?;
+        Some(match (&r.status, r.output_hash) {
+            (NodeStatus::Failed(_) | NodeStatus::Skipped { .. }, _) => Upstream::Unavailable,
+            (_, Some(h)) => Upstream::Hash(h),
+            _ => Upstream::Unknown,
+        })
+    })
+}
+
+/// What a consumer knows of one upstream node when its inputs are recorded.
+enum Upstream {
+    Hash(ContentHash),
+    Unknown,
+    Unavailable,
+}
+
+fn recorded_with(
+    dag: &Dag,
+    node: &Node,
+    file_hashes: &[ContentHash],
+    upstream: impl Fn(NodeId) -> Option<Upstream>,
+) -> Vec<RecordedInput> {
+    let mut files = file_hashes.iter();
+    node.inputs
+        .iter()
+        .map(|(label, r)| {
+            let (source, hash) = match r {
+                InputRef::File(p) => (
+                    format!("file {}", p.display()),
+                    files.next().map(|h| h.to_string()).unwrap_or_default(),
+                ),
+                InputRef::Node(u) | InputRef::OptionalNode(u) => {
+                    let hash = match (upstream(*u), r) {
+                        (Some(Upstream::Unavailable), InputRef::OptionalNode(_)) => {
+                            ABSENT.to_string()
+                        }
+                        (Some(Upstream::Hash(h)), _) => h.to_string(),
+                        _ => String::new(),
+                    };
+                    (dag.nodes[*u].identity(), hash)
+                }
+            };
+            RecordedInput {
+                label: label.to_string(),
+                source,
+                hash,
+            }
+        })
+        .collect()
 }
 
 /// Everything an execution produced.
@@ -118,8 +184,8 @@ struct Slot {
     hash: Option<ContentHash>,
     value: Option<AnyValue>,
     seconds: f64,
-    inputs: Vec<RecordedInput>,
-    consumers_left: usize,
+    file_hashes: Vec<ContentHash>,
+    consumers_left: u32,
 }
 
 enum Check {
@@ -143,6 +209,17 @@ struct Exec<'a> {
     mode: Mode,
     slots: Vec<Mutex<Slot>>,
     warnings: Mutex<(Vec<String>, BTreeSet<String>)>,
+    /// The record packs' index: last key and output hash of each node, output hash of each key.
+    index: RecordIndex,
+    /// Plan mode: the keys of the index whose entry exists, from one listing of the store (`None`: the store
+    /// holds far more entries than the graph has nodes, each node checks its own entry).
+    present: Option<crate::dag::objects_listing::Present>,
+    /// The pack this execution writes its records into (opened on the first record).
+    pack: Mutex<Option<PackWriter>>,
+    /// Whether any failure record exists (only then does a success remove the node's failure record).
+    failures_recorded: bool,
+    /// Run mode: marks cached entries used.
+    marker: crate::dag::objects_listing::EntryMarker,
 }
 
 /// Execute (or plan) `dag`. Never panics on stage errors/panics or store trouble; those become node
@@ -157,12 +234,22 @@ pub fn execute(dag: &Dag, env: &Env<'_>, mode: Mode) -> Outcome {
             lock(&mut slots, u).consumers_left += 1;
         }
     }
+    let index = RecordIndex::load(env.store);
+    let present = match mode {
+        Mode::Plan => crate::dag::objects_listing::Present::list(env.store, &index, dag.len()),
+        Mode::Run => None,
+    };
     let ex = Exec {
         dag,
         env,
         mode,
         slots,
         warnings: Mutex::new((Vec::new(), BTreeSet::new())),
+        index,
+        present,
+        pack: Mutex::new(None),
+        failures_recorded: record::any_failure_recorded(env.store),
+        marker: crate::dag::objects_listing::EntryMarker::new(env.store),
     };
     let mut totals: BTreeMap<&'static str, usize> = BTreeMap::new();
     for n in &dag.nodes {
@@ -186,11 +273,28 @@ pub fn execute(dag: &Dag, env: &Env<'_>, mode: Mode) -> Outcome {
     }
     if mode == Mode::Run {
         env.progress.end();
+        ex.commit_records();
     }
+    // The index is not needed any more: free it before the reports are built (peak memory).
+    let Exec {
+        slots,
+        warnings,
+        index,
+        present,
+        ..
+    } = ex;
+    drop((index, present));
     let mut values = HashMap::new();
     let mut reports = Vec::with_capacity(dag.nodes.len());
-    for (id, node) in dag.nodes.iter().enumerate() {
-        let mut s = ex.slot(id);
+    // Last node first, giving the slots' memory back as the reports take it (peak memory of a large graph).
+    let mut slots = slots;
+    while let Some(slot) = slots.pop() {
+        let id = slots.len();
+        let node = &dag.nodes[id];
+        if id % 4096 == 0 && slots.capacity() > slots.len() + slots.len() / 8 {
+            slots.shrink_to_fit();
+        }
+        let mut s = slot.into_inner().unwrap_or_else(|e| e.into_inner());
         if node.requested {
             if let Some(v) = s.value.take() {
                 values.insert(id, v);
@@ -208,9 +312,10 @@ pub fn execute(dag: &Dag, env: &Env<'_>, mode: Mode) -> Outcome {
             key: s.key,
             output_hash: s.hash,
             seconds: s.seconds,
-            inputs: std::mem::take(&mut s.inputs),
+            file_hashes: s.file_hashes,
         });
     }
+    reports.reverse();
     let mut metrics = Vec::new();
     for sink in &dag.sinks {
         if let Some(v) = values.get(&sink.node) {
@@ -219,11 +324,7 @@ pub fn execute(dag: &Dag, env: &Env<'_>, mode: Mode) -> Outcome {
             }
         }
     }
-    let warnings = ex
-        .warnings
-        .into_inner()
-        .unwrap_or_else(|e| e.into_inner())
-        .0;
+    let warnings = warnings.into_inner().unwrap_or_else(|e| e.into_inner()).0;
     Outcome {
         reports,
         values,
@@ -333,8 +434,7 @@ impl<'a> Exec<'a> {
                     record_stale,
                 } => {
                     if record_stale && self.mode == Mode::Run {
-                        let inputs = self.slot(id).inputs.clone();
-                        self.write_records(node, key, hash, 0.0, inputs);
+                        self.write_records(id, key, hash, 0.0);
                     }
                     let mut s = self.slot(id);
                     s.key = Some(key);
@@ -441,102 +541,103 @@ impl<'a> Exec<'a> {
         }
     }
 
-    /// Step 1 for one node.
-    fn check(&self, id: NodeId) -> Check {
+    /// The inputs of node `id` as recorded now (from the slots of its upstream nodes).
+    fn recorded_now(&self, id: NodeId) -> Vec<RecordedInput> {
+        let files = self.slot(id).file_hashes.clone();
+        recorded_with(self.dag, &self.dag.nodes[id], &files, |u| {
+            let s = self.slot(u);
+            Some(match (&s.status, s.hash) {
+                (Some(NodeStatus::Failed(_) | NodeStatus::Skipped { .. }), _) => {
+                    Upstream::Unavailable
+                }
+                (Some(NodeStatus::WillRun { .. }), _) => Upstream::Unknown,
+                (_, Some(h)) => Upstream::Hash(h),
+                _ => Upstream::Unknown,
+            })
+        })
+    }
+
+    /// The input hashes of node `id` for its key, in input order; whether an upstream will run (plan mode);
+    /// or why the node cannot run.
+    fn input_hashes(&self, id: NodeId) -> Result<(Vec<ContentHash>, bool), Check> {
         let node = &self.dag.nodes[id];
         let mut hashes = Vec::with_capacity(node.inputs.len());
-        let mut recorded = Vec::with_capacity(node.inputs.len());
-        let mut upstream_running = Vec::new();
-        for (label, r) in &node.inputs {
+        let mut files = Vec::new();
+        let mut upstream_running = false;
+        for (_, r) in &node.inputs {
             match r {
-                InputRef::OptionalNode(u) if self.unavailable(*u) => {
-                    hashes.push(absent_hash());
-                    recorded.push(RecordedInput {
-                        label: label.clone(),
-                        source: self.dag.nodes[*u].identity(),
-                        hash: ABSENT.to_string(),
-                    });
-                }
                 InputRef::Node(u) | InputRef::OptionalNode(u) => {
                     let s = self.slot(*u);
-                    let source = self.dag.nodes[*u].identity();
-                    match &s.status {
-                        Some(NodeStatus::Failed(_)) => return Check::Skipped(source),
-                        Some(NodeStatus::Skipped { upstream }) => return Check::Skipped(upstream.clone()),
-                        Some(NodeStatus::WillRun { .. }) => {
-                            if !upstream_running.contains(&source) {
-                                upstream_running.push(source.clone());
-                            }
+                    match (&s.status, r) {
+                        (Some(NodeStatus::Failed(_) | NodeStatus::Skipped { .. }), InputRef::OptionalNode(_)) => {
+                            hashes.push(absent_hash())
+                        }
+                        (Some(NodeStatus::Failed(_)), _) => {
+                            return Err(Check::Skipped(self.dag.nodes[*u].identity()))
+                        }
+                        (Some(NodeStatus::Skipped { upstream }), _) => {
+                            return Err(Check::Skipped(upstream.clone()))
+                        }
+                        (Some(NodeStatus::WillRun { .. }), _) => {
+                            upstream_running = true;
                             hashes.push(ContentHash([0; 32]));
-                            recorded.push(RecordedInput { label: label.clone(), source, hash: String::new() });
                         }
                         _ => match s.hash {
-                            Some(h) => {
-                                hashes.push(h);
-                                recorded.push(RecordedInput { label: label.clone(), source, hash: h.to_string() });
+                            Some(h) => hashes.push(h),
+                            None => {
+                                return Err(Check::Failed(format!(
+                                    "internal error: upstream {} has no output",
+                                    self.dag.nodes[*u].identity()
+                                )))
                             }
-                            None => return Check::Failed(format!("internal error: upstream {source} has no output")),
                         },
                     }
                 }
                 InputRef::File(p) => match self.env.stat_cache.hash_file(p) {
                     Ok(h) => {
                         hashes.push(h);
-                        recorded.push(RecordedInput {
-                            label: label.clone(),
-                            source: format!("file {}", p.display()),
-                            hash: h.to_string(),
-                        });
+                        files.push(h);
                     }
                     Err(e) => {
-                        return Check::Failed(format!(
+                        return Err(Check::Failed(format!(
                             "cannot read input file {}: {e} (check that the campaign folder is complete)",
                             p.display()
-                        ))
+                        )))
                     }
                 },
             }
         }
+        if !files.is_empty() {
+            self.slot(id).file_hashes = files;
+        }
+        Ok((hashes, upstream_running))
+    }
+
+    /// Step 1 for one node.
+    fn check(&self, id: NodeId) -> Check {
+        let node = &self.dag.nodes[id];
+        let (hashes, upstream_running) = match self.input_hashes(id) {
+            Ok(h) => h,
+            Err(check) => return check,
+        };
         let variant = node
             .variants
             .first()
             .map(String::as_str)
             .unwrap_or("default");
-        let identity = node.identity();
-        if !upstream_running.is_empty() {
-            let prev = record::load_record(self.env.store, &identity, variant);
-            let mut why =
-                record::reasons(prev.as_ref(), node.version, &node.params_json, &recorded);
-            why.retain(|w| {
-                !w.starts_with("same ingredients") && !w.starts_with("upstream will run")
-            });
-            if prev.is_some() {
-                const SHOWN: usize = 5;
-                let mut list = upstream_running
-                    .iter()
-                    .take(SHOWN)
-                    .cloned()
-                    .collect::<Vec<_>>()
-                    .join(", ");
-                if upstream_running.len() > SHOWN {
-                    list.push_str(&format!(" and {} more", upstream_running.len() - SHOWN));
-                }
-                why.push(format!("upstream will run: {list}"));
-            }
-            self.slot(id).inputs = recorded;
-            return Check::WillRun(why);
+        if upstream_running {
+            return Check::WillRun(self.upstream_running_reasons(id, variant));
         }
         let key = node_key(node, &hashes);
-        let key_hex = key.to_string();
-        let prev = record::load_record(self.env.store, &identity, variant);
-        let known_hash = match &prev {
-            Some(r) if r.key == key_hex => ContentHash::from_hex(&r.output_hash).ok(),
-            _ => record::load_output_hash(self.env.store, &key),
+        let latest = self
+            .index
+            .latest(name_hash(node.stage, &node.item, variant));
+        let (known_hash, record_stale) = match latest {
+            Some((k, h)) if k == key => (Some(h), false),
+            _ => (self.index.output_of(&key), true),
         };
-        let record_stale = prev.as_ref().is_none_or(|r| r.key != key_hex);
-        self.slot(id).inputs = recorded;
         if let Some(hash) = known_hash {
-            if touch_entry(self.env.store, &key) {
+            if self.entry_exists(&key) {
                 return Check::Cached {
                     key,
                     hash,
@@ -553,15 +654,68 @@ impl<'a> Exec<'a> {
                 record_stale: true,
             },
             _ if self.mode == Mode::Plan => {
-                let inputs = self.slot(id).inputs.clone();
+                let prev = self.load_record(node, variant);
                 Check::WillRun(record::reasons(
                     prev.as_ref(),
                     node.version,
                     &node.params_json,
-                    &inputs,
+                    &self.recorded_now(id),
                 ))
             }
             _ => Check::Run { key },
+        }
+    }
+
+    /// Plan mode, for a node an upstream of which will run: what changed since its last record, and which
+    /// upstream nodes will run.
+    fn upstream_running_reasons(&self, id: NodeId, variant: &str) -> Vec<String> {
+        let node = &self.dag.nodes[id];
+        let prev = self.load_record(node, variant);
+        let recorded = self.recorded_now(id);
+        let mut why = record::reasons(prev.as_ref(), node.version, &node.params_json, &recorded);
+        why.retain(|w| !w.starts_with("same ingredients") && !w.starts_with("upstream will run"));
+        if prev.is_some() {
+            const SHOWN: usize = 5;
+            let mut running: Vec<String> = Vec::new();
+            for (i, (_, r)) in node.inputs.iter().enumerate() {
+                if let (Some(u), true) = (r.node(), recorded[i].hash.is_empty()) {
+                    let source = self.dag.nodes[u].identity();
+                    if !running.contains(&source) {
+                        running.push(source);
+                    }
+                }
+            }
+            let mut list = running
+                .iter()
+                .take(SHOWN)
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", ");
+            if running.len() > SHOWN {
+                list.push_str(&format!(" and {} more", running.len() - SHOWN));
+            }
+            why.push(format!("upstream will run: {list}"));
+        }
+        why
+    }
+
+    /// The node's last record (for the reasons it will run).
+    fn load_record(&self, node: &Node, variant: &str) -> Option<NodeRecord> {
+        let identity = node.identity();
+        record::record_in(&self.index, &identity, variant)
+            .or_else(|| record::load_record_file(self.env.store, &identity, variant))
+    }
+
+    /// Whether the entry of `key` exists. Plan mode: from the listing when there is one, else a `stat`. Run
+    /// mode: the entry is also marked used now (see [`touch_entry`]).
+    fn entry_exists(&self, key: &NodeKey) -> bool {
+        match (self.mode, &self.present) {
+            (Mode::Plan, Some(present)) => present.contains(&self.index, key),
+            (Mode::Plan, None) => self.env.store.object_path(key).is_file(),
+            (Mode::Run, _) => self
+                .marker
+                .mark(key)
+                .unwrap_or_else(|| touch_entry(self.env.store, key)),
         }
     }
 
@@ -757,7 +911,7 @@ impl<'a> Exec<'a> {
                         .hash_file(p)
                         .map_err(|e| format!("cannot read input file {}: {e}", p.display()))?;
                     values.push(InputValue::File(RawFileValue {
-                        path: p.clone(),
+                        path: p.to_path_buf(),
                         hash: h,
                     }));
                     hashes.push(h);
@@ -816,8 +970,12 @@ impl<'a> Exec<'a> {
                 ))
             }
         };
-        let inputs = self.slot(id).inputs.clone();
-        self.write_records(node, key, hash, seconds, inputs);
+        {
+            let mut s = self.slot(id);
+            s.key = Some(key);
+            s.hash = Some(hash);
+        }
+        self.write_records(id, key, hash, seconds);
         let mut s = self.slot(id);
         s.key = Some(key);
         s.hash = Some(hash);
@@ -825,36 +983,66 @@ impl<'a> Exec<'a> {
         Ok(seconds)
     }
 
-    fn write_records(
-        &self,
-        node: &Node,
-        key: NodeKey,
-        hash: ContentHash,
-        seconds: f64,
-        inputs: Vec<RecordedInput>,
-    ) {
-        let store = self.env.store;
-        if let Err(e) = record::save_output_hash(store, &key, &hash) {
-            self.warn(format!("could not write a cache record: {e}"));
-            return;
-        }
+    /// Records node `id`'s run (key, output hash, ingredients) in this execution's pack, once per variant.
+    fn write_records(&self, id: NodeId, key: NodeKey, hash: ContentHash, seconds: f64) {
+        let node = &self.dag.nodes[id];
         let identity = node.identity();
+        let inputs = self.recorded_now(id);
+        let mut pack = self.pack.lock().unwrap_or_else(|e| e.into_inner());
+        if pack.is_none() {
+            match PackWriter::open(self.env.store) {
+                Ok(w) => *pack = Some(w),
+                Err(e) => {
+                    drop(pack);
+                    self.warn(format!("could not write the run's records: {e}"));
+                    return;
+                }
+            }
+        }
+        let Some(writer) = pack.as_mut() else { return };
         for variant in &node.variants {
             let rec = NodeRecord {
                 identity: identity.clone(),
                 variant: variant.clone(),
                 key: key.to_string(),
                 stage_version: node.version.to_string(),
-                params: node.params_json.clone(),
+                params: (*node.params_json).clone(),
                 inputs: inputs.clone(),
                 output_hash: hash.to_string(),
                 seconds,
                 recorded_unix_s: now_unix_s(),
                 skytie_version: env!("CARGO_PKG_VERSION").to_string(),
             };
-            if let Err(e) = record::save_record(store, &rec) {
-                self.warn(format!("could not write a cache record: {e}"));
+            let name = name_hash(node.stage, &node.item, variant);
+            let pushed = serde_json::to_vec(&rec)
+                .map_err(std::io::Error::other)
+                .and_then(|bytes| writer.push(name, key, hash, &bytes));
+            if let Err(e) = pushed {
+                drop(pack);
+                self.warn(format!("could not write the run's records: {e}"));
+                return;
             }
+        }
+        drop(pack);
+        if self.failures_recorded {
+            for variant in &node.variants {
+                let name = record::record_name(&identity, variant);
+                if let Err(e) = self.env.store.remove_record(record::FAILURES_NS, &name) {
+                    self.warn(format!("could not update a failure record: {e}"));
+                }
+            }
+        }
+    }
+
+    /// Commits this execution's record pack and flushes the entries it stored to disk.
+    fn commit_records(&self) {
+        let pack = self.pack.lock().unwrap_or_else(|e| e.into_inner()).take();
+        let Some(pack) = pack else { return };
+        if let Err(e) = pack.finish() {
+            self.warn(format!("could not write the run's records: {e}"));
+        }
+        if let Err(e) = self.env.store.sync() {
+            self.warn(format!("could not flush the cache to disk: {e}"));
         }
     }
 }

@@ -67,13 +67,13 @@ pub struct RawFileValue {
     pub hash: ContentHash,
 }
 
-/// One input edge, as the builder records it.
+/// One input edge, as the builder records it (16 bytes: a graph holds millions).
 #[derive(Clone, Debug)]
 pub enum InputRef {
     Node(NodeId),
     /// A node's output the consumer can do without (see [`Optional`]).
     OptionalNode(NodeId),
-    File(PathBuf),
+    File(Arc<PathBuf>),
 }
 
 impl InputRef {
@@ -98,9 +98,13 @@ pub enum InputValue {
 /// The input hash standing for an [`Optional`] input whose node failed or was skipped: a consumer that ran
 /// without it has a key of its own, and runs again once the input is produced.
 pub fn absent_hash() -> ContentHash {
-    ContentHash(
-        *blake3::hash(b"skytie: optional input absent (its node failed or was skipped)").as_bytes(),
-    )
+    static ABSENT: std::sync::OnceLock<ContentHash> = std::sync::OnceLock::new();
+    *ABSENT.get_or_init(|| {
+        ContentHash(
+            *blake3::hash(b"skytie: optional input absent (its node failed or was skipped)")
+                .as_bytes(),
+        )
+    })
 }
 
 /// An input the consumer can do without: when its node fails or is skipped, the consumer still runs and
@@ -199,7 +203,7 @@ impl<T: Send + Sync + 'static> InputSet for Handle<T> {
 impl InputSet for RawFile {
     type Values = RawFileValue;
     fn collect_refs(&self, label: &str, out: &mut Vec<(String, InputRef)>) {
-        out.push((label.to_string(), InputRef::File(self.0.clone())));
+        out.push((label.to_string(), InputRef::File(Arc::new(self.0.clone()))));
     }
     fn take_values(
         &self,

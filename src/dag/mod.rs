@@ -8,15 +8,17 @@ pub mod inputs;
 pub mod json_diff;
 pub mod key;
 pub mod node;
+pub mod objects_listing;
 pub mod progress;
 pub mod record;
+pub mod record_pack;
 pub mod shard;
 pub mod stage;
 pub mod status;
 
 pub use builder::{BuildError, Dag, DagBuilder};
 pub use error::StageError;
-pub use executor::{execute, Env, Mode, NodeReport, NodeStatus, Outcome};
+pub use executor::{execute, recorded_inputs, Env, Mode, NodeReport, NodeStatus, Outcome};
 pub use inputs::{optional_all, Handle, InputSet, NodeId, Optional, RawFile, RawFileValue};
 pub use stage::{InputsOf, NodeCtx, RunResult, Stage};
 pub mod pipeline;

@@ -67,12 +67,12 @@ pub struct Node {
     pub item: String,
     /// Variants of a sweep that use this node (a node shared by variants lists all of them).
     pub variants: Vec<String>,
-    /// Canonical params bytes (part of the key).
-    pub params_bytes: Vec<u8>,
+    /// Canonical params bytes (part of the key), shared by the nodes with equal params.
+    pub params_bytes: Arc<[u8]>,
     /// The same params as JSON, to tell which field changed.
-    pub params_json: serde_json::Value,
-    /// Labelled input edges, in the order the stage receives them.
-    pub inputs: Vec<(String, InputRef)>,
+    pub params_json: Arc<serde_json::Value>,
+    /// Labelled input edges, in the order the stage receives them (labels are shared between nodes).
+    pub inputs: Vec<(Arc<str>, InputRef)>,
     pub(crate) erased: Box<dyn ErasedStage>,
     /// The caller wants this node's value after the run.
     pub requested: bool,

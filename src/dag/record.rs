@@ -4,7 +4,8 @@
 //! `explain` prints the record as the node's provenance. A second record maps an output key to its content
 //! hash so an all-cached run need not read artifacts it does not use. A third one keeps a node's last
 //! failure (error message and ingredients) until the node next succeeds, so `plan` can say "failed last
-//! time: `<error>`" instead of calling the node new.
+//! time: `<error>`" instead of calling the node new. A run keeps the records of its nodes in one pack
+//! ([`crate::dag::record_pack`]), which also maps keys to output hashes.
 
 use crate::hashing::{ContentHash, NodeKey};
 use crate::store::Store;
@@ -84,12 +85,43 @@ pub fn record_name(identity: &str, variant: &str) -> String {
     format!("{identity}@{variant}")
 }
 
+/// The last record of node `identity` in `variant`: from the record packs (where runs keep them, see
+/// [`crate::dag::record_pack`]), else a record of its own (as [`save_record`] writes).
 pub fn load_record(store: &Store, identity: &str, variant: &str) -> Option<NodeRecord> {
+    record_in(
+        &crate::dag::record_pack::RecordIndex::load(store),
+        identity,
+        variant,
+    )
+    .or_else(|| load_record_file(store, identity, variant))
+}
+
+/// The record of node `identity` in `variant` from the loaded record packs, if it is there and names it.
+pub fn record_in(
+    index: &crate::dag::record_pack::RecordIndex,
+    identity: &str,
+    variant: &str,
+) -> Option<NodeRecord> {
+    let rec: NodeRecord = serde_json::from_slice(&index.record_bytes(identity, variant)?).ok()?;
+    (rec.identity == identity && rec.variant == variant).then_some(rec)
+}
+
+/// A record of its own of node `identity` in `variant` (as [`save_record`] writes, and earlier versions did
+/// for every node), without looking into the packs.
+pub fn load_record_file(store: &Store, identity: &str, variant: &str) -> Option<NodeRecord> {
     let bytes = store.get_record(NODES_NS, &record_name(identity, variant))?;
     serde_json::from_slice(&bytes).ok()
 }
 
-/// Saves the record of a successful run; a failure recorded for the node is removed (it succeeded since).
+/// Whether any failure record exists (one listing of their folder).
+pub fn any_failure_recorded(store: &Store) -> bool {
+    std::fs::read_dir(store.root().join("records").join(FAILURES_NS))
+        .map(|mut d| d.next().is_some())
+        .unwrap_or(false)
+}
+
+/// Saves the record of a successful run as a record of its own (runs write theirs into a pack); a failure
+/// recorded for the node is removed (it succeeded since).
 pub fn save_record(store: &Store, record: &NodeRecord) -> Result<(), String> {
     let bytes = serde_json::to_vec(record).map_err(|e| e.to_string())?;
     let name = record_name(&record.identity, &record.variant);

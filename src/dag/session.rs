@@ -96,6 +96,13 @@ pub struct Phase {
     pub requested: Vec<NodeId>,
 }
 
+impl Phase {
+    /// The inputs of node `id` with their sources and hashes (see [`crate::dag::executor::recorded_inputs`]).
+    pub fn inputs(&self, id: NodeId) -> Vec<crate::dag::record::RecordedInput> {
+        crate::dag::executor::recorded_inputs(&self.dag, &self.reports, id)
+    }
+}
+
 /// See the module documentation.
 pub struct Session<'a> {
     pub store: &'a Store,

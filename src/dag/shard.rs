@@ -25,7 +25,6 @@ use crate::dag::executor::{execute, Env, Mode};
 use crate::dag::inputs::{InputRef, NodeId};
 use crate::dag::record::load_failure;
 use crate::dag::status::NodeStatus;
-use petgraph::graph::{DiGraph, NodeIndex};
 use std::fmt;
 use std::ops::Range;
 use std::str::FromStr;
@@ -157,7 +156,6 @@ impl Dag {
         let mut new_id: Vec<Option<NodeId>> = vec![None; nodes.len()];
         let mut old_ids = Vec::new();
         let mut kept = Vec::new();
-        let mut graph = DiGraph::new();
         for (old, mut node) in nodes.into_iter().enumerate() {
             if !keep[old] {
                 continue;
@@ -165,7 +163,6 @@ impl Dag {
             let id = kept.len();
             new_id[old] = Some(id);
             old_ids.push(old);
-            let gid = graph.add_node(id);
             for (_, r) in node.inputs.iter_mut() {
                 if let InputRef::Node(u) | InputRef::OptionalNode(u) = r {
                     // Kept nodes' ancestors are kept (`with_ancestors`), and come first.
@@ -173,9 +170,6 @@ impl Dag {
                         *u = n;
                     }
                 }
-            }
-            for u in node.upstream_ids() {
-                graph.add_edge(NodeIndex::new(u), gid, ());
             }
             kept.push(node);
         }
@@ -186,11 +180,7 @@ impl Dag {
             }
             None => false,
         });
-        let dag = Dag {
-            nodes: kept,
-            graph,
-            sinks,
-        };
+        let dag = Dag { nodes: kept, sinks };
         (dag, old_ids)
     }
 }

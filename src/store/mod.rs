@@ -292,7 +292,8 @@ impl Store {
         }
     }
 
-    /// Atomically stores `payload` as the entry of `key` (temporary file in the same folder, fsync, rename).
+    /// Atomically stores `payload` as the entry of `key` (temporary file in the same folder, rename; durable
+    /// after [`Store::sync`]).
     /// Returns the payload's content hash. Concurrent saves of one key are safe (identical bytes, atomic rename).
     pub fn save(
         &self,
@@ -306,8 +307,8 @@ impl Store {
     /// Atomically stores the payload that `encode` writes to its sink (e.g.
     /// [`Artifact::encode_to`](crate::codec::Artifact::encode_to)) as the entry of `key`, without building it
     /// in memory first: the bytes go straight to a temporary file and are hashed on the way; the header
-    /// (length and hash) is written over its placeholder at the end, then the file is fsynced and renamed into
-    /// place. Returns the payload's content hash. An error of `encode` leaves no entry.
+    /// (length and hash) is written over its placeholder at the end, then the file is renamed into place
+    /// (durable after [`Store::sync`]). Returns the payload's content hash. An error of `encode` leaves no entry.
     pub fn save_with(
         &self,
         key: &NodeKey,
@@ -323,7 +324,9 @@ impl Store {
         let placeholder = entry::encode_header(key, &meta_block, 0, &ContentHash::default());
         let path = self.object_path(key);
         let mut content_hash = ContentHash::default();
-        skytie_util::fsutil::atomic_write_with(&path, |w| {
+        // No fsync per entry: an entry is verified on every read, so one damaged by a machine crash is found,
+        // deleted and recomputed; [`Store::sync`] makes a run's entries durable at once.
+        skytie_util::fsutil::atomic_write_unsynced_with(&path, |w| {
             w.write_all(&placeholder)?;
             let mut sink = HashingWriter::new(&mut *w);
             encode(&mut sink)?;
@@ -345,6 +348,13 @@ impl Store {
             }
         }
         Ok(content_hash)
+    }
+
+    /// Flushes the entries written so far to disk (one `syncfs` of the cache's file system instead of an fsync
+    /// per entry); a run calls it when it has stored its results.
+    pub fn sync(&self) -> Result<(), StoreError> {
+        skytie_util::fsutil::sync_file_system(&self.objects)
+            .map_err(StoreError::io("flush cache entries", &self.objects))
     }
 
     /// Whether an entry file for `key` exists (no verification). While a run holds a lease from this handle,
