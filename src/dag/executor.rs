@@ -1014,9 +1014,23 @@ impl<'a> Exec<'a> {
                 skytie_version: env!("CARGO_PKG_VERSION").to_string(),
             };
             let name = name_hash(node.stage, &node.item, variant);
+            // With a remote cache every node record (and below, the key's output hash) is also a record of its own,
+            // uploaded: other hosts and the remote collection (whose roots they are) read the remote's records, not
+            // this host's packs.
+            let remote = self.env.store.remote_url().is_some();
             let pushed = serde_json::to_vec(&rec)
                 .map_err(std::io::Error::other)
-                .and_then(|bytes| writer.push(name, key, hash, &bytes));
+                .and_then(|bytes| {
+                    writer.push(name, key, hash, &bytes)?;
+                    if remote {
+                        let own = record::record_name(&identity, variant);
+                        self.env
+                            .store
+                            .put_record(record::NODES_NS, &own, &bytes)
+                            .map_err(std::io::Error::other)?;
+                    }
+                    Ok(())
+                });
             if let Err(e) = pushed {
                 drop(pack);
                 self.warn(format!("could not write the run's records: {e}"));
@@ -1024,6 +1038,11 @@ impl<'a> Exec<'a> {
             }
         }
         drop(pack);
+        if self.env.store.remote_url().is_some() {
+            if let Err(e) = record::save_output_hash(self.env.store, &key, &hash) {
+                self.warn(format!("could not write the run's records: {e}"));
+            }
+        }
         if self.failures_recorded {
             for variant in &node.variants {
                 let name = record::record_name(&identity, variant);
