@@ -8,35 +8,10 @@
 #[path = "support/cli.rs"]
 mod cli;
 
-use cli::skytie;
+use cli::{json, output_files, skytie};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::Path;
-
-/// Every file under `root` except the HTML report, by relative path.
-fn output_files(root: &Path) -> BTreeMap<String, Vec<u8>> {
-    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<String, Vec<u8>>) {
-        for e in std::fs::read_dir(dir).unwrap() {
-            let p = e.unwrap().path();
-            let rel = p.strip_prefix(root).unwrap().display().to_string();
-            if rel == "report" || rel == "shards" {
-                continue;
-            }
-            if p.is_dir() {
-                walk(root, &p, out);
-            } else {
-                out.insert(rel, std::fs::read(&p).unwrap());
-            }
-        }
-    }
-    let mut out = BTreeMap::new();
-    walk(root, root, &mut out);
-    out
-}
-
-fn json(path: &Path) -> Value {
-    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
-}
 
 /// metrics.json without the engine's bookkeeping (node counts, seconds).
 fn results_of(metrics: &Value) -> Value {

@@ -11,7 +11,7 @@
 mod cli;
 mod support;
 
-use cli::skytie;
+use cli::{json, output_files, skytie};
 use serde_json::Value;
 use skytie::dag::progress::{Progress, ProgressMode};
 use skytie::dag::{execute, DagBuilder, Env, Mode, Outcome};
@@ -433,31 +433,6 @@ fn cli_run(
         String::from_utf8_lossy(&o.stderr)
     );
     (o.status.code().unwrap_or(-1), text)
-}
-
-fn json(path: &Path) -> Value {
-    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
-}
-
-/// Every output file except the report and the per-part summaries, by relative path.
-fn output_files(root: &Path) -> BTreeMap<String, Vec<u8>> {
-    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<String, Vec<u8>>) {
-        for e in std::fs::read_dir(dir).unwrap() {
-            let p = e.unwrap().path();
-            let rel = p.strip_prefix(root).unwrap().display().to_string();
-            if rel == "report" || rel == "shards" {
-                continue;
-            }
-            if p.is_dir() {
-                walk(root, &p, out);
-            } else {
-                out.insert(rel, std::fs::read(&p).unwrap());
-            }
-        }
-    }
-    let mut out = BTreeMap::new();
-    walk(root, root, &mut out);
-    out
 }
 
 /// metrics.json without the engine's bookkeeping (node counts, seconds).
