@@ -5,7 +5,7 @@
 use crate::report::inputs::{num_at, read_csv_opt, RunOutputs};
 use serde_json::Value;
 use skytie_stages::campaign::{read_recordings_csv, Recording};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
 /// Which way a metric gets better.
@@ -163,7 +163,13 @@ fn segment_truth(out: &Path, campaign: &Path) -> Result<Vec<(f64, bool)>, String
     recorded.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
     let true_of: BTreeMap<&str, &Recording> =
         truth.iter().map(|t| (t.image_id.as_str(), t)).collect();
-    let pos = |id: &str| recorded.iter().position(|r| r.image_id == id);
+    let position_of: HashMap<&str, usize> = recorded
+        .iter()
+        .enumerate()
+        .rev()
+        .map(|(i, r)| (r.image_id.as_str(), i))
+        .collect();
+    let pos = |id: &str| position_of.get(id).copied();
     let mut out_rows = Vec::new();
     for row in &v.rows {
         if v.text(row, "segment") == "all" {

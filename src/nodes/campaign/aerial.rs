@@ -31,19 +31,12 @@ impl Stage for SelectAerial {
     crate::nodes::stage_types!(STAGE, SelectAerialParams => AerialImage, inputs: Handle<CampaignSnapshot>);
 
     fn run(&self, p: &SelectAerialParams, snap: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
-        let rows = match p.kind {
-            AerialKind::Nadir => &snap.campaign.nadir,
-            AerialKind::Oblique => &snap.campaign.oblique,
-        };
-        rows.iter()
-            .find(|r| r.image_id == p.image_id)
-            .cloned()
-            .ok_or_else(|| {
-                StageError::new(format!(
-                    "aerial image '{}' is not in the campaign any more",
-                    p.image_id
-                ))
-            })
+        snap.aerial(p.kind, &p.image_id).cloned().ok_or_else(|| {
+            StageError::new(format!(
+                "aerial image '{}' is not in the campaign any more",
+                p.image_id
+            ))
+        })
     }
 }
 

@@ -7,9 +7,11 @@
 //! new or edited recordings' downstream nodes run again.
 
 use crate::dag::{Handle, InputsOf, NodeCtx, RawFile, RunResult, Stage, StageError};
+use crate::nodes::campaign::row_index::RowIndex;
 use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::{
-    read_sourced, Campaign, Problem, Recording, SourceRows, SourcedCampaign,
+    read_sourced, AerialImage, AerialKind, Campaign, Problem, Recording, SourceRows,
+    SourcedCampaign,
 };
 use skytie_stages::params::StageId;
 use std::path::Path;
@@ -41,6 +43,9 @@ pub struct CampaignSnapshot {
     /// The row each item came from (parallel to the campaign's vectors).
     pub rows: SourceRows,
     pub problems: Vec<Problem>,
+    /// Rows by `image_id`, built on first use (not part of the artifact's bytes).
+    #[serde(skip)]
+    pub index: RowIndex,
 }
 
 impl CampaignSnapshot {
@@ -49,6 +54,22 @@ impl CampaignSnapshot {
             campaign: sourced.campaign,
             rows: sourced.rows,
             problems,
+            index: RowIndex::default(),
+        }
+    }
+
+    /// The recording `image_id`, found through the index (constant time per look-up).
+    pub fn recording(&self, image_id: &str) -> Option<&Recording> {
+        let i = self.index.recording(&self.campaign, image_id)?;
+        self.campaign.recordings.get(i)
+    }
+
+    /// The aerial image `image_id` among the rows of `kind`.
+    pub fn aerial(&self, kind: AerialKind, image_id: &str) -> Option<&AerialImage> {
+        let i = self.index.aerial(&self.campaign, kind, image_id)?;
+        match kind {
+            AerialKind::Nadir => self.campaign.nadir.get(i),
+            AerialKind::Oblique => self.campaign.oblique.get(i),
         }
     }
 
@@ -117,16 +138,11 @@ impl Stage for SelectRecording {
         inputs: Handle<CampaignSnapshot>);
 
     fn run(&self, p: &SelectRecordingParams, snap: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
-        snap.campaign
-            .recordings
-            .iter()
-            .find(|r| r.image_id == p.image_id)
-            .cloned()
-            .ok_or_else(|| {
-                StageError::new(format!(
-                    "recording '{}' is not in the campaign any more",
-                    p.image_id
-                ))
-            })
+        snap.recording(&p.image_id).cloned().ok_or_else(|| {
+            StageError::new(format!(
+                "recording '{}' is not in the campaign any more",
+                p.image_id
+            ))
+        })
     }
 }

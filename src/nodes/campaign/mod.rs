@@ -8,6 +8,7 @@ pub mod image_tiles;
 pub mod ingest;
 pub mod load;
 pub mod panorama_sizes;
+pub mod row_index;
 pub mod summary;
 pub mod synth;
 pub mod validate;
