@@ -166,3 +166,32 @@ mod tests {
         assert_eq!(f.iter().filter(|f| f.regression).count(), 2, "{f:?}");
     }
 }
+
+#[cfg(test)]
+mod committed {
+    use super::*;
+    use crate::eval::Matrix;
+    use std::path::Path;
+
+    /// The committed baseline parses, and every row it judges is a preset/profile of the held-out matrix with
+    /// the matrix's seeds (a baseline made on other seeds would compare unlike with like).
+    #[test]
+    fn the_committed_baseline_matches_the_held_out_matrix() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(root.join("benches/eval/baseline.json")).unwrap();
+        let base: Baseline = serde_json::from_str(&text).unwrap();
+        let matrix = Matrix::load(&root.join("benches/eval/matrix.toml")).unwrap();
+        assert!(!base.table.is_empty());
+        for (key, row) in &base.table {
+            let (preset, profile) = key.split_once('/').unwrap();
+            let cells = matrix
+                .presets
+                .iter()
+                .find(|p| p.name == preset)
+                .unwrap_or_else(|| panic!("{key}: preset not in the matrix"));
+            assert!(cells.profiles.iter().any(|p| p == profile), "{key}");
+            assert_eq!(row.seeds, cells.seeds, "{key}");
+            assert!(row.metrics.contains_key("cp_2d_after"), "{key}");
+        }
+    }
+}

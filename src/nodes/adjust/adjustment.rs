@@ -86,6 +86,7 @@ impl AdjustReport {
             "variance_factor": r.variance_factor,
             "redundancy": r.redundancy,
             "build": r.build,
+            "relative_sigma": r.relative_sigma,
             "trajectory": recording_metrics(r),
             "verdict": self.verdict().label(),
         }})

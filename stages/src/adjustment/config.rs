@@ -113,8 +113,10 @@ crate::params! {
         /// Keep the recorded differences between consecutive recordings (thesis 3.4.2) with σ
         /// `relative_sigma_m`.
         relative_constraints: bool = false;
-        /// σ of a relative constraint per axis.
-        relative_sigma_m: f64 = 0.02, unit "m", above 0.0;
+        /// σ of a relative constraint per axis (the recorded trajectory's relative accuracy between
+        /// consecutive recordings); absent = estimated from the recorded trajectory itself (cross-track second
+        /// differences, `adjustment::relative_noise`).
+        relative_sigma_m: Option<f64> = None, unit "m", above 0.0;
         /// Consecutive recordings farther apart than this are not linked (a gap in the trajectory).
         relative_max_gap_m: f64 = 15.0, unit "m", above 0.0;
         /// Estimate a yaw correction per recording.

@@ -12,6 +12,7 @@
 use super::adjust::{adjust, ObservationCounts};
 use super::config::{AdjustConfig, ControlWeighting};
 use super::error::AdjustError;
+use super::relative_noise::RelativeSigma;
 use super::problem::{
     AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, PanoObservation,
     RelativeConstraint,
@@ -26,7 +27,7 @@ use std::collections::HashMap;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("adjust", "3");
+pub const STAGE: StageId = StageId::new("adjust", "4");
 
 /// The inputs of one adjustment.
 #[derive(Clone, Copy, Debug)]
@@ -100,6 +101,8 @@ pub struct BlockBuild {
     pub points: Vec<BlockPoint>,
     pub aerial_images: Vec<AerialImageRef>,
     pub counts: BuildCounts,
+    /// The σ of the relative constraints (given, or estimated from the recorded trajectory).
+    pub relative_sigma: RelativeSigma,
 }
 
 /// One adjusted recording.
@@ -151,6 +154,9 @@ pub struct AdjustmentRun {
     pub redundancy: i64,
     pub rejection_rounds: usize,
     pub build: BuildCounts,
+    /// The σ of the relative constraints between consecutive recordings (used by them when they are on, and
+    /// by the corrections' interpolation between recordings always).
+    pub relative_sigma: RelativeSigma,
 }
 
 /// Builds the block of one configuration.
@@ -255,8 +261,14 @@ pub fn build_block(
         .map(|r| FrameCamera::from_aerial(r))
         .collect();
 
+    let relative_sigma = RelativeSigma::resolve(
+        config.relative_sigma_m,
+        inputs.recordings,
+        config.relative_max_gap_m,
+    );
     if config.relative_constraints {
-        block.relative_constraints = relative_constraints(inputs.recordings, config);
+        block.relative_constraints =
+            relative_constraints(inputs.recordings, config, relative_sigma.sigma_m);
         counts.relative_constraints = block.relative_constraints.len();
     }
     block.validate()?;
@@ -271,6 +283,7 @@ pub fn build_block(
         points,
         aerial_images: cameras.images,
         counts,
+        relative_sigma,
     })
 }
 
@@ -510,6 +523,7 @@ fn control_covariance(
 fn relative_constraints(
     recordings: &[Recording],
     config: &AdjustConfig,
+    sigma_m: f64,
 ) -> Vec<RelativeConstraint> {
     (1..recordings.len())
         .filter(|&i| {
@@ -519,7 +533,7 @@ fn relative_constraints(
         .map(|i| RelativeConstraint {
             from: i - 1,
             to: i,
-            sigma_m: config.relative_sigma_m,
+            sigma_m,
         })
         .collect()
 }
@@ -604,5 +618,6 @@ pub fn run(inputs: &AdjustInputs, config: &AdjustConfig) -> Result<AdjustmentRun
         redundancy: adj.redundancy,
         rejection_rounds: adj.rounds.len(),
         build: build.counts,
+        relative_sigma: build.relative_sigma,
     })
 }

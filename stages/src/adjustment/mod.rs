@@ -9,7 +9,8 @@
 //! (block sparse Cholesky with a fill-reducing ordering, and selected inversion), [`layout`] (observations
 //! by point and recording, structure of the reduced camera matrix), [`prepared`] (one solve's setup and
 //! cost), [`linearization`] (normal-equation blocks), [`schur`] (the reduced camera system), [`solver`]
-//! (Levenberg–Marquardt), [`covariance`] (posterior σ per recording), [`adjust`](mod@adjust) (solve, reject by
+//! (Levenberg–Marquardt), [`relative_noise`] (the trajectory's relative accuracy from its own second differences),
+//! [`covariance`] (posterior σ per recording), [`adjust`](mod@adjust) (solve, reject by
 //! normalised residuals, re-solve), [`evaluate`] (check-point triangulation and RMSE), [`synthetic_block`]
 //! (known-answer test blocks). On top: [`config`] (the adjust node's params), [`from_correspondences`]
 //! (correspondences → block → [`AdjustmentRun`]), [`verify`] (thesis Table 5-13 verification per trajectory
@@ -32,6 +33,7 @@ pub mod linearization;
 pub mod parallel;
 pub mod prepared;
 pub mod problem;
+pub mod relative_noise;
 pub mod residuals;
 pub mod robust;
 pub mod schur;

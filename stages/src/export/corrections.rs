@@ -7,7 +7,8 @@
 //!
 //! Error model of the interpolation: the trajectory error between two recordings is a random walk tied down
 //! at both ends (a Brownian bridge) with rate `q = relative_sigma_m² / Δt_median` m²/s per axis, i.e. the
-//! adjustment's own relative accuracy between consecutive recordings (`[adjust] relative_sigma_m`) spread over
+//! adjustment's relative accuracy between consecutive recordings (`[adjust] relative_sigma_m`, or its estimate
+//! from the recorded trajectory when not given) spread over
 //! the median time between recordings. At time t between recordings i and j (w = (t − tᵢ)/(tⱼ − tᵢ)):
 //! `Δ(t) = (1 − w)·Δᵢ + w·Δⱼ`, `σ(t)² = ((1 − w)·σᵢ + w·σⱼ)² + q·(t − tᵢ)·(tⱼ − t)/(tⱼ − tᵢ)` (the σ term
 //! assumes the two ends fully correlated, the conservative case). Outside the span: `σ(t)² = σ_end² +
@@ -146,7 +147,7 @@ impl CorrectionSeries {
         let c = &run.config;
         Ok(Self {
             recordings: out,
-            q_position_m2_per_s: c.relative_sigma_m * c.relative_sigma_m / step,
+            q_position_m2_per_s: run.relative_sigma.sigma_m * run.relative_sigma.sigma_m / step,
             q_yaw_deg2_per_s: if c.estimate_yaw {
                 c.yaw_prior_sigma_deg * c.yaw_prior_sigma_deg / step
             } else {
@@ -255,6 +256,7 @@ impl CorrectionSeries {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::adjustment::relative_noise::RelativeSigma;
     use crate::adjustment::{AdjustConfig, PointKind};
     use crate::export::fixture::{point, recording, run};
 
@@ -284,19 +286,21 @@ pub(crate) mod tests {
                 r
             })
             .collect();
-        let recs = run_recs
+        let recs: Vec<Recording> = run_recs
             .iter()
             .enumerate()
             .map(|(i, a)| campaign_recording(a, 100.0 + 0.5 * i as f64))
             .collect();
         let config = AdjustConfig {
             relative_constraints: true,
-            relative_sigma_m: 0.15,
+            relative_sigma_m: Some(0.15),
             estimate_yaw: true,
             ..AdjustConfig::default()
         };
         let points = (0..4).map(|i| point(PointKind::Control, &[i])).collect();
-        (recs, run(config, run_recs, points))
+        let mut run = run(config, run_recs, points);
+        run.relative_sigma = RelativeSigma::resolve(Some(0.15), &recs, 15.0);
+        (recs, run)
     }
 
     #[test]

@@ -53,5 +53,6 @@ pub fn run(
         redundancy: 0,
         rejection_rounds: 0,
         build: Default::default(),
+        relative_sigma: Default::default(),
     }
 }

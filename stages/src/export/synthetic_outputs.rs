@@ -305,6 +305,7 @@ impl OutputsSpec {
             redundancy: 1,
             rejection_rounds: 0,
             build: Default::default(),
+            relative_sigma: Default::default(),
         };
         SyntheticOutputs {
             spec: *self,
