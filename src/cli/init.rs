@@ -23,6 +23,8 @@ const CAMPAIGN_TOML: &str = r#"# A skytie campaign (docs/campaign-format.md).
 # name: free text shown in reports.
 # crs: the projected CRS of every coordinate in this folder, horizontal + vertical EPSG codes,
 #      e.g. "EPSG:28992+5709" (RD New + NAP height) or "EPSG:25832+7837" (ETRS89 / UTM 32N + DHHN2016).
+# frame (optional): "projected" (default: x, y are map coordinates of crs; aerial rays are intersected in its
+#      tangent frame) or "cartesian" (the coordinates already are a Cartesian frame, used as they are).
 "#;
 
 const RECORDINGS: &str = "# One row per panorama (equirectangular, width = 2 x height, in mm/panoramas/).

@@ -10,6 +10,7 @@ use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::campaign::aerial::AerialRowNodes;
 use crate::nodes::campaign::ingest::{ingest_file, IngestedImage};
 use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::map_frame::MapFrameStage;
 use crate::nodes::campaign::summary::SummaryParams;
 use crate::nodes::nadir::baseline::BaselineStage;
 use crate::nodes::nadir::control::ControlStage;
@@ -116,6 +117,8 @@ pub fn add_nadir(
     let transform_params: TransformParams = wf.params(stage::TRANSFORM, variant).map_err(wf_err)?;
     let refine_params: RefineParams = wf.params(stage::REFINE, variant).map_err(wf_err)?;
     let control_params: ControlParams = wf.params(stage::CONTROL, variant).map_err(wf_err)?;
+    // The frame the aerial rays of the control points are intersected in.
+    let map_frame = b.add(MapFrameStage, "", SummaryParams::default(), snap)?;
     let window_len = if options.triples { 2 } else { 1 };
     let Some(orthos) = items.iter().map(|i| i.ortho).collect::<Option<Vec<_>>>() else {
         return Err(wf_err(format!(
@@ -258,7 +261,12 @@ pub fn add_nadir(
                 ControlStage,
                 &label,
                 control_params.clone(),
-                (window, optional_all(&rec_refinements), rec_aerials),
+                (
+                    window,
+                    optional_all(&rec_refinements),
+                    rec_aerials,
+                    map_frame,
+                ),
             )?);
         }
     }

@@ -85,7 +85,13 @@ fn write_base(root: &Path) {
         u_px: 30.0,
         v_px: 20.0,
     };
-    write_campaign_toml(&root.join("campaign.toml"), "Corpus", "EPSG:28992").unwrap();
+    write_campaign_toml(
+        &root.join("campaign.toml"),
+        "Corpus",
+        "EPSG:28992",
+        Default::default(),
+    )
+    .unwrap();
     write_recordings_csv(&root.join(REC), &recordings).unwrap();
     write_aerial_cameras_csv(&root.join(NADIR), &nadir).unwrap();
     write_aerial_cameras_csv(&root.join(OBL), &oblique).unwrap();
@@ -778,6 +784,19 @@ fn path_and_image_cases() -> Vec<Case> {
             "campaign.toml empty crs",
             |r| std::fs::write(r.join("campaign.toml"), "name = \"x\"\ncrs = \" \"\n").unwrap(),
             vec![("campaign.toml", None, Some("crs"), "is empty")],
+        ),
+        case(
+            "campaign.toml unknown frame",
+            |r| {
+                let toml = "name = \"x\"\ncrs = \"EPSG:28992\"\nframe = \"polar\"\n";
+                std::fs::write(r.join("campaign.toml"), toml).unwrap()
+            },
+            vec![(
+                "campaign.toml",
+                None,
+                Some("frame"),
+                "is not a coordinate frame skytie knows",
+            )],
         ),
         case(
             "campaign.toml missing",

@@ -113,7 +113,13 @@ fn write_valid_campaign(root: &Path) -> Campaign {
             v_px: 32.0,
         },
     ];
-    write_campaign_toml(&root.join("campaign.toml"), "Teststraat", "EPSG:28992").unwrap();
+    write_campaign_toml(
+        &root.join("campaign.toml"),
+        "Teststraat",
+        "EPSG:28992",
+        Default::default(),
+    )
+    .unwrap();
     write_recordings_csv(&root.join("mm/recordings.csv"), &recordings).unwrap();
     write_aerial_cameras_csv(&root.join("aerial/nadir/cameras.csv"), &nadir).unwrap();
     write_aerial_cameras_csv(&root.join("aerial/oblique/cameras.csv"), &oblique).unwrap();
@@ -123,6 +129,7 @@ fn write_valid_campaign(root: &Path) -> Campaign {
         root: root.to_path_buf(),
         name: "Teststraat".into(),
         crs: "EPSG:28992".into(),
+        frame: Default::default(),
         recordings,
         nadir,
         oblique,

@@ -154,7 +154,13 @@ fn recordings_csv_has_documented_columns_and_exact_values() {
 fn other_tables_and_toml_have_documented_columns() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    write_campaign_toml(&d.join("campaign.toml"), "Test \"street\"", "EPSG:28992").unwrap();
+    write_campaign_toml(
+        &d.join("campaign.toml"),
+        "Test \"street\"",
+        "EPSG:28992",
+        Default::default(),
+    )
+    .unwrap();
     let toml_value: toml::Value =
         toml::from_str(&std::fs::read_to_string(d.join("campaign.toml")).unwrap()).unwrap();
     assert_eq!(toml_value["name"].as_str(), Some("Test \"street\""));

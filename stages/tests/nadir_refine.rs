@@ -8,7 +8,9 @@ use skytie_stages::correspondence::{AerialObservation, MmTiePoint, PanoObservati
 use skytie_stages::geometry::{FrameCamera, PanoramaCamera, PointPair, Similarity2};
 use skytie_stages::imaging::pyramid::MemoryPyramid;
 use skytie_stages::imaging::GrayImage;
-use skytie_stages::nadir::control_points::{aerial_control_points, ControlParams};
+use skytie_stages::nadir::control_points::{
+    aerial_control_points, aerial_control_points_in, ControlParams,
+};
 use skytie_stages::nadir::refine::{refine_in_aerial, RefineParams};
 use skytie_stages::nadir::{
     AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch, OrthoGeoref, OrthoImage,
@@ -567,6 +569,68 @@ fn control_points_from_exact_observations_are_exact() {
         assert!(e.norm() < 1e-3, "point {i}: {e:?}");
         assert!(cp.covariance_m2.is_some());
     }
+}
+
+/// Wide-angle nadir frames 1000 m above a real RD New scene (tables in map coordinates, as an import of a
+/// rigorous aerial triangulation gives them) see a point 400 m off their nadirs. Intersected in the campaign's
+/// tangent frame the control point lands on the true map point to < 1 mm; intersected in map coordinates as
+/// if they were Cartesian it misses by the map scale and the earth's curvature (centimetres).
+#[test]
+fn control_points_in_the_campaign_frame_are_free_of_map_scale_and_curvature() {
+    use skytie_stages::crs::{CoordinateFrame, MapFrame, MapFrameSpec};
+    // Near Utrecht: RD New's scale factor there is ≈ 0.99991.
+    let truth_map = Vector3::new(136_400.0, 455_300.0, 2.0);
+    let (spec, note) = MapFrameSpec::for_campaign(
+        CoordinateFrame::Projected,
+        "EPSG:28992",
+        Some([truth_map.x, truth_map.y, truth_map.z]),
+    );
+    assert!(note.is_none(), "{note:?}");
+    let frame = MapFrame::from_spec(&spec).unwrap();
+    let rows: Vec<AerialImage> = [(-400.0, -150.0), (-400.0, 150.0), (-250.0, 0.0)]
+        .into_iter()
+        .enumerate()
+        .map(|(k, (dx, dy))| {
+            let centre = [truth_map.x + dx, truth_map.y + dy, 1000.0];
+            AerialImage::ideal(
+                &format!("w{k}"),
+                centre,
+                [0.0; 3],
+                10_000.0,
+                [20_000, 20_000],
+            )
+        })
+        .collect();
+    let truth_local = frame.point_to_local(&truth_map).unwrap();
+    let refs: Vec<AerialRefinement> = rows
+        .iter()
+        .map(|r| {
+            // The real camera is the row's pose taken into the tangent frame.
+            let camera = frame.camera_to_local(&FrameCamera::from_aerial(r)).unwrap();
+            let uv = camera.project_world(&truth_local).unwrap();
+            refinement_of(r, &[("rec#0".to_string(), uv)])
+        })
+        .collect();
+    let pairs: Vec<(&AerialImage, &AerialRefinement)> = rows.iter().zip(&refs).collect();
+    let window = window_of(&[truth_map]);
+    let error = |cps: Vec<skytie_stages::correspondence::AerialControlPoint>| {
+        assert_eq!(cps.len(), 1);
+        let x = cps[0].point_world.unwrap();
+        (Vector3::new(x[0], x[1], x[2]) - truth_map).norm()
+    };
+    let in_frame = error(aerial_control_points_in(
+        &window,
+        &pairs,
+        &ControlParams::default(),
+        &frame,
+    ));
+    let in_map = error(aerial_control_points(
+        &window,
+        &pairs,
+        &ControlParams::default(),
+    ));
+    assert!(in_frame < 1e-3, "tangent frame: {in_frame} m");
+    assert!(in_map > 0.01, "map coordinates: {in_map} m");
 }
 
 #[test]

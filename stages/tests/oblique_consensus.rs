@@ -6,6 +6,7 @@ mod support;
 use nalgebra::Vector3;
 use skytie_stages::campaign::Recording;
 use skytie_stages::correspondence::{MmTiePoint, PanoObservation};
+use skytie_stages::crs::MapFrame;
 use skytie_stages::geometry::FrameCamera;
 use skytie_stages::oblique::consensus::{
     consensus, consensus_with_diagnostics, ConsensusParams, SmallSetPolicy,
@@ -120,8 +121,15 @@ fn coarse_rejected_matches_do_not_enter() {
     s.matches[0].rejected_coarse = true;
     s.matches[2].rejected_coarse = true; // an outlier
     let recs = vec![street_recording("r1", 1, 102.0)];
-    let (r, d) =
-        consensus_with_diagnostics(&[s], &[], &recs, &[], &[], &ConsensusParams::default());
+    let (r, d) = consensus_with_diagnostics(
+        &[s],
+        &[],
+        &recs,
+        &[],
+        &[],
+        &ConsensusParams::default(),
+        &MapFrame::Cartesian,
+    );
     assert_eq!(r.stats.correspondences, 23);
     assert_eq!(r.stats.kept, 19);
     assert_eq!(d.coarse_rejected, 2);
@@ -287,6 +295,7 @@ fn control_points_from_two_oblique_cameras_triangulate_to_under_a_millimetre() {
         &images,
         &[],
         &ConsensusParams::default(),
+        &MapFrame::Cartesian,
     );
     assert_eq!(r.stats.kept, 7);
     assert_eq!(d.duplicate_observations, 1);
@@ -309,6 +318,7 @@ fn control_points_from_two_oblique_cameras_triangulate_to_under_a_millimetre() {
         &images,
         &[],
         &ConsensusParams::default(),
+        &MapFrame::Cartesian,
     );
     assert_eq!(
         (r.stats.control_points, r.stats.single_image_points),

@@ -7,6 +7,7 @@ pub mod image_artifact;
 pub mod image_tiles;
 pub mod ingest;
 pub mod load;
+pub mod map_frame;
 pub mod panorama_sizes;
 pub mod row_index;
 pub mod summary;

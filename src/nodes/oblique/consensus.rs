@@ -2,11 +2,14 @@
 //! registration set, optional consensus tracking, and the oblique control points (thesis 4.4.7,
 //! `skytie_stages::oblique::consensus`), with the pipeline's own counts (`oblique.*` metrics that need no truth).
 
+use crate::dag::StageError;
 use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RawFile, RunResult, Stage};
 use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::map_frame::campaign_frame_spec;
 use crate::nodes::campaign::panorama_sizes::pano_sizes;
 use serde::{Deserialize, Serialize};
-use skytie_stages::oblique::consensus::{consensus, ConsensusParams};
+use skytie_stages::crs::MapFrame;
+use skytie_stages::oblique::consensus::{consensus_with_diagnostics, ConsensusParams};
 use skytie_stages::oblique::summary::ObliqueSummary;
 use skytie_stages::oblique::{ObliqueResult, PatchRegistrationSet, SparseCloud, TripletFacades};
 
@@ -35,7 +38,18 @@ impl Stage for ConsensusStage {
             facades.iter().flatten().map(|x| (**x).clone()).collect();
         let sets: Vec<PatchRegistrationSet> =
             sets.iter().flatten().map(|x| (**x).clone()).collect();
-        let result = consensus(&sets, &clouds, &c.recordings, &c.oblique, &sizes, p);
+        let frame = MapFrame::from_spec(&campaign_frame_spec(c).0)
+            .map_err(|e| StageError::new(format!("the campaign's frame: {e}")))?;
+        let result = consensus_with_diagnostics(
+            &sets,
+            &clouds,
+            &c.recordings,
+            &c.oblique,
+            &sizes,
+            p,
+            &frame,
+        )
+        .0;
         let summary = ObliqueSummary::from_parts(&clouds, &facades, &sets, &result);
         Ok(ObliqueOutput { result, summary })
     }

@@ -12,11 +12,11 @@
 use super::adjust::{adjust, ObservationCounts};
 use super::config::{AdjustConfig, ControlWeighting};
 use super::error::AdjustError;
-use super::relative_noise::RelativeSigma;
 use super::problem::{
     AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, PanoObservation,
     RelativeConstraint,
 };
+use super::relative_noise::RelativeSigma;
 use crate::campaign::{AerialImage, AerialKind, Recording};
 use crate::correspondence::{AerialControlPoint, MmTiePoint};
 use crate::geometry::{triangulate_rays, FrameCamera, PanoramaCamera};

@@ -103,7 +103,10 @@ fn cross_track_second_differences(recordings: &[Recording], max_gap_m: f64) -> V
         .filter_map(|w| {
             let (tx, ty) = (w[2].x - w[0].x, w[2].y - w[0].y);
             let chord = tx.hypot(ty);
-            let (dx, dy) = (w[2].x - 2.0 * w[1].x + w[0].x, w[2].y - 2.0 * w[1].y + w[0].y);
+            let (dx, dy) = (
+                w[2].x - 2.0 * w[1].x + w[0].x,
+                w[2].y - 2.0 * w[1].y + w[0].y,
+            );
             let cross = (dx * -ty + dy * tx) / chord;
             (chord > 0.0 && cross.is_finite()).then_some(cross)
         })
@@ -163,7 +166,9 @@ mod tests {
             ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
         };
         (0..n)
-            .map(|_| (-2.0 * uniform().ln()).sqrt() * (2.0 * std::f64::consts::PI * uniform()).cos())
+            .map(|_| {
+                (-2.0 * uniform().ln()).sqrt() * (2.0 * std::f64::consts::PI * uniform()).cos()
+            })
             .collect()
     }
 

@@ -170,8 +170,13 @@ pub struct Campaign {
     pub root: PathBuf,
     /// `campaign.toml`: `name`.
     pub name: String,
-    /// `campaign.toml`: `crs` (informative, never reprojected).
+    /// `campaign.toml`: `crs` (never reprojected; a projected CRS's tangent frame is where aerial rays are
+    /// intersected, see `frame`).
     pub crs: String,
+    /// `campaign.toml`: `frame` — whether the coordinates are map coordinates of `crs` (default) or already
+    /// Cartesian.
+    #[serde(default)]
+    pub frame: crate::crs::CoordinateFrame,
     /// Recordings sorted by `time_s`.
     pub recordings: Vec<Recording>,
     pub nadir: Vec<AerialImage>,

@@ -10,6 +10,7 @@ use super::read_aerial::read_aerial_rows;
 use super::read_control::{read_checkpoint_rows, read_observation_rows};
 use super::read_recordings::{read_recording_rows, sort_by_time};
 use super::unique::{keep_unique, Sourced};
+use crate::crs::{CoordinateFrame, MapFrameSpec};
 use crate::params::StageId;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -73,6 +74,21 @@ pub fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>), Camp
     }
     let mut problems = Vec::new();
     let (name, crs, parsed) = read_toml(root, &mut problems);
+    let frame = match &parsed {
+        Some((_, table)) => read_frame(table, &mut problems),
+        None => CoordinateFrame::default(),
+    };
+    if !crs.is_empty() {
+        if let (_, Some(note)) = MapFrameSpec::for_campaign(frame, &crs, None) {
+            problems.push(Problem::warning(
+                TOML,
+                None,
+                Some("crs"),
+                note,
+                "name a projected CRS as EPSG:<code>, or declare frame = \"cartesian\"",
+            ));
+        }
+    }
     let (orthophoto, dtm) = match &parsed {
         Some((text, table)) => read_orthophoto_tables(root, text, table, &crs, &mut problems),
         None => (None, None),
@@ -226,6 +242,7 @@ pub fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>), Camp
         root: root.to_path_buf(),
         name,
         crs,
+        frame,
         recordings,
         nadir,
         oblique,
@@ -299,6 +316,27 @@ pub fn sort_problems(problems: &mut [Problem]) {
             .unwrap_or(ORDER.len());
         (rank, p.row.unwrap_or(0))
     });
+}
+
+/// `frame` of `campaign.toml`: `"projected"` (the default) or `"cartesian"`; anything else is an error and the
+/// default is used.
+fn read_frame(table: &toml::Table, problems: &mut Vec<Problem>) -> CoordinateFrame {
+    let hint = "write frame = \"projected\" (map coordinates of crs, the default) or frame = \"cartesian\"";
+    match table.get("frame") {
+        None => CoordinateFrame::default(),
+        Some(toml::Value::String(s)) if s == "projected" => CoordinateFrame::Projected,
+        Some(toml::Value::String(s)) if s == "cartesian" => CoordinateFrame::Cartesian,
+        Some(other) => {
+            problems.push(Problem::error(
+                TOML,
+                None,
+                Some("frame"),
+                format!("{other} is not a coordinate frame skytie knows"),
+                hint,
+            ));
+            CoordinateFrame::default()
+        }
+    }
 }
 
 /// `name` and `crs` of `campaign.toml` (empty strings when missing, with a problem), and its text and table

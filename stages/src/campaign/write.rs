@@ -9,6 +9,7 @@
 use super::model::{AerialImage, CheckPoint, Observation, Recording};
 use super::read_recordings::RECORDING_COLUMNS;
 use super::time::format_time_iso;
+use crate::crs::CoordinateFrame;
 use crate::fsutil::atomic_write_with;
 use std::collections::BTreeMap;
 use std::io::{self, Write};
@@ -44,14 +45,22 @@ pub struct PlyPoint {
     pub source: i32,
 }
 
-/// `campaign.toml` with the two documented keys.
-pub fn write_campaign_toml(path: &Path, name: &str, crs: &str) -> io::Result<()> {
+/// `campaign.toml` with `name`, `crs` and — when the coordinates are not map coordinates of `crs` — `frame`.
+pub fn write_campaign_toml(
+    path: &Path,
+    name: &str,
+    crs: &str,
+    frame: CoordinateFrame,
+) -> io::Result<()> {
     #[derive(serde::Serialize)]
     struct CampaignToml<'a> {
         name: &'a str,
         crs: &'a str,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        frame: Option<CoordinateFrame>,
     }
-    let text = toml::to_string(&CampaignToml { name, crs }).map_err(io::Error::other)?;
+    let frame = (frame != CoordinateFrame::default()).then_some(frame);
+    let text = toml::to_string(&CampaignToml { name, crs, frame }).map_err(io::Error::other)?;
     atomic_write_with(path, |w| w.write_all(text.as_bytes()))
 }
 

@@ -2,7 +2,8 @@
 //! (horizontal + vertical, e.g. `EPSG:28992+5709`), horizontal transformations between CRSs (pure-Rust
 //! `proj4rs` with the EPSG definitions of `crs-definitions`), geoid models for ellipsoidal ↔ orthometric
 //! heights, meridian convergence and point scale factor of a map projection, geodetic ↔ earth-centred
-//! coordinates and a local tangent (east-north-up) frame for computations that need a Cartesian frame.
+//! coordinates and a local tangent (east-north-up) frame for computations that need a Cartesian frame
+//! ([`map_frame`]: where the pipeline intersects aerial rays).
 //!
 //! Units: geographic coordinates in degrees (latitude, longitude), projected coordinates and heights in
 //! metres, angles of convergence in degrees (`_deg`).
@@ -14,6 +15,7 @@ pub mod error_budget;
 pub mod geoid;
 pub mod grid_north;
 pub mod heights;
+pub mod map_frame;
 pub mod transform;
 mod vertical;
 
@@ -26,4 +28,5 @@ pub use ellipsoid::{Ellipsoid, LocalTangentFrame};
 pub use geoid::{GeoidError, GeoidModel};
 pub use grid_north::GridNorth;
 pub use heights::{HeightConversion, HeightKind};
+pub use map_frame::{CoordinateFrame, MapFrame, MapFrameSpec};
 pub use transform::{Geographic, HorizontalTransform};

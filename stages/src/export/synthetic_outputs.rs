@@ -348,6 +348,8 @@ impl SyntheticOutputs {
             root: root.to_path_buf(),
             name: format!("synthetic city, {} recordings", self.recordings.len()),
             crs: self.crs.clone(),
+            // The synthetic street grid is a Cartesian scene labelled with a CRS.
+            frame: crate::crs::CoordinateFrame::Cartesian,
             recordings: self.recordings.clone(),
             nadir: self.nadir.clone(),
             oblique: self.oblique.clone(),

@@ -17,6 +17,11 @@
 //! positioning error (3.4.5.4). After the least-squares triangulation (`triangulate_rays`, σ of each ray from
 //! the aerial row's `sigma_px`) the reprojection residuals must also stay within `k_sigma`·`sigma_px`.
 //!
+//! **Frame.** Rays from an aerial camera hundreds of metres up are intersected in the campaign's Cartesian frame
+//! ([`MapFrame`]: the tangent frame of a projected CRS, or the coordinates themselves when they are Cartesian)
+//! and the point and its covariance are converted back to map coordinates, so the map projection's scale and
+//! the earth's curvature do not enter the control point (`crs::error_budget`).
+//!
 //! Points seen in one aerial image are kept with `point_world: None` (a bundle with fixed aerial orientation
 //! can still use them). Output order: the window's tie-point order; observations sorted by aerial `image_id`.
 
@@ -25,11 +30,12 @@ use std::collections::HashMap;
 use super::registration::{AerialRefinement, MmWindowMatch};
 use crate::campaign::AerialImage;
 use crate::correspondence::{AerialControlPoint, AerialObservation};
+use crate::crs::MapFrame;
 use crate::geometry::{
     intersect_ray_plane, triangulate_rays, FrameCamera, Plane, Ray, Triangulation,
 };
 use crate::params::{Params, StageId};
-use nalgebra::{Vector2, Vector3};
+use nalgebra::{Matrix3, Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
@@ -68,8 +74,9 @@ fn candidate(
     obs: &AerialObservation,
     mm_z: f64,
     p: &ControlParams,
+    frame: &MapFrame,
 ) -> Option<Candidate> {
-    let camera = FrameCamera::from_aerial(row);
+    let camera = frame.camera_to_local(&FrameCamera::from_aerial(row)).ok()?;
     let sigma_px = if row.sigma_px.is_finite() && row.sigma_px > 0.0 {
         row.sigma_px
     } else {
@@ -197,12 +204,23 @@ fn triangulate_checked(
 }
 
 /// Aerial control points of one MM window from its refinements in all overlapping aerial images
-/// (thesis 3.4.5.4). `refinements` pairs each aerial row with its refinement; refinements of other
-/// recordings, unknown tie points and repeated images (the best score is kept) are ignored.
+/// (thesis 3.4.5.4), for coordinates that are Cartesian. `refinements` pairs each aerial row with its
+/// refinement; refinements of other recordings, unknown tie points and repeated images (the best score is
+/// kept) are ignored.
 pub fn aerial_control_points(
     window: &MmWindowMatch,
     refinements: &[(&AerialImage, &AerialRefinement)],
     p: &ControlParams,
+) -> Vec<AerialControlPoint> {
+    aerial_control_points_in(window, refinements, p, &MapFrame::Cartesian)
+}
+
+/// [`aerial_control_points`] with the rays intersected in `frame` (see the module documentation).
+pub fn aerial_control_points_in(
+    window: &MmWindowMatch,
+    refinements: &[(&AerialImage, &AerialRefinement)],
+    p: &ControlParams,
+    frame: &MapFrame,
 ) -> Vec<AerialControlPoint> {
     if p.validate().is_err() {
         return Vec::new();
@@ -239,18 +257,20 @@ pub fn aerial_control_points(
     let mut out = Vec::new();
     for (tp, mut list) in window.tie_points.iter().zip(per_point) {
         list.sort_by(|a, b| a.0.image_id.cmp(&b.0.image_id));
-        let mm_z = tp.point_world[2];
+        let Ok(mm_local) = frame.point_to_local(&Vector3::from(tp.point_world)) else {
+            continue;
+        };
         let candidates: Vec<Candidate> = list
             .iter()
-            .filter_map(|(row, obs)| candidate(row, obs, mm_z, p))
+            .filter_map(|(row, obs)| candidate(row, obs, mm_local.z, p, frame))
             .collect();
         let kept = consistent_subset(candidates, p.k_sigma);
         let (kept, point) = match kept.len() {
             0 => continue,
             1 => (kept, None),
-            _ => match triangulate_checked(kept, p.k_sigma) {
-                Some((kept, t)) => (kept, Some(t)),
-                None => continue,
+            _ => match triangulate_checked(kept, p.k_sigma).map(|(k, t)| (k, in_map(frame, &t))) {
+                Some((kept, Some(point))) => (kept, Some(point)),
+                _ => continue,
             },
         };
         out.push(AerialControlPoint {
@@ -258,9 +278,8 @@ pub fn aerial_control_points(
             tie_point_id: tp.id.clone(),
             mm: tp.observations.clone(),
             aerial: kept.into_iter().map(|c| c.observation).collect(),
-            point_world: point.as_ref().map(|t| to_array(&t.point_world)),
-            covariance_m2: point.as_ref().map(|t| {
-                let c = &t.covariance_m2;
+            point_world: point.as_ref().map(|(x, _)| to_array(x)),
+            covariance_m2: point.as_ref().map(|(_, c)| {
                 [
                     [c[(0, 0)], c[(0, 1)], c[(0, 2)]],
                     [c[(1, 0)], c[(1, 1)], c[(1, 2)]],
@@ -270,6 +289,13 @@ pub fn aerial_control_points(
         });
     }
     out
+}
+
+/// The triangulated point and its covariance in map coordinates (`None` when the frame cannot convert it).
+fn in_map(frame: &MapFrame, t: &Triangulation) -> Option<(Vector3<f64>, Matrix3<f64>)> {
+    let point = frame.point_to_map(&t.point_world).ok()?;
+    let covariance = frame.covariance_to_map(&point, &t.covariance_m2).ok()?;
+    Some((point, covariance))
 }
 
 fn to_array(v: &Vector3<f64>) -> [f64; 3] {

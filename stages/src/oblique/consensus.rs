@@ -34,16 +34,18 @@ use super::types::{ConsensusStats, ObliqueCorrespondence, PatchRegistrationSet, 
 use super::ObliqueResult;
 use crate::campaign::{AerialImage, AerialKind, Recording};
 use crate::correspondence::{AerialControlPoint, AerialObservation, MmTiePoint, PanoObservation};
+use crate::crs::MapFrame;
 use crate::estimators::median_consensus::median_consensus;
 use crate::geometry::aerial_intersection::{
-    intersect_checked, IntersectionLimits, IntersectionRejection, PixelObservation,
+    intersect_checked, AerialIntersection, IntersectionLimits, IntersectionRejection,
+    PixelObservation,
 };
 use crate::geometry::FrameCamera;
 use crate::params::{Params, StageId};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("oblique", "2");
+pub const STAGE: StageId = StageId::new("oblique", "3");
 
 /// What happens to the matches of a set smaller than `min_set_size` (`"keep"` or `"drop"` in a workflow).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -100,7 +102,7 @@ pub struct ConsensusDiagnostics {
     pub invalid_params: bool,
 }
 
-/// [`consensus_with_diagnostics`] without the extra counts.
+/// [`consensus_with_diagnostics`] without the extra counts, for coordinates that are Cartesian.
 pub fn consensus(
     sets: &[PatchRegistrationSet],
     clouds: &[SparseCloud],
@@ -109,7 +111,8 @@ pub fn consensus(
     pano_size_px: &[(u32, u32)],
     p: &ConsensusParams,
 ) -> ObliqueResult {
-    consensus_with_diagnostics(sets, clouds, recordings, oblique, pano_size_px, p).0
+    let frame = MapFrame::Cartesian;
+    consensus_with_diagnostics(sets, clouds, recordings, oblique, pano_size_px, p, &frame).0
 }
 
 fn translation(m: &super::types::PatchMatch) -> [f64; 3] {
@@ -119,7 +122,8 @@ fn translation(m: &super::types::PatchMatch) -> [f64; 3] {
 
 /// The 3-D median consensus, optional tracking and the oblique control points (see the module doc).
 /// `recordings` is in trajectory order; `pano_size_px` is accepted for the node's interface (same order as
-/// `recordings`) and is not needed by the consensus itself.
+/// `recordings`) and is not needed by the consensus itself. The oblique rays of a control point are
+/// intersected in `frame` (the campaign's Cartesian frame) and the point converted back to map coordinates.
 pub fn consensus_with_diagnostics(
     sets: &[PatchRegistrationSet],
     clouds: &[SparseCloud],
@@ -127,6 +131,7 @@ pub fn consensus_with_diagnostics(
     oblique: &[AerialImage],
     _pano_size_px: &[(u32, u32)],
     p: &ConsensusParams,
+    frame: &MapFrame,
 ) -> (ObliqueResult, ConsensusDiagnostics) {
     let mut diag = ConsensusDiagnostics::default();
     let mut stats = ConsensusStats::default();
@@ -235,7 +240,14 @@ pub fn consensus_with_diagnostics(
     with.dedup();
     stats.recordings_with_correspondences = with.len();
 
-    let control = control_points(&correspondences, clouds, oblique, p, &mut stats, &mut diag);
+    let control = control_points(
+        &correspondences,
+        clouds,
+        oblique,
+        p,
+        frame,
+        (&mut stats, &mut diag),
+    );
     (
         ObliqueResult {
             correspondences,
@@ -252,8 +264,8 @@ fn control_points(
     clouds: &[SparseCloud],
     oblique: &[AerialImage],
     p: &ConsensusParams,
-    stats: &mut ConsensusStats,
-    diag: &mut ConsensusDiagnostics,
+    frame: &MapFrame,
+    (stats, diag): (&mut ConsensusStats, &mut ConsensusDiagnostics),
 ) -> Vec<AerialControlPoint> {
     let ties: HashMap<&str, &MmTiePoint> = clouds
         .iter()
@@ -311,7 +323,7 @@ fn control_points(
             })
             .collect();
         let (point_world, covariance_m2) = if aerial.len() >= 2 {
-            let cams: Vec<(FrameCamera, f64)> = aerial
+            let cams: Result<Vec<(FrameCamera, f64)>, _> = aerial
                 .iter()
                 .map(|o| {
                     let row = images[o.image_id.as_str()];
@@ -320,9 +332,15 @@ fn control_points(
                     } else {
                         p.default_oblique_sigma_px
                     };
-                    (FrameCamera::from_aerial(row), sigma)
+                    frame
+                        .camera_to_local(&FrameCamera::from_aerial(row))
+                        .map(|c| (c, sigma))
                 })
                 .collect();
+            let Ok(cams) = cams else {
+                diag.failed_intersection += 1;
+                continue;
+            };
             let obs: Vec<PixelObservation> = aerial
                 .iter()
                 .zip(&cams)
@@ -333,8 +351,12 @@ fn control_points(
                     sigma_px: *sigma,
                 })
                 .collect();
-            match intersect_checked(&obs, &limits) {
-                Ok(x) => (Some(x.point_array()), Some(x.covariance_rows())),
+            match intersect_checked(&obs, &limits).map(|x| in_map(frame, &x)) {
+                Ok(Some((point, covariance))) => (Some(point), Some(covariance)),
+                Ok(None) => {
+                    diag.failed_intersection += 1;
+                    continue;
+                }
                 Err(IntersectionRejection::SmallAngle { .. }) => {
                     diag.rejected_small_angle += 1;
                     continue;
@@ -366,4 +388,16 @@ fn control_points(
         });
     }
     out
+}
+
+/// An intersection in `frame` as a map point and its covariance rows (`None` when the frame cannot convert it).
+fn in_map(frame: &MapFrame, x: &AerialIntersection) -> Option<([f64; 3], [[f64; 3]; 3])> {
+    let point = frame.point_to_map(&x.point_world).ok()?;
+    let c = frame.covariance_to_map(&point, &x.covariance_m2).ok()?;
+    let rows = [
+        [c[(0, 0)], c[(0, 1)], c[(0, 2)]],
+        [c[(1, 0)], c[(1, 1)], c[(1, 2)]],
+        [c[(2, 0)], c[(2, 1)], c[(2, 2)]],
+    ];
+    Some(([point.x, point.y, point.z], rows))
 }

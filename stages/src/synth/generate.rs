@@ -12,6 +12,7 @@ pub use super::options::{RenderIdentity, SynthOptions};
 use super::orthophoto::{self, OrthophotoOptions};
 use super::output::{render_factor, write_aerial_image, write_jpeg};
 pub use super::plan::{plan_campaign, AreaPlan, CampaignPlan};
+use crate::crs::CoordinateFrame;
 
 use super::postprocess::{apply_look, EpochLook};
 use super::preset::{Preset, PresetParams};
@@ -36,11 +37,11 @@ use std::time::Instant;
 
 /// The identity of the generator stage (the rendered campaign with an error profile applied) in cache keys;
 /// bump the version whenever its output for the same inputs and parameters changes.
-pub const STAGE: StageId = StageId::new("synth", "2");
+pub const STAGE: StageId = StageId::new("synth", "3");
 
 /// The identity of the render stage (the error-free campaign of a [`RenderIdentity`]); bump the version
 /// whenever the generator renders differently (scenes, presets, cameras, looks).
-pub const RENDER_STAGE: StageId = StageId::new("render", "4");
+pub const RENDER_STAGE: StageId = StageId::new("render", "5");
 
 /// What was generated and how long it took.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -206,7 +207,10 @@ fn write_error_free(
     }
     let truth = plan.true_tables();
     let path = root.join("campaign.toml");
-    cw::write_campaign_toml(&path, name, "EPSG:28992").map_err(io(path.clone()))?;
+    // The scene is built in a flat Cartesian world whose coordinates look like RD New: say so, or the
+    // pipeline would treat them as map coordinates of a projection.
+    cw::write_campaign_toml(&path, name, "EPSG:28992", CoordinateFrame::Cartesian)
+        .map_err(io(path.clone()))?;
     if let Some(o) = &plan.orthophoto {
         write_orthophotos(plan, o, root, &path)?;
     }

@@ -8,6 +8,7 @@ use super::readme::readme;
 use super::{Profile, Tables};
 use crate::campaign::write as cw;
 use crate::campaign::{read_aerial_csv, read_recordings_csv, AerialImage, Severity};
+use crate::crs::CoordinateFrame;
 use crate::synth::SynthError;
 use std::path::Path;
 
@@ -78,16 +79,21 @@ fn read_truth(rendered: &Path) -> Result<Tables, SynthError> {
     })
 }
 
-/// The `crs` of the rendered folder's `campaign.toml`.
-fn read_crs(rendered: &Path) -> Result<String, SynthError> {
+/// The `crs` and `frame` of the rendered folder's `campaign.toml`.
+fn read_crs(rendered: &Path) -> Result<(String, CoordinateFrame), SynthError> {
     let path = rendered.join("campaign.toml");
     let text = std::fs::read_to_string(&path).map_err(|e| SynthError::io(&path, e))?;
     let table: toml::Table = toml::from_str(&text).map_err(|e| SynthError::io(&path, e))?;
-    Ok(table
+    let crs = table
         .get("crs")
         .and_then(|v| v.as_str())
         .unwrap_or_default()
-        .to_string())
+        .to_string();
+    let frame = match table.get("frame").and_then(|v| v.as_str()) {
+        Some("cartesian") => CoordinateFrame::Cartesian,
+        _ => CoordinateFrame::Projected,
+    };
+    Ok((crs, frame))
 }
 
 /// Hard-link (else copy) `from` to `to`, creating `to`'s folder.
@@ -111,7 +117,7 @@ pub fn apply_profile_dir(
     out: &Path,
 ) -> Result<(), SynthError> {
     let truth = read_truth(rendered)?;
-    let crs = read_crs(rendered)?;
+    let (crs, frame) = read_crs(rendered)?;
     let applied = profile.apply(seed, &truth);
     for rel in relative_files(rendered)? {
         if !WRITTEN.contains(&rel.as_str()) {
@@ -126,7 +132,9 @@ pub fn apply_profile_dir(
         f(&path).map_err(|e| SynthError::io(&path, e))
     };
     let t = &applied.tables;
-    write("campaign.toml", &|p| cw::write_campaign_toml(p, name, &crs))?;
+    write("campaign.toml", &|p| {
+        cw::write_campaign_toml(p, name, &crs, frame)
+    })?;
     crate::synth::orthophoto::carry_tables(
         &rendered.join("campaign.toml"),
         &out.join("campaign.toml"),
