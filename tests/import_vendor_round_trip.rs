@@ -216,6 +216,8 @@ fn round_trip(preset: &str, seed: u32, geoid: Geoid, workflow: &str) {
         crs: "EPSG:28992+5709".into(),
         geoid_grid: None,
         geoid_separation_m: None,
+        // The synthetic scene is Cartesian; so is the campaign imported from its export.
+        frame: orig.frame,
     };
     match geoid {
         Geoid::Constant => campaign.geoid_separation_m = Some(43.25),

@@ -20,7 +20,7 @@
 //! ```
 
 use super::Problem;
-use crate::crs::{Crs, GeoidModel};
+use crate::crs::{CoordinateFrame, Crs, GeoidModel};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -108,11 +108,12 @@ impl TrajectoryProvenance {
     }
 }
 
-/// `campaign.toml` with `name`, `crs` and the `[source]` table.
+/// `campaign.toml` with `name`, `crs`, `frame` (when not the default) and the `[source]` table.
 pub fn write_campaign_toml_with_source(
     path: &Path,
     name: &str,
     crs: &str,
+    frame: CoordinateFrame,
     source: &SourceSection,
 ) -> std::io::Result<()> {
     #[derive(Serialize)]
@@ -120,10 +121,19 @@ pub fn write_campaign_toml_with_source(
         name: &'a str,
         crs: &'a str,
         #[serde(skip_serializing_if = "Option::is_none")]
+        frame: Option<CoordinateFrame>,
+        #[serde(skip_serializing_if = "Option::is_none")]
         source: Option<&'a SourceSection>,
     }
+    let frame = (frame != CoordinateFrame::default()).then_some(frame);
     let source = (source != &SourceSection::default()).then_some(source);
-    let text = toml::to_string(&Toml { name, crs, source }).map_err(std::io::Error::other)?;
+    let text = toml::to_string(&Toml {
+        name,
+        crs,
+        frame,
+        source,
+    })
+    .map_err(std::io::Error::other)?;
     crate::fsutil::atomic_write(path, text.as_bytes())
 }
 

@@ -68,6 +68,7 @@ impl Frames {
             crs: campaign_crs.to_string(),
             geoid_grid: p.geoid_grid.as_ref().map(|g| root.join(g)),
             geoid_separation_m: p.geoid_separation_m,
+            frame: Default::default(),
         };
         let ctx = ImportContext::new(&section).map_err(|e| invalid(e.to_string()))?;
         let geographic = format!("geographic:{}", p.crs);

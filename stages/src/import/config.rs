@@ -59,6 +59,9 @@ pub struct CampaignSection {
     /// A constant separation instead of a grid, m.
     #[serde(default)]
     pub geoid_separation_m: Option<f64>,
+    /// `frame` of the campaign written (`projected`, the default, or `cartesian`; campaign-format.md).
+    #[serde(default)]
+    pub frame: crate::crs::CoordinateFrame,
 }
 
 /// Which aerial folder the images go to.

@@ -162,8 +162,8 @@ pub fn run_import(config: &ImportConfig, out: &Path) -> Result<ImportReport, Imp
         report.sources.extend(reports);
     }
     let toml = partial.join("campaign.toml");
-    write_campaign_toml_with_source(&toml, &config.campaign.name, &config.campaign.crs, &source)
-        .map_err(io(&toml))?;
+    let c = &config.campaign;
+    write_campaign_toml_with_source(&toml, &c.name, &c.crs, c.frame, &source).map_err(io(&toml))?;
     let text = report_text(&report, &ctx);
     let path = partial.join("import_report.txt");
     crate::fsutil::atomic_write(&path, text.as_bytes()).map_err(io(&path))?;
