@@ -20,8 +20,14 @@ use std::path::Path;
 
 /// The vendored files written to `OUT/report/assets/`.
 const ASSETS: [(&str, &[u8]); 4] = [
-    ("leaflet.js", include_bytes!("assets/vendor/leaflet/leaflet.js")),
-    ("leaflet.css", include_bytes!("assets/vendor/leaflet/leaflet.css")),
+    (
+        "leaflet.js",
+        include_bytes!("assets/vendor/leaflet/leaflet.js"),
+    ),
+    (
+        "leaflet.css",
+        include_bytes!("assets/vendor/leaflet/leaflet.css"),
+    ),
     (
         "leaflet-LICENSE.txt",
         include_bytes!("assets/vendor/leaflet/LICENSE"),
