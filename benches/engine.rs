@@ -5,10 +5,8 @@
 //!
 //! `cargo bench --bench engine` (SKYTIE_BENCH_ITEMS overrides the item count).
 
-use skytie::dag::progress::{Progress, ProgressMode};
-use skytie::dag::{execute, Dag, DagBuilder, Env, Mode, RawFile};
-use skytie::hashing::StatCache;
-use skytie::store::Store;
+use skytie::dag::{Dag, DagBuilder, Mode, RawFile};
+use skytie::testing::harness::{cpu_seconds, SilentEngine};
 use skytie::testing::toy::{write_item, ToyParse, ToyScale, ToySum};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -29,18 +27,6 @@ fn build(items: &[PathBuf]) -> Dag {
     let s = b.add(ToySum, "", Default::default(), hs).expect("add sum");
     b.request(s);
     b.build()
-}
-
-/// CPU time (user + system) of the whole process, seconds: on a loaded machine this is the engine's own
-/// cost, independent of waiting for a core.
-fn cpu_seconds() -> f64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid, writable timespec.
-    unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
 }
 
 fn main() {
@@ -65,19 +51,12 @@ fn main() {
             }
         })
         .collect();
-    let store = Store::open(&dir.join("cache")).expect("store");
-    let stat = StatCache::open(store.root());
-    let progress = Progress::new(ProgressMode::Silent);
-    let env = Env {
-        store: &store,
-        stat_cache: &stat,
-        progress: &progress,
-    };
+    let engine = SilentEngine::open(&dir.join("cache")).expect("store");
 
     let t = Instant::now();
     let dag = build(&items);
     let nodes = dag.len();
-    let o = execute(&dag, &env, Mode::Run);
+    let o = engine.execute(&dag, Mode::Run);
     if !reuse {
         assert_eq!(o.executed(), nodes, "first run executes everything");
         println!(
@@ -87,8 +66,8 @@ fn main() {
     }
     // Let the stat cache remember the files (entries younger than 2 s are not trusted).
     std::thread::sleep(std::time::Duration::from_millis(2100));
-    stat.save().expect("save stat cache");
-    let o = execute(&build(&items), &env, Mode::Run);
+    engine.stat_cache.save().expect("save stat cache");
+    let o = engine.execute(&build(&items), Mode::Run);
     assert_eq!(o.cached(), nodes);
 
     for threads in [1usize, 0] {
@@ -105,7 +84,7 @@ fn main() {
             let (mut best, mut best_cpu) = (f64::INFINITY, f64::INFINITY);
             for _ in 0..3 {
                 let (t, c) = (Instant::now(), cpu_seconds());
-                let o = pool.install(|| execute(&build(&items), &env, mode));
+                let o = pool.install(|| engine.execute(&build(&items), mode));
                 let (secs, cpu) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
                 assert_eq!(o.cached(), nodes, "all cached");
                 best = best.min(secs);

@@ -11,46 +11,17 @@
 //! `cold`, `plan` or `noop` runs one measurement in this process, e.g. under `perf record`).
 //! Targets: plan ≤ 10 µs/node, no-op ≤ 20 µs/node, ≤ 1 KB/node.
 
-use skytie::dag::progress::{Progress, ProgressMode};
-use skytie::dag::{execute, DagBuilder, Env, Mode};
-use skytie::hashing::StatCache;
-use skytie::store::Store;
+use skytie::dag::{DagBuilder, Mode};
 use skytie::testing::city::{build_city, recordings_for_nodes};
+use skytie::testing::harness::{cpu_seconds, status_bytes, SilentEngine};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-/// CPU time (user + system) of the whole process, seconds.
-fn cpu_seconds() -> f64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid, writable timespec.
-    unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-}
-
-/// A `kB` field of `/proc/self/status` (`VmRSS`, `VmHWM`), in bytes.
-fn status_bytes(field: &str) -> u64 {
-    let text = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    text.lines()
-        .find_map(|l| l.strip_prefix(field)?.strip_prefix(':'))
-        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
-        .map_or(0, |kb| kb * 1024)
-}
-
 /// One measurement in this process: prints `RESULT role nodes wall_s cpu_s build_s bytes executed cached`.
 fn measure(role: &str, dir: &Path, recordings: usize) {
-    let store = Store::open(&dir.join("cache")).expect("open the store");
-    let stat = StatCache::open(store.root());
-    let progress = Progress::new(ProgressMode::Silent);
-    let env = Env {
-        store: &store,
-        stat_cache: &stat,
-        progress: &progress,
-    };
-    let _lease = store.begin_run().expect("lease");
+    let engine = SilentEngine::open(&dir.join("cache")).expect("open the store");
+    let _lease = engine.store.begin_run().expect("lease");
     let baseline = status_bytes("VmRSS");
     let (t, c) = (Instant::now(), cpu_seconds());
     let mut b = DagBuilder::new();
@@ -64,7 +35,7 @@ fn measure(role: &str, dir: &Path, recordings: usize) {
     } else {
         Mode::Run
     };
-    let o = execute(&dag, &env, mode);
+    let o = engine.execute(&dag, mode);
     let (wall, cpu) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
     let peak = status_bytes("VmHWM").saturating_sub(baseline);
     let nodes = dag.len();

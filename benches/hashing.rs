@@ -8,6 +8,7 @@ use std::io::Write;
 use std::time::{Duration, Instant, SystemTime};
 
 use skytie::hashing::{hash_bytes, hash_file, StatCache};
+use skytie::testing::harness::cpu_time;
 
 const FILE_BYTES: usize = 1 << 30;
 const RUNS: usize = 5;
@@ -25,17 +26,6 @@ fn best<T>(mut f: impl FnMut() -> T) -> (Duration, Duration, T) {
         last = Some(out);
     }
     (best_wall, best_cpu, last.expect("RUNS > 0"))
-}
-
-/// CPU time (user + system, all threads) used by this process so far.
-fn cpu_time() -> Duration {
-    // SAFETY: getrusage only writes the zero-initialised struct we pass.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } != 0 {
-        return Duration::ZERO;
-    }
-    let tv = |t: libc::timeval| Duration::new(t.tv_sec as u64, t.tv_usec as u32 * 1000);
-    tv(usage.ru_utime) + tv(usage.ru_stime)
 }
 
 fn gbps(bytes: usize, t: Duration) -> f64 {

@@ -27,20 +27,10 @@ use std::time::{Duration, Instant};
 use skytie::codec::Artifact;
 use skytie::hashing::{hash_bytes, KeyBuilder};
 use skytie::store::{EntryMeta, Loaded, Lookup, Store};
+use skytie::testing::harness::cpu_time;
 use skytie_stages::imaging::GrayImage;
 
 const RUNS: usize = 7;
-
-/// CPU time (user + system, all threads) used by this process so far.
-fn cpu_time() -> Duration {
-    // SAFETY: getrusage only writes the zero-initialised struct we pass.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } != 0 {
-        return Duration::ZERO;
-    }
-    let tv = |t: libc::timeval| Duration::new(t.tv_sec as u64, t.tv_usec as u32 * 1000);
-    tv(usage.ru_utime) + tv(usage.ru_stime)
-}
 
 /// Best wall time and best CPU time of `RUNS` calls of `f`; `setup` runs before each call, untimed.
 fn measure_with(mut setup: impl FnMut(), mut f: impl FnMut()) -> (Duration, Duration) {

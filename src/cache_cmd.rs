@@ -90,6 +90,11 @@ pub fn format_bytes(bytes: u64) -> String {
     }
 }
 
+/// One row of the `cache stats` table: a label, an entry count and their size.
+fn stats_row(out: &mut String, label: &str, entries: u64, bytes: u64) {
+    let _ = writeln!(out, "{label:<28} {entries:>10} {:>12}", format_bytes(bytes));
+}
+
 /// `skytie cache stats`: totals and a per-stage table.
 pub fn stats(store: &Store) -> String {
     let stats = match store.stats() {
@@ -100,39 +105,32 @@ pub fn stats(store: &Store) -> String {
     let _ = writeln!(out, "cache {}", store.root().display());
     let _ = writeln!(out, "{:<28} {:>10} {:>12}", "stage", "entries", "size");
     for (stage, s) in &stats.per_stage {
-        let _ = writeln!(
-            out,
-            "{:<28} {:>10} {:>12}",
-            stage,
-            s.entries,
-            format_bytes(s.bytes)
-        );
+        stats_row(&mut out, stage, s.entries, s.bytes);
     }
     if stats.unreadable.entries > 0 {
-        let _ = writeln!(
-            out,
-            "{:<28} {:>10} {:>12}",
-            "(unreadable or old format)",
-            stats.unreadable.entries,
-            format_bytes(stats.unreadable.bytes)
-        );
+        let u = &stats.unreadable;
+        stats_row(&mut out, "(unreadable or old format)", u.entries, u.bytes);
     }
-    let _ = writeln!(
-        out,
-        "{:<28} {:>10} {:>12}",
-        "total",
-        stats.entries,
-        format_bytes(stats.bytes)
-    );
-    let _ = writeln!(
-        out,
-        "{:<28} {:>10} {:>12}",
-        "records",
-        stats.records.entries,
-        format_bytes(stats.records.bytes)
-    );
+    stats_row(&mut out, "total", stats.entries, stats.bytes);
+    let r = &stats.records;
+    stats_row(&mut out, "records", r.entries, r.bytes);
     let _ = writeln!(out, "live runs: {}", stats.live_runs);
     out
+}
+
+/// The lines of one verified store in `cache verify`: its summary, then each damaged entry (where it is,
+/// what is wrong) with what was done about it (`actions`: the words for removed and for not removed).
+fn verify_lines<'a>(
+    out: &mut String,
+    summary: &str,
+    bad: impl Iterator<Item = (String, &'a str, bool)>,
+    actions: [&str; 2],
+) {
+    let _ = writeln!(out, "{summary}");
+    for (place, reason, removed) in bad {
+        let action = actions[usize::from(!removed)];
+        let _ = writeln!(out, "  {place}  {reason} — {action}");
+    }
 }
 
 /// `skytie cache verify`: re-hashes every entry; the flag is false if any entry was bad (exit status 1).
@@ -142,22 +140,18 @@ pub fn verify(store: &Store) -> (String, bool) {
         Err(e) => return (format!("{e}\n"), false),
     };
     let mut out = String::new();
-    let _ = writeln!(
-        out,
+    let summary = format!(
         "checked {} entries ({}): {} ok, {} bad",
         report.checked,
         format_bytes(report.bytes_checked),
         report.ok,
         report.bad.len()
     );
-    for bad in &report.bad {
-        let action = if bad.removed {
-            "removed"
-        } else {
-            "could NOT be removed"
-        };
-        let _ = writeln!(out, "  {}  {} — {action}", bad.path.display(), bad.reason);
-    }
+    let bad = report
+        .bad
+        .iter()
+        .map(|b| (b.path.display().to_string(), b.reason.as_str(), b.removed));
+    verify_lines(&mut out, &summary, bad, ["removed", "could NOT be removed"]);
     if report.temp_files_removed > 0 {
         let _ = writeln!(
             out,
@@ -173,8 +167,7 @@ pub fn verify(store: &Store) -> (String, bool) {
             all_ok = false;
         }
         Some(Ok(remote)) => {
-            let _ = writeln!(
-                out,
+            let summary = format!(
                 "remote {}: checked {} entries ({}) and {} generated folders: {} bad",
                 remote.url,
                 remote.entries_checked,
@@ -182,14 +175,12 @@ pub fn verify(store: &Store) -> (String, bool) {
                 remote.folders_checked,
                 remote.bad.len()
             );
-            for bad in &remote.bad {
-                let action = if bad.removed {
-                    "deleted from the remote"
-                } else {
-                    "could NOT be deleted"
-                };
-                let _ = writeln!(out, "  {}  {} — {action}", bad.name, bad.reason);
-            }
+            let bad = remote
+                .bad
+                .iter()
+                .map(|b| (b.name.clone(), b.reason.as_str(), b.removed));
+            let actions = ["deleted from the remote", "could NOT be deleted"];
+            verify_lines(&mut out, &summary, bad, actions);
             all_ok &= remote.bad.is_empty();
         }
     }

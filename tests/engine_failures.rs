@@ -3,12 +3,11 @@
 
 mod support;
 
-use skytie::dag::progress::{Progress, ProgressMode};
 use skytie::dag::record::{self, FailureRecord};
-use skytie::dag::{Mode, Session};
-use skytie::hashing::StatCache;
+use skytie::dag::Mode;
 use skytie::plan::plan_text;
 use skytie::store::Store;
+use skytie::testing::harness::SilentEngine;
 use support::*;
 
 /// Runs (or plans) the toy DAG of `cfg` in a session; in run mode the phase's failures are recorded.
@@ -19,10 +18,8 @@ fn session(
     cfg: &ToyConfig,
     mode: Mode,
 ) -> (String, usize) {
-    let store = Store::open(cache).unwrap();
-    let stat = StatCache::open(store.root());
-    let progress = Progress::new(ProgressMode::Silent);
-    let mut s = Session::new(&store, &stat, &progress, mode);
+    let engine = SilentEngine::open(cache).unwrap();
+    let mut s = engine.session(mode);
     s.execute("items", toy_dag(items, cfg).0);
     let phase = &s.phases[0];
     let failed = phase
@@ -32,7 +29,8 @@ fn session(
         .count();
     if mode == Mode::Run {
         // Idempotent: a session that records failures itself writes the same record.
-        let n = skytie::dag::failures::save_failures(&store, &phase.dag, &phase.reports).unwrap();
+        let n = skytie::dag::failures::save_failures(&engine.store, &phase.dag, &phase.reports)
+            .unwrap();
         assert_eq!(n, failed);
     }
     (plan_text(&s, None), failed)

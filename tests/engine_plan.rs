@@ -2,10 +2,8 @@
 
 mod support;
 
-use skytie::dag::progress::{Progress, ProgressMode};
-use skytie::dag::{DagBuilder, Mode, NodeStatus, RawFile, Session};
-use skytie::hashing::StatCache;
-use skytie::store::Store;
+use skytie::dag::{DagBuilder, Mode, NodeStatus, RawFile};
+use skytie::testing::harness::SilentEngine;
 use skytie::testing::toy::{
     item_label, list_items, ToyDir, ToyGen, ToyGenParams, ToyParse, ToySum,
 };
@@ -77,10 +75,8 @@ fn write_item_value(path: &std::path::Path, v: f64) {
 
 /// Phase 1 generates the campaign folder; phase 2 is built from it.
 fn staged(cache: &std::path::Path, count: u32, mode: Mode) -> (Vec<(usize, usize)>, Option<f64>) {
-    let store = Store::open(cache).unwrap();
-    let stat = StatCache::open(store.root());
-    let progress = Progress::new(ProgressMode::Silent);
-    let mut session = Session::new(&store, &stat, &progress, mode);
+    let engine = SilentEngine::open(cache).unwrap();
+    let mut session = engine.session(mode);
     let mut b = DagBuilder::new();
     let gen = b
         .add(

@@ -8,28 +8,8 @@
 #[path = "support/cli.rs"]
 mod cli;
 
-use cli::{run_ok, skytie};
-use std::collections::BTreeMap;
+use cli::{files_under, run_ok, skytie};
 use std::path::{Path, PathBuf};
-
-fn files(root: &Path) -> BTreeMap<String, Vec<u8>> {
-    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<String, Vec<u8>>) {
-        for e in std::fs::read_dir(dir).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                walk(root, &p, out);
-            } else {
-                out.insert(
-                    p.strip_prefix(root).unwrap().display().to_string(),
-                    std::fs::read(&p).unwrap(),
-                );
-            }
-        }
-    }
-    let mut out = BTreeMap::new();
-    walk(root, root, &mut out);
-    out
-}
 
 fn metrics(out: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(out.join("metrics.json")).unwrap()).unwrap()
@@ -129,9 +109,9 @@ fn tiny_campaign_end_to_end() {
         .collect();
     // Two folders: the error-free rendering and the campaign with the error profile applied to it.
     assert_eq!(generated.len(), 2, "{generated:?}");
-    let camp_files = files(&camp);
+    let camp_files = files_under(&camp, &[]);
     assert!(
-        generated.iter().any(|g| files(g) == camp_files),
+        generated.iter().any(|g| files_under(g, &[]) == camp_files),
         "the synth node's campaign differs from `skytie synth`'s"
     );
     let m = run_workflow(&wf, &cache, &out);
@@ -140,7 +120,7 @@ fn tiny_campaign_end_to_end() {
     // 3. A user campaign (other ortho params) that grows by one recording re-runs only that recording's ortho.
     let user = dir.join("user");
     std::fs::create_dir_all(&user).unwrap();
-    for (rel, bytes) in files(&camp) {
+    for (rel, bytes) in files_under(&camp, &[]) {
         let p = user.join(&rel);
         std::fs::create_dir_all(p.parent().unwrap()).unwrap();
         std::fs::write(p, bytes).unwrap();

@@ -7,7 +7,7 @@
 #[path = "support/cli.rs"]
 mod cli;
 
-use cli::{run_ok, skytie};
+use cli::{finish, run_ok, skytie};
 use std::path::Path;
 
 fn png(path: &Path, w: u32, h: u32, claim: Option<(u32, u32)>) {
@@ -52,25 +52,20 @@ fn copy_dir(from: &Path, to: &Path) {
 }
 
 fn run(wf: &Path, campaign: &Path, cache: &Path, out: &Path) -> (i32, String) {
-    let o = skytie()
-        .arg("run")
-        .arg(wf)
-        .arg("--campaign")
-        .arg(campaign)
-        .arg("--cache")
-        .arg(cache)
-        .arg("--out")
-        .arg(out)
-        .arg("--quiet")
-        .output()
-        .unwrap();
-    // Warnings (stderr) first: the run's own last line is the last line of stdout.
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stderr),
-        String::from_utf8_lossy(&o.stdout)
+    let (code, stdout, stderr) = finish(
+        skytie()
+            .arg("run")
+            .arg(wf)
+            .arg("--campaign")
+            .arg(campaign)
+            .arg("--cache")
+            .arg(cache)
+            .arg("--out")
+            .arg(out)
+            .arg("--quiet"),
     );
-    (o.status.code().unwrap_or(-1), text)
+    // Warnings (stderr) first: the run's own last line is the last line of stdout.
+    (code, stderr + &stdout)
 }
 
 /// Written by every run that reached the adjustment (`trajectory_adjusted.csv` only when it corrected

@@ -8,7 +8,7 @@
 #[path = "support/cli.rs"]
 mod cli;
 
-use cli::{json, output_files, skytie};
+use cli::{exit_and_output, json, output_files, skytie};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -35,20 +35,14 @@ fn executed(metrics: &Value) -> BTreeMap<String, u64> {
 
 /// `skytie run tiny --cache CACHE --out OUT --quiet EXTRA…`: (exit code, stdout + stderr).
 fn run(cache: &Path, out: &Path, extra: &[&str]) -> (i32, String) {
-    let o = skytie()
-        .args(["run", "tiny", "--quiet", "--cache"])
-        .arg(cache)
-        .arg("--out")
-        .arg(out)
-        .args(extra)
-        .output()
-        .unwrap();
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    (o.status.code().unwrap_or(-1), text)
+    exit_and_output(
+        skytie()
+            .args(["run", "tiny", "--quiet", "--cache"])
+            .arg(cache)
+            .arg("--out")
+            .arg(out)
+            .args(extra),
+    )
 }
 
 fn add(total: &mut BTreeMap<String, u64>, part: &BTreeMap<String, u64>) {

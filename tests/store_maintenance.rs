@@ -34,6 +34,26 @@ fn file_len(store: &Store, key: &NodeKey) -> u64 {
     fs::metadata(store.object_path(key)).unwrap().len()
 }
 
+/// A store in a fresh temporary folder; `None` in the child process of
+/// `a_sigkilled_runs_lease_neither_blocks_nor_protects`, where the other tests do nothing.
+fn fresh_store() -> Option<(tempfile::TempDir, Store)> {
+    if std::env::var(CHILD_ENV).is_ok() {
+        return None;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let store = Store::open(dir.path()).unwrap();
+    Some((dir, store))
+}
+
+/// Saves entries `key(0) … key(count − 1)` of stage `s` with payload `payload(n)`; returns their meta.
+fn save_entries(store: &Store, count: u32, payload: impl Fn(u32) -> Vec<u8>) -> EntryMeta {
+    let meta = EntryMeta::new("s", "1", "i");
+    for n in 0..count {
+        store.save(&key(n), &meta, &payload(n)).unwrap();
+    }
+    meta
+}
+
 #[test]
 fn a_sigkilled_runs_lease_neither_blocks_nor_protects() {
     if let Ok(root) = std::env::var(CHILD_ENV) {
@@ -118,17 +138,10 @@ fn a_sigkilled_runs_lease_neither_blocks_nor_protects() {
 
 #[test]
 fn gc_removes_least_recently_used_first_down_to_the_limit() {
-    if std::env::var(CHILD_ENV).is_ok() {
+    let Some((_dir, store)) = fresh_store() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    let store = Store::open(dir.path()).unwrap();
-    let meta = EntryMeta::new("s", "1", "i");
-    for n in 0..5 {
-        store
-            .save(&key(n), &meta, &vec![n as u8; 1000 * (n as usize + 1)])
-            .unwrap();
-    }
+    };
+    save_entries(&store, 5, |n| vec![n as u8; 1000 * (n as usize + 1)]);
     // Last used: key 3 longest ago, then 0, 4, 1, 2.
     for (n, hours) in [(3, 50), (0, 40), (4, 30), (1, 20), (2, 10)] {
         age(&store, &key(n), Duration::from_secs(hours * 3600));
@@ -163,14 +176,11 @@ fn gc_removes_least_recently_used_first_down_to_the_limit() {
 
 #[test]
 fn gc_to_zero_keeps_everything_a_live_run_used_and_removes_the_rest() {
-    if std::env::var(CHILD_ENV).is_ok() {
+    let Some((dir, store)) = fresh_store() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    let store = Store::open(dir.path()).unwrap();
-    let meta = EntryMeta::new("s", "1", "i");
+    };
+    let meta = save_entries(&store, 6, |n| vec![n as u8; 100]);
     for n in 0..6 {
-        store.save(&key(n), &meta, &[n as u8; 100]).unwrap();
         age(&store, &key(n), Duration::from_secs(3600 * (n as u64 + 1)));
     }
     let lease = store.begin_run().unwrap();
@@ -202,11 +212,9 @@ fn gc_to_zero_keeps_everything_a_live_run_used_and_removes_the_rest() {
 
 #[test]
 fn stats_count_entries_and_bytes_per_stage() {
-    if std::env::var(CHILD_ENV).is_ok() {
+    let Some((_dir, store)) = fresh_store() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    let store = Store::open(dir.path()).unwrap();
+    };
     let empty = store.stats().unwrap();
     assert_eq!(
         (empty.entries, empty.bytes, empty.per_stage.len()),
@@ -256,17 +264,10 @@ fn stats_count_entries_and_bytes_per_stage() {
 
 #[test]
 fn verify_rehashes_everything_and_removes_bad_entries() {
-    if std::env::var(CHILD_ENV).is_ok() {
+    let Some((_dir, store)) = fresh_store() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    let store = Store::open(dir.path()).unwrap();
-    let meta = EntryMeta::new("s", "1", "i");
-    for n in 0..8 {
-        store
-            .save(&key(n), &meta, &vec![n as u8; 2000 + n as usize])
-            .unwrap();
-    }
+    };
+    save_entries(&store, 8, |n| vec![n as u8; 2000 + n as usize]);
     let (text, ok) = cache_cmd::verify(&store);
     assert!(ok, "{text}");
     assert!(text.contains("checked 8 entries"), "{text}");
@@ -319,14 +320,11 @@ fn verify_rehashes_everything_and_removes_bad_entries() {
 
 #[test]
 fn contains_marks_entries_used_only_while_this_handle_runs() {
-    if std::env::var(CHILD_ENV).is_ok() {
+    let Some((_dir, store)) = fresh_store() else {
         return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    let store = Store::open(dir.path()).unwrap();
-    let meta = EntryMeta::new("s", "1", "i");
+    };
+    save_entries(&store, 3, |_| b"x".to_vec());
     for n in 0..3 {
-        store.save(&key(n), &meta, b"x").unwrap();
         age(&store, &key(n), Duration::from_secs(3600));
     }
     let mtime = |n| {

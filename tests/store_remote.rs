@@ -11,7 +11,7 @@
 mod cli;
 mod support;
 
-use cli::{json, output_files, skytie};
+use cli::{exit_and_output, json, output_files, skytie};
 use serde_json::Value;
 use skytie::dag::progress::{Progress, ProgressMode};
 use skytie::dag::{execute, DagBuilder, Env, Mode, Outcome};
@@ -417,22 +417,16 @@ fn cli_run(
     out: &Path,
     extra: &[&str],
 ) -> (i32, String) {
-    let o = skytie()
-        .args(["run", workflow, "--quiet", "--cache"])
-        .arg(cache)
-        .arg("--cache-remote")
-        .arg(remote)
-        .arg("--out")
-        .arg(out)
-        .args(extra)
-        .output()
-        .unwrap();
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    (o.status.code().unwrap_or(-1), text)
+    exit_and_output(
+        skytie()
+            .args(["run", workflow, "--quiet", "--cache"])
+            .arg(cache)
+            .arg("--cache-remote")
+            .arg(remote)
+            .arg("--out")
+            .arg(out)
+            .args(extra),
+    )
 }
 
 /// metrics.json without the engine's bookkeeping (node counts, seconds).

@@ -57,6 +57,38 @@ impl CacheOpt {
     }
 }
 
+/// The workflow a command works on, its campaign override and the cache: `WORKFLOW [--campaign DIR]
+/// [--cache DIR]`, shared by `plan`, `explain` and `slurm`.
+#[derive(Args, Debug, Clone)]
+pub struct WorkflowTarget {
+    /// Workflow: a built-in name (`skytie workflows` lists them) or a TOML file.
+    pub workflow: PathBuf,
+    /// Use this campaign folder instead of the workflow's `campaign`.
+    #[arg(long, value_name = "DIR")]
+    pub campaign: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: CacheOpt,
+}
+
+impl WorkflowTarget {
+    /// Load the workflow with the campaign override (see [`load_workflow`]).
+    pub fn load(&self) -> Result<(Workflow, &'static dyn Pipeline), String> {
+        load_workflow(&self.workflow, self.campaign.as_deref())
+    }
+}
+
+/// The exit code of a command's result: `ok`'s for a success; for an error (exit code, message) the message
+/// printed to stderr and the code.
+pub fn exit_code<T>(result: Result<T, (i32, String)>, ok: impl FnOnce(T) -> i32) -> i32 {
+    match result {
+        Ok(value) => ok(value),
+        Err((code, msg)) => {
+            eprintln!("error: {msg}");
+            code
+        }
+    }
+}
+
 /// `--threads N` (0 = all cores).
 #[derive(Args, Debug, Clone, Default)]
 pub struct ThreadsOpt {
@@ -97,9 +129,7 @@ pub fn load_workflow(
 /// `plan_stop` gives when planning stopped at a phase whose inputs are not computed yet. Shared by `plan` and
 /// `explain`. Errors are (exit code, message).
 pub fn with_plan_session<T>(
-    workflow: &Path,
-    campaign: Option<&Path>,
-    cache: &CacheOpt,
+    target: &WorkflowTarget,
     threads: &ThreadsOpt,
     report: impl FnOnce(
         &crate::dag::Session<'_>,
@@ -107,8 +137,8 @@ pub fn with_plan_session<T>(
     ) -> Result<T, (i32, String)>,
 ) -> Result<T, (i32, String)> {
     use crate::dag::progress::{Progress, ProgressMode};
-    let (wf, pipeline) = load_workflow(workflow, campaign).map_err(|e| (2, e))?;
-    let store = cache.open().map_err(|e| (2, e))?;
+    let (wf, pipeline) = target.load().map_err(|e| (2, e))?;
+    let store = target.cache.open().map_err(|e| (2, e))?;
     let stat_cache = crate::hashing::StatCache::open(store.root());
     let progress = Progress::new(ProgressMode::Quiet);
     let mut session =

@@ -15,7 +15,9 @@
 //! requested output failed or was skipped. **2** for usage/setup errors before anything ran (workflow does
 //! not load, unknown pipeline, cache cannot be opened) or when the output files cannot be written.
 
-use crate::cli::common::{load_workflow, print_problems, CacheOpt, ThreadsOpt, DEFAULT_WORKFLOW};
+use crate::cli::common::{
+    exit_code, load_workflow, print_problems, CacheOpt, ThreadsOpt, DEFAULT_WORKFLOW,
+};
 use crate::cli::shard::ShardOpt;
 use crate::dag::progress::{Progress, ProgressMode};
 use crate::dag::{Mode, NodeStatus, Partition, PipelineError, Session};
@@ -64,13 +66,7 @@ pub struct RunResult {
 }
 
 pub fn main(args: &RunArgs) -> i32 {
-    match run(args) {
-        Ok(r) => r.exit_code,
-        Err((code, msg)) => {
-            eprintln!("error: {msg}");
-            code
-        }
-    }
+    exit_code(run(args), |r| r.exit_code)
 }
 
 /// Run a workflow as the CLI does. Err = (exit code, message).

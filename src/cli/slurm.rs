@@ -7,7 +7,7 @@
 //! cached); after a failed task, submitting again recomputes only what is missing (`--tasks` limits the array
 //! to some shards). See docs/cluster.md.
 
-use crate::cli::common::{load_workflow, CacheOpt};
+use crate::cli::common::{exit_code, WorkflowTarget};
 use crate::workflow::CampaignSource;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -18,13 +18,8 @@ pub const MIN_RECORDINGS_PER_SHARD: usize = 100;
 
 #[derive(Args, Debug, Clone)]
 pub struct SlurmArgs {
-    /// Workflow: a built-in name or a TOML file.
-    pub workflow: PathBuf,
-    /// Use this campaign folder instead of the workflow's `campaign`.
-    #[arg(long, value_name = "DIR")]
-    pub campaign: Option<PathBuf>,
     #[command(flatten)]
-    pub cache: CacheOpt,
+    pub target: WorkflowTarget,
     /// Output folder, on a file system every node sees (default: `out/<workflow name>/`).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -73,13 +68,7 @@ pub struct SlurmArgs {
 }
 
 pub fn main(args: &SlurmArgs) -> i32 {
-    match run(args) {
-        Ok(()) => 0,
-        Err((code, msg)) => {
-            eprintln!("error: {msg}");
-            code
-        }
-    }
+    exit_code(run(args), |()| 0)
 }
 
 /// Absolute form of a path (jobs start in another working directory).
@@ -101,8 +90,8 @@ struct Plan {
 }
 
 fn run(args: &SlurmArgs) -> Result<(), (i32, String)> {
-    let (wf, _) = load_workflow(&args.workflow, args.campaign.as_deref()).map_err(|e| (2, e))?;
-    if args.cache.cache.is_none() && std::env::var_os("SKYTIE_CACHE").is_none() {
+    let (wf, _) = args.target.load().map_err(|e| (2, e))?;
+    if args.target.cache.cache.is_none() && std::env::var_os("SKYTIE_CACHE").is_none() {
         return Err((
             2,
             "give the shared cache folder with --cache DIR (or SKYTIE_CACHE): every job must see the same cache \
@@ -117,10 +106,10 @@ fn run(args: &SlurmArgs) -> Result<(), (i32, String)> {
             .clone()
             .unwrap_or_else(|| Path::new("out").join(&wf.name)),
     );
-    let workflow = if args.workflow.is_file() {
-        absolute(&args.workflow)
+    let workflow = if args.target.workflow.is_file() {
+        absolute(&args.target.workflow)
     } else {
-        args.workflow.clone()
+        args.target.workflow.clone()
     };
     let skytie = match &args.skytie {
         Some(p) => absolute(p),
@@ -135,13 +124,13 @@ fn run(args: &SlurmArgs) -> Result<(), (i32, String)> {
         "{} run {} --cache {} --out {} --threads \"${{SLURM_CPUS_PER_TASK:-0}}\" --quiet",
         quoted(&skytie),
         quoted(&workflow),
-        quoted(&absolute(&args.cache.root())),
+        quoted(&absolute(&args.target.cache.root())),
         quoted(&out)
     );
-    if let Some(c) = &args.campaign {
+    if let Some(c) = &args.target.campaign {
         command.push_str(&format!(" --campaign {}", quoted(&absolute(c))));
     }
-    if let Some(remote) = args.cache.remote() {
+    if let Some(remote) = args.target.cache.remote() {
         command.push_str(&format!(" --cache-remote {}", quoted(Path::new(&remote))));
     }
     let dir = out.join("slurm");

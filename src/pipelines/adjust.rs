@@ -2,21 +2,19 @@
 //! node fed by the registration stages' per-recording outputs, its truth grade `grade_adjust` (synthetic
 //! campaigns only) and the `verify` node (Table 5-13).
 
-use super::nadir::{NadirHandles, RecordingItem};
+use super::nadir::NadirHandles;
 use super::oblique::ObliqueHandles;
 use super::stage;
+use super::variant::VariantContext;
 use super::wf_err;
 use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::adjust::adjustment::{AdjustReport, AdjustStage};
 use crate::nodes::adjust::grade::{AdjustGrade, GradeAdjust};
 use crate::nodes::adjust::verify::{verify_metrics, VerifyStage};
-use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::summary::SummaryParams;
 use crate::nodes::nadir::grade::TRUTH_RECORDINGS;
-use crate::workflow::Workflow;
 use skytie_stages::adjustment::verify::{Verification, VerifyConfig};
 use skytie_stages::adjustment::{AdjustConfig, Sources};
-use std::path::Path;
 
 /// Handles of the adjustment outputs (for the exports written after the run).
 pub struct AdjustHandles {
@@ -27,19 +25,15 @@ pub struct AdjustHandles {
     pub verification_adjusted: Option<Handle<Verification>>,
 }
 
-/// Add `adjust`, `grade_adjust` and `verify` when the workflow enables them.
-#[allow(clippy::too_many_arguments)]
+/// Add `adjust`, `grade_adjust` and `verify` for the variant of `cx` when the workflow enables them.
 pub fn add_adjust(
     b: &mut DagBuilder,
-    wf: &Workflow,
-    variant: &str,
-    root: &Path,
-    snap: Handle<CampaignSnapshot>,
-    items: &[RecordingItem<'_>],
+    cx: &VariantContext<'_>,
     nadir: Option<&NadirHandles>,
     oblique: Option<&ObliqueHandles>,
 ) -> Result<AdjustHandles, PipelineError> {
-    let on = |s: &str| wf.stages.iter().any(|x| x == s);
+    let (wf, root, snap, items) = (cx.wf, cx.root, cx.snap, cx.items);
+    let on = |s: &str| cx.on(s);
     let mut out = AdjustHandles {
         report: None,
         verification: None,
@@ -60,7 +54,7 @@ pub fn add_adjust(
     }
     let panos: Vec<RawFile> = items.iter().map(|i| i.pano.clone()).collect();
     if on(stage::ADJUST) {
-        let config: AdjustConfig = wf.params(stage::ADJUST, variant).map_err(wf_err)?;
+        let config: AdjustConfig = cx.params(stage::ADJUST)?;
         let use_nadir = matches!(config.sources, Sources::Nadir | Sources::Combined);
         let use_oblique = matches!(config.sources, Sources::Oblique | Sources::Combined);
         let missing = match (
@@ -113,7 +107,7 @@ pub fn add_adjust(
         }
     }
     if on(stage::VERIFY) {
-        let config: VerifyConfig = wf.params(stage::VERIFY, variant).map_err(wf_err)?;
+        let config: VerifyConfig = cx.params(stage::VERIFY)?;
         let Some(nadir) = nadir else {
             return Err(wf_err(format!(
                 "{}: 'verify' compares aerial nadir control points with the MM data: enable the nadir chain",

@@ -10,79 +10,52 @@ pub mod orthophoto;
 pub mod shards;
 pub mod skytie;
 pub mod validate;
+pub mod variant;
 pub mod vehicle;
 
 use crate::dag::{Pipeline, PipelineError};
 use crate::workflow::Workflow;
 use skytie_stages::campaign::Recording;
 
-/// Stage names as each stage defines them next to its algorithm (`STAGE.name`); workflows enable stages and
-/// name parameter tables with these.
-pub mod stage {
-    #[allow(missing_docs)]
-    pub const SYNTH: &str = skytie_stages::synth::generate::STAGE.name;
-    #[allow(missing_docs)]
-    pub const LOAD: &str = skytie_stages::campaign::read::STAGE.name;
-    #[allow(missing_docs)]
-    pub const ORTHO: &str = skytie_stages::nadir::ortho::STAGE.name;
-    #[allow(missing_docs)]
-    pub const SUMMARY: &str = crate::nodes::campaign::summary::STAGE.name;
-    #[allow(missing_docs)]
-    pub const MM_MATCH: &str = skytie_stages::nadir::mm_matching::STAGE.name;
-    #[allow(missing_docs)]
-    pub const ORTHO_AERIAL: &str = skytie_stages::nadir::aerial_patch::STAGE.name;
-    #[allow(missing_docs)]
-    pub const TRANSFORM: &str = skytie_stages::nadir::initial_transform::STAGE.name;
-    #[allow(missing_docs)]
-    pub const REFINE: &str = skytie_stages::nadir::refine::STAGE.name;
-    #[allow(missing_docs)]
-    pub const CONTROL: &str = skytie_stages::nadir::control_points::STAGE.name;
-    #[allow(missing_docs)]
-    pub const NADIR: &str = skytie_stages::nadir::summary::STAGE.name;
-    #[allow(missing_docs)]
-    pub const GRADE_NADIR: &str = skytie_stages::nadir::grading::STAGE.name;
-    #[allow(missing_docs)]
-    pub const ADJUST: &str = skytie_stages::adjustment::from_correspondences::STAGE.name;
-    #[allow(missing_docs)]
-    pub const GRADE_ADJUST: &str = crate::nodes::adjust::grade::STAGE.name;
-    #[allow(missing_docs)]
-    pub const VERIFY: &str = skytie_stages::adjustment::verify::STAGE.name;
-    #[allow(missing_docs)]
-    pub const BASELINE: &str = skytie_stages::nadir::baseline::STAGE.name;
-    #[allow(missing_docs)]
-    pub const SPARSE_CLOUD: &str = skytie_stages::oblique::sparse_cloud::STAGE.name;
-    #[allow(missing_docs)]
-    pub const FACADES: &str = skytie_stages::oblique::facades::STAGE.name;
-    #[allow(missing_docs)]
-    pub const PATCHES: &str = skytie_stages::oblique::patch_registration::STAGE.name;
-    #[allow(missing_docs)]
-    pub const OBLIQUE: &str = skytie_stages::oblique::consensus::STAGE.name;
-    #[allow(missing_docs)]
-    pub const GRADE_OBLIQUE: &str = skytie_stages::oblique::grading::STAGE.name;
+/// Declares the module `stage`: one constant per stage name, taken from the stage's `STAGE` next to its
+/// algorithm, and `ALL`, every name in the order listed.
+macro_rules! stage_names {
+    ($($name:ident = $id:path),+ $(,)?) => {
+        /// Stage names as each stage defines them next to its algorithm (`STAGE.name`); workflows enable stages
+        /// and name parameter tables with these.
+        pub mod stage {
+            $(
+                #[allow(missing_docs)]
+                pub const $name: &str = $id.name;
+            )+
 
-    /// Every stage a workflow may enable in `stages = [...]`, in pipeline order.
-    pub const ALL: [&str; 20] = [
-        SYNTH,
-        LOAD,
-        ORTHO,
-        SUMMARY,
-        MM_MATCH,
-        ORTHO_AERIAL,
-        TRANSFORM,
-        REFINE,
-        CONTROL,
-        NADIR,
-        GRADE_NADIR,
-        ADJUST,
-        GRADE_ADJUST,
-        VERIFY,
-        BASELINE,
-        SPARSE_CLOUD,
-        FACADES,
-        PATCHES,
-        OBLIQUE,
-        GRADE_OBLIQUE,
-    ];
+            /// Every stage a workflow may enable in `stages = [...]`, in pipeline order.
+            pub const ALL: [&str; [$(stringify!($name)),+].len()] = [$($name),+];
+        }
+    };
+}
+
+stage_names! {
+    SYNTH = skytie_stages::synth::generate::STAGE,
+    LOAD = skytie_stages::campaign::read::STAGE,
+    ORTHO = skytie_stages::nadir::ortho::STAGE,
+    SUMMARY = crate::nodes::campaign::summary::STAGE,
+    MM_MATCH = skytie_stages::nadir::mm_matching::STAGE,
+    ORTHO_AERIAL = skytie_stages::nadir::aerial_patch::STAGE,
+    TRANSFORM = skytie_stages::nadir::initial_transform::STAGE,
+    REFINE = skytie_stages::nadir::refine::STAGE,
+    CONTROL = skytie_stages::nadir::control_points::STAGE,
+    NADIR = skytie_stages::nadir::summary::STAGE,
+    GRADE_NADIR = skytie_stages::nadir::grading::STAGE,
+    ADJUST = skytie_stages::adjustment::from_correspondences::STAGE,
+    GRADE_ADJUST = crate::nodes::adjust::grade::STAGE,
+    VERIFY = skytie_stages::adjustment::verify::STAGE,
+    BASELINE = skytie_stages::nadir::baseline::STAGE,
+    SPARSE_CLOUD = skytie_stages::oblique::sparse_cloud::STAGE,
+    FACADES = skytie_stages::oblique::facades::STAGE,
+    PATCHES = skytie_stages::oblique::patch_registration::STAGE,
+    OBLIQUE = skytie_stages::oblique::consensus::STAGE,
+    GRADE_OBLIQUE = skytie_stages::oblique::grading::STAGE,
 }
 
 /// A workflow problem found while building the graph.

@@ -5,16 +5,16 @@
 //! `truth/` — the evaluation node `grade_nadir`.
 
 use super::orthophoto::OrthophotoRoute;
+use super::variant::{RecordingItem, VariantContext};
 use super::{distance_m, missing_upstream, stage, wf_err};
-use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
+use crate::dag::{optional_all, DagBuilder, Handle, PipelineError};
 use crate::nodes::campaign::aerial::AerialRowNodes;
 use crate::nodes::campaign::ingest::{ingest_file, IngestedImage};
-use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::map_frame::MapFrameStage;
 use crate::nodes::campaign::summary::SummaryParams;
 use crate::nodes::nadir::baseline::BaselineStage;
 use crate::nodes::nadir::control::ControlStage;
-use crate::nodes::nadir::grade::{grade_metrics, GradeNadir, TRUTH_AERIAL_NADIR, TRUTH_RECORDINGS};
+use crate::nodes::nadir::grade::{grade_metrics, GradeNadir, TRUTH_AERIAL_NADIR};
 use crate::nodes::nadir::mm_match::MmMatch;
 use crate::nodes::nadir::options::{Matcher, NadirOptions};
 use crate::nodes::nadir::ortho_aerial::OrthoForAerial;
@@ -23,7 +23,7 @@ use crate::nodes::nadir::summary::SummarizeNadir;
 use crate::nodes::nadir::transform::InitialTransformStage;
 use crate::nodes::nadir::transform_agreement::TransformAgreementStage;
 use crate::workflow::Workflow;
-use skytie_stages::campaign::{AerialKind, Recording};
+use skytie_stages::campaign::{AerialImage, AerialKind};
 use skytie_stages::nadir::aerial_overlap::NadirOverlap;
 use skytie_stages::nadir::baseline::BaselineParams;
 use skytie_stages::nadir::control_points::ControlParams;
@@ -35,7 +35,6 @@ use skytie_stages::nadir::summary::NadirSummary;
 use skytie_stages::nadir::{
     AerialRefinement, MmWindowMatch, OrthoImage, OrthoParams, RecordingControl, TransformOutcome,
 };
-use std::path::Path;
 
 /// The stages of the nadir chain, in dependency order.
 pub const NADIR_STAGES: [&str; 7] = [
@@ -47,18 +46,6 @@ pub const NADIR_STAGES: [&str; 7] = [
     stage::NADIR,
     stage::GRADE_NADIR,
 ];
-
-/// One recording's per-item handles, built by the main pipeline.
-pub struct RecordingItem<'a> {
-    pub recording: &'a Recording,
-    pub row: Handle<Recording>,
-    /// The 3 cm ortho image (thesis 3.4.3); `None` when the workflow does not enable `ortho`.
-    pub ortho: Option<Handle<OrthoImage>>,
-    /// The panorama file (stages that only read its header or hash).
-    pub pano: RawFile,
-    /// The panorama ingested into its pyramid (stages that read its pixels).
-    pub pano_image: Handle<IngestedImage>,
-}
 
 /// What the nadir chain hands to later stages (the adjustment).
 pub struct NadirHandles {
@@ -99,51 +86,78 @@ pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
     Ok(true)
 }
 
-/// Add the nadir chain for `variant`. `items` are in trajectory (time) order.
-#[allow(clippy::too_many_arguments)]
+/// One (recording × overlapping nadir image) pair's nodes up to its initial transform.
+struct AerialPair {
+    aerial: Handle<AerialImage>,
+    aerial_file: Handle<IngestedImage>,
+    label: String,
+    ortho: Handle<OrthoImage>,
+    outcome: Handle<TransformOutcome>,
+    aerial_id: String,
+}
+
+/// One recording's refinements and the aerial image of each.
+struct Refined {
+    refinements: Vec<Handle<AerialRefinement>>,
+    aerials: Vec<Handle<AerialImage>>,
+}
+
+/// The nadir chain of one variant while it is being added: its parameters and the nodes added so far.
+struct NadirChain<'c, 'a> {
+    cx: &'c VariantContext<'a>,
+    ortho_base: &'c OrthoParams,
+    options: NadirOptions,
+    transform_params: TransformParams,
+    refine_params: RefineParams,
+    aerial_rows: AerialRowNodes,
+    windows: Vec<Handle<MmWindowMatch>>,
+    transforms: Vec<Handle<TransformOutcome>>,
+    refinements: Vec<Handle<AerialRefinement>>,
+    control: Vec<Handle<RecordingControl>>,
+}
+
+/// Add the nadir chain for the variant of `cx`.
 pub fn add_nadir(
     b: &mut DagBuilder,
-    wf: &Workflow,
-    variant: &str,
-    root: &Path,
-    snapshot: &CampaignSnapshot,
-    snap: Handle<CampaignSnapshot>,
-    items: &[RecordingItem<'_>],
+    cx: &VariantContext<'_>,
     ortho_base: &OrthoParams,
 ) -> Result<NadirHandles, PipelineError> {
-    let on = |s: &str| wf.stages.iter().any(|x| x == s);
-    let options: NadirOptions = wf.params(stage::NADIR, variant).map_err(wf_err)?;
-    let mm_params: MmMatchParams = wf.params(stage::MM_MATCH, variant).map_err(wf_err)?;
-    let transform_params: TransformParams = wf.params(stage::TRANSFORM, variant).map_err(wf_err)?;
-    let refine_params: RefineParams = wf.params(stage::REFINE, variant).map_err(wf_err)?;
-    let control_params: ControlParams = wf.params(stage::CONTROL, variant).map_err(wf_err)?;
-    // The frame the aerial rays of the control points are intersected in.
-    let map_frame = b.add(MapFrameStage, "", SummaryParams::default(), snap)?;
-    let window_len = if options.triples { 2 } else { 1 };
-    let Some(orthos) = items.iter().map(|i| i.ortho).collect::<Option<Vec<_>>>() else {
+    let Some(orthos) = cx.items.iter().map(|i| i.ortho).collect::<Option<Vec<_>>>() else {
         return Err(wf_err(format!(
             "{}: the nadir chain needs stage 'ortho' in `stages`",
-            wf.path.display()
+            cx.wf.path.display()
         )));
     };
-    let nadir_dir = root.join("aerial/nadir");
-    let mut photo_route = match on(stage::CONTROL) {
-        true => OrthophotoRoute::new(b, wf, variant, root, snapshot, ortho_base)?,
+    let mut chain = NadirChain {
+        cx,
+        ortho_base,
+        options: cx.params(stage::NADIR)?,
+        transform_params: cx.params(stage::TRANSFORM)?,
+        refine_params: cx.params(stage::REFINE)?,
+        aerial_rows: AerialRowNodes::new(AerialKind::Nadir, cx.snap),
+        windows: Vec::new(),
+        transforms: Vec::new(),
+        refinements: Vec::new(),
+        control: Vec::new(),
+    };
+    let mm_params: MmMatchParams = cx.params(stage::MM_MATCH)?;
+    let control_params: ControlParams = cx.params(stage::CONTROL)?;
+    // The frame the aerial rays of the control points are intersected in.
+    let map_frame = b.add(MapFrameStage, "", SummaryParams::default(), cx.snap)?;
+    let mut photo_route = match cx.on(stage::CONTROL) {
+        true => OrthophotoRoute::new(b, cx.wf, cx.variant, cx.root, cx.snapshot, ortho_base)?,
         false => None,
     };
-
-    let mut aerial_rows = AerialRowNodes::new(AerialKind::Nadir, snap);
-    let overlap = NadirOverlap::new(&snapshot.campaign.nadir, &snapshot.campaign.recordings);
-    let mut windows = Vec::new();
-    let mut transforms: Vec<Handle<TransformOutcome>> = Vec::new();
-    let mut refinements: Vec<Handle<AerialRefinement>> = Vec::new();
-    let mut control = Vec::new();
+    let campaign = &cx.snapshot.campaign;
+    let overlap = NadirOverlap::new(&campaign.nadir, &campaign.recordings);
+    let window_len = if chain.options.triples { 2 } else { 1 };
+    let items = cx.items;
     for (i, item) in items.iter().enumerate() {
         let neighbours: Vec<&RecordingItem> = items[i + 1..]
             .iter()
             .take(window_len)
             .take_while(|n| {
-                distance_m(item.recording, n.recording) <= options.max_neighbour_distance_m
+                distance_m(item.recording, n.recording) <= chain.options.max_neighbour_distance_m
             })
             .collect();
         if neighbours.is_empty() {
@@ -162,109 +176,29 @@ pub fn add_nadir(
                 members.iter().map(|m| m.pano.clone()).collect::<Vec<_>>(),
             ),
         )?;
-        windows.push(window);
+        chain.windows.push(window);
         if let Some(route) = photo_route.as_mut() {
-            control.extend(route.add_recording(
+            chain.control.extend(route.add_recording(
                 b,
                 (item.recording, item.row, item.pano_image),
                 window,
             )?);
         }
-        if !on(stage::ORTHO_AERIAL) {
+        if !cx.on(stage::ORTHO_AERIAL) {
             continue;
         }
-        let mut rec_refinements = Vec::new();
-        let mut rec_aerials = Vec::new();
-        // Per overlapping nadir image: (aerial handle, file, pair label, ortho, transform outcome, aerial image_id).
-        let mut pairs = Vec::new();
-        for a in overlap.overlapping(item.recording, options.overlap_margin_m) {
-            let row = &snapshot.campaign.nadir[a];
-            let aerial = aerial_rows.get_or_add(b, a, row)?;
-            let pair = pair_label(&item.recording.image_id, &row.image_id);
-            let aerial_file = ingest_file(
-                b,
-                &format!("nadir {}", row.image_id),
-                nadir_dir.join(&row.file),
-            )?;
-            let ortho = b.add(
-                OrthoForAerial,
-                &pair,
-                ortho_base.clone(),
-                (item.row, item.pano_image, aerial),
-            )?;
-            if !on(stage::TRANSFORM) {
-                continue;
-            }
-            let outcome = b.add(
-                InitialTransformStage,
-                &pair,
-                transform_params.clone(),
-                (item.row, ortho, aerial_file, aerial),
-            )?;
-            pairs.push((
-                aerial,
-                aerial_file,
-                pair,
-                ortho,
-                outcome,
-                row.image_id.clone(),
-            ));
-        }
-        // The recording's transforms must agree with each other (`nadir::transform_agreement`).
-        let outcomes: Vec<Handle<TransformOutcome>> = pairs.iter().map(|p| p.4).collect();
-        for (aerial, aerial_file, pair, ortho, outcome, aerial_id) in pairs {
-            let outcome = b.add(
-                TransformAgreementStage,
-                &pair,
-                transform_params.clone(),
-                (outcome, outcomes.clone()),
-            )?;
-            transforms.push(outcome);
-            if !on(stage::REFINE) {
-                continue;
-            }
-            let inputs = (ortho, aerial_file, aerial, outcome, window);
-            let refined = match options.matcher {
-                Matcher::PhaseCorrelation => {
-                    // The neighbours' orthos for this aerial image (the same nodes their own pairs use), in
-                    // the window's neighbour order, for the parallax check.
-                    let neighbour_orthos = members[1..]
-                        .iter()
-                        .map(|n| {
-                            b.add(
-                                OrthoForAerial,
-                                &pair_label(&n.recording.image_id, &aerial_id),
-                                ortho_base.clone(),
-                                (n.row, n.pano_image, aerial),
-                            )
-                        })
-                        .collect::<Result<Vec<_>, _>>()?;
-                    let (o, f, a, t, w) = inputs;
-                    b.add(
-                        RefineStage,
-                        &pair,
-                        refine_params.clone(),
-                        (o, f, a, t, w, neighbour_orthos),
-                    )?
-                }
-                Matcher::Baseline => {
-                    let p: BaselineParams = wf.params(stage::BASELINE, variant).map_err(wf_err)?;
-                    b.add(BaselineStage, &pair, p, inputs)?
-                }
-            };
-            refinements.push(refined);
-            rec_refinements.push(refined);
-            rec_aerials.push(aerial);
-        }
-        if on(stage::CONTROL) {
-            control.push(b.add(
+        let margin_m = chain.options.overlap_margin_m;
+        let pairs = chain.add_pairs(b, item, overlap.overlapping(item.recording, margin_m))?;
+        let refined = chain.add_refinements(b, pairs, window, &members)?;
+        if cx.on(stage::CONTROL) {
+            chain.control.push(b.add(
                 ControlStage,
                 &label,
                 control_params.clone(),
                 (
                     window,
-                    optional_all(&rec_refinements),
-                    rec_aerials,
+                    optional_all(&refined.refinements),
+                    refined.aerials,
                     map_frame,
                 ),
             )?);
@@ -273,44 +207,159 @@ pub fn add_nadir(
     if let Some(route) = photo_route {
         route.finish(b)?;
     }
-    if on(stage::NADIR) {
-        let summary = b.add(
-            SummarizeNadir,
-            "",
-            SummaryParams::default(),
-            (
-                snap,
-                optional_all(&windows),
-                optional_all(&transforms),
-                optional_all(&refinements),
-                optional_all(&control),
-            ),
-        )?;
-        b.metrics(summary, "nadir", |s: &NadirSummary| s.metrics());
-    }
-    let truth = root.join(TRUTH_RECORDINGS);
-    if on(stage::GRADE_NADIR) && truth.is_file() {
-        let mut truth_files = vec![RawFile(truth)];
-        let truth_aerial = root.join(TRUTH_AERIAL_NADIR);
-        if truth_aerial.is_file() {
-            truth_files.push(RawFile(truth_aerial));
+    chain.add_summary_and_grade(b)?;
+    Ok(NadirHandles {
+        windows: chain.windows,
+        control: chain.control,
+    })
+}
+
+impl NadirChain<'_, '_> {
+    /// Per nadir image (campaign row index) overlapping `item`: the aerial-oriented ortho (thesis 3.4.5.1)
+    /// and, when enabled, the initial transform (3.4.5.2).
+    fn add_pairs(
+        &mut self,
+        b: &mut DagBuilder,
+        item: &RecordingItem<'_>,
+        overlapping: Vec<usize>,
+    ) -> Result<Vec<AerialPair>, PipelineError> {
+        let nadir_dir = self.cx.root.join("aerial/nadir");
+        let mut pairs = Vec::new();
+        for a in overlapping {
+            let row = &self.cx.snapshot.campaign.nadir[a];
+            let aerial = self.aerial_rows.get_or_add(b, a, row)?;
+            let label = pair_label(&item.recording.image_id, &row.image_id);
+            let aerial_file = ingest_file(
+                b,
+                &format!("nadir {}", row.image_id),
+                nadir_dir.join(&row.file),
+            )?;
+            let ortho = b.add(
+                OrthoForAerial,
+                &label,
+                self.ortho_base.clone(),
+                (item.row, item.pano_image, aerial),
+            )?;
+            if !self.cx.on(stage::TRANSFORM) {
+                continue;
+            }
+            let outcome = b.add(
+                InitialTransformStage,
+                &label,
+                self.transform_params.clone(),
+                (item.row, ortho, aerial_file, aerial),
+            )?;
+            pairs.push(AerialPair {
+                aerial,
+                aerial_file,
+                label,
+                ortho,
+                outcome,
+                aerial_id: row.image_id.clone(),
+            });
         }
-        let grade = b.add(
-            GradeNadir,
-            "",
-            SummaryParams::default(),
-            (
-                snap,
-                truth_files,
-                items.iter().map(|i| i.pano.clone()).collect::<Vec<_>>(),
-                windows.clone(),
-                refinements,
-                control.clone(),
-            ),
-        )?;
-        b.metrics(grade, "nadir", |g: &NadirGrade| grade_metrics(g));
+        Ok(pairs)
     }
-    Ok(NadirHandles { windows, control })
+
+    /// The recording's transforms checked against each other (`nadir::transform_agreement`), then refined
+    /// (thesis 3.4.5.3) against the MM matching `window` of `members` (the recording, then its neighbours).
+    /// Returns the recording's refinements with their aerial images.
+    fn add_refinements(
+        &mut self,
+        b: &mut DagBuilder,
+        pairs: Vec<AerialPair>,
+        window: Handle<MmWindowMatch>,
+        members: &[&RecordingItem<'_>],
+    ) -> Result<Refined, PipelineError> {
+        let mut rec_refinements = Vec::new();
+        let mut rec_aerials = Vec::new();
+        let outcomes: Vec<Handle<TransformOutcome>> = pairs.iter().map(|p| p.outcome).collect();
+        for p in pairs {
+            let outcome = b.add(
+                TransformAgreementStage,
+                &p.label,
+                self.transform_params.clone(),
+                (p.outcome, outcomes.clone()),
+            )?;
+            self.transforms.push(outcome);
+            if !self.cx.on(stage::REFINE) {
+                continue;
+            }
+            let inputs = (p.ortho, p.aerial_file, p.aerial, outcome, window);
+            let refined = match self.options.matcher {
+                Matcher::PhaseCorrelation => {
+                    // The neighbours' orthos for this aerial image (the same nodes their own pairs use), in
+                    // the window's neighbour order, for the parallax check.
+                    let neighbour_orthos = members[1..]
+                        .iter()
+                        .map(|n| {
+                            b.add(
+                                OrthoForAerial,
+                                &pair_label(&n.recording.image_id, &p.aerial_id),
+                                self.ortho_base.clone(),
+                                (n.row, n.pano_image, p.aerial),
+                            )
+                        })
+                        .collect::<Result<Vec<_>, _>>()?;
+                    let (o, f, a, t, w) = inputs;
+                    b.add(
+                        RefineStage,
+                        &p.label,
+                        self.refine_params.clone(),
+                        (o, f, a, t, w, neighbour_orthos),
+                    )?
+                }
+                Matcher::Baseline => {
+                    let params: BaselineParams = self.cx.params(stage::BASELINE)?;
+                    b.add(BaselineStage, &p.label, params, inputs)?
+                }
+            };
+            self.refinements.push(refined);
+            rec_refinements.push(refined);
+            rec_aerials.push(p.aerial);
+        }
+        Ok(Refined {
+            refinements: rec_refinements,
+            aerials: rec_aerials,
+        })
+    }
+
+    /// The global `nadir` summary and, on campaigns with `truth/`, the evaluation node `grade_nadir`.
+    fn add_summary_and_grade(&self, b: &mut DagBuilder) -> Result<(), PipelineError> {
+        let (cx, snap) = (self.cx, self.cx.snap);
+        if cx.on(stage::NADIR) {
+            let summary = b.add(
+                SummarizeNadir,
+                "",
+                SummaryParams::default(),
+                (
+                    snap,
+                    optional_all(&self.windows),
+                    optional_all(&self.transforms),
+                    optional_all(&self.refinements),
+                    optional_all(&self.control),
+                ),
+            )?;
+            b.metrics(summary, "nadir", |s: &NadirSummary| s.metrics());
+        }
+        if let Some(truth_files) = cx.truth_files(stage::GRADE_NADIR, &[TRUTH_AERIAL_NADIR]) {
+            let grade = b.add(
+                GradeNadir,
+                "",
+                SummaryParams::default(),
+                (
+                    snap,
+                    truth_files,
+                    cx.items.iter().map(|i| i.pano.clone()).collect::<Vec<_>>(),
+                    self.windows.clone(),
+                    self.refinements.clone(),
+                    self.control.clone(),
+                ),
+            )?;
+            b.metrics(grade, "nadir", |g: &NadirGrade| grade_metrics(g));
+        }
+        Ok(())
+    }
 }
 
 /// The item label of a (recording × nadir image) node; the neighbours' orthos for the parallax check reuse the

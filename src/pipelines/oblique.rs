@@ -7,18 +7,15 @@
 //! patch or consensus parameter, so an 18-variant sweep computes it once; `facades` once per distinct plane
 //! setting; `patches` once per distinct (façades, registration setting).
 
-use super::nadir::RecordingItem;
-use super::{distance_m, missing_upstream, stage, wf_err};
+use super::variant::{RecordingItem, VariantContext};
+use super::{distance_m, missing_upstream, stage};
 use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
 use crate::nodes::campaign::aerial::AerialRowNodes;
 use crate::nodes::campaign::ingest::ingest_file;
-use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::summary::SummaryParams;
 use crate::nodes::oblique::consensus::{ConsensusStage, ObliqueOutput};
 use crate::nodes::oblique::facades::FacadesStage;
-use crate::nodes::oblique::grade::{
-    GradeOblique, SCENE_TRUTH_FILE, TRUTH_AERIAL_OBLIQUE, TRUTH_RECORDINGS,
-};
+use crate::nodes::oblique::grade::{GradeOblique, SCENE_TRUTH_FILE, TRUTH_AERIAL_OBLIQUE};
 use crate::nodes::oblique::options::ObliqueOptions;
 use crate::nodes::oblique::patches::PatchesStage;
 use crate::nodes::oblique::sparse_cloud::SparseCloudStage;
@@ -29,7 +26,6 @@ use skytie_stages::oblique::facades::FacadeParams;
 use skytie_stages::oblique::patch_registration::PatchParams;
 use skytie_stages::oblique::sparse_cloud::SparseCloudParams;
 use skytie_stages::oblique::{PatchRegistrationSet, SparseCloud, TripletFacades};
-use std::path::Path;
 
 /// The stages of the oblique chain, in dependency order.
 pub const OBLIQUE_STAGES: [&str; 5] = [
@@ -74,38 +70,71 @@ pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
     Ok(true)
 }
 
-/// Add the oblique chain for `variant`. `items` are in trajectory (time) order.
-#[allow(clippy::too_many_arguments)]
+/// Add the oblique chain for the variant of `cx`.
 pub fn add_oblique(
     b: &mut DagBuilder,
-    wf: &Workflow,
-    variant: &str,
-    root: &Path,
-    snapshot: &CampaignSnapshot,
-    snap: Handle<CampaignSnapshot>,
-    items: &[RecordingItem<'_>],
+    cx: &VariantContext<'_>,
 ) -> Result<ObliqueHandles, PipelineError> {
-    let on = |s: &str| wf.stages.iter().any(|x| x == s);
-    let options: ObliqueOptions = wf.params(stage::OBLIQUE, variant).map_err(wf_err)?;
-    let cloud_params: SparseCloudParams =
-        wf.params(stage::SPARSE_CLOUD, variant).map_err(wf_err)?;
-    let facade_params: FacadeParams = wf.params(stage::FACADES, variant).map_err(wf_err)?;
-    let patch_params: PatchParams = wf.params(stage::PATCHES, variant).map_err(wf_err)?;
-    let oblique_dir = root.join("aerial/oblique");
-    let oblique_rows = &snapshot.campaign.oblique;
-    let candidate_index = ObliqueCandidates::new(
-        oblique_rows,
-        &snapshot.campaign.recordings,
-        options.max_facade_distance_m,
-        options.max_facade_height_m,
-    );
+    let options: ObliqueOptions = cx.params(stage::OBLIQUE)?;
+    let triplets = add_sparse_clouds(b, cx, &options)?;
+    let clouds: Vec<Handle<SparseCloud>> = triplets.iter().map(|(_, c)| *c).collect();
+    let FacadesAndPatches {
+        facades: all_facades,
+        sets,
+    } = match cx.on(stage::FACADES) {
+        true => add_facades_and_patches(b, cx, &options, &triplets)?,
+        false => FacadesAndPatches::default(),
+    };
+    let mut out = ObliqueHandles {
+        clouds: clouds.clone(),
+        result: None,
+    };
+    if !cx.on(stage::OBLIQUE) {
+        return Ok(out);
+    }
+    let panos: Vec<RawFile> = cx.items.iter().map(|i| i.pano.clone()).collect();
+    let result = b.add(
+        ConsensusStage,
+        "",
+        options.consensus.clone(),
+        (
+            cx.snap,
+            panos.clone(),
+            optional_all(&clouds),
+            optional_all(&all_facades),
+            optional_all(&sets),
+        ),
+    )?;
+    b.metrics(result, "oblique", |o: &ObliqueOutput| o.summary.metrics());
+    out.result = Some(result);
+    if let Some(truth_files) = cx.truth_files(stage::GRADE_OBLIQUE, &[TRUTH_AERIAL_OBLIQUE]) {
+        let scene_file = cx.root.join(SCENE_TRUTH_FILE);
+        let scene_files: Vec<RawFile> = if scene_file.is_file() {
+            vec![RawFile(scene_file)]
+        } else {
+            Vec::new()
+        };
+        let grade = b.add(
+            GradeOblique,
+            "",
+            SummaryParams::default(),
+            (cx.snap, truth_files, scene_files, panos, clouds, result),
+        )?;
+        b.metrics(grade, "oblique", GradeOblique::metrics);
+    }
+    Ok(out)
+}
 
-    let mut aerial_rows = AerialRowNodes::new(AerialKind::Oblique, snap);
-    let mut all_facades: Vec<Handle<TripletFacades>> = Vec::new();
-    let mut sets: Vec<Handle<PatchRegistrationSet>> = Vec::new();
-    // Pass 1: the sparse cloud of every triplet (centre item index → cloud).
-    let mut triplets: Vec<(usize, Handle<SparseCloud>)> = Vec::new();
-    for (i, w) in items.windows(3).enumerate() {
+/// Pass 1 (thesis 4.4.1): the sparse cloud of every triplet of consecutive recordings close enough together,
+/// as (centre item index, cloud).
+fn add_sparse_clouds(
+    b: &mut DagBuilder,
+    cx: &VariantContext<'_>,
+    options: &ObliqueOptions,
+) -> Result<Vec<(usize, Handle<SparseCloud>)>, PipelineError> {
+    let cloud_params: SparseCloudParams = cx.params(stage::SPARSE_CLOUD)?;
+    let mut triplets = Vec::new();
+    for (i, w) in cx.items.windows(3).enumerate() {
         let (first, centre, last) = (&w[0], &w[1], &w[2]);
         if distance_m(first.recording, centre.recording) > options.max_neighbour_distance_m
             || distance_m(centre.recording, last.recording) > options.max_neighbour_distance_m
@@ -123,40 +152,76 @@ pub fn add_oblique(
         )?;
         triplets.push((i + 1, cloud));
     }
-    let clouds: Vec<Handle<SparseCloud>> = triplets.iter().map(|(_, c)| *c).collect();
-    // Pass 2: per triplet its façades (fitted to its own and its neighbours' points) and patches.
-    for (t, &(centre_idx, cloud)) in triplets.iter().enumerate() {
-        if !on(stage::FACADES) {
-            break;
-        }
-        let centre = &items[centre_idx];
+    Ok(triplets)
+}
+
+/// The clouds a triplet's façades are fitted to: its own, then those of the neighbouring triplets along the
+/// same street (consecutive, within `plane_neighbours` triplets and `max_plane_distance_m` of the centre's
+/// recorded position).
+fn neighbourhood(
+    items: &[RecordingItem<'_>],
+    options: &ObliqueOptions,
+    triplets: &[(usize, Handle<SparseCloud>)],
+    t: usize,
+) -> Vec<Handle<SparseCloud>> {
+    let (centre_idx, cloud) = triplets[t];
+    let centre = &items[centre_idx];
+    let near = |&&(j, _): &&(usize, Handle<SparseCloud>)| {
+        j.abs_diff(centre_idx) <= options.plane_neighbours
+            && distance_m(items[j].recording, centre.recording) <= options.max_plane_distance_m
+    };
+    std::iter::once(cloud)
+        .chain(
+            triplets[t.saturating_sub(options.plane_neighbours)..]
+                .iter()
+                .take(2 * options.plane_neighbours + 1)
+                .filter(near)
+                .filter(|(j, _)| *j != centre_idx)
+                .map(|(_, c)| *c),
+        )
+        .collect()
+}
+
+/// The façade nodes of every triplet and the patch-registration nodes of every (triplet × oblique image).
+#[derive(Default)]
+struct FacadesAndPatches {
+    facades: Vec<Handle<TripletFacades>>,
+    sets: Vec<Handle<PatchRegistrationSet>>,
+}
+
+/// Pass 2: per triplet its façades (thesis 4.4.2–4.4.4, fitted to its own and its neighbours' points) and,
+/// when enabled, per candidate oblique image its patch registrations (4.4.5–4.4.6).
+fn add_facades_and_patches(
+    b: &mut DagBuilder,
+    cx: &VariantContext<'_>,
+    options: &ObliqueOptions,
+    triplets: &[(usize, Handle<SparseCloud>)],
+) -> Result<FacadesAndPatches, PipelineError> {
+    let facade_params: FacadeParams = cx.params(stage::FACADES)?;
+    let patch_params: PatchParams = cx.params(stage::PATCHES)?;
+    let oblique_dir = cx.root.join("aerial/oblique");
+    let oblique_rows = &cx.snapshot.campaign.oblique;
+    let candidate_index = ObliqueCandidates::new(
+        oblique_rows,
+        &cx.snapshot.campaign.recordings,
+        options.max_facade_distance_m,
+        options.max_facade_height_m,
+    );
+    let mut aerial_rows = AerialRowNodes::new(AerialKind::Oblique, cx.snap);
+    let mut all_facades = Vec::new();
+    let mut sets = Vec::new();
+    for (t, &(centre_idx, _)) in triplets.iter().enumerate() {
+        let centre = &cx.items[centre_idx];
         let label = format!("rec {}", centre.recording.image_id);
-        let rows: Vec<Handle<Recording>> = items[centre_idx - 1..=centre_idx + 1]
+        let rows: Vec<Handle<Recording>> = cx.items[centre_idx - 1..=centre_idx + 1]
             .iter()
             .map(|m| m.row)
             .collect();
-        // Neighbouring triplets along the same street: consecutive, within `plane_neighbours` triplets and
-        // `max_plane_distance_m` of the centre (recorded positions).
-        let near = |&&(j, _): &&(usize, Handle<SparseCloud>)| {
-            j.abs_diff(centre_idx) <= options.plane_neighbours
-                && distance_m(items[j].recording, centre.recording) <= options.max_plane_distance_m
-        };
-        let neighbourhood: Vec<Handle<SparseCloud>> = std::iter::once(cloud)
-            .chain(
-                triplets[t.saturating_sub(options.plane_neighbours)..]
-                    .iter()
-                    .take(2 * options.plane_neighbours + 1)
-                    .filter(near)
-                    .filter(|(j, _)| *j != centre_idx)
-                    .map(|(_, c)| *c),
-            )
-            .collect();
+        let neighbourhood = neighbourhood(cx.items, options, triplets, t);
         let candidates = candidate_index.candidates(centre.recording);
         let mut aerials = Vec::with_capacity(candidates.len());
         for &a in &candidates {
-            let row = &oblique_rows[a];
-            let h = aerial_rows.get_or_add(b, a, row)?;
-            aerials.push((a, h));
+            aerials.push((a, aerial_rows.get_or_add(b, a, &oblique_rows[a])?));
         }
         let facades = b.add(
             FacadesStage,
@@ -169,7 +234,7 @@ pub fn add_oblique(
             ),
         )?;
         all_facades.push(facades);
-        if !on(stage::PATCHES) {
+        if !cx.on(stage::PATCHES) {
             continue;
         }
         for (a, aerial) in aerials {
@@ -195,48 +260,8 @@ pub fn add_oblique(
             )?);
         }
     }
-    let mut out = ObliqueHandles {
-        clouds: clouds.clone(),
-        result: None,
-    };
-    if !on(stage::OBLIQUE) {
-        return Ok(out);
-    }
-    let panos: Vec<RawFile> = items.iter().map(|i| i.pano.clone()).collect();
-    let result = b.add(
-        ConsensusStage,
-        "",
-        options.consensus.clone(),
-        (
-            snap,
-            panos.clone(),
-            optional_all(&clouds),
-            optional_all(&all_facades),
-            optional_all(&sets),
-        ),
-    )?;
-    b.metrics(result, "oblique", |o: &ObliqueOutput| o.summary.metrics());
-    out.result = Some(result);
-    let truth = root.join(TRUTH_RECORDINGS);
-    if on(stage::GRADE_OBLIQUE) && truth.is_file() {
-        let mut truth_files = vec![RawFile(truth)];
-        let truth_aerial = root.join(TRUTH_AERIAL_OBLIQUE);
-        if truth_aerial.is_file() {
-            truth_files.push(RawFile(truth_aerial));
-        }
-        let scene_file = root.join(SCENE_TRUTH_FILE);
-        let scene_files: Vec<RawFile> = if scene_file.is_file() {
-            vec![RawFile(scene_file)]
-        } else {
-            Vec::new()
-        };
-        let grade = b.add(
-            GradeOblique,
-            "",
-            SummaryParams::default(),
-            (snap, truth_files, scene_files, panos, clouds, result),
-        )?;
-        b.metrics(grade, "oblique", GradeOblique::metrics);
-    }
-    Ok(out)
+    Ok(FacadesAndPatches {
+        facades: all_facades,
+        sets,
+    })
 }

@@ -11,23 +11,29 @@
 //! After phase 3 the exports of every variant are written into `OUT` (`OUT/variants/<name>/` in a sweep).
 //! A stage name the pipeline does not know is refused with the list of available ones.
 
+use super::adjust::AdjustHandles;
 use super::validate::add_validated_snapshot;
+use super::variant::{RecordingItem, VariantContext};
+use super::vehicle::LoadedCampaign;
 use super::{adjust, nadir, oblique, stage, vehicle, wf_err};
 use crate::dag::{
-    optional_all, DagBuilder, NodeId, Pipeline, PipelineError, RawFile, Seeds, Session,
+    optional_all, DagBuilder, Handle, NodeId, PhaseValues, Pipeline, PipelineError, RawFile, Seeds,
+    Session,
 };
 use crate::exports::{write_exports, ExportInputs};
 use crate::nodes::campaign::ingest::ingest_file;
-use crate::nodes::campaign::load::{listing_hash, metadata_inputs};
+use crate::nodes::campaign::load::{listing_hash, metadata_inputs, CampaignSnapshot};
+use crate::nodes::oblique::consensus::ObliqueOutput;
 use crate::nodes::{
     CampaignSummary, LoadCampaign, LoadCampaignParams, OrthoProject, RenderCampaign,
     SelectRecording, SelectRecordingParams, SummarizeCampaign, SummaryParams, SynthCampaign,
     SynthParams,
 };
 use crate::workflow::{CampaignSource, Workflow};
-use skytie_stages::nadir::OrthoParams;
+use skytie_stages::nadir::{OrthoParams, RecordingControl};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// See the module documentation.
 pub struct SkytiePipeline;
@@ -54,172 +60,24 @@ impl Pipeline for SkytiePipeline {
     }
 
     fn run(&self, wf: &Workflow, session: &mut Session<'_>) -> Result<(), PipelineError> {
-        for s in &wf.stages {
-            if !STAGES.contains(&s.as_str()) {
-                return Err(PipelineError::Workflow(format!(
-                    "{}: stage '{s}' is not available in this skytie (available: {})",
-                    wf.path.display(),
-                    STAGES.join(", ")
-                )));
-            }
-        }
-        // Phase 1: the campaign folder.
-        let root: PathBuf = match &wf.campaign {
-            CampaignSource::Path(p) => absolute(p),
-            CampaignSource::Synth { preset, seed } => {
-                let mut params: SynthParams = wf.params(stage::SYNTH, "default").map_err(wf_err)?;
-                params.preset = preset.clone();
-                params.seed = *seed;
-                let options = params
-                    .options()
-                    .map_err(|v| wf_err(format!("[synth] {v}")))?;
-                let mut b = DagBuilder::new();
-                let rendered = b.add(RenderCampaign, preset, options.render_identity(), ())?;
-                let h = b.add(SynthCampaign, preset, params, rendered)?;
-                b.request(h);
-                let values = session.execute("campaign", b.build());
-                values.require(h, "the synthetic campaign")?.path()
-            }
-        };
-        // Phase 2: read and validate it.
-        let load_params = LoadCampaignParams {
-            root: root.to_string_lossy().into_owned(),
-            listing_hash: listing_hash(&root).map_err(|e| {
-                PipelineError::Input(format!(
-                    "{}: cannot list the campaign folder: {e}",
-                    root.display()
-                ))
-            })?,
-        };
-        let inputs = metadata_inputs(&root);
-        if inputs.is_empty() {
-            return Err(PipelineError::Input(format!(
-                "{}: not a campaign (no campaign.toml or mm/recordings.csv; see docs/campaign-format.md)",
-                root.display()
-            )));
-        }
-        let mut b = DagBuilder::new();
-        let snap_h = b.add(LoadCampaign, "", load_params.clone(), inputs.clone())?;
-        b.request(snap_h);
-        let values = session.execute("load", b.build());
-        let loaded = values.require(snap_h, "the campaign")?;
-        // Phase 2b: its images, probed by content (the validation `skytie check` applies).
-        let mut b = DagBuilder::new();
-        let valid_h = add_validated_snapshot(&mut b, &root, &load_params, &inputs, &loaded)?;
-        b.request(valid_h);
-        let values = session.execute("validate", b.build());
-        let snapshot = values.require(valid_h, "the validated campaign")?;
-        if !snapshot.problems.is_empty() {
-            eprintln!(
-                "campaign {}: {} problem(s) in the input; affected items are skipped (run `skytie check {}` for the list)",
-                root.display(),
-                snapshot.problems.len(),
-                root.display()
-            );
-        }
+        check_stage_names(wf)?;
+        let root = campaign_root(wf, session)?;
+        let campaign = load_campaign(session, root)?;
         // Phase 2c: the recording vehicle, found in the panoramas (masks every ortho image).
-        let campaign = vehicle::LoadedCampaign {
-            root: &root,
-            load_params: &load_params,
-            inputs: &inputs,
-            loaded: &loaded,
-            validated: &snapshot,
-        };
-        let vehicle = vehicle::detect(wf, session, &campaign)?;
+        let vehicle = vehicle::detect(wf, session, &campaign.view())?;
         // Phase 3: per-recording stages and the summary, for every variant.
-        let ortho_on = wf.stages.iter().any(|s| s == stage::ORTHO);
-        let nadir_on = nadir::enabled(wf)?;
-        let oblique_on = oblique::enabled(wf)?;
         let mut b = DagBuilder::new();
+        let mut seeds = ShardSeeds::default();
         let mut exports = Vec::new();
-        // The shard seeds: one node per recording, in trajectory order (shared by every variant).
-        let mut seeds: Vec<NodeId> = Vec::new();
-        let mut seeded: HashSet<NodeId> = HashSet::new();
         for variant in wf.variants() {
             b.set_variant(&variant);
-            let snap = add_validated_snapshot(&mut b, &root, &load_params, &inputs, &loaded)?;
-            let ortho: OrthoParams = vehicle::ortho_params(wf, &variant, vehicle.as_ref())?;
-            let mut orthos = Vec::new();
-            let mut items = Vec::new();
-            for rec in &snapshot.campaign.recordings {
-                let label = format!("rec {}", rec.image_id);
-                let row = b.add(
-                    SelectRecording,
-                    &label,
-                    SelectRecordingParams {
-                        image_id: rec.image_id.clone(),
-                    },
-                    snap,
-                )?;
-                if seeded.insert(row.id) {
-                    seeds.push(row.id);
-                }
-                let pano = RawFile(root.join("mm/panoramas").join(&rec.file));
-                let pano_image = ingest_file(&mut b, &label, pano.0.clone())?;
-                let ortho = if ortho_on {
-                    let o = b.add(OrthoProject, &label, ortho.clone(), (row, pano_image))?;
-                    orthos.push(o);
-                    Some(o)
-                } else {
-                    None
-                };
-                items.push(nadir::RecordingItem {
-                    recording: rec,
-                    row,
-                    ortho,
-                    pano,
-                    pano_image,
-                });
-            }
-            let nadir_handles = if nadir_on {
-                Some(nadir::add_nadir(
-                    &mut b, wf, &variant, &root, &snapshot, snap, &items, &ortho,
-                )?)
-            } else {
-                None
-            };
-            let oblique_handles = if oblique_on {
-                Some(oblique::add_oblique(
-                    &mut b, wf, &variant, &root, &snapshot, snap, &items,
-                )?)
-            } else {
-                None
-            };
-            let adjust_handles = adjust::add_adjust(
-                &mut b,
-                wf,
-                &variant,
-                &root,
-                snap,
-                &items,
-                nadir_handles.as_ref(),
-                oblique_handles.as_ref(),
-            )?;
-            // The exports (correspondences.csv) read these values: request them, or cached runs would not
-            // load them.
-            for c in nadir_handles.iter().flat_map(|n| &n.control) {
-                b.request(*c);
-            }
-            if let Some(o) = oblique_handles.as_ref().and_then(|o| o.result) {
-                b.request(o);
-            }
-            exports.push((
-                variant.clone(),
-                adjust_handles,
-                nadir_handles.map(|n| n.control).unwrap_or_default(),
-                oblique_handles.and_then(|o| o.result),
-            ));
-            let summary = b.add(
-                SummarizeCampaign,
-                "",
-                SummaryParams::default(),
-                (snap, optional_all(&orthos)),
-            )?;
-            b.metrics(summary, "campaign", |s: &CampaignSummary| s.metrics().0);
-            b.metrics(summary, "ortho", |s: &CampaignSummary| s.metrics().1);
+            let ortho = vehicle::ortho_params(wf, &variant, vehicle.as_ref())?;
+            exports.push(add_variant(
+                &mut b, wf, &variant, &campaign, &ortho, &mut seeds,
+            )?);
         }
         let seeds = Seeds {
-            nodes: &seeds,
+            nodes: &seeds.nodes,
             per_item_stages: &super::shards::PER_ITEM_STAGES,
         };
         let values = session.execute_sharded("items", b.build(), &seeds)?;
@@ -227,40 +85,256 @@ impl Pipeline for SkytiePipeline {
             return Ok(());
         }
         if let Some(out) = session.out_dir.clone() {
-            for (variant, h, nadir_control, oblique_result) in &exports {
-                let report = h.report.and_then(|r| values.get(r));
-                let verification = h.verification.and_then(|v| values.get(v));
-                let verification_adjusted = h.verification_adjusted.and_then(|v| values.get(v));
-                let nadir_control: Vec<_> = nadir_control
-                    .iter()
-                    .filter_map(|c| values.get(*c))
-                    .collect();
-                let oblique = oblique_result.and_then(|o| values.get(o));
-                if report.is_none()
-                    && verification.is_none()
-                    && nadir_control.is_empty()
-                    && oblique.is_none()
-                {
-                    continue;
-                }
+            for e in &exports {
                 let dir = if wf.is_sweep() {
-                    out.join("variants").join(variant)
+                    out.join("variants").join(&e.variant)
                 } else {
                     out.clone()
                 };
-                let inputs = ExportInputs {
-                    snapshot: &snapshot,
-                    report: report.as_deref(),
-                    verification: verification.as_deref(),
-                    verification_adjusted: verification_adjusted.as_deref(),
-                    nadir_control: &nadir_control,
-                    oblique: oblique.as_deref(),
-                };
-                for problem in write_exports(&dir, &inputs) {
+                for problem in e.write(&dir, &campaign.snapshot, &values) {
                     session.progress.warn(&problem);
                 }
             }
         }
         Ok(())
+    }
+}
+
+/// A stage name the pipeline does not know is refused with the list of available ones.
+fn check_stage_names(wf: &Workflow) -> Result<(), PipelineError> {
+    match wf.stages.iter().find(|s| !STAGES.contains(&s.as_str())) {
+        Some(s) => Err(PipelineError::Workflow(format!(
+            "{}: stage '{s}' is not available in this skytie (available: {})",
+            wf.path.display(),
+            STAGES.join(", ")
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// Phase 1: the campaign folder — the workflow's folder, or the synthetic campaign generated for it.
+fn campaign_root(wf: &Workflow, session: &mut Session<'_>) -> Result<PathBuf, PipelineError> {
+    let (preset, seed) = match &wf.campaign {
+        CampaignSource::Path(p) => return Ok(absolute(p)),
+        CampaignSource::Synth { preset, seed } => (preset, seed),
+    };
+    let mut params: SynthParams = wf.params(stage::SYNTH, "default").map_err(wf_err)?;
+    params.preset = preset.clone();
+    params.seed = *seed;
+    let options = params
+        .options()
+        .map_err(|v| wf_err(format!("[synth] {v}")))?;
+    let mut b = DagBuilder::new();
+    let rendered = b.add(RenderCampaign, preset, options.render_identity(), ())?;
+    let h = b.add(SynthCampaign, preset, params, rendered)?;
+    b.request(h);
+    let values = session.execute("campaign", b.build());
+    Ok(values.require(h, "the synthetic campaign")?.path())
+}
+
+/// The campaign as phase 2 read and validated it.
+struct Campaign {
+    root: PathBuf,
+    load_params: LoadCampaignParams,
+    inputs: Vec<RawFile>,
+    /// The tables as read.
+    loaded: Arc<CampaignSnapshot>,
+    /// The usable rows once every image file is probed.
+    snapshot: Arc<CampaignSnapshot>,
+}
+
+impl Campaign {
+    fn view(&self) -> LoadedCampaign<'_> {
+        LoadedCampaign {
+            root: &self.root,
+            load_params: &self.load_params,
+            inputs: &self.inputs,
+            loaded: &self.loaded,
+            validated: &self.snapshot,
+        }
+    }
+
+    /// The validated snapshot's node in `b`.
+    fn add_snapshot(&self, b: &mut DagBuilder) -> Result<Handle<CampaignSnapshot>, PipelineError> {
+        Ok(add_validated_snapshot(
+            b,
+            &self.root,
+            &self.load_params,
+            &self.inputs,
+            &self.loaded,
+        )?)
+    }
+}
+
+/// Phase 2: read the campaign's tables, then probe its images by content (the validation `skytie check`
+/// applies).
+fn load_campaign(session: &mut Session<'_>, root: PathBuf) -> Result<Campaign, PipelineError> {
+    let load_params = LoadCampaignParams {
+        root: root.to_string_lossy().into_owned(),
+        listing_hash: listing_hash(&root).map_err(|e| {
+            PipelineError::Input(format!(
+                "{}: cannot list the campaign folder: {e}",
+                root.display()
+            ))
+        })?,
+    };
+    let inputs = metadata_inputs(&root);
+    if inputs.is_empty() {
+        return Err(PipelineError::Input(format!(
+            "{}: not a campaign (no campaign.toml or mm/recordings.csv; see docs/campaign-format.md)",
+            root.display()
+        )));
+    }
+    let mut b = DagBuilder::new();
+    let snap_h = b.add(LoadCampaign, "", load_params.clone(), inputs.clone())?;
+    b.request(snap_h);
+    let values = session.execute("load", b.build());
+    let loaded = values.require(snap_h, "the campaign")?;
+    let mut b = DagBuilder::new();
+    let valid_h = add_validated_snapshot(&mut b, &root, &load_params, &inputs, &loaded)?;
+    b.request(valid_h);
+    let values = session.execute("validate", b.build());
+    let snapshot = values.require(valid_h, "the validated campaign")?;
+    if !snapshot.problems.is_empty() {
+        eprintln!(
+            "campaign {}: {} problem(s) in the input; affected items are skipped (run `skytie check {}` for the list)",
+            root.display(),
+            snapshot.problems.len(),
+            root.display()
+        );
+    }
+    Ok(Campaign {
+        root,
+        load_params,
+        inputs,
+        loaded,
+        snapshot,
+    })
+}
+
+/// The shard seeds: one node per recording, in trajectory order (shared by every variant).
+#[derive(Default)]
+struct ShardSeeds {
+    nodes: Vec<NodeId>,
+    seen: HashSet<NodeId>,
+}
+
+/// Add one variant's graph: per recording its row, panorama and ortho image, then the nadir and oblique
+/// chains, the adjustment and the campaign summary. Returns what the exports read.
+fn add_variant(
+    b: &mut DagBuilder,
+    wf: &Workflow,
+    variant: &str,
+    campaign: &Campaign,
+    ortho: &OrthoParams,
+    seeds: &mut ShardSeeds,
+) -> Result<VariantExports, PipelineError> {
+    let snap = campaign.add_snapshot(b)?;
+    let ortho_on = wf.stages.iter().any(|s| s == stage::ORTHO);
+    let mut items = Vec::new();
+    for rec in &campaign.snapshot.campaign.recordings {
+        let label = format!("rec {}", rec.image_id);
+        let params = SelectRecordingParams {
+            image_id: rec.image_id.clone(),
+        };
+        let row = b.add(SelectRecording, &label, params, snap)?;
+        if seeds.seen.insert(row.id) {
+            seeds.nodes.push(row.id);
+        }
+        let pano = RawFile(campaign.root.join("mm/panoramas").join(&rec.file));
+        let pano_image = ingest_file(b, &label, pano.0.clone())?;
+        let ortho = match ortho_on {
+            true => Some(b.add(OrthoProject, &label, ortho.clone(), (row, pano_image))?),
+            false => None,
+        };
+        items.push(RecordingItem {
+            recording: rec,
+            row,
+            ortho,
+            pano,
+            pano_image,
+        });
+    }
+    let cx = VariantContext {
+        wf,
+        variant,
+        root: &campaign.root,
+        snapshot: &campaign.snapshot,
+        snap,
+        items: &items,
+    };
+    let nadir_handles = match nadir::enabled(wf)? {
+        true => Some(nadir::add_nadir(b, &cx, ortho)?),
+        false => None,
+    };
+    let oblique_handles = match oblique::enabled(wf)? {
+        true => Some(oblique::add_oblique(b, &cx)?),
+        false => None,
+    };
+    let adjust = adjust::add_adjust(b, &cx, nadir_handles.as_ref(), oblique_handles.as_ref())?;
+    let nadir_control = nadir_handles.map(|n| n.control).unwrap_or_default();
+    let oblique = oblique_handles.and_then(|o| o.result);
+    // The exports (correspondences.csv) read these values: request them, or cached runs would not load them.
+    for c in &nadir_control {
+        b.request(*c);
+    }
+    if let Some(o) = oblique {
+        b.request(o);
+    }
+    let orthos: Vec<_> = items.iter().filter_map(|i| i.ortho).collect();
+    let summary = b.add(
+        SummarizeCampaign,
+        "",
+        SummaryParams::default(),
+        (snap, optional_all(&orthos)),
+    )?;
+    b.metrics(summary, "campaign", |s: &CampaignSummary| s.metrics().0);
+    b.metrics(summary, "ortho", |s: &CampaignSummary| s.metrics().1);
+    Ok(VariantExports {
+        variant: variant.to_string(),
+        adjust,
+        nadir_control,
+        oblique,
+    })
+}
+
+/// What one variant's exports read once the graph has run.
+struct VariantExports {
+    variant: String,
+    adjust: AdjustHandles,
+    nadir_control: Vec<Handle<RecordingControl>>,
+    oblique: Option<Handle<ObliqueOutput>>,
+}
+
+impl VariantExports {
+    /// Write the variant's output files into `dir` (nothing when none of their inputs was produced); returns
+    /// the problems to warn about.
+    fn write(&self, dir: &Path, snapshot: &CampaignSnapshot, values: &PhaseValues) -> Vec<String> {
+        let h = &self.adjust;
+        let report = h.report.and_then(|r| values.get(r));
+        let verification = h.verification.and_then(|v| values.get(v));
+        let verification_adjusted = h.verification_adjusted.and_then(|v| values.get(v));
+        let nadir_control: Vec<_> = self
+            .nadir_control
+            .iter()
+            .filter_map(|c| values.get(*c))
+            .collect();
+        let oblique = self.oblique.and_then(|o| values.get(o));
+        if report.is_none()
+            && verification.is_none()
+            && nadir_control.is_empty()
+            && oblique.is_none()
+        {
+            return Vec::new();
+        }
+        let inputs = ExportInputs {
+            snapshot,
+            report: report.as_deref(),
+            verification: verification.as_deref(),
+            verification_adjusted: verification_adjusted.as_deref(),
+            nadir_control: &nadir_control,
+            oblique: oblique.as_deref(),
+        };
+        write_exports(dir, &inputs)
     }
 }

@@ -1,7 +1,7 @@
 //! The report's interactive map (pan/zoom): recorded and adjusted positions coloured by what supports their
 //! correction, correction vectors exaggerated with their own scale bar, verification colours per trajectory
 //! segment, aerial control and check points, and the nadir images as background; clicking a recording shows
-//! its numbers and registration views. Leaflet (vendored, `assets/leaflet/`) does the pan/zoom in the
+//! its numbers and registration views. Leaflet (vendored, `assets/vendor/leaflet/`) does the pan/zoom in the
 //! campaign's projected metres (CRS.Simple); `assets/map.js` draws all data on one canvas so 10⁴ recordings
 //! stay responsive. The data go to `figures/<prefix>map-data.js` as columnar arrays relative to a local origin
 //! (world coordinates of ~10⁵ m would cost precision in the browser's pixel arithmetic).
@@ -20,11 +20,17 @@ use std::path::Path;
 
 /// The vendored files written to `OUT/report/assets/`.
 const ASSETS: [(&str, &[u8]); 4] = [
-    ("leaflet.js", include_bytes!("assets/leaflet/leaflet.js")),
-    ("leaflet.css", include_bytes!("assets/leaflet/leaflet.css")),
+    (
+        "leaflet.js",
+        include_bytes!("assets/vendor/leaflet/leaflet.js"),
+    ),
+    (
+        "leaflet.css",
+        include_bytes!("assets/vendor/leaflet/leaflet.css"),
+    ),
     (
         "leaflet-LICENSE.txt",
-        include_bytes!("assets/leaflet/LICENSE"),
+        include_bytes!("assets/vendor/leaflet/LICENSE"),
     ),
     ("map.js", include_bytes!("assets/map.js")),
 ];

@@ -6,29 +6,17 @@
 
 #[path = "../tests/imaging_support/mod.rs"]
 mod imaging_support;
-
-use std::time::Instant;
+#[path = "peer_support/mod.rs"]
+mod peer_support;
 
 use imaging_support::{radiometric, SplitMix64, Texture};
+use peer_support::median_wall_ms;
 use skytie_stages::features::forstner::{forstner_corners, ForstnerParams};
 use skytie_stages::imaging::gaussian::gaussian_blur;
 use skytie_stages::imaging::io::{load_gray, save_gray};
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::matching::ncc::match_template;
 use skytie_stages::matching::phase_correlation::{phase_correlate, PhaseCorrelationParams};
-
-/// Median of `reps` timings of `f`, in milliseconds.
-fn median_ms(reps: usize, mut f: impl FnMut()) -> f64 {
-    let mut t: Vec<f64> = (0..reps)
-        .map(|_| {
-            let s = Instant::now();
-            f();
-            s.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
-    t.sort_by(f64::total_cmp);
-    t[reps / 2]
-}
 
 fn bench_phase_correlation(size: usize) {
     let tex = Texture::new(512, 128, 42);
@@ -57,14 +45,14 @@ fn bench_phase_correlation(size: usize) {
     if let Some(dir) = std::env::var_os("SKYTIE_PEER_DIR") {
         write_peer_pairs(std::path::Path::new(&dir), size, &pairs, &p);
     }
-    let ms = median_ms(50, || {
+    let ms = median_wall_ms(50, || {
         std::hint::black_box(phase_correlate(&pairs[0].0, &pairs[0].1, &p).unwrap());
     });
     let single = PhaseCorrelationParams {
         refinements: 0,
         ..p
     };
-    let ms1 = median_ms(50, || {
+    let ms1 = median_wall_ms(50, || {
         std::hint::black_box(phase_correlate(&pairs[0].0, &pairs[0].1, &single).unwrap());
     });
     println!(
@@ -108,16 +96,9 @@ fn bench_ncc() {
     let img = tex.render(100, 100, 0.0, 0.0, 0.0, 0.0);
     let (cx, cy): (f64, f64) = (47.3, 52.6);
     let (ox, oy) = (cx - 20.0, cy - 20.0);
-    let t = tex.render(
-        40,
-        40,
-        ox.floor(),
-        oy.floor(),
-        ox.floor() - ox,
-        oy.floor() - oy,
-    );
+    let t = tex.crop_at(40, 40, (ox, oy));
     let m = match_template(&img, &t).unwrap();
-    let ms = median_ms(30, || {
+    let ms = median_wall_ms(30, || {
         std::hint::black_box(match_template(&img, &t).unwrap());
     });
     println!(
@@ -133,7 +114,7 @@ fn bench_blur() {
     let data: Vec<f32> = (0..w * h).map(|_| rng.uniform() as f32).collect();
     let img = GrayImage::from_vec(w, h, data).unwrap();
     for sigma in [1.0f32, 2.0, 4.0] {
-        let ms = median_ms(5, || {
+        let ms = median_wall_ms(5, || {
             std::hint::black_box(gaussian_blur(&img, sigma));
         });
         println!(
@@ -148,7 +129,7 @@ fn bench_forstner() {
     let img = tex.render(512, 512, 0.0, 0.0, 0.0, 0.0);
     let p = ForstnerParams::default();
     let n = forstner_corners(&img, &p).len();
-    let ms = median_ms(5, || {
+    let ms = median_wall_ms(5, || {
         std::hint::black_box(forstner_corners(&img, &p));
     });
     println!("Förstner (2x tensor) 512x512: {ms:.1} ms, {n} corners");

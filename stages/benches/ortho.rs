@@ -19,9 +19,8 @@
 #[path = "peer_support/mod.rs"]
 mod peer_support;
 
-use peer_support::{median_round_ms, peer_dir, write_npy_f32};
+use peer_support::{median_round_ms, median_wall_ms, peer_dir, write_npy_f32};
 use std::path::Path;
-use std::time::Instant;
 
 use skytie_stages::campaign::Recording;
 use skytie_stages::geometry::PanoramaCamera;
@@ -66,7 +65,7 @@ fn recording() -> Recording {
 /// Median time (ms) of `reps` runs of `f` inside a rayon pool of `threads`: with 1 thread the CPU time of the
 /// pool's thread (robust against other processes sharing the cores, the clock the peer script uses for
 /// `cv2.remap` with 1 thread), else wall time.
-fn median_ms(threads: usize, reps: usize, mut f: impl FnMut() + Send) -> f64 {
+fn median_ms(threads: usize, reps: usize, f: impl FnMut() + Send) -> f64 {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -75,15 +74,7 @@ fn median_ms(threads: usize, reps: usize, mut f: impl FnMut() + Send) -> f64 {
         if threads == 1 {
             return median_round_ms(reps, f);
         }
-        let mut t: Vec<f64> = (0..reps)
-            .map(|_| {
-                let s = Instant::now();
-                f();
-                s.elapsed().as_secs_f64() * 1e3
-            })
-            .collect();
-        t.sort_by(f64::total_cmp);
-        t[reps / 2]
+        median_wall_ms(reps, f)
     })
 }
 

@@ -3,11 +3,10 @@
 //! unknown CRS gives layers without a CRS. Without `ogrinfo` the test says SKIPPED for that part and still
 //! checks the file with SQLite.
 
-use skytie_stages::adjustment::campaign_checkpoints::compare_checkpoints;
-use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
-use skytie_stages::adjustment::{
-    run, AdjustConfig, AdjustmentRun, SyntheticBlockSpec, ViewSelection,
-};
+mod support;
+
+use skytie_stages::adjustment::synthetic_campaign::SyntheticCampaign;
+use skytie_stages::adjustment::{AdjustConfig, AdjustmentRun, SyntheticBlockSpec, ViewSelection};
 use skytie_stages::export::checkpoint_rows;
 use skytie_stages::export::gpkg::{run_layers, srs_for, write_geopackage, RunLayers};
 use skytie_stages::export::CorrectionSeries;
@@ -15,19 +14,13 @@ use std::path::Path;
 use std::process::Command;
 
 fn setup() -> (SyntheticCampaign, AdjustmentRun) {
-    let c = SyntheticCampaignSpec {
-        block: SyntheticBlockSpec {
-            recordings: 12,
-            control_points: 6,
-            seed: 5,
-            ..SyntheticBlockSpec::default()
-        },
-        ..SyntheticCampaignSpec::default()
-    }
-    .generate();
-    let inputs = c.adjust_inputs();
-    let r = run(&inputs, &AdjustConfig::default()).unwrap();
-    (c, r)
+    let block = SyntheticBlockSpec {
+        recordings: 12,
+        control_points: 6,
+        seed: 5,
+        ..SyntheticBlockSpec::default()
+    };
+    support::adjusted::adjusted_campaign(block, &AdjustConfig::default())
 }
 
 fn ogrinfo(args: &[&str], file: &Path) -> Option<String> {
@@ -43,16 +36,11 @@ fn ogrinfo(args: &[&str], file: &Path) -> Option<String> {
 fn write(dir: &Path, crs: &str) -> (std::path::PathBuf, Vec<(String, usize)>) {
     let (c, r) = setup();
     let series = CorrectionSeries::from_run(&c.recordings, &r).unwrap();
-    let cmp = compare_checkpoints(
-        &c.recordings,
-        &c.pano_size_px,
+    let cmp = support::adjusted::checkpoint_comparison(
+        &c,
         &r,
-        &c.checkpoints,
-        &c.observations,
         ViewSelection::WithinRadius { radius_m: 15.0 },
-        1.0,
-    )
-    .unwrap();
+    );
     let rows = checkpoint_rows(&cmp);
     let groups = [("nadir", &c.control[..])];
     let layers = run_layers(&RunLayers {

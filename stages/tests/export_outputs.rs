@@ -4,11 +4,11 @@
 //! observation with COLMAP's own camera-model formulas (EQUIRECTANGULAR, PINHOLE/OPENCV).
 
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
-use skytie_stages::adjustment::campaign_checkpoints::{adjusted_cameras, compare_checkpoints};
-use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
-use skytie_stages::adjustment::{
-    run, AdjustConfig, AdjustmentRun, SyntheticBlockSpec, ViewSelection,
-};
+mod support;
+
+use skytie_stages::adjustment::campaign_checkpoints::adjusted_cameras;
+use skytie_stages::adjustment::synthetic_campaign::SyntheticCampaign;
+use skytie_stages::adjustment::{AdjustConfig, AdjustmentRun, SyntheticBlockSpec, ViewSelection};
 use skytie_stages::campaign::{read_recordings_csv, write_recordings_csv};
 use skytie_stages::export::{
     checkpoint_rows, write_adjusted_trajectory, write_checkpoint_errors_csv, write_colmap_model,
@@ -20,17 +20,13 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 
 fn setup() -> (SyntheticCampaign, AdjustmentRun) {
-    let c = SyntheticCampaignSpec {
-        block: SyntheticBlockSpec {
-            recordings: 24,
-            control_points: 10,
-            yaw_error_deg: 0.3,
-            seed: 21,
-            ..SyntheticBlockSpec::default()
-        },
-        ..SyntheticCampaignSpec::default()
-    }
-    .generate();
+    let block = SyntheticBlockSpec {
+        recordings: 24,
+        control_points: 10,
+        yaw_error_deg: 0.3,
+        seed: 21,
+        ..SyntheticBlockSpec::default()
+    };
     let config = AdjustConfig {
         aerial_observations: true,
         estimate_yaw: true,
@@ -38,9 +34,7 @@ fn setup() -> (SyntheticCampaign, AdjustmentRun) {
         yaw_prior_sigma_deg: 100.0,
         ..AdjustConfig::default()
     };
-    let inputs = c.adjust_inputs();
-    let r = run(&inputs, &config).unwrap();
-    (c, r)
+    support::adjusted::adjusted_campaign(block, &config)
 }
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -74,16 +68,11 @@ fn trajectory_csv_geojson_and_ply_round_trip() {
     }
 
     // GeoJSON.
-    let comparison = compare_checkpoints(
-        &c.recordings,
-        &c.pano_size_px,
+    let comparison = support::adjusted::checkpoint_comparison(
+        &c,
         &r,
-        &c.checkpoints,
-        &c.observations,
         ViewSelection::WithinRadius { radius_m: 15.0 },
-        1.0,
-    )
-    .unwrap();
+    );
     let rows = checkpoint_rows(&comparison);
     let gj = dir.join("trajectory.geojson");
     write_run_geojson(
@@ -162,16 +151,7 @@ fn trajectory_csv_geojson_and_ply_round_trip() {
 #[test]
 fn checkpoints_csv_round_trip() {
     let (c, r) = setup();
-    let comparison = compare_checkpoints(
-        &c.recordings,
-        &c.pano_size_px,
-        &r,
-        &c.checkpoints,
-        &c.observations,
-        ViewSelection::TwoNearest,
-        1.0,
-    )
-    .unwrap();
+    let comparison = support::adjusted::checkpoint_comparison(&c, &r, ViewSelection::TwoNearest);
     assert_eq!(comparison.skipped_observations, 0);
     assert!(
         comparison.before.rmse.d2 > 0.5,

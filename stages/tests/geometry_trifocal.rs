@@ -45,6 +45,25 @@ fn random_camera(rng: &mut SplitMix64) -> Matrix3x4<f64> {
     p
 }
 
+/// Three random cameras (see [`random_camera`]).
+fn random_cameras(rng: &mut SplitMix64) -> [Matrix3x4<f64>; 3] {
+    [random_camera(rng), random_camera(rng), random_camera(rng)]
+}
+
+/// A random point in the cube of ±2 m around the origin.
+fn random_point(rng: &mut SplitMix64) -> Vector3<f64> {
+    Vector3::new(
+        range(rng, -2.0, 2.0),
+        range(rng, -2.0, 2.0),
+        range(rng, -2.0, 2.0),
+    )
+}
+
+/// `x` in each of the three views.
+fn project_three(ps: &[Matrix3x4<f64>; 3], x: &Vector3<f64>) -> ([f64; 2], [f64; 2], [f64; 2]) {
+    (project(&ps[0], x), project(&ps[1], x), project(&ps[2], x))
+}
+
 fn project(p: &Matrix3x4<f64>, x: &Vector3<f64>) -> [f64; 2] {
     let h = p * x.push(1.0);
     [h.x / h.z, h.y / h.z]
@@ -70,23 +89,11 @@ fn transfer_of_exact_triples_is_exact() {
     let mut rng = SplitMix64::new(11);
     let mut worst: f64 = 0.0;
     for _ in 0..50 {
-        let ps = [
-            random_camera(&mut rng),
-            random_camera(&mut rng),
-            random_camera(&mut rng),
-        ];
+        let ps = random_cameras(&mut rng);
         let t = TrifocalTensor::from_cameras(&ps[0], &ps[1], &ps[2]);
         for _ in 0..20 {
-            let x = Vector3::new(
-                range(&mut rng, -2.0, 2.0),
-                range(&mut rng, -2.0, 2.0),
-                range(&mut rng, -2.0, 2.0),
-            );
-            let (x1, x2, x3) = (
-                project(&ps[0], &x),
-                project(&ps[1], &x),
-                project(&ps[2], &x),
-            );
+            let x = random_point(&mut rng);
+            let (x1, x2, x3) = project_three(&ps, &x);
             let got = t.transfer(x1, x2).unwrap();
             worst = worst.max((got[0] - x3[0]).hypot(got[1] - x3[1]));
             // Relative to the scale of the homogeneous pixel vectors (‖x'‖·‖x''‖ ≈ 10⁶).
@@ -105,26 +112,14 @@ fn incidence_residual_vanishes_for_exact_triples_relative_to_scale() {
     // Normalised pixel coordinates (f ≈ 1) so that the residual's absolute scale is meaningful: < 1e-10.
     let mut rng = SplitMix64::new(5);
     for _ in 0..20 {
-        let mut ps = [
-            random_camera(&mut rng),
-            random_camera(&mut rng),
-            random_camera(&mut rng),
-        ];
+        let mut ps = random_cameras(&mut rng);
         let s = Matrix3::new(1e-3, 0.0, 0.0, 0.0, 1e-3, 0.0, 0.0, 0.0, 1.0);
         for p in &mut ps {
             *p = s * *p;
         }
         let t = TrifocalTensor::from_cameras(&ps[0], &ps[1], &ps[2]);
-        let x = Vector3::new(
-            range(&mut rng, -2.0, 2.0),
-            range(&mut rng, -2.0, 2.0),
-            range(&mut rng, -2.0, 2.0),
-        );
-        let (x1, x2, x3) = (
-            project(&ps[0], &x),
-            project(&ps[1], &x),
-            project(&ps[2], &x),
-        );
+        let x = random_point(&mut rng);
+        let (x1, x2, x3) = project_three(&ps, &x);
         assert!(t.incidence_residual(x1, x2, x3) < 1e-10);
         // A wrong view-3 point breaks incidence.
         assert!(t.incidence_residual(x1, x2, [x3[0] + 0.01, x3[1]]) > 1e-6);
@@ -168,11 +163,7 @@ fn canonical_and_determinant_forms_agree() {
 fn tensor_is_invariant_to_a_projective_change_of_world_frame() {
     let mut rng = SplitMix64::new(17);
     for _ in 0..20 {
-        let ps = [
-            random_camera(&mut rng),
-            random_camera(&mut rng),
-            random_camera(&mut rng),
-        ];
+        let ps = random_cameras(&mut rng);
         let g =
             Matrix4::from_fn(|r, c| if r == c { 1.0 } else { 0.0 } + range(&mut rng, -0.3, 0.3));
         assert!(g.determinant().abs() > 1e-3);

@@ -48,29 +48,9 @@ fn write_tiled(
     let mut w = TiledTiffWriter::create(path, spec).unwrap();
     for r in 0..H {
         if bytes == 1 {
-            let row: Vec<u8> = (0..W)
-                .flat_map(|c| {
-                    let p = rgb8(c, r);
-                    if channels == 3 {
-                        p.to_vec()
-                    } else {
-                        vec![p[0]]
-                    }
-                })
-                .collect();
-            w.push_row_u8(&row).unwrap();
+            w.push_row_u8(&test_row(r, channels, rgb8)).unwrap();
         } else {
-            let row: Vec<u16> = (0..W)
-                .flat_map(|c| {
-                    let p = rgb16(c, r);
-                    if channels == 3 {
-                        p.to_vec()
-                    } else {
-                        vec![p[0]]
-                    }
-                })
-                .collect();
-            w.push_row_u16(&row).unwrap();
+            w.push_row_u16(&test_row(r, channels, rgb16)).unwrap();
         }
     }
     w.finish().unwrap();
@@ -90,6 +70,16 @@ fn expected(c: usize, r: usize, channels: usize, bytes: usize) -> f32 {
             f32::from(luma16(p[0], p[1], p[2])) / 4095.0
         }
     }
+}
+
+/// Row `r` of the test pattern `rgb`: its RGB samples, or only their first channel for a grey image.
+fn test_row<T: Copy>(r: usize, channels: usize, rgb: impl Fn(usize, usize) -> [T; 3]) -> Vec<T> {
+    (0..W)
+        .flat_map(|c| {
+            let p = rgb(c, r);
+            p[..if channels == 3 { 3 } else { 1 }].to_vec()
+        })
+        .collect()
 }
 
 #[test]

@@ -138,14 +138,7 @@ fn subpixel_placement_is_recovered() {
     for _ in 0..trials {
         let (cx, cy) = (rng.range(30.0, 70.0), rng.range(30.0, 70.0));
         let (ox, oy) = (cx - 8.0, cy - 8.0);
-        let t = tex.render(
-            16,
-            16,
-            ox.floor(),
-            oy.floor(),
-            ox.floor() - ox,
-            oy.floor() - oy,
-        );
+        let t = tex.crop_at(16, 16, (ox, oy));
         let m = match_template(&img, &t).unwrap();
         sum_sq += (m.u_px - cx).powi(2) + (m.v_px - cy).powi(2);
         assert!(m.score > 0.9, "{m:?}");

@@ -12,15 +12,20 @@ use skytie_stages::matching::phase_correlation::{
 };
 use skytie_stages::matching::subpixel::PeakFit;
 
+/// Default parameters without the spatial window (a rectangular one): circular shifts stay exact.
+fn unwindowed() -> PhaseCorrelationParams {
+    PhaseCorrelationParams {
+        window: WindowKind::Rectangular,
+        ..Default::default()
+    }
+}
+
 #[test]
 fn integer_circular_shift_gives_exact_peak() {
     let tex = Texture::new(128, 32, 1);
     let f1 = tex.render(128, 128, 0.0, 0.0, 0.0, 0.0);
     let f2 = tex.render(128, 128, 0.0, 0.0, 5.0, -3.0);
-    let p = PhaseCorrelationParams {
-        window: WindowKind::Rectangular,
-        ..Default::default()
-    };
+    let p = unwindowed();
     let s = phase_correlate(&f1, &f2, &p).unwrap();
     assert!(
         (s.dx_px - 5.0).abs() < 1e-6 && (s.dy_px + 3.0).abs() < 1e-6,
@@ -42,10 +47,7 @@ fn circular_fourier_shift_is_recovered() {
     let tex = Texture::new(128, 32, 2);
     let f1 = tex.render(128, 128, 0.0, 0.0, 0.0, 0.0);
     let f2 = tex.render(128, 128, 0.0, 0.0, 2.3, -1.7);
-    let p = PhaseCorrelationParams {
-        window: WindowKind::Rectangular,
-        ..Default::default()
-    };
+    let p = unwindowed();
     let s = phase_correlate(&f1, &f2, &p).unwrap();
     assert!(
         (s.dx_px - 2.3).abs() < 0.02 && (s.dy_px + 1.7).abs() < 0.02,
@@ -139,14 +141,7 @@ fn template_is_located_in_a_larger_search_window() {
         // Template = the texture around search position (cx, cy), i.e. a 24×24 crop with a sub-pixel origin.
         let (cx, cy) = (rng.range(20.0, 28.0), rng.range(20.0, 28.0));
         let (ox, oy) = (100.0 + cx - 12.0, 80.0 + cy - 12.0);
-        let template = tex.render(
-            24,
-            24,
-            ox.floor(),
-            oy.floor(),
-            ox.floor() - ox,
-            oy.floor() - oy,
-        );
+        let template = tex.crop_at(24, 24, (ox, oy));
         let loc = locate_template(&template, &search, &p).unwrap();
         sum_sq += (loc.u_px - cx).powi(2) + (loc.v_px - cy).powi(2);
         assert!(loc.peak > 0.2, "{loc:?}");

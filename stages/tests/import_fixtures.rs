@@ -29,6 +29,15 @@ fn run(config: &str) -> (PathBuf, String, tempfile::TempDir) {
     (out, report.to_string(), dir)
 }
 
+/// The nadir rows of the campaign imported with `config`, whose report must name `problem` (file, line and
+/// field of a row that is refused).
+fn import_nadir(config: &str, problem: &str) -> (Vec<AerialImage>, tempfile::TempDir) {
+    let (out, report, dir) = run(config);
+    assert!(report.contains(problem), "{report}");
+    let (c, _) = read_campaign(&out).unwrap();
+    (c.nadir, dir)
+}
+
 fn camera_of(row: &AerialImage) -> FrameCamera {
     FrameCamera::from_aerial(row)
 }
@@ -40,15 +49,10 @@ fn world_of_cam(cam: &FrameCamera, p_cam: Vector3<f64>) -> Vector3<f64> {
 
 #[test]
 fn pix4d_files_by_the_documented_model() {
-    let (out, report, _dir) = run("[[aerial]]\nkind = \"nadir\"\nformat = \"pix4d\"\norientations = \"fixtures/pix4d_external.txt\"\ninternals = \"fixtures/pix4d_internal.cam\"\nimages = \"fixtures\"\nimage_width_px = 6000\nimage_height_px = 4000\n");
     // The NaN height of DSC0002 is reported with file, line and field, the other rows imported.
-    assert!(
-        report.contains("pix4d_external.txt:3: field 'z'"),
-        "{report}"
-    );
-    let (c, _) = read_campaign(&out).unwrap();
-    assert_eq!(c.nadir.len(), 2);
-    let a = &c.nadir[0];
+    let (nadir, _dir) = import_nadir("[[aerial]]\nkind = \"nadir\"\nformat = \"pix4d\"\norientations = \"fixtures/pix4d_external.txt\"\ninternals = \"fixtures/pix4d_internal.cam\"\nimages = \"fixtures\"\nimage_width_px = 6000\nimage_height_px = 4000\n", "pix4d_external.txt:3: field 'z'");
+    assert_eq!(nadir.len(), 2);
+    let a = &nadir[0];
     // Pixel 13.2 mm / 6000 px = 2.2 µm: f = 8.8 / 0.0022 = 4000 px; cx = 6.66 / 0.0022; cy from the bottom.
     assert!((a.focal_px - 4000.0).abs() < 1e-9);
     assert!((a.cx_px - 6.66 / 0.0022).abs() < 1e-9);
@@ -78,28 +82,18 @@ fn pix4d_files_by_the_documented_model() {
 
 #[test]
 fn metashape_opk_matrix_must_match_the_angles() {
-    let (out, report, _dir) = run("[[aerial]]\nkind = \"nadir\"\nformat = \"metashape-opk\"\norientations = \"fixtures/metashape_opk.txt\"\nimages = \"fixtures\"\n[aerial.camera]\nfocal_px = 4000\ncx_px = 3000\ncy_px = 2000\nwidth_px = 6000\nheight_px = 4000\n");
     // IMG_2's identity matrix contradicts κ = 90°: refused on its line (4), not guessed.
-    assert!(
-        report.contains("metashape_opk.txt:4: field 'r11'"),
-        "{report}"
-    );
-    let (c, _) = read_campaign(&out).unwrap();
-    assert_eq!(c.nadir.len(), 1);
-    assert!((c.nadir[0].kappa_deg - 90.0).abs() < 1e-12);
+    let (nadir, _dir) = import_nadir("[[aerial]]\nkind = \"nadir\"\nformat = \"metashape-opk\"\norientations = \"fixtures/metashape_opk.txt\"\nimages = \"fixtures\"\n[aerial.camera]\nfocal_px = 4000\ncx_px = 3000\ncy_px = 2000\nwidth_px = 6000\nheight_px = 4000\n", "metashape_opk.txt:4: field 'r11'");
+    assert_eq!(nadir.len(), 1);
+    assert!((nadir[0].kappa_deg - 90.0).abs() < 1e-12);
 }
 
 #[test]
 fn metashape_xml_calibration_and_chunk() {
-    let (out, report, _dir) = run("[[aerial]]\nkind = \"nadir\"\nformat = \"metashape-xml\"\norientations = \"fixtures/metashape_cameras.xml\"\nimages = \"fixtures\"\n");
     // Camera B has no transform (not aligned): reported on its line, skipped.
-    assert!(
-        report.contains("metashape_cameras.xml:28: field 'transform'"),
-        "{report}"
-    );
-    let (c, _) = read_campaign(&out).unwrap();
-    assert_eq!(c.nadir.len(), 1);
-    let a = &c.nadir[0];
+    let (nadir, _dir) = import_nadir("[[aerial]]\nkind = \"nadir\"\nformat = \"metashape-xml\"\norientations = \"fixtures/metashape_cameras.xml\"\nimages = \"fixtures\"\n", "metashape_cameras.xml:28: field 'transform'");
+    assert_eq!(nadir.len(), 1);
+    let a = &nadir[0];
     // Calibration: cx, cy offsets from the centre; p1/p2 swapped and y flipped; b2 flipped.
     assert_eq!((a.cx_px, a.cy_px), (510.5, 395.75));
     assert_eq!((a.p1, a.p2, a.b1, a.b2), (0.0002, 0.0003, 0.5, 0.25));

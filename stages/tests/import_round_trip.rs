@@ -163,14 +163,10 @@ const CAMPAIGN: &str =
 
 #[test]
 fn pix4d_round_trip() {
-    let dir = tempfile::tempdir().unwrap();
     let rows: Vec<AerialImage> = (0..4)
         .map(|i| aerial(&format!("n{i}"), i, false, false))
         .collect();
-    touch_all(
-        &dir.path().join("images"),
-        rows.iter().map(|r| r.file.clone()),
-    );
+    let dir = with_images(&rows);
     export_pix4d(
         &rows,
         &context(43.25),
@@ -186,14 +182,10 @@ fn pix4d_round_trip() {
 
 #[test]
 fn metashape_xml_round_trip_through_earth_centred_chunk() {
-    let dir = tempfile::tempdir().unwrap();
     let rows: Vec<AerialImage> = (0..4)
         .map(|i| aerial(&format!("o{i}"), i, true, true))
         .collect();
-    touch_all(
-        &dir.path().join("images"),
-        rows.iter().map(|r| r.file.clone()),
-    );
+    let dir = with_images(&rows);
     export_metashape_xml(
         &rows,
         &context(43.25),

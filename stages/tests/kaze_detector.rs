@@ -70,6 +70,16 @@ fn strongest(f: &Features) -> usize {
         .expect("no keypoints")
 }
 
+/// Upright, extended (128-value) descriptors over `octaves` octaves.
+fn upright_extended(octaves: usize) -> KazeParams {
+    KazeParams {
+        upright: true,
+        extended: true,
+        octaves,
+        ..KazeParams::default()
+    }
+}
+
 #[test]
 fn gaussian_blob_is_found_within_a_fifth_of_a_pixel() {
     let (cu, cv) = (64.3, 70.6);
@@ -100,12 +110,7 @@ fn integer_translation_moves_keypoints_exactly_and_keeps_upright_descriptors() {
     let (du, dv) = (9i32, -6i32);
     let a = tex.render(200, 200, 0.0, 0.0);
     let b = tex.render(200, 200, -du as f64, -dv as f64);
-    let p = KazeParams {
-        upright: true,
-        extended: true,
-        octaves: 2,
-        ..KazeParams::default()
-    };
+    let p = upright_extended(2);
     let fa = detect_and_describe(&a, &p);
     let fb = detect_and_describe(&b, &p);
     assert!(fa.len() >= 30, "only {} keypoints", fa.len());
@@ -144,12 +149,7 @@ fn integer_shifted_crop_repeats_at_least_90_percent_of_keypoints() {
     let (du, dv) = (11.0, 7.0);
     let a = tex.render(256, 256, 0.0, 0.0);
     let b = tex.render(256, 256, du, dv);
-    let p = KazeParams {
-        upright: true,
-        extended: true,
-        octaves: 1,
-        ..KazeParams::default()
-    };
+    let p = upright_extended(1);
     let fa = detect_and_describe(&a, &p);
     let fb = detect_and_describe(&b, &p);
     let inside = |u: f32, v: f32| u > 30.0 && v > 30.0 && u < 256.0 - 30.0 && v < 256.0 - 30.0;

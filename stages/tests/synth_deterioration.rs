@@ -4,6 +4,7 @@
 //! the 0.5 px measurement noise (per-axis RMS 0.35–0.65 px) and are far off with the recorded poses. The other
 //! profiles on the demo trajectory: outage drift above 1.5 m and back, INS heading errors in range.
 
+use skytie_stages::campaign::Recording;
 use skytie_stages::geometry::PanoramaCamera;
 use skytie_stages::synth::generate::plan_campaign;
 use skytie_stages::synth::profile::Routes;
@@ -26,18 +27,15 @@ fn demo_deterioration_and_observations_have_the_documented_statistics() {
     assert!((30..=45).contains(&n), "demo has ~40 panoramas: {n}");
 
     // Seed 1 alone: n ≈ 40 ⇒ SE of a mean ≈ 0.016 m, SE of an SD ≈ 0.011 m; bounds are ≈ 4 SE.
-    let dx: Vec<f64> = plan
-        .recorded()
-        .iter()
-        .zip(&truth)
-        .map(|(r, t)| r.x - t.x)
-        .collect();
-    let dy: Vec<f64> = plan
-        .recorded()
-        .iter()
-        .zip(&truth)
-        .map(|(r, t)| r.y - t.y)
-        .collect();
+    let offsets = |axis: fn(&Recording) -> f64| -> Vec<f64> {
+        let recorded = plan.recorded();
+        recorded
+            .iter()
+            .zip(&truth)
+            .map(|(r, t)| axis(r) - axis(t))
+            .collect()
+    };
+    let (dx, dy) = (offsets(|r| r.x), offsets(|r| r.y));
     let ((mx, sx), (my, sy)) = (mean_sd(&dx), mean_sd(&dy));
     let offset = mx.hypot(my);
     eprintln!("seed 1: mean offset {offset:.3} m (dx {mx:.3}, dy {my:.3}), SD x {sx:.3} m, SD y {sy:.3} m");

@@ -1,10 +1,8 @@
 //! Shared helpers of the engine tests: toy campaigns in temp folders, a toy DAG builder, one-call runs.
 #![allow(dead_code)]
 
-use skytie::dag::progress::{Progress, ProgressMode};
-use skytie::dag::{execute, Dag, DagBuilder, Env, Handle, Mode, Outcome, RawFile};
-use skytie::hashing::StatCache;
-use skytie::store::Store;
+use skytie::dag::{Dag, DagBuilder, Handle, Mode, Outcome, RawFile};
+use skytie::testing::harness::SilentEngine;
 use skytie::testing::toy::{
     write_item, ToyParse, ToyParseParams, ToyScale, ToyScaleParams, ToyScaleV2, ToySum,
     ToySumParams, ToySummary,
@@ -59,15 +57,7 @@ pub fn toy_dag(items: &[PathBuf], cfg: &ToyConfig) -> (Dag, Handle<ToySummary>) 
 
 /// Execute `dag` against the cache at `cache` (silent progress).
 pub fn run(cache: &Path, dag: &Dag, mode: Mode) -> Outcome {
-    let store = Store::open(cache).unwrap();
-    let stat = StatCache::open(store.root());
-    let progress = Progress::new(ProgressMode::Silent);
-    let env = Env {
-        store: &store,
-        stat_cache: &stat,
-        progress: &progress,
-    };
-    execute(dag, &env, mode)
+    SilentEngine::open(cache).unwrap().execute(dag, mode)
 }
 
 /// Executed count per stage name of an outcome, as (parse, scale, sum).

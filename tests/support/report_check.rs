@@ -1,8 +1,7 @@
 //! Helpers of the report test: the files a report page references, headless Chromium (find, render,
-//! read each image's natural size from the dumped DOM, screenshot) and folder snapshots.
+//! read each image's natural size from the dumped DOM, screenshot).
 #![allow(dead_code)]
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -35,30 +34,6 @@ pub fn referenced_files(page: &Path) -> (Vec<PathBuf>, Vec<PathBuf>) {
         .map(|s| dir.join(s))
         .collect();
     (imgs, links)
-}
-
-/// Every file under `root` with its bytes (relative path → bytes).
-pub fn snapshot(root: &Path) -> BTreeMap<String, Vec<u8>> {
-    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<String, Vec<u8>>) {
-        let mut entries: Vec<_> = std::fs::read_dir(dir)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .collect();
-        entries.sort();
-        for p in entries {
-            if p.is_dir() {
-                walk(root, &p, out);
-            } else {
-                out.insert(
-                    p.strip_prefix(root).unwrap().display().to_string(),
-                    std::fs::read(&p).unwrap(),
-                );
-            }
-        }
-    }
-    let mut out = BTreeMap::new();
-    walk(root, root, &mut out);
-    out
 }
 
 /// `chromium` or `chromium-browser` on PATH.

@@ -8,7 +8,7 @@ use crate::dag::StageError;
 use crate::nodes::campaign::ingest::IngestedImage;
 use skytie_stages::imaging::budget;
 use skytie_stages::imaging::pyramid::{
-    PyramidError, PyramidLayout, TileId, TileSource, TiledPyramid,
+    PyramidError, PyramidHeader, TileId, TileSource, TiledPyramid,
 };
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
@@ -87,12 +87,8 @@ pub struct CachedPyramid {
 }
 
 impl TileSource for CachedPyramid {
-    fn layout(&self) -> &PyramidLayout {
-        self.file.layout()
-    }
-
-    fn white(&self) -> u16 {
-        self.file.white()
+    fn header(&self) -> &PyramidHeader {
+        self.file.header()
     }
 
     fn tile(&self, id: TileId) -> Result<Arc<[u8]>, PyramidError> {

@@ -11,6 +11,8 @@ use super::{
     nice_floor, plot_err, write_svg, BLUE, CAPTION_PX, DARK, FONT, GREY, LABEL_PX, ORANGE, PURPLE,
     TICK_PX, VERMILLION,
 };
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
@@ -87,6 +89,295 @@ pub fn exaggeration_for(extent_m: f64, max_error_m: f64) -> f64 {
     nice_floor(0.08 * extent_m / max_error_m).max(1.0)
 }
 
+/// The map's extent in local coordinates (relative to a round origin), at equal metres per pixel on both axes.
+struct MapFrame {
+    /// The round local origin, world metres.
+    origin: [f64; 2],
+    /// Local x and y ranges of the plot area, m.
+    x: (f64, f64),
+    y: (f64, f64),
+    /// Size of the plot area, px.
+    plot_w: f64,
+    plot_h: f64,
+    m_per_px: f64,
+    /// The larger side of the drawn positions' bounding box (at least 10 m), m.
+    extent_m: f64,
+}
+
+impl MapFrame {
+    /// The frame around every position of `recordings` and `checkpoints` (an error when there is none).
+    fn around(
+        recordings: &[MapRecording],
+        checkpoints: &[MapCheckPoint],
+        fig: &str,
+    ) -> Result<MapFrame, String> {
+        let points: Vec<[f64; 2]> = recordings
+            .iter()
+            .flat_map(|r| {
+                [Some(r.recorded), r.adjusted, r.truth]
+                    .into_iter()
+                    .flatten()
+            })
+            .chain(checkpoints.iter().map(|c| c.position))
+            .collect();
+        if points.is_empty() {
+            return Err(format!("figure {fig}: no positions to draw"));
+        }
+        let min = |k: usize| points.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+        let max = |k: usize| {
+            points
+                .iter()
+                .map(|p| p[k])
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
+        let (x0, x1, y0, y1) = (min(0), max(0), min(1), max(1));
+        let extent_m = (x1 - x0).max(y1 - y0).max(10.0);
+        let pad = 0.12 * extent_m;
+        // Round local origin, so tick labels stay short.
+        let origin = [
+            ((x0 - pad) / 100.0).floor() * 100.0,
+            ((y0 - pad) / 100.0).floor() * 100.0,
+        ];
+        let (lx0, lx1) = (x0 - pad - origin[0], x1 + pad - origin[0]);
+        let (ly0, ly1) = (y0 - pad - origin[1], y1 + pad - origin[1]);
+        // Equal scale: the plot area is plot_w × plot_h pixels.
+        let plot_w = 820.0;
+        let aspect = ((ly1 - ly0) / (lx1 - lx0)).clamp(0.45, 1.2);
+        let plot_h = (plot_w * aspect).round();
+        let m_per_px = ((lx1 - lx0) / plot_w).max((ly1 - ly0) / plot_h);
+        let (cx, cy) = ((lx0 + lx1) / 2.0, (ly0 + ly1) / 2.0);
+        let (half_w, half_h) = (m_per_px * plot_w / 2.0, m_per_px * plot_h / 2.0);
+        Ok(MapFrame {
+            origin,
+            x: (cx - half_w, cx + half_w),
+            y: (cy - half_h, cy + half_h),
+            plot_w,
+            plot_h,
+            m_per_px,
+            extent_m,
+        })
+    }
+
+    /// A world position in local coordinates.
+    fn local(&self, p: [f64; 2]) -> (f64, f64) {
+        (p[0] - self.origin[0], p[1] - self.origin[1])
+    }
+}
+
+/// The correspondence kinds present among `recordings`, in order.
+fn kinds_of(recordings: &[MapRecording]) -> Vec<CorrespondenceKind> {
+    let mut kinds: Vec<CorrespondenceKind> = recordings.iter().map(|r| r.kind).collect();
+    kinds.sort();
+    kinds.dedup();
+    kinds
+}
+
+/// Legend rows: recorded, true (if any), one per correspondence kind, check point + its two vectors.
+fn legend_rows(recordings: &[MapRecording], checkpoints: &[MapCheckPoint]) -> u32 {
+    1 + u32::from(recordings.iter().any(|r| r.truth.is_some()))
+        + kinds_of(recordings).len() as u32
+        + if checkpoints.is_empty() { 0 } else { 3 }
+}
+
+/// An error vector `e` from `from`, drawn `exaggeration` times its length, with an arrow head.
+fn error_arrow(
+    from: (f64, f64),
+    e: [f64; 2],
+    color: RGBColor,
+    exaggeration: f64,
+    m_per_px: f64,
+) -> Vec<PathElement<(f64, f64)>> {
+    let to = (from.0 + e[0] * exaggeration, from.1 + e[1] * exaggeration);
+    let len = (to.0 - from.0).hypot(to.1 - from.1);
+    let mut parts = vec![PathElement::new(vec![from, to], color.stroke_width(2))];
+    if len > 0.0 {
+        let head = (len * 0.3).min(8.0 * m_per_px);
+        let ang = (to.1 - from.1).atan2(to.0 - from.0);
+        for s in [-0.45f64, 0.45] {
+            let a = ang + std::f64::consts::PI + s;
+            parts.push(PathElement::new(
+                vec![to, (to.0 + head * a.cos(), to.1 + head * a.sin())],
+                color.stroke_width(2),
+            ));
+        }
+    }
+    parts
+}
+
+type MapChart<'a, 'b> =
+    ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// Recorded positions (hollow grey circles), true ones (black crosses), adjusted ones (filled, coloured by
+/// correspondences), the check points and their exaggerated error vectors before and after.
+fn draw_positions(
+    chart: &mut MapChart<'_, '_>,
+    frame: &MapFrame,
+    recordings: &[MapRecording],
+    checkpoints: &[MapCheckPoint],
+    exaggeration: f64,
+    fig: &str,
+) -> Result<(), String> {
+    let local = |p: [f64; 2]| frame.local(p);
+    chart
+        .draw_series(
+            recordings
+                .iter()
+                .map(|r| Circle::new(local(r.recorded), 6, GREY.stroke_width(1))),
+        )
+        .map_err(plot_err(fig))?;
+    chart
+        .draw_series(
+            recordings
+                .iter()
+                .filter_map(|r| r.truth)
+                .map(|p| Cross::new(local(p), 4, BLACK.stroke_width(1))),
+        )
+        .map_err(plot_err(fig))?;
+    chart
+        .draw_series(recordings.iter().map(|r| {
+            Circle::new(
+                local(r.adjusted.unwrap_or(r.recorded)),
+                3,
+                r.kind.color().filled(),
+            )
+        }))
+        .map_err(plot_err(fig))?;
+    let mut vectors = Vec::new();
+    for c in checkpoints {
+        let p = local(c.position);
+        for (e, color) in [(c.error_before, GREY), (c.error_after, VERMILLION)] {
+            if let Some(e) = e {
+                vectors.extend(error_arrow(p, e, color, exaggeration, frame.m_per_px));
+            }
+        }
+    }
+    chart.draw_series(vectors).map_err(plot_err(fig))?;
+    chart
+        .draw_series(
+            checkpoints
+                .iter()
+                .map(|c| TriangleMarker::new(local(c.position), 6, DARK.filled())),
+        )
+        .map_err(plot_err(fig))?;
+    Ok(())
+}
+
+/// The metric and the vector scale bars in the lower-right corner of the plot.
+fn draw_scale_bars(
+    root: &DrawingArea<SVGBackend<'_>, Shift>,
+    chart: &mut MapChart<'_, '_>,
+    frame: &MapFrame,
+    scales: &MapScales,
+    fig: &str,
+) -> Result<(), String> {
+    let m_per_px = frame.m_per_px;
+    let bar_y = frame.y.0 + 14.0 * m_per_px;
+    let bar_x1 = frame.x.1 - 20.0 * m_per_px;
+    let text = TextStyle::from((FONT, TICK_PX).into_font())
+        .color(&DARK)
+        .pos(Pos::new(HPos::Right, VPos::Center));
+    let vector_label = format!(
+        "error vector {} m (×{})",
+        trim(scales.vector_bar_m),
+        trim(scales.exaggeration)
+    );
+    let bars = [
+        (
+            scales.scale_bar_m,
+            bar_y,
+            DARK,
+            format!("{} m", trim(scales.scale_bar_m)),
+        ),
+        (
+            scales.vector_bar_m * scales.exaggeration,
+            bar_y + 22.0 * m_per_px,
+            VERMILLION,
+            vector_label,
+        ),
+    ];
+    for (len, y, color, label) in bars {
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(bar_x1 - len, y), (bar_x1, y)],
+                color.stroke_width(4),
+            )))
+            .map_err(plot_err(fig))?;
+        let (px, py) = chart.backend_coord(&(bar_x1 - len, y));
+        root.draw(&Text::new(label, (px - 8, py), text.clone()))
+            .map_err(plot_err(fig))?;
+    }
+    Ok(())
+}
+
+/// The legend, in its own area below the plot (it never covers data): one row per symbol drawn.
+fn draw_legend(
+    area: &DrawingArea<SVGBackend<'_>, Shift>,
+    recordings: &[MapRecording],
+    checkpoints: &[MapCheckPoint],
+    fig: &str,
+) -> Result<(), String> {
+    let font = TextStyle::from((FONT, LABEL_PX).into_font())
+        .color(&DARK)
+        .pos(Pos::new(HPos::Left, VPos::Center));
+    let x = 100i32;
+    let y_of = |row: i32| 12 + 22 * row;
+    let mut row = 0i32;
+    // Draws one row: its symbol (drawn by `symbol` at the row's symbol position) and its text.
+    let mut add = |symbol: &dyn Fn((i32, i32)) -> Result<(), String>, s: &str| {
+        symbol((x + 8, y_of(row)))?;
+        area.draw(&Text::new(s.to_string(), (x + 24, y_of(row)), font.clone()))
+            .map_err(plot_err(fig))?;
+        row += 1;
+        Ok::<(), String>(())
+    };
+    let circle = |r: i32, style: ShapeStyle| {
+        move |at: (i32, i32)| area.draw(&Circle::new(at, r, style)).map_err(plot_err(fig))
+    };
+    add(&circle(6, GREY.stroke_width(1)), "recorded position")?;
+    if recordings.iter().any(|r| r.truth.is_some()) {
+        let cross = |at| {
+            area.draw(&Cross::new(at, 4, BLACK.stroke_width(1)))
+                .map_err(plot_err(fig))
+        };
+        add(&cross, "true position (truth/)")?;
+    }
+    let adjusted_word = if recordings.iter().any(|r| r.adjusted.is_some()) {
+        "adjusted position"
+    } else {
+        "recorded position"
+    };
+    for k in kinds_of(recordings) {
+        add(
+            &circle(3, k.color().filled()),
+            &format!("{adjusted_word}, {}", k.label()),
+        )?;
+    }
+    if !checkpoints.is_empty() {
+        let triangle = |at| {
+            area.draw(&TriangleMarker::new(at, 6, DARK.filled()))
+                .map_err(plot_err(fig))
+        };
+        add(&triangle, "check point")?;
+        for (color, s) in [
+            (GREY, "check-point error before adjustment (exaggerated)"),
+            (
+                VERMILLION,
+                "check-point error after adjustment (exaggerated)",
+            ),
+        ] {
+            let line = |(sx, sy): (i32, i32)| {
+                area.draw(&PathElement::new(
+                    vec![(sx - 8, sy), (sx + 10, sy)],
+                    color.stroke_width(2),
+                ))
+                .map_err(plot_err(fig))
+            };
+            add(&line, s)?;
+        }
+    }
+    Ok(())
+}
+
 /// Draws the map into `path` (SVG) and returns the scales used.
 pub fn trajectory_map(
     path: &Path,
@@ -95,69 +386,22 @@ pub fn trajectory_map(
     checkpoints: &[MapCheckPoint],
 ) -> Result<MapScales, String> {
     let fig = "trajectory map";
-    let mut xs: Vec<f64> = Vec::new();
-    let mut ys: Vec<f64> = Vec::new();
-    for r in recordings {
-        for p in [Some(r.recorded), r.adjusted, r.truth]
-            .into_iter()
-            .flatten()
-        {
-            xs.push(p[0]);
-            ys.push(p[1]);
-        }
-    }
-    for c in checkpoints {
-        xs.push(c.position[0]);
-        ys.push(c.position[1]);
-    }
-    if xs.is_empty() {
-        return Err(format!("figure {fig}: no positions to draw"));
-    }
-    let min = |v: &[f64]| v.iter().cloned().fold(f64::INFINITY, f64::min);
-    let max = |v: &[f64]| v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-    let (x0, x1, y0, y1) = (min(&xs), max(&xs), min(&ys), max(&ys));
-    let extent = (x1 - x0).max(y1 - y0).max(10.0);
-    let pad = 0.12 * extent;
-    // Round local origin, so tick labels stay short.
-    let origin = [
-        ((x0 - pad) / 100.0).floor() * 100.0,
-        ((y0 - pad) / 100.0).floor() * 100.0,
-    ];
-    let (mut lx0, mut lx1) = (x0 - pad - origin[0], x1 + pad - origin[0]);
-    let (mut ly0, mut ly1) = (y0 - pad - origin[1], y1 + pad - origin[1]);
-    // Equal scale: the plot area is plot_w × plot_h pixels.
-    let plot_w = 820.0;
-    let aspect = ((ly1 - ly0) / (lx1 - lx0)).clamp(0.45, 1.2);
-    let plot_h = (plot_w * aspect).round();
-    let m_per_px = ((lx1 - lx0) / plot_w).max((ly1 - ly0) / plot_h);
-    let (cx, cy) = ((lx0 + lx1) / 2.0, (ly0 + ly1) / 2.0);
-    lx0 = cx - m_per_px * plot_w / 2.0;
-    lx1 = cx + m_per_px * plot_w / 2.0;
-    ly0 = cy - m_per_px * plot_h / 2.0;
-    ly1 = cy + m_per_px * plot_h / 2.0;
+    let frame = MapFrame::around(recordings, checkpoints, fig)?;
     let max_err = checkpoints
         .iter()
         .flat_map(|c| [c.error_before, c.error_after].into_iter().flatten())
         .map(|e| e[0].hypot(e[1]))
         .filter(|v| v.is_finite())
         .fold(0.0f64, f64::max);
-    let exaggeration = exaggeration_for(extent, max_err);
-    let scale_bar_m = nice_floor((lx1 - lx0) / 5.0);
-    let vector_bar_m = nice_floor(if max_err > 0.0 { max_err } else { 0.1 });
-    // Legend rows: recorded, true (if any), one per correspondence kind, check point + its two vectors.
-    let n_kinds = {
-        let mut k: Vec<CorrespondenceKind> = recordings.iter().map(|r| r.kind).collect();
-        k.sort();
-        k.dedup();
-        k.len() as u32
+    let scales = MapScales {
+        exaggeration: exaggeration_for(frame.extent_m, max_err),
+        scale_bar_m: nice_floor((frame.x.1 - frame.x.0) / 5.0),
+        vector_bar_m: nice_floor(if max_err > 0.0 { max_err } else { 0.1 }),
     };
-    let legend_rows = 1
-        + u32::from(recordings.iter().any(|r| r.truth.is_some()))
-        + n_kinds
-        + if checkpoints.is_empty() { 0 } else { 3 };
+    let legend_rows = legend_rows(recordings, checkpoints);
     let (width, height) = (
-        plot_w as u32 + 90 + 30,
-        plot_h as u32 + 60 + 70 + 22 * legend_rows,
+        frame.plot_w as u32 + 90 + 30,
+        frame.plot_h as u32 + 60 + 70 + 22 * legend_rows,
     );
     let mut svg = String::new();
     {
@@ -171,12 +415,12 @@ pub fn trajectory_map(
             .margin_top(10)
             .x_label_area_size(50)
             .y_label_area_size(80)
-            .build_cartesian_2d(lx0..lx1, ly0..ly1)
+            .build_cartesian_2d(frame.x.0..frame.x.1, frame.y.0..frame.y.1)
             .map_err(plot_err(fig))?;
         chart
             .configure_mesh()
-            .x_desc(format!("easting − {:.0} [m]", origin[0]))
-            .y_desc(format!("northing − {:.0} [m]", origin[1]))
+            .x_desc(format!("easting − {:.0} [m]", frame.origin[0]))
+            .y_desc(format!("northing − {:.0} [m]", frame.origin[1]))
             .x_label_formatter(&|v| trim(*v))
             .y_label_formatter(&|v| trim(*v))
             .axis_desc_style((FONT, LABEL_PX))
@@ -184,170 +428,20 @@ pub fn trajectory_map(
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(plot_err(fig))?;
-        let local = |p: [f64; 2]| (p[0] - origin[0], p[1] - origin[1]);
-        // Recorded: hollow grey circles; true: black crosses; adjusted: filled, coloured by correspondences.
-        chart
-            .draw_series(
-                recordings
-                    .iter()
-                    .map(|r| Circle::new(local(r.recorded), 6, GREY.stroke_width(1))),
-            )
-            .map_err(plot_err(fig))?;
-        chart
-            .draw_series(
-                recordings
-                    .iter()
-                    .filter_map(|r| r.truth)
-                    .map(|p| Cross::new(local(p), 4, BLACK.stroke_width(1))),
-            )
-            .map_err(plot_err(fig))?;
-        chart
-            .draw_series(recordings.iter().map(|r| {
-                Circle::new(
-                    local(r.adjusted.unwrap_or(r.recorded)),
-                    3,
-                    r.kind.color().filled(),
-                )
-            }))
-            .map_err(plot_err(fig))?;
-        // Error vectors, exaggerated.
-        let arrow = |from: (f64, f64), e: [f64; 2], color: RGBColor| {
-            let to = (from.0 + e[0] * exaggeration, from.1 + e[1] * exaggeration);
-            let len = (to.0 - from.0).hypot(to.1 - from.1);
-            let mut parts = vec![PathElement::new(vec![from, to], color.stroke_width(2))];
-            if len > 0.0 {
-                let head = (len * 0.3).min(8.0 * m_per_px);
-                let ang = (to.1 - from.1).atan2(to.0 - from.0);
-                for s in [-0.45f64, 0.45] {
-                    let a = ang + std::f64::consts::PI + s;
-                    parts.push(PathElement::new(
-                        vec![to, (to.0 + head * a.cos(), to.1 + head * a.sin())],
-                        color.stroke_width(2),
-                    ));
-                }
-            }
-            parts
-        };
-        let mut vectors = Vec::new();
-        for c in checkpoints {
-            let p = local(c.position);
-            if let Some(e) = c.error_before {
-                vectors.extend(arrow(p, e, GREY));
-            }
-            if let Some(e) = c.error_after {
-                vectors.extend(arrow(p, e, VERMILLION));
-            }
-        }
-        chart.draw_series(vectors).map_err(plot_err(fig))?;
-        chart
-            .draw_series(
-                checkpoints
-                    .iter()
-                    .map(|c| TriangleMarker::new(local(c.position), 6, DARK.filled())),
-            )
-            .map_err(plot_err(fig))?;
-        // Scale bars in the lower-right corner of the plot.
-        let bar_y = ly0 + 14.0 * m_per_px;
-        let bar_x1 = lx1 - 20.0 * m_per_px;
-        let text = TextStyle::from((FONT, TICK_PX).into_font())
-            .color(&DARK)
-            .pos(Pos::new(HPos::Right, VPos::Center));
-        let bars = [
-            (scale_bar_m, bar_y, DARK, format!("{} m", trim(scale_bar_m))),
-            (
-                vector_bar_m * exaggeration,
-                bar_y + 22.0 * m_per_px,
-                VERMILLION,
-                format!(
-                    "error vector {} m (×{})",
-                    trim(vector_bar_m),
-                    trim(exaggeration)
-                ),
-            ),
-        ];
-        for (len, y, color, label) in bars {
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    vec![(bar_x1 - len, y), (bar_x1, y)],
-                    color.stroke_width(4),
-                )))
-                .map_err(plot_err(fig))?;
-            let (px, py) = chart.backend_coord(&(bar_x1 - len, y));
-            root.draw(&Text::new(label, (px - 8, py), text.clone()))
-                .map_err(plot_err(fig))?;
-        }
-        // Legend (own area below the plot: never covers data).
-        let legend_font = TextStyle::from((FONT, LABEL_PX).into_font())
-            .color(&DARK)
-            .pos(Pos::new(HPos::Left, VPos::Center));
-        let mut kinds: Vec<CorrespondenceKind> = recordings.iter().map(|r| r.kind).collect();
-        kinds.sort();
-        kinds.dedup();
-        let mut row = 0i32;
-        let x = 100i32;
-        let y_of = |row: i32| 12 + 22 * row;
-        let draw_text = |row: i32, s: &str| {
-            legend_area.draw(&Text::new(
-                s.to_string(),
-                (x + 24, y_of(row)),
-                legend_font.clone(),
-            ))
-        };
-        legend_area
-            .draw(&Circle::new((x + 8, y_of(row)), 6, GREY.stroke_width(1)))
-            .map_err(plot_err(fig))?;
-        draw_text(row, "recorded position").map_err(plot_err(fig))?;
-        row += 1;
-        if recordings.iter().any(|r| r.truth.is_some()) {
-            legend_area
-                .draw(&Cross::new((x + 8, y_of(row)), 4, BLACK.stroke_width(1)))
-                .map_err(plot_err(fig))?;
-            draw_text(row, "true position (truth/)").map_err(plot_err(fig))?;
-            row += 1;
-        }
-        let adjusted_word = if recordings.iter().any(|r| r.adjusted.is_some()) {
-            "adjusted position"
-        } else {
-            "recorded position"
-        };
-        for k in kinds {
-            legend_area
-                .draw(&Circle::new((x + 8, y_of(row)), 3, k.color().filled()))
-                .map_err(plot_err(fig))?;
-            draw_text(row, &format!("{adjusted_word}, {}", k.label())).map_err(plot_err(fig))?;
-            row += 1;
-        }
-        if !checkpoints.is_empty() {
-            legend_area
-                .draw(&TriangleMarker::new((x + 8, y_of(row)), 6, DARK.filled()))
-                .map_err(plot_err(fig))?;
-            draw_text(row, "check point").map_err(plot_err(fig))?;
-            row += 1;
-            for (color, s) in [
-                (GREY, "check-point error before adjustment (exaggerated)"),
-                (
-                    VERMILLION,
-                    "check-point error after adjustment (exaggerated)",
-                ),
-            ] {
-                legend_area
-                    .draw(&PathElement::new(
-                        vec![(x, y_of(row)), (x + 18, y_of(row))],
-                        color.stroke_width(2),
-                    ))
-                    .map_err(plot_err(fig))?;
-                draw_text(row, s).map_err(plot_err(fig))?;
-                row += 1;
-            }
-        }
+        draw_positions(
+            &mut chart,
+            &frame,
+            recordings,
+            checkpoints,
+            scales.exaggeration,
+            fig,
+        )?;
+        draw_scale_bars(&root, &mut chart, &frame, &scales, fig)?;
+        draw_legend(&legend_area, recordings, checkpoints, fig)?;
         root.present().map_err(plot_err(fig))?;
     }
     write_svg(path, &svg)?;
-    Ok(MapScales {
-        exaggeration,
-        scale_bar_m,
-        vector_bar_m,
-    })
+    Ok(scales)
 }
 
 /// A number without trailing zeros ("0.05", "200").

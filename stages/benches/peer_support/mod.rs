@@ -1,5 +1,5 @@
-//! Helpers shared by the peer-comparison benches (`phasecorr`, `ortho`, `mi`, `daisy_agast`): the folder the
-//! identical inputs go to, thread CPU time, a median timer and a minimal `.npy` writer. Included with
+//! Helpers shared by the peer-comparison benches (`phasecorr`, `ortho`, `mi`, `daisy_agast`) and `imaging`: the
+//! folder the identical inputs go to, thread CPU time, median timers and a minimal `.npy` writer. Included with
 //! `#[path = "peer_support/mod.rs"] mod peer_support;` (not a bench target of its own).
 
 #![allow(dead_code)]
@@ -40,6 +40,19 @@ pub fn median_round_ms(reps: usize, mut round: impl FnMut()) -> f64 {
                 (Some(a), Some(b)) => b.saturating_sub(a) as f64 * 1e-6,
                 _ => s.elapsed().as_secs_f64() * 1e3,
             }
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t[t.len() / 2]
+}
+
+/// Median over `reps` runs of the wall time of one call of `f`, ms.
+pub fn median_wall_ms(reps: usize, mut f: impl FnMut()) -> f64 {
+    let mut t: Vec<f64> = (0..reps.max(1))
+        .map(|_| {
+            let s = Instant::now();
+            f();
+            s.elapsed().as_secs_f64() * 1e3
         })
         .collect();
     t.sort_by(f64::total_cmp);

@@ -52,211 +52,254 @@ fn numbers(text: &str) -> Option<Vec<f64>> {
         .collect()
 }
 
-/// Read the document; cameras without a transform (not aligned) are reported and left out.
-pub fn read_metashape_xml(path: &Path) -> Result<(MetashapeDocument, Vec<Problem>), Vec<Problem>> {
-    let err = |line: Option<usize>, field: Option<&str>, msg: String| {
+type Node<'a, 'input> = roxmltree::Node<'a, 'input>;
+
+/// The file being read: where its problems are reported (file, line, field, and what to do).
+struct Source<'a> {
+    path: &'a Path,
+    text: &'a str,
+}
+
+impl Source<'_> {
+    fn err(&self, line: Option<usize>, field: Option<&str>, msg: String) -> Problem {
         Problem::error(
-            path,
+            self.path,
             line,
             field,
             msg,
             "export the cameras again from Metashape as Agisoft XML",
         )
-    };
-    let text = std::fs::read_to_string(path).map_err(|e| vec![super::unreadable(path, &e)])?;
-    let doc = roxmltree::Document::parse(&text).map_err(|e| {
-        vec![err(
-            Some(e.pos().row as usize),
-            None,
-            format!("is not valid XML ({e})"),
-        )]
-    })?;
-    let line = |n: roxmltree::Node| doc.text_pos_at(n.range().start).row as usize;
-    let root = doc.root_element();
+    }
+
+    /// The error at element `n`.
+    fn err_at(&self, n: Node, field: &str, msg: String) -> Problem {
+        self.err(Some(self.line(n)), Some(field), msg)
+    }
+
+    /// The line of element `n` (1-based).
+    fn line(&self, n: Node) -> usize {
+        line_of(self.text, n.range().start)
+    }
+}
+
+/// The line (1-based) of byte `pos` of `text`.
+fn line_of(text: &str, pos: usize) -> usize {
+    text.as_bytes()[..pos.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+/// The document's only `<chunk>` under its root `<document>`.
+fn the_chunk<'a, 'input>(
+    src: &Source,
+    root: Node<'a, 'input>,
+) -> Result<Node<'a, 'input>, Problem> {
     if root.tag_name().name() != "document" {
-        return Err(vec![err(
-            Some(1),
-            None,
-            format!(
-                "has root element <{}>, not <document>",
-                root.tag_name().name()
-            ),
-        )]);
+        let msg = format!(
+            "has root element <{}>, not <document>",
+            root.tag_name().name()
+        );
+        return Err(src.err(Some(1), None, msg));
     }
     let chunks: Vec<_> = root
         .children()
         .filter(|n| n.has_tag_name("chunk"))
         .collect();
-    let chunk = match chunks.as_slice() {
-        [c] => *c,
-        [] => return Err(vec![err(None, None, "has no <chunk>".into())]),
-        _ => {
-            return Err(vec![err(
-                Some(line(chunks[1])),
-                Some("chunk"),
-                format!(
-                    "has {} chunks; which one is meant is ambiguous",
-                    chunks.len()
-                ),
-            )])
-        }
-    };
+    match chunks.as_slice() {
+        [c] => Ok(*c),
+        [] => Err(src.err(None, None, "has no <chunk>".into())),
+        _ => Err(src.err_at(
+            chunks[1],
+            "chunk",
+            format!(
+                "has {} chunks; which one is meant is ambiguous",
+                chunks.len()
+            ),
+        )),
+    }
+}
+
+/// One `<sensor>` with its calibration; what makes it unusable goes to `fatal`.
+fn read_sensor(src: &Source, s: Node, fatal: &mut Vec<Problem>) -> Option<MetashapeSensor> {
     let child = child_element;
-    let mut problems = Vec::new();
-    let mut fatal = Vec::new();
-    let mut sensors = Vec::new();
-    for s in child(chunk, "sensors")
-        .into_iter()
-        .flat_map(|s| s.children().filter(|c| c.has_tag_name("sensor")))
-    {
-        let id = s.attribute("id").unwrap_or_default().to_string();
-        if s.attribute("type").is_some_and(|t| t != "frame") {
-            fatal.push(err(
-                Some(line(s)),
-                Some("type"),
-                format!(
-                    "sensor {id} is of type '{}'; only frame cameras are supported",
-                    s.attribute("type").unwrap_or_default()
-                ),
-            ));
-            continue;
-        }
-        let Some(cal) = child(s, "calibration") else {
-            fatal.push(err(
-                Some(line(s)),
-                Some("calibration"),
-                format!("sensor {id} has no calibration"),
-            ));
-            continue;
-        };
-        let res = child(cal, "resolution").or_else(|| child(s, "resolution"));
-        let dim = |k: &str| {
-            res.and_then(|r| r.attribute(k))
-                .and_then(|v| v.parse::<u32>().ok())
-        };
-        let mut c = MetashapeCalibration::default();
-        match (dim("width"), dim("height")) {
-            (Some(w), Some(h)) => (c.width_px, c.height_px) = (w, h),
-            _ => fatal.push(err(
-                Some(line(cal)),
-                Some("resolution"),
-                format!("sensor {id}: calibration without resolution"),
-            )),
-        }
-        for el in cal.children().filter(|n| n.is_element()) {
-            let name = el.tag_name().name();
-            let value = el
-                .text()
-                .and_then(|t| t.trim().parse::<f64>().ok())
-                .filter(|v| v.is_finite());
-            let slot = match name {
-                "f" => &mut c.f,
-                "cx" => &mut c.cx,
-                "cy" => &mut c.cy,
-                "b1" => &mut c.b1,
-                "b2" => &mut c.b2,
-                "k1" => &mut c.k1,
-                "k2" => &mut c.k2,
-                "k3" => &mut c.k3,
-                "k4" => &mut c.k4,
-                "p1" => &mut c.p1,
-                "p2" => &mut c.p2,
-                "p3" | "p4" => {
-                    if value != Some(0.0) {
-                        fatal.push(err(
-                            Some(line(el)),
-                            Some(name),
-                            format!(
-                                "sensor {id}: {name} is not supported by skytie's camera model"
-                            ),
-                        ));
-                    }
-                    continue;
+    let id = s.attribute("id").unwrap_or_default().to_string();
+    if s.attribute("type").is_some_and(|t| t != "frame") {
+        fatal.push(src.err_at(
+            s,
+            "type",
+            format!(
+                "sensor {id} is of type '{}'; only frame cameras are supported",
+                s.attribute("type").unwrap_or_default()
+            ),
+        ));
+        return None;
+    }
+    let Some(cal) = child(s, "calibration") else {
+        fatal.push(src.err_at(s, "calibration", format!("sensor {id} has no calibration")));
+        return None;
+    };
+    let res = child(cal, "resolution").or_else(|| child(s, "resolution"));
+    let dim = |k: &str| {
+        res.and_then(|r| r.attribute(k))
+            .and_then(|v| v.parse::<u32>().ok())
+    };
+    let mut c = MetashapeCalibration::default();
+    match (dim("width"), dim("height")) {
+        (Some(w), Some(h)) => (c.width_px, c.height_px) = (w, h),
+        _ => fatal.push(src.err_at(
+            cal,
+            "resolution",
+            format!("sensor {id}: calibration without resolution"),
+        )),
+    }
+    read_calibration_terms(src, &id, cal, &mut c, fatal);
+    if c.f.is_nan() || c.f <= 0.0 {
+        fatal.push(src.err_at(cal, "f", format!("sensor {id}: no focal length f > 0")));
+    }
+    Some(MetashapeSensor {
+        id,
+        label: s.attribute("label").unwrap_or_default().to_string(),
+        calibration: c,
+    })
+}
+
+/// The model terms of `<calibration>` element `cal` of sensor `id` into `c`; p3 and p4 other than 0, and terms
+/// that are not numbers, go to `fatal`.
+fn read_calibration_terms(
+    src: &Source,
+    id: &str,
+    cal: Node,
+    c: &mut MetashapeCalibration,
+    fatal: &mut Vec<Problem>,
+) {
+    for el in cal.children().filter(|n| n.is_element()) {
+        let name = el.tag_name().name();
+        let value = el
+            .text()
+            .and_then(|t| t.trim().parse::<f64>().ok())
+            .filter(|v| v.is_finite());
+        let slot = match name {
+            "f" => &mut c.f,
+            "cx" => &mut c.cx,
+            "cy" => &mut c.cy,
+            "b1" => &mut c.b1,
+            "b2" => &mut c.b2,
+            "k1" => &mut c.k1,
+            "k2" => &mut c.k2,
+            "k3" => &mut c.k3,
+            "k4" => &mut c.k4,
+            "p1" => &mut c.p1,
+            "p2" => &mut c.p2,
+            "p3" | "p4" => {
+                if value != Some(0.0) {
+                    let msg =
+                        format!("sensor {id}: {name} is not supported by skytie's camera model");
+                    fatal.push(src.err_at(el, name, msg));
                 }
-                _ => continue,
-            };
-            match value {
-                Some(v) => *slot = v,
-                None => fatal.push(err(
-                    Some(line(el)),
-                    Some(name),
-                    format!("sensor {id}: {name} is not a number"),
-                )),
+                continue;
+            }
+            _ => continue,
+        };
+        match value {
+            Some(v) => *slot = v,
+            None => {
+                fatal.push(src.err_at(el, name, format!("sensor {id}: {name} is not a number")))
             }
         }
-        if c.f.is_nan() || c.f <= 0.0 {
-            fatal.push(err(
-                Some(line(cal)),
-                Some("f"),
-                format!("sensor {id}: no focal length f > 0"),
-            ));
-        }
-        sensors.push(MetashapeSensor {
-            id,
-            label: s.attribute("label").unwrap_or_default().to_string(),
-            calibration: c,
-        });
     }
+}
+
+/// The aligned `<camera>`s under `<cameras>`; the others are reported in `problems` and left out.
+fn read_cameras(src: &Source, chunk: Node, problems: &mut Vec<Problem>) -> Vec<MetashapeCamera> {
     let mut cameras = Vec::new();
-    for cam in child(chunk, "cameras")
+    for cam in child_element(chunk, "cameras")
         .into_iter()
         .flat_map(|c| c.descendants().filter(|n| n.has_tag_name("camera")))
     {
         let label = cam.attribute("label").unwrap_or_default().to_string();
         let sensor_id = cam.attribute("sensor_id").unwrap_or_default().to_string();
-        let m = child(cam, "transform")
+        let m = child_element(cam, "transform")
             .and_then(|t| t.text())
             .and_then(numbers);
         match m {
             Some(v) if v.len() == 16 => cameras.push(MetashapeCamera {
-                line: line(cam),
+                line: src.line(cam),
                 sensor_id,
                 label,
                 transform: Matrix4::from_row_slice(&v),
             }),
-            Some(_) => problems.push(err(
-                Some(line(cam)),
-                Some("transform"),
+            Some(_) => problems.push(src.err_at(
+                cam,
+                "transform",
                 format!("camera '{label}': transform is not 16 numbers; skipped"),
             )),
-            None => problems.push(err(
-                Some(line(cam)),
-                Some("transform"),
+            None => problems.push(src.err_at(
+                cam,
+                "transform",
                 format!("camera '{label}' is not aligned (no transform); skipped"),
             )),
         }
     }
-    let chunk_transform = match child(chunk, "transform") {
-        None => None,
-        Some(t) => {
-            let get = |name: &str, n: usize| {
-                child(t, name)
-                    .and_then(|e| e.text())
-                    .and_then(numbers)
-                    .filter(|v| v.len() == n)
-            };
-            match (get("rotation", 9), get("translation", 3), get("scale", 1)) {
-                (Some(r), Some(tr), s) => Some(ChunkTransform {
-                    rotation: Matrix3::from_row_slice(&r),
-                    translation: Vector3::from_row_slice(&tr),
-                    scale: s.map_or(1.0, |s| s[0]),
-                }),
-                _ => {
-                    fatal.push(err(
-                        Some(line(t)),
-                        Some("transform"),
-                        "chunk transform without rotation (9 numbers) and translation (3 numbers)"
-                            .into(),
-                    ));
-                    None
-                }
-            }
-        }
+    cameras
+}
+
+/// The chunk's `<transform>`, if it has one; an incomplete one goes to `fatal`.
+fn read_chunk_transform(
+    src: &Source,
+    chunk: Node,
+    fatal: &mut Vec<Problem>,
+) -> Option<ChunkTransform> {
+    let t = child_element(chunk, "transform")?;
+    let get = |name: &str, n: usize| {
+        child_element(t, name)
+            .and_then(|e| e.text())
+            .and_then(numbers)
+            .filter(|v| v.len() == n)
     };
+    match (get("rotation", 9), get("translation", 3), get("scale", 1)) {
+        (Some(r), Some(tr), s) => Some(ChunkTransform {
+            rotation: Matrix3::from_row_slice(&r),
+            translation: Vector3::from_row_slice(&tr),
+            scale: s.map_or(1.0, |s| s[0]),
+        }),
+        _ => {
+            fatal.push(src.err_at(
+                t,
+                "transform",
+                "chunk transform without rotation (9 numbers) and translation (3 numbers)".into(),
+            ));
+            None
+        }
+    }
+}
+
+/// Read the document; cameras without a transform (not aligned) are reported and left out.
+pub fn read_metashape_xml(path: &Path) -> Result<(MetashapeDocument, Vec<Problem>), Vec<Problem>> {
+    let text = std::fs::read_to_string(path).map_err(|e| vec![super::unreadable(path, &e)])?;
+    let src = Source { path, text: &text };
+    let doc = roxmltree::Document::parse(&text).map_err(|e| {
+        vec![src.err(
+            Some(e.pos().row as usize),
+            None,
+            format!("is not valid XML ({e})"),
+        )]
+    })?;
+    let chunk = the_chunk(&src, doc.root_element()).map_err(|e| vec![e])?;
+    let mut problems = Vec::new();
+    let mut fatal = Vec::new();
+    let sensors: Vec<MetashapeSensor> = child_element(chunk, "sensors")
+        .into_iter()
+        .flat_map(|s| s.children().filter(|c| c.has_tag_name("sensor")))
+        .filter_map(|s| read_sensor(&src, s, &mut fatal))
+        .collect();
+    let cameras = read_cameras(&src, chunk, &mut problems);
+    let chunk_transform = read_chunk_transform(&src, chunk, &mut fatal);
     if !fatal.is_empty() {
         return Err(fatal);
     }
-    let reference_wkt = child(chunk, "reference")
+    let reference_wkt = child_element(chunk, "reference")
         .and_then(|r| r.text())
         .map(|t| t.trim().to_string());
     Ok((

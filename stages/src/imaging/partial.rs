@@ -6,7 +6,7 @@
 
 use super::pyramid::builder::{Chain, TileSink};
 use super::pyramid::layout::{PyramidLayout, SampleDepth, DEFAULT_TILE_SIDE};
-use super::pyramid::reader::{PyramidError, TileId, TileSource};
+use super::pyramid::reader::{PyramidError, PyramidHeader, TileId, TileSource};
 use crate::imaging::decode::{decode_grey, limits, GreyInfo, GreyRowSink};
 use crate::imaging::io_error::ImageIoError;
 use std::collections::HashMap;
@@ -175,8 +175,7 @@ impl<F: FnOnce(&PyramidLayout) -> Vec<Region>> GreyRowSink for PartialBuild<F> {
 /// The tiles of some regions of an image file's pyramid, in memory; see the module documentation.
 pub struct PartialPyramid {
     path: PathBuf,
-    layout: PyramidLayout,
-    white: u16,
+    header: PyramidHeader,
     tiles: HashMap<usize, Arc<[u8]>>,
 }
 
@@ -216,42 +215,30 @@ impl PartialPyramid {
         };
         Ok(Self {
             path: path.to_path_buf(),
-            layout,
-            white,
+            header: PyramidHeader { layout, white },
             tiles: sink.tiles.into_inner().unwrap_or_else(|p| p.into_inner()),
         })
     }
 
     /// Bytes of the tiles held.
     pub fn kept_bytes(&self) -> usize {
-        self.tiles.len() * self.layout.tile_bytes()
+        self.tiles.len() * self.header.layout.tile_bytes()
     }
 }
 
 impl TileSource for PartialPyramid {
-    fn layout(&self) -> &PyramidLayout {
-        &self.layout
+    fn header(&self) -> &PyramidHeader {
+        &self.header
     }
 
-    fn white(&self) -> u16 {
-        self.white
-    }
-
-    fn tile(&self, (level, tx, ty): TileId) -> Result<Arc<[u8]>, PyramidError> {
-        let (across, down) = self.layout.tiles(level.min(self.layout.levels() - 1));
-        let index = (level < self.layout.levels() && tx < across && ty < down)
-            .then(|| self.layout.tile_index(level, tx, ty));
-        index
+    fn tile(&self, id: TileId) -> Result<Arc<[u8]>, PyramidError> {
+        let why = "was not kept when the file was decoded";
+        self.header
+            .layout
+            .existing_tile_index(id)
             .and_then(|i| self.tiles.get(&i))
             .map(Arc::clone)
-            .ok_or_else(|| {
-                PyramidError::new(
-                    &self.path,
-                    format!(
-                        "internal: tile ({level}, {tx}, {ty}) was not kept when the file was decoded"
-                    ),
-                )
-            })
+            .ok_or_else(|| PyramidError::missing_tile(&self.path, id, why))
     }
 }
 

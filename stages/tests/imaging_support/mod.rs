@@ -76,6 +76,18 @@ impl Texture {
         }
     }
 
+    /// The `w × h` window of the texture whose top-left corner is at the sub-pixel position `(ox, oy)`.
+    pub fn crop_at(&self, w: usize, h: usize, (ox, oy): (f64, f64)) -> GrayImage {
+        self.render(
+            w,
+            h,
+            ox.floor(),
+            oy.floor(),
+            ox.floor() - ox,
+            oy.floor() - oy,
+        )
+    }
+
     /// `w × h` image, pixel (i, j) = `0.5 + 0.15·f(x0 + i + 0.5 − tx, y0 + j + 0.5 − ty)` with integer crop
     /// origin (x0, y0) (rounded to integers; put fractions into t): the crop of the texture translated by
     /// (tx, ty). Sample positions wrap periodically.

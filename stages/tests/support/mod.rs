@@ -7,6 +7,7 @@ use nalgebra::Vector3;
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::geometry::{look_at_matrix, matrix_to_opk};
 
+pub mod adjusted;
 pub mod tiny;
 
 /// Easting of the street's first recording, metres.

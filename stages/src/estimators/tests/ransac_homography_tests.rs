@@ -1,6 +1,7 @@
 //! RANSAC homography (Hartley & Zisserman 2004, ch. 4 KAT): 40 % outliers, noisy inliers, degenerate samples, determinism.
 
-use crate::estimators::{ransac, RansacParams, SplitMix64};
+use super::fixtures::{self, ransac_params};
+use crate::estimators::ransac;
 use crate::geometry::{Homography, PointPair};
 use nalgebra::{Matrix3, Vector2};
 
@@ -11,53 +12,16 @@ fn truth() -> Homography {
     .normalized()
 }
 
+/// `n_in` correspondences of `truth()` with N(0, noise) in dst, then `n_out` random ones over the image.
 fn contaminated(n_in: usize, n_out: usize, noise: f64, seed: u64) -> Vec<PointPair> {
-    let mut rng = SplitMix64::new(seed);
     let h = truth();
-    let mut pairs: Vec<PointPair> = (0..n_in)
-        .map(|_| {
-            let src = Vector2::new(800.0 * rng.next_f64(), 800.0 * rng.next_f64());
-            let dst = h.apply(&src).unwrap()
-                + Vector2::new(rng.next_gaussian(), rng.next_gaussian()) * noise;
-            PointPair { src, dst }
-        })
-        .collect();
-    pairs.extend((0..n_out).map(|_| {
-        PointPair::new(
-            800.0 * rng.next_f64(),
-            800.0 * rng.next_f64(),
-            800.0 * rng.next_f64(),
-            800.0 * rng.next_f64(),
-        )
-    }));
-    pairs
-}
-
-fn max_corner_difference(a: &Homography, b: &Homography) -> f64 {
-    [
-        (0.0, 0.0),
-        (800.0, 0.0),
-        (0.0, 800.0),
-        (800.0, 800.0),
-        (400.0, 400.0),
-    ]
-    .iter()
-    .map(|&(x, y)| {
-        let p = Vector2::new(x, y);
-        (a.apply(&p).unwrap() - b.apply(&p).unwrap()).norm()
-    })
-    .fold(0.0, f64::max)
+    fixtures::contaminated(|p| h.apply(p).unwrap(), 800.0, (n_in, n_out), noise, seed)
 }
 
 #[test]
 fn exact_inliers_with_40_percent_outliers() {
     let pairs = contaminated(90, 60, 0.0, 31);
-    let params = RansacParams {
-        threshold: 1.0,
-        confidence: 0.99,
-        max_iterations: 2000,
-        seed: 5,
-    };
+    let params = ransac_params(1.0, 0.99, 2000, 5);
     let r = ransac::<Homography>(&pairs, &params).unwrap();
     let (got, want) = (r.model.normalized(), truth().normalized());
     assert!((got.0 - want.0).norm() < 1e-10, "{:?}", got.0);
@@ -72,17 +36,16 @@ fn exact_inliers_with_40_percent_outliers() {
 fn noisy_inliers_match_least_squares_on_true_inliers() {
     let noise = 0.5;
     let pairs = contaminated(150, 100, noise, 32);
-    let params = RansacParams {
-        threshold: 3.0 * noise * 2f64.sqrt(),
-        confidence: 0.995,
-        max_iterations: 2000,
-        seed: 6,
-    };
+    let params = ransac_params(3.0 * noise * 2f64.sqrt(), 0.995, 2000, 6);
     let r = ransac::<Homography>(&pairs, &params).unwrap();
     let recall = (0..150).filter(|i| r.inliers.contains(i)).count() as f64 / 150.0;
     assert!(recall > 0.98, "recall {recall}");
     let reference = Homography::from_pairs(&pairs[..150]).unwrap();
-    let d = max_corner_difference(&r.model, &reference);
+    let d = fixtures::max_corner_difference(
+        |p| r.model.apply(p).unwrap(),
+        |p| reference.apply(p).unwrap(),
+        800.0,
+    );
     assert!(
         d < 0.5 * noise,
         "differs from the LS fit on the true inliers by {d} px"
@@ -102,24 +65,14 @@ fn all_collinear_data_give_none() {
             }
         })
         .collect();
-    let params = RansacParams {
-        threshold: 1.0,
-        confidence: 0.99,
-        max_iterations: 200,
-        seed: 1,
-    };
+    let params = ransac_params(1.0, 0.99, 200, 1);
     assert!(ransac::<Homography>(&pairs, &params).is_none());
 }
 
 #[test]
 fn deterministic_for_a_seed() {
     let pairs = contaminated(60, 40, 0.3, 33);
-    let params = RansacParams {
-        threshold: 1.5,
-        confidence: 0.99,
-        max_iterations: 2000,
-        seed: 12345,
-    };
+    let params = ransac_params(1.5, 0.99, 2000, 12345);
     let a = ransac::<Homography>(&pairs, &params).unwrap();
     let b = ransac::<Homography>(&pairs, &params).unwrap();
     assert_eq!(a, b);

@@ -1,5 +1,6 @@
 //! RANSAC similarity (Hartley & Zisserman 2004, ch. 4 KAT): 50 % outliers, noisy inliers, determinism.
 
+use super::fixtures::{self, ransac_params};
 use crate::estimators::{ransac, ransac_filtered, RansacParams, SplitMix64};
 use crate::geometry::{PointPair, Similarity2};
 use nalgebra::Vector2;
@@ -15,36 +16,14 @@ fn truth() -> Similarity2 {
 
 /// `n_in` correspondences of `truth()` with N(0, noise) in dst, then `n_out` random ones over the image.
 fn contaminated(n_in: usize, n_out: usize, noise: f64, seed: u64) -> Vec<PointPair> {
-    let mut rng = SplitMix64::new(seed);
     let sim = truth();
-    let mut pairs: Vec<PointPair> = (0..n_in)
-        .map(|_| {
-            let src = Vector2::new(600.0 * rng.next_f64(), 600.0 * rng.next_f64());
-            let dst =
-                sim.apply(&src) + Vector2::new(rng.next_gaussian(), rng.next_gaussian()) * noise;
-            PointPair { src, dst }
-        })
-        .collect();
-    pairs.extend((0..n_out).map(|_| {
-        PointPair::new(
-            600.0 * rng.next_f64(),
-            600.0 * rng.next_f64(),
-            600.0 * rng.next_f64(),
-            600.0 * rng.next_f64(),
-        )
-    }));
-    pairs
+    fixtures::contaminated(|p| sim.apply(p), 600.0, (n_in, n_out), noise, seed)
 }
 
 #[test]
 fn exact_inliers_with_50_percent_outliers() {
     let pairs = contaminated(100, 100, 0.0, 21);
-    let params = RansacParams {
-        threshold: 1.0,
-        confidence: 0.99,
-        max_iterations: 2000,
-        seed: 7,
-    };
+    let params = ransac_params(1.0, 0.99, 2000, 7);
     let r = ransac::<Similarity2>(&pairs, &params).unwrap();
     let t = truth();
     assert!((r.model.scale - t.scale).abs() < 1e-9 * t.scale);
@@ -63,39 +42,20 @@ fn exact_inliers_with_50_percent_outliers() {
 fn noisy_inliers_match_least_squares_on_true_inliers() {
     let noise = 0.5;
     let pairs = contaminated(120, 120, noise, 22);
-    let params = RansacParams {
-        threshold: 3.0 * noise * 2f64.sqrt(),
-        confidence: 0.99,
-        max_iterations: 2000,
-        seed: 8,
-    };
+    let params = ransac_params(3.0 * noise * 2f64.sqrt(), 0.99, 2000, 8);
     let r = ransac::<Similarity2>(&pairs, &params).unwrap();
     let recall = (0..120).filter(|i| r.inliers.contains(i)).count() as f64 / 120.0;
     assert!(recall > 0.98, "recall {recall}");
     let reference = Similarity2::least_squares(&pairs[..120]).unwrap();
     // Compare where it matters: transferred positions over the image differ far less than the noise.
-    for &(x, y) in &[
-        (0.0, 0.0),
-        (600.0, 0.0),
-        (0.0, 600.0),
-        (600.0, 600.0),
-        (300.0, 300.0),
-    ] {
-        let p = Vector2::new(x, y);
-        let d = (r.model.apply(&p) - reference.apply(&p)).norm();
-        assert!(d < 0.3 * noise, "corner ({x},{y}) differs by {d} px");
-    }
+    let d = fixtures::max_corner_difference(|p| r.model.apply(p), |p| reference.apply(p), 600.0);
+    assert!(d < 0.3 * noise, "a corner differs by {d} px");
 }
 
 #[test]
 fn deterministic_for_a_seed() {
     let pairs = contaminated(80, 80, 0.3, 23);
-    let params = RansacParams {
-        threshold: 1.5,
-        confidence: 0.995,
-        max_iterations: 2000,
-        seed: 99,
-    };
+    let params = ransac_params(1.5, 0.995, 2000, 99);
     let a = ransac::<Similarity2>(&pairs, &params).unwrap();
     let b = ransac::<Similarity2>(&pairs, &params).unwrap();
     assert_eq!(a, b);
@@ -130,12 +90,7 @@ fn acceptance_test_rejects_implausible_hypotheses() {
             dst: shifted.apply(&src),
         }
     }));
-    let params = RansacParams {
-        threshold: 1.0,
-        confidence: 0.999,
-        max_iterations: 2000,
-        seed: 4,
-    };
+    let params = ransac_params(1.0, 0.999, 2000, 4);
     let centre = Vector2::new(300.0, 300.0);
     let plain = ransac::<Similarity2>(&pairs, &params).unwrap();
     assert_eq!(plain.inliers, (0..60).collect::<Vec<_>>());

@@ -1,5 +1,6 @@
 //! Generic RANSAC behaviour: trial counts, parameter validation, a 1-D model with a known answer.
 
+use super::fixtures::ransac_params;
 use crate::estimators::{ransac, required_iterations, Model, RansacParams};
 use crate::params::Params;
 
@@ -34,12 +35,7 @@ fn finds_the_majority_cluster_and_refits() {
         .map(|i| 10.0 + 0.1 * ((f64::from(i) * 0.37).fract() * 2.0 - 1.0))
         .collect();
     data.extend((0..40).map(|i| 100.0 + 10.0 * f64::from(i)));
-    let params = RansacParams {
-        threshold: 0.25,
-        confidence: 0.999,
-        max_iterations: 500,
-        seed: 3,
-    };
+    let params = ransac_params(0.25, 0.999, 500, 3);
     let result = ransac::<Constant>(&data, &params).unwrap();
     assert_eq!(result.inliers, (0..60).collect::<Vec<_>>());
     let mean = data[..60].iter().sum::<f64>() / 60.0;
@@ -83,12 +79,7 @@ fn invalid_parameters_or_too_few_data_give_none() {
 fn max_iterations_caps_the_trials() {
     // Only outliers (every pair is far apart): no consensus above 1, so the trial count stays at the cap.
     let data: Vec<f64> = (0..50).map(|i| f64::from(i) * 100.0).collect();
-    let params = RansacParams {
-        threshold: 1.0,
-        confidence: 0.99,
-        max_iterations: 37,
-        seed: 1,
-    };
+    let params = ransac_params(1.0, 0.99, 37, 1);
     let result = ransac::<Constant>(&data, &params).unwrap();
     assert_eq!(result.iterations, 37);
     assert_eq!(result.inliers.len(), 1);

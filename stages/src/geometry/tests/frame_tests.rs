@@ -17,6 +17,24 @@ fn camera(omega: f64, phi: f64, kappa: f64, distortion: BrownDistortion) -> Fram
     FrameCamera::from_opk(centre(), omega, phi, kappa, F, CX, CY, W, H, distortion)
 }
 
+/// The ground point (z = 0) `offset_m` = (east, north) of the camera centre projects to (u, v) within `tol` px.
+fn assert_ground_px(cam: &FrameCamera, offset_m: [f64; 2], (u, v): (f64, f64), tol: f64) {
+    let c = centre();
+    let ground = Vector3::new(c.x + offset_m[0], c.y + offset_m[1], 0.0);
+    assert_px(cam.project_world(&ground), u, v, tol);
+}
+
+/// Brown distortion with radial (k1, k2) and decentring (p1, p2) terms of typical size.
+fn radial_and_decentring() -> BrownDistortion {
+    BrownDistortion {
+        k1: -0.12,
+        k2: 0.03,
+        p1: 2e-3,
+        p2: -1.5e-3,
+        ..BrownDistortion::NONE
+    }
+}
+
 fn assert_px(got: Option<(f64, f64)>, u: f64, v: f64, tol: f64) {
     let (gu, gv) = got.expect("point should project");
     assert!(
@@ -30,25 +48,10 @@ fn nadir_image_top_is_north() {
     let cam = camera(0.0, 0.0, 0.0, BrownDistortion::NONE);
     let c = centre();
     // 100 m north of the nadir point at 1000 m depth: y = 0.1 → 1000 px above the principal point.
-    assert_px(
-        cam.project_world(&Vector3::new(c.x, c.y + 100.0, 0.0)),
-        CX,
-        CY - 1000.0,
-        1e-9,
-    );
+    assert_ground_px(&cam, [0.0, 100.0], (CX, CY - 1000.0), 1e-9);
     // 100 m east: x = 0.1 → 1000 px right.
-    assert_px(
-        cam.project_world(&Vector3::new(c.x + 100.0, c.y, 0.0)),
-        CX + 1000.0,
-        CY,
-        1e-9,
-    );
-    assert_px(
-        cam.project_world(&Vector3::new(c.x, c.y, 0.0)),
-        CX,
-        CY,
-        1e-9,
-    );
+    assert_ground_px(&cam, [100.0, 0.0], (CX + 1000.0, CY), 1e-9);
+    assert_ground_px(&cam, [0.0, 0.0], (CX, CY), 1e-9);
     assert!((cam.viewing_direction_world() - Vector3::new(0.0, 0.0, -1.0)).norm() < 1e-15);
     assert!((cam.gsd_at(&Vector3::new(c.x + 50.0, c.y - 20.0, 0.0)) - 0.1).abs() < 1e-12);
 }
@@ -73,19 +76,9 @@ fn oblique_45_looking_east_with_image_top_north() {
     assert!((cam.viewing_direction_world() - Vector3::new(s, 0.0, -s)).norm() < 1e-15);
     let c = centre();
     // The axis meets the ground 1000 m east of the nadir point.
-    assert_px(
-        cam.project_world(&Vector3::new(c.x + 1000.0, c.y, 0.0)),
-        CX,
-        CY,
-        1e-9,
-    );
+    assert_ground_px(&cam, [1000.0, 0.0], (CX, CY), 1e-9);
     // 2000 m east: 63.43° from the vertical, 18.43° right of the axis: x = tan 18.43° = 1/3.
-    assert_px(
-        cam.project_world(&Vector3::new(c.x + 2000.0, c.y, 0.0)),
-        CX + F / 3.0,
-        CY,
-        1e-7,
-    );
+    assert_ground_px(&cam, [2000.0, 0.0], (CX + F / 3.0, CY), 1e-7);
     // North is still up in the image.
     let (_, v) = cam
         .project_world(&Vector3::new(c.x + 1000.0, c.y + 50.0, 0.0))
@@ -100,47 +93,20 @@ fn oblique_45_looking_east_with_image_top_away() {
     // κ = −90°: camera y axis = Ry(−45°)·(1,0,0) = (√½, 0, √½) (east and up), camera x axis = (0,−1,0)
     // (south, i.e. to the right when facing east).
     let cam = camera(0.0, -45.0, -90.0, BrownDistortion::NONE);
-    let c = centre();
-    assert_px(
-        cam.project_world(&Vector3::new(c.x + 1000.0, c.y, 0.0)),
-        CX,
-        CY,
-        1e-9,
-    );
+    assert_ground_px(&cam, [1000.0, 0.0], (CX, CY), 1e-9);
     // Farther east appears higher in the image (v < cy) by exactly f/3.
-    assert_px(
-        cam.project_world(&Vector3::new(c.x + 2000.0, c.y, 0.0)),
-        CX,
-        CY - F / 3.0,
-        1e-7,
-    );
+    assert_ground_px(&cam, [2000.0, 0.0], (CX, CY - F / 3.0), 1e-7);
     // South of the axis point appears right of the principal point: x = 100 / (√2·1000).
     let x = 100.0 / (2f64.sqrt() * 1000.0);
-    assert_px(
-        cam.project_world(&Vector3::new(c.x + 1000.0, c.y - 100.0, 0.0)),
-        CX + F * x,
-        CY,
-        1e-7,
-    );
+    assert_ground_px(&cam, [1000.0, -100.0], (CX + F * x, CY), 1e-7);
 }
 
 #[test]
 fn oblique_looking_north_uses_omega() {
     // Rx(ω)·(0,0,−1) = (0, sin ω, −cos ω): ω = +45° looks north-down; image top then points north-up.
     let cam = camera(45.0, 0.0, 0.0, BrownDistortion::NONE);
-    let c = centre();
-    assert_px(
-        cam.project_world(&Vector3::new(c.x, c.y + 1000.0, 0.0)),
-        CX,
-        CY,
-        1e-9,
-    );
-    assert_px(
-        cam.project_world(&Vector3::new(c.x, c.y + 2000.0, 0.0)),
-        CX,
-        CY - F / 3.0,
-        1e-7,
-    );
+    assert_ground_px(&cam, [0.0, 1000.0], (CX, CY), 1e-9);
+    assert_ground_px(&cam, [0.0, 2000.0], (CX, CY - F / 3.0), 1e-7);
 }
 
 #[test]
@@ -184,13 +150,7 @@ fn brown_distortion_by_hand() {
 
 #[test]
 fn distortion_jacobian_matches_finite_differences() {
-    let d = BrownDistortion {
-        k1: -0.12,
-        k2: 0.03,
-        p1: 2e-3,
-        p2: -1.5e-3,
-        ..BrownDistortion::NONE
-    };
+    let d = radial_and_decentring();
     for &(x, y) in &[(0.1, 0.2), (-0.4, 0.3), (0.55, -0.35)] {
         let j = d.distort_jacobian(x, y);
         let e = 1e-6;
@@ -207,13 +167,7 @@ fn distortion_jacobian_matches_finite_differences() {
 
 #[test]
 fn undistort_inverts_distort_to_1e12() {
-    let d = BrownDistortion {
-        k1: -0.12,
-        k2: 0.03,
-        p1: 2e-3,
-        p2: -1.5e-3,
-        ..BrownDistortion::NONE
-    };
+    let d = radial_and_decentring();
     for i in -12..=12 {
         for j in -8..=8 {
             let (x, y) = (f64::from(i) * 0.05, f64::from(j) * 0.05);
@@ -247,13 +201,7 @@ fn round_trip_worst_px(cam: &FrameCamera) -> f64 {
 fn pixel_ray_pixel_round_trip_whole_image() {
     let distortions = [
         BrownDistortion::NONE,
-        BrownDistortion {
-            k1: -0.12,
-            k2: 0.03,
-            p1: 2e-3,
-            p2: -1.5e-3,
-            ..BrownDistortion::NONE
-        },
+        radial_and_decentring(),
         BrownDistortion {
             k1: 0.08,
             k2: -0.01,

@@ -37,21 +37,16 @@ impl Channels {
 
 /// Grey of every pixel of 8-bit `samples` (whole pixels) into `out`.
 pub fn grey_row8(samples: &[u8], channels: Channels, out: &mut Vec<u8>) {
-    out.clear();
-    let n = channels.samples();
-    match channels {
-        Channels::Grey { extra: 0 } => out.extend_from_slice(samples),
-        Channels::Grey { .. } | Channels::YCbCr => {
-            out.extend(samples.chunks_exact(n).map(|p| p[0]))
-        }
-        Channels::Rgb { .. } => {
-            out.extend(samples.chunks_exact(n).map(|p| luma8(p[0], p[1], p[2])))
-        }
-    }
+    grey_row(samples, channels, out, luma8);
 }
 
 /// Grey of every pixel of 16-bit `samples` into `out`.
 pub fn grey_row16(samples: &[u16], channels: Channels, out: &mut Vec<u16>) {
+    grey_row(samples, channels, out, luma16);
+}
+
+/// Grey of every pixel of `samples` into `out`: the first sample of grey and YCbCr pixels, `luma` of RGB ones.
+fn grey_row<T: Copy>(samples: &[T], channels: Channels, out: &mut Vec<T>, luma: fn(T, T, T) -> T) {
     out.clear();
     let n = channels.samples();
     match channels {
@@ -59,9 +54,7 @@ pub fn grey_row16(samples: &[u16], channels: Channels, out: &mut Vec<u16>) {
         Channels::Grey { .. } | Channels::YCbCr => {
             out.extend(samples.chunks_exact(n).map(|p| p[0]))
         }
-        Channels::Rgb { .. } => {
-            out.extend(samples.chunks_exact(n).map(|p| luma16(p[0], p[1], p[2])))
-        }
+        Channels::Rgb { .. } => out.extend(samples.chunks_exact(n).map(|p| luma(p[0], p[1], p[2]))),
     }
 }
 

@@ -134,6 +134,12 @@ impl PyramidLayout {
         self.tile_side * self.tile_side * self.depth.bytes()
     }
 
+    /// Index of tile (`level`, `tx`, `ty`) in file order, or `None` when the pyramid has no such tile.
+    pub fn existing_tile_index(&self, (level, tx, ty): (usize, usize, usize)) -> Option<usize> {
+        let (across, down) = self.tiles(level.min(self.levels() - 1));
+        (level < self.levels() && tx < across && ty < down).then(|| self.tile_index(level, tx, ty))
+    }
+
     /// Index of tile (`tx`, `ty`) of `level` in file order.
     pub fn tile_index(&self, level: usize, tx: usize, ty: usize) -> usize {
         let (across, _) = self.tiles(level);

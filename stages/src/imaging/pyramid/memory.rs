@@ -3,7 +3,7 @@
 
 use super::builder::{Chain, TileSink};
 use super::layout::{PyramidLayout, SampleDepth, DEFAULT_TILE_SIDE};
-use super::reader::{PyramidError, TileId, TileSource};
+use super::reader::{PyramidError, PyramidHeader, TileId, TileSource};
 use crate::imaging::GrayImage;
 use std::io;
 use std::path::Path;
@@ -22,8 +22,7 @@ impl TileSink for MemorySink {
 
 /// A pyramid in memory.
 pub struct MemoryPyramid {
-    layout: PyramidLayout,
-    white: u16,
+    header: PyramidHeader,
     tiles: Vec<Arc<[u8]>>,
 }
 
@@ -64,32 +63,28 @@ impl MemoryPyramid {
             .collect();
         // Grey = sample / 65535 whatever the largest value (the image's own 0..1 scale).
         Self {
-            layout,
-            white: u16::MAX,
+            header: PyramidHeader {
+                layout,
+                white: u16::MAX,
+            },
             tiles,
         }
     }
 }
 
 impl TileSource for MemoryPyramid {
-    fn layout(&self) -> &PyramidLayout {
-        &self.layout
+    fn header(&self) -> &PyramidHeader {
+        &self.header
     }
 
-    fn white(&self) -> u16 {
-        self.white
-    }
-
-    fn tile(&self, (level, tx, ty): TileId) -> Result<Arc<[u8]>, PyramidError> {
-        let (across, down) = self.layout.tiles(level.min(self.layout.levels() - 1));
-        if level >= self.layout.levels() || tx >= across || ty >= down {
-            return Err(PyramidError::new(
+    fn tile(&self, id: TileId) -> Result<Arc<[u8]>, PyramidError> {
+        match self.header.layout.existing_tile_index(id) {
+            Some(index) => Ok(Arc::clone(&self.tiles[index])),
+            None => Err(PyramidError::missing_tile(
                 Path::new("(memory)"),
-                format!("internal: tile ({level}, {tx}, {ty}) does not exist"),
-            ));
+                id,
+                "does not exist",
+            )),
         }
-        Ok(Arc::clone(
-            &self.tiles[self.layout.tile_index(level, tx, ty)],
-        ))
     }
 }

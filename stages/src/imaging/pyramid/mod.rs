@@ -19,7 +19,7 @@ pub mod sample;
 pub use builder::{PyramidBuilder, PyramidSummary};
 pub use layout::{PixelRect, PyramidLayout, SampleDepth, DEFAULT_TILE_SIDE};
 pub use memory::MemoryPyramid;
-pub use reader::{read_window, PyramidError, TileId, TileSource, TiledPyramid};
+pub use reader::{read_window, PyramidError, PyramidHeader, TileId, TileSource, TiledPyramid};
 
 use crate::imaging::GrayImage;
 

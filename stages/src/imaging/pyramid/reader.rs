@@ -25,6 +25,11 @@ impl PyramidError {
             message: message.into(),
         }
     }
+
+    /// Tile `id` of the pyramid at `path` is not there (`why`: "does not exist", "was not kept …").
+    pub fn missing_tile(path: &Path, (level, tx, ty): TileId, why: &str) -> Self {
+        Self::new(path, format!("internal: tile ({level}, {tx}, {ty}) {why}"))
+    }
 }
 
 /// Identity of one tile: (level, tx, ty).
@@ -33,20 +38,32 @@ pub type TileId = (usize, usize, usize);
 /// Something that hands out the verified bytes of a pyramid's tiles (the file itself, or a cache in front of
 /// it), from which windows are assembled.
 pub trait TileSource: Send + Sync {
+    /// Layout and white value of the pyramid.
+    fn header(&self) -> &PyramidHeader;
     /// Layout of the pyramid.
-    fn layout(&self) -> &PyramidLayout;
+    fn layout(&self) -> &PyramidLayout {
+        &self.header().layout
+    }
     /// The sample value that maps to grey 1.0.
-    fn white(&self) -> u16;
+    fn white(&self) -> u16 {
+        self.header().white
+    }
     /// The verified bytes of a tile (`layout().tile_bytes()` of them).
     fn tile(&self, id: TileId) -> Result<Arc<[u8]>, PyramidError>;
+}
+
+/// What a pyramid's header says of it: its layout and the sample value that maps to grey 1.0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PyramidHeader {
+    pub layout: PyramidLayout,
+    pub white: u16,
 }
 
 /// An opened pyramid file with its verified index.
 pub struct TiledPyramid {
     path: PathBuf,
     file: File,
-    layout: PyramidLayout,
-    white: u16,
+    header: PyramidHeader,
     hashes: Vec<u8>,
 }
 
@@ -85,8 +102,7 @@ impl TiledPyramid {
         Ok(Self {
             path: path.to_path_buf(),
             file,
-            layout,
-            white,
+            header: PyramidHeader { layout, white },
             hashes,
         })
     }
@@ -97,24 +113,15 @@ impl TiledPyramid {
 }
 
 impl TileSource for TiledPyramid {
-    fn layout(&self) -> &PyramidLayout {
-        &self.layout
+    fn header(&self) -> &PyramidHeader {
+        &self.header
     }
 
-    fn white(&self) -> u16 {
-        self.white
-    }
-
-    fn tile(&self, (level, tx, ty): TileId) -> Result<Arc<[u8]>, PyramidError> {
-        let l = &self.layout;
-        let (across, down) = l.tiles(level.min(l.levels() - 1));
-        if level >= l.levels() || tx >= across || ty >= down {
-            return Err(PyramidError::new(
-                &self.path,
-                format!("internal: tile ({level}, {tx}, {ty}) does not exist"),
-            ));
-        }
-        let index = l.tile_index(level, tx, ty);
+    fn tile(&self, id: TileId) -> Result<Arc<[u8]>, PyramidError> {
+        let l = &self.header.layout;
+        let index = l
+            .existing_tile_index(id)
+            .ok_or_else(|| PyramidError::missing_tile(&self.path, id, "does not exist"))?;
         let mut bytes = vec![0u8; l.tile_bytes()];
         self.file
             .read_exact_at(&mut bytes, l.tile_offset(index))
@@ -126,7 +133,8 @@ impl TileSource for TiledPyramid {
             return Err(PyramidError::new(
                 &self.path,
                 format!(
-                    "tile {index} (level {level}) is damaged: its hash does not match the index"
+                    "tile {index} (level {}) is damaged: its hash does not match the index",
+                    id.0
                 ),
             ));
         }

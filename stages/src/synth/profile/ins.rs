@@ -34,21 +34,15 @@ impl InsParams {
 
     /// Add the orientation errors to the recorded yaw, pitch, roll and heading; returns the README lines.
     pub fn apply(&self, on: &Draw<'_>, out: &mut Tables) -> Vec<String> {
-        let Draw {
-            seed,
-            truth,
-            routes,
-        } = *on;
         let mut notes = Vec::new();
-        for (route, members) in routes.members.iter().enumerate() {
-            let bias = self.bias_deg(seed, route);
-            let mut walk = Stream::new(&[seed, hash_str("ins-walk"), route as u64]);
+        for (route, members) in on.routes.members.iter().enumerate() {
+            let bias = self.bias_deg(on.seed, route);
+            let mut walk = on.route_stream("ins-walk", route);
             let mut wander = 0.0;
             let mut largest: f64 = 0.0;
             for &i in members {
-                let t = &truth.recordings[i];
                 wander += self.heading_walk_step_deg * walk.normal();
-                let mut n = Stream::new(&[seed, hash_str("ins-noise"), hash_str(&t.image_id)]);
+                let mut n = on.recording_stream("ins-noise", &on.truth.recordings[i].image_id);
                 let r = &mut out.recordings[i];
                 let dyaw = bias + wander;
                 r.yaw_deg += dyaw;

@@ -73,20 +73,16 @@ impl OutageParams {
 
     /// Add the outage errors to the recorded positions; returns the README lines.
     pub fn apply(&self, on: &Draw<'_>, out: &mut Tables) -> Vec<String> {
-        let Draw {
-            seed,
-            truth,
-            routes,
-        } = *on;
+        let routes = on.routes;
         let mut notes = Vec::new();
         for (route, members) in routes.members.iter().enumerate() {
-            let o = self.draw(seed, route, routes.length_m[route]);
-            let mut walk = Stream::new(&[seed, hash_str("outage-walk"), route as u64]);
+            let o = self.draw(on.seed, route, routes.length_m[route]);
+            let mut walk = on.route_stream("outage-walk", route);
             let (mut wx, mut wy) = (0.0, 0.0);
             let mut inside = Vec::new();
             for &i in members {
-                let t = &truth.recordings[i];
-                let mut fix = Stream::new(&[seed, hash_str("outage-fix"), hash_str(&t.image_id)]);
+                let t = &on.truth.recordings[i];
+                let mut fix = on.recording_stream("outage-fix", &t.image_id);
                 let (mut dx, mut dy) = (
                     self.fix_sigma_m * fix.normal(),
                     self.fix_sigma_m * fix.normal(),

@@ -6,6 +6,7 @@
 
 use super::Tables;
 use crate::campaign::Recording;
+use crate::synth::rng::{hash_str, Stream};
 
 /// A new route starts where consecutive recordings (in time order) are more than this apart in time, s.
 pub const ROUTE_TIME_GAP_S: f64 = 60.0;
@@ -19,6 +20,18 @@ pub struct Draw<'a> {
     pub seed: u64,
     pub truth: &'a Tables,
     pub routes: &'a Routes,
+}
+
+impl Draw<'_> {
+    /// The random stream of error component `what` on route `route` (the same for the same seed).
+    pub fn route_stream(&self, what: &str, route: usize) -> Stream {
+        Stream::new(&[self.seed, hash_str(what), route as u64])
+    }
+
+    /// The random stream of error component `what` for the recording `image_id`.
+    pub fn recording_stream(&self, what: &str, image_id: &str) -> Stream {
+        Stream::new(&[self.seed, hash_str(what), hash_str(image_id)])
+    }
 }
 
 /// Where each recording lies on its route (indices refer to the table as given, not to time order).

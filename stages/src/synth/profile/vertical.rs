@@ -28,24 +28,15 @@ crate::params! {
 impl VerticalParams {
     /// Add the height and camera-height errors; returns the README lines.
     pub fn apply(&self, on: &Draw<'_>, out: &mut Tables) -> Vec<String> {
-        let Draw {
-            seed,
-            truth,
-            routes,
-        } = *on;
         let mut notes = Vec::new();
         let camera_bias = signed_draw(
-            &mut Stream::new(&[seed, hash_str("camera-height-bias")]),
+            &mut Stream::new(&[on.seed, hash_str("camera-height-bias")]),
             self.camera_height_bias_m,
         );
-        for (route, members) in routes.members.iter().enumerate() {
-            let z_bias = signed_draw(
-                &mut Stream::new(&[seed, hash_str("z-bias"), route as u64]),
-                self.z_bias_m,
-            );
+        for (route, members) in on.routes.members.iter().enumerate() {
+            let z_bias = signed_draw(&mut on.route_stream("z-bias", route), self.z_bias_m);
             for &i in members {
-                let t = &truth.recordings[i];
-                let mut n = Stream::new(&[seed, hash_str("vertical-noise"), hash_str(&t.image_id)]);
+                let mut n = on.recording_stream("vertical-noise", &on.truth.recordings[i].image_id);
                 let r = &mut out.recordings[i];
                 r.z += z_bias + self.z_sigma_m * n.normal();
                 r.camera_height_m += camera_bias + self.camera_height_sigma_m * n.normal();

@@ -263,16 +263,7 @@ impl StreetMarkings {
                 // approach towards +s ends at b: arrow, stop line (right lane q < 0), zebra
                 let z1 = b - 1.0;
                 let z0 = z1 - 4.0;
-                let n = ((2.0 * (hw - 0.3)) / 1.0).floor() as usize;
-                let q0 = -(n as f64 - 1.0) * 0.5 - 0.25;
-                paints.push(Paint::Zebra {
-                    s0: z0,
-                    s1: z1,
-                    q0,
-                    n_stripes: n,
-                    stripe: 0.5,
-                    period: 1.0,
-                });
+                paints.push(zebra_crossing(z0, z1, hw));
                 let st1 = z0 - 1.5;
                 let st0 = st1 - 0.3;
                 paints.push(Paint::Rect {
@@ -293,16 +284,7 @@ impl StreetMarkings {
             if inp.paint && a_j && b - a > 25.0 {
                 let z0 = a + 1.0;
                 let z1 = z0 + 4.0;
-                let n = ((2.0 * (hw - 0.3)) / 1.0).floor() as usize;
-                let q0 = -(n as f64 - 1.0) * 0.5 - 0.25;
-                paints.push(Paint::Zebra {
-                    s0: z0,
-                    s1: z1,
-                    q0,
-                    n_stripes: n,
-                    stripe: 0.5,
-                    period: 1.0,
-                });
+                paints.push(zebra_crossing(z0, z1, hw));
                 let st0 = z1 + 1.5;
                 let st1 = st0 + 0.3;
                 paints.push(Paint::Rect {
@@ -428,6 +410,20 @@ impl StreetMarkings {
             out.push(("manhole_centre", self.axis.to_xy(s, q)));
         }
         out
+    }
+}
+
+/// A zebra crossing from `s0` to `s1` along the street across a carriageway of half width `hw`: 0.5 m stripes
+/// every metre, centred on the axis, 0.3 m clear of each kerb.
+fn zebra_crossing(s0: f64, s1: f64, hw: f64) -> Paint {
+    let n = ((2.0 * (hw - 0.3)) / 1.0).floor() as usize;
+    Paint::Zebra {
+        s0,
+        s1,
+        q0: -(n as f64 - 1.0) * 0.5 - 0.25,
+        n_stripes: n,
+        stripe: 0.5,
+        period: 1.0,
     }
 }
 

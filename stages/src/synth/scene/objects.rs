@@ -112,14 +112,7 @@ impl Object {
                 Aabb::new(centre - Vector3::repeat(r), centre + Vector3::repeat(r))
             }
         };
-        Self {
-            shape,
-            bounds,
-            material,
-            epochs,
-            children_end: 0,
-            is_child: false,
-        }
+        Self::with_bounds(shape, bounds, material, epochs)
     }
 
     pub fn with_bounds(shape: Shape, bounds: Aabb, material: Material, epochs: u8) -> Self {
