@@ -161,11 +161,11 @@ pub fn add_nadir(
         )?;
         windows.push(window);
         if let Some(route) = photo_route.as_mut() {
-            control.extend(route.add_recording(
-                b,
-                (item.recording, item.row, item.pano_image),
-                window,
-            )?);
+            let handles: Vec<_> = members
+                .iter()
+                .map(|m| (m.recording, m.row, m.pano_image))
+                .collect();
+            control.extend(route.add_recording(b, &handles, window)?);
         }
         if !on(stage::ORTHO_AERIAL) {
             continue;
