@@ -22,6 +22,10 @@ pub const BUILT_IN: &[(&str, &str)] = &[
         include_str!("../../workflows/oblique-sweep.toml"),
     ),
     ("oblique.toml", include_str!("../../workflows/oblique.toml")),
+    (
+        "orthophoto.toml",
+        include_str!("../../workflows/orthophoto.toml"),
+    ),
     ("paper.toml", include_str!("../../workflows/paper.toml")),
     ("tiny.toml", include_str!("../../workflows/tiny.toml")),
 ];

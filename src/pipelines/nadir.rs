@@ -178,11 +178,13 @@ pub fn add_nadir(
         )?;
         chain.windows.push(window);
         if let Some(route) = photo_route.as_mut() {
-            chain.control.extend(route.add_recording(
-                b,
-                (item.recording, item.row, item.pano_image),
-                window,
-            )?);
+            let handles: Vec<_> = members
+                .iter()
+                .map(|m| (m.recording, m.row, m.pano_image))
+                .collect();
+            chain
+                .control
+                .extend(route.add_recording(b, &handles, window)?);
         }
         if !cx.on(stage::ORTHO_AERIAL) {
             continue;

@@ -85,18 +85,22 @@ impl<'a> OrthophotoRoute<'a> {
         }))
     }
 
-    /// The route for one recording whose MM matching window is `window`; its control points, or `None` when
-    /// no orthophoto tile covers the recording.
+    /// The route for the detecting recording of the MM matching window `window`, whose members (the
+    /// recording, then its neighbours in the window's order) are given as (row, its handle, its panorama);
+    /// its control points, or `None` when no orthophoto tile covers the recording. The neighbours' orthos for
+    /// the same tile feed the parallax check of the refinement (the same nodes as their own routes').
     pub fn add_recording(
         &mut self,
         b: &mut DagBuilder,
-        (r, row, pano_image): (&Recording, Handle<Recording>, Handle<IngestedImage>),
+        members: &[(&Recording, Handle<Recording>, Handle<IngestedImage>)],
         window: Handle<MmWindowMatch>,
     ) -> Result<Option<Handle<RecordingControl>>, PipelineError> {
-        let foot = [r.x, r.y];
+        let Some(&(r, _, _)) = members.first() else {
+            return Ok(None);
+        };
         let Some(k) = self
             .source
-            .tile_at(foot[0], foot[1], self.params.max_offset_m)
+            .tile_at(r.x, r.y, self.params.transform.max_localisation_error_m)
         else {
             return Ok(None);
         };
@@ -124,8 +128,12 @@ impl<'a> OrthophotoRoute<'a> {
             rotation_deg: 0.0,
             ..self.ortho_base.clone()
         };
+        let mut orthos = Vec::with_capacity(members.len());
+        for &(m, row, pano) in members {
+            let label = format!("rec {} × {}", m.image_id, tile.file);
+            orthos.push(b.add(OrthoProject, &label, ortho_params.clone(), (row, pano))?);
+        }
         let label = format!("rec {} × {}", r.image_id, tile.file);
-        let ortho = b.add(OrthoProject, &label, ortho_params, (row, pano_image))?;
         let params = OrthophotoNodeParams {
             route: self.params.clone(),
             tile: tile.clone(),
@@ -133,7 +141,8 @@ impl<'a> OrthophotoRoute<'a> {
             dtm_sigma_m: self.dtm.map_or(DEFAULT_DTM_SIGMA_M, |d| d.1),
         };
         let dtm: Vec<Handle<Dtm>> = self.dtm.iter().map(|d| d.0).collect();
-        let result = b.add(OrthophotoStage, &label, params, (window, ortho, image, dtm))?;
+        let inputs = (window, orthos[0], image, dtm, orthos[1..].to_vec());
+        let result = b.add(OrthophotoStage, &label, params, inputs)?;
         self.results.push(result);
         Ok(Some(b.add(
             OrthophotoPoints,

@@ -1,5 +1,6 @@
 //! `orthophoto`: the orthophoto route of one recording (`skytie_stages::orthophoto`): its north-up ground ortho
-//! registered to the orthophoto tile around it, its tie points located there, and control points with XY from
+//! registered to the orthophoto tile around it, its tie points located there (each template first compared with
+//! the window's neighbouring recordings' north-up orthos, the parallax check), and control points with XY from
 //! the orthophoto and Z from the DTM (or the MM ground, flagged).
 
 use crate::dag::{Handle, NodeCtx, Stage, StageError};
@@ -8,6 +9,7 @@ use crate::nodes::campaign::ingest::IngestedImage;
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::orthophoto::RasterFile;
+use skytie_stages::nadir::refine::NeighbourOrtho;
 use skytie_stages::nadir::{MmWindowMatch, OrthoImage};
 use skytie_stages::orthophoto::{
     orthophoto_control, Dtm, OrthophotoControl, OrthophotoInput, OrthophotoParams,
@@ -39,16 +41,18 @@ pub struct OrthophotoStage;
 
 impl Stage for OrthophotoStage {
     crate::nodes::stage_types!(skytie_stages::orthophoto::STAGE, OrthophotoNodeParams => OrthophotoControl,
-        inputs: (Handle<MmWindowMatch>, Handle<OrthoImage>, Handle<IngestedImage>, Vec<Handle<Dtm>>));
+        inputs: (Handle<MmWindowMatch>, Handle<OrthoImage>, Handle<IngestedImage>, Vec<Handle<Dtm>>,
+            Vec<Handle<OrthoImage>>));
 
     fn run(
         &self,
         p: &OrthophotoNodeParams,
-        (window, ortho, photo, dtm): (
+        (window, ortho, photo, dtm, neighbour_orthos): (
             Arc<MmWindowMatch>,
             Arc<OrthoImage>,
             Arc<IngestedImage>,
             Vec<Arc<Dtm>>,
+            Vec<Arc<OrthoImage>>,
         ),
         _: &NodeCtx,
     ) -> Result<OrthophotoControl, StageError> {
@@ -59,7 +63,17 @@ impl Stage for OrthophotoStage {
             sigma_m: p.sigma_m,
             dtm: dtm.first().map(|d| (d.as_ref(), p.dtm_sigma_m)),
         };
-        orthophoto_control(&ortho, &window, &input, &p.route)
+        // The neighbours' orthos come in the window's neighbour order (`window.pairs`).
+        let neighbours: Vec<NeighbourOrtho> = window
+            .pairs
+            .iter()
+            .zip(&neighbour_orthos)
+            .map(|(pair, o)| NeighbourOrtho {
+                recording_id: &pair.to_id,
+                ortho: o,
+            })
+            .collect();
+        orthophoto_control(&ortho, &window, &neighbours, &input, &p.route)
             .map_err(|e| StageError::new(format!("orthophoto {}: {e}", p.tile.file)))
     }
 }

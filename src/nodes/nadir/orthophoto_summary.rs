@@ -12,7 +12,7 @@ crate::serde_artifact!(OrthophotoSummary);
 pub struct SummarizeOrthophoto;
 
 impl Stage for SummarizeOrthophoto {
-    crate::nodes::stage_types!(named "orthophoto_summary" version "1", SummaryParams => OrthophotoSummary,
+    crate::nodes::stage_types!(named "orthophoto_summary" version "2", SummaryParams => OrthophotoSummary,
         inputs: Vec<Optional<OrthophotoControl>>);
 
     fn run(

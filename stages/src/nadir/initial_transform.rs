@@ -218,7 +218,7 @@ fn wrap_deg(a: f64) -> f64 {
 
 /// A copy of the ortho image with masked pixels replaced by the mean of the valid ones (so the Wallis filter and
 /// the detector see no artificial edge at the mask border).
-fn fill_masked(ortho: &OrthoImage) -> GrayImage {
+pub(crate) fn fill_masked(ortho: &OrthoImage) -> GrayImage {
     let mut img = ortho.image.clone();
     let (mut sum, mut n) = (0.0f64, 0usize);
     for (&g, &ok) in img.data.iter().zip(&ortho.valid) {
@@ -237,7 +237,14 @@ fn fill_masked(ortho: &OrthoImage) -> GrayImage {
 }
 
 /// True if a masked pixel (valid = 0) lies within `radius_px` of the continuous pixel (u, v).
-fn near_mask(valid: &[u8], width: usize, height: usize, u: f64, v: f64, radius_px: f64) -> bool {
+pub(crate) fn near_mask(
+    valid: &[u8],
+    width: usize,
+    height: usize,
+    u: f64,
+    v: f64,
+    radius_px: f64,
+) -> bool {
     if width == 0 || height == 0 {
         return false;
     }
@@ -264,7 +271,7 @@ fn near_mask(valid: &[u8], width: usize, height: usize, u: f64, v: f64, radius_p
 }
 
 /// The KAZE features of the Wallis-filtered image with threshold `threshold`; `Err` names what failed.
-fn wallis_kaze(
+pub(crate) fn wallis_kaze(
     img: &GrayImage,
     p: &TransformParams,
     threshold: f32,

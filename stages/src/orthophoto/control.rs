@@ -5,7 +5,8 @@
 //! panoramas (flagged [`HeightSource::MmGround`] and counted). Its covariance is diagonal: σ_xy² = (stated
 //! orthophoto accuracy)² + (`match_sigma_px` · working pixel size)², σ_z = the DTM's stated accuracy or
 //! `mm_height_sigma_m`. The whole route of one recording — initial transform ([`super::register`]),
-//! refinement (`nadir::refine`), control points — is [`orthophoto_control`].
+//! refinement with the parallax check against the window's neighbours (`nadir::refine`), control points — is
+//! [`orthophoto_control`].
 
 use super::dtm::Dtm;
 use super::register::register_translation;
@@ -14,7 +15,7 @@ use crate::campaign::orthophoto::RasterFile;
 use crate::campaign::AerialKind;
 use crate::correspondence::{AerialControlPoint, HeightSource, MapControl};
 use crate::imaging::pyramid::{PyramidError, TileSource};
-use crate::nadir::refine::refine_in_image;
+use crate::nadir::refine::{refine_in_image, NeighbourOrtho};
 use crate::nadir::{
     AerialRefinement, MmWindowMatch, OrthoImage, RecordingControl, TransformOutcome,
 };
@@ -46,10 +47,14 @@ pub struct OrthophotoInput<'a> {
 }
 
 /// The orthophoto route for the recording of `window`, whose ground ortho `ortho` was made north-up at the
-/// orthophoto's working resolution. `Err` only when the orthophoto cannot be read.
+/// orthophoto's working resolution; `neighbours` are the window's other recordings' orthos made the same way,
+/// for the refinement's parallax check (`nadir::parallax_check`: a template whose structure a neighbour sees
+/// differently shows content at another height than its corner, a kerb, and is not located). `Err` only when
+/// the orthophoto cannot be read.
 pub fn orthophoto_control(
     ortho: &OrthoImage,
     window: &MmWindowMatch,
+    neighbours: &[NeighbourOrtho],
     photo: &OrthophotoInput,
     p: &OrthophotoParams,
 ) -> Result<OrthophotoControl, PyramidError> {
@@ -78,15 +83,13 @@ pub fn orthophoto_control(
     let TransformOutcome::Accepted(t) = &transform else {
         return Ok(out);
     };
-    // No neighbouring orthos: the orthophoto shows the ground orthographically, there is no oblique view of
-    // raised structure to compare with.
     out.refinement = refine_in_image(
         ortho,
         photo.pixels,
         (file, AerialKind::Nadir),
         t,
         window,
-        &[],
+        neighbours,
         &p.refine,
     )?;
     let sigma_xy_m = photo.sigma_m.hypot(p.match_sigma_px * ortho.georef.gsd_m);

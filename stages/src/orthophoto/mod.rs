@@ -17,23 +17,22 @@ pub use dtm::{Dtm, DtmTile};
 pub use register::{nominal_transform, register_translation};
 pub use summary::OrthophotoSummary;
 
+use crate::nadir::initial_transform::TransformParams;
 use crate::nadir::refine::RefineParams;
 use crate::params::StageId;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("orthophoto", "1");
+pub const STAGE: StageId = StageId::new("orthophoto", "2");
 
 crate::params! {
     /// Parameters of the orthophoto route (registration, refinement and control points).
     pub struct OrthophotoParams {
-        /// The largest offset of a recorded position from the orthophoto that the registration searches
-        /// (the expected maximum localisation error, thesis 3.4.5.1).
-        max_offset_m: f64 = 3.0, unit "m", min 0.1, max 50.0;
-        /// Side of the ortho's central square (the road around the vehicle) registered to the orthophoto.
-        road_template_m: f64 = 12.0, unit "m", min 2.0, max 100.0;
-        /// A coarse registration whose correlation peak is below this is rejected.
-        min_peak: f64 = 0.05, min 0.0, max 1.0;
+        /// The initial transform of a recording's ground ortho into the orthophoto (thesis 3.4.5.2 in
+        /// translation mode, [`register`]): the keys and defaults of `[transform]`. `max_localisation_error_m`
+        /// bounds the offset searched; `estimate_shape`, `seed` and `max_offset_disagreement_m` do not apply
+        /// (one north-up orthophoto at a known scale: the translation alone).
+        transform: TransformParams = TransformParams::default(), section;
         /// Precision of a located tie point in the orthophoto at the working resolution, added to the stated
         /// accuracy of the orthophoto for the control point's planimetric σ.
         match_sigma_px: f64 = 0.3, unit "px", min 0.0, max 10.0;

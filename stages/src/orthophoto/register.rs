@@ -1,22 +1,25 @@
 //! The initial transform of a panorama's ground ortho into the orthophoto (the orthophoto's counterpart of
-//! thesis 3.4.5.2). An orthophoto is north-up with a known pixel size, so the ortho is made north-up at the
-//! orthophoto's resolution and the two differ by a translation only — the recording's position error. It is
-//! found by phase correlation of the ortho's centre — the road around the vehicle, `road_template_m` wide,
-//! without the façades that the ortho-projection smears across the ground (the vehicle's masked pixels set to
-//! the mean) — against the orthophoto sampled on the ortho grid, grown on every side by the largest offset
-//! searched; both Wallis-filtered first. A peak below
-//! `min_peak` or an offset beyond `max_offset_m` rejects the recording, with the reason.
+//! thesis 3.4.5.2). An orthophoto is north-up with a known pixel size, and the ortho is made north-up at the
+//! orthophoto's working resolution, so the two differ by a translation only: the recording's position error
+//! (plus the orthophoto's own error there). It is found like a frame's in translation mode
+//! (`nadir::initial_transform`): both images Wallis-filtered; KAZE keypoints in each (the ortho's vehicle pixels
+//! filled with the mean of the valid ones, its keypoints next to the mask left out); every ortho keypoint
+//! matched by descriptor to the orthophoto keypoints within ± `max_localisation_error_m` of where the recorded
+//! position puts it; the translation that most matches agree on within `ransac_threshold_px`
+//! (`nadir::translation_consensus`), kept when it has at least `min_inliers`, beats the best competing
+//! translation by `min_consensus_margin` and is not what chance gives (`max_false_alarms`, a-contrario). Its
+//! offset must lie within `max_localisation_error_m`. Every failure rejects the recording, with its reason.
 
 use super::OrthophotoParams;
-use crate::geometry::Similarity2;
+use crate::geometry::{PointPair, Similarity2};
 use crate::imaging::georef::GeoTransform;
 use crate::imaging::pyramid::{PyramidError, TileSource};
-use crate::imaging::wallis::{wallis_filter, WallisParams};
-use crate::imaging::GrayImage;
-use crate::matching::phase_correlation::{locate_template, PhaseCorrelationParams};
+use crate::matching::descriptor_match::match_windowed;
 use crate::nadir::aerial_patch::AerialWindow;
-use crate::nadir::refine::sample_aerial_on_ortho_grid;
+use crate::nadir::initial_transform::{fill_masked, near_mask, wallis_kaze, TransformParams};
+use crate::nadir::translation_consensus::{false_alarms, translation_consensus};
 use crate::nadir::{InitialTransform, OrthoGeoref, OrthoImage, TransformOutcome};
+use nalgebra::Vector2;
 
 /// Ortho pixel → full orthophoto pixel for the ortho's recorded placement.
 pub fn nominal_transform(georef: &OrthoGeoref, photo: &GeoTransform) -> Similarity2 {
@@ -27,44 +30,19 @@ pub fn nominal_transform(georef: &OrthoGeoref, photo: &GeoTransform) -> Similari
     Similarity2::from_ab(u1 - u0, v1 - v0, u0, v0)
 }
 
-/// The central `side × side` pixels of the ortho (the road around the vehicle), masked pixels set to the mean
-/// of the valid ones, Wallis-filtered like the search window; and the crop's top-left ortho pixel.
-fn road_template(ortho: &OrthoImage, side: usize) -> (GrayImage, (usize, usize)) {
-    let filled = filled_template(ortho);
-    let (w, h) = (filled.width, filled.height);
-    let (cw, ch) = (side.min(w), side.min(h));
-    let (x0, y0) = ((w - cw) / 2, (h - ch) / 2);
-    let mut crop = GrayImage::filled(cw, ch, 0.0);
-    for r in 0..ch {
-        let start = (y0 + r) * w + x0;
-        crop.data[r * cw..(r + 1) * cw].copy_from_slice(&filled.data[start..start + cw]);
-    }
-    (wallis_or_same(crop), (x0, y0))
+/// Why a registration was rejected, with the matches and inliers it had got to by then.
+struct Rejection {
+    reason: String,
+    matches: usize,
+    inliers: usize,
 }
 
-/// The image Wallis-filtered (thesis 3.4.5.2 equalises MM and aerial contrast so), or unchanged if it cannot be.
-fn wallis_or_same(img: GrayImage) -> GrayImage {
-    wallis_filter(&img, &WallisParams::default()).unwrap_or(img)
-}
-
-/// The ortho's grey values with masked pixels set to the mean of the valid ones.
-fn filled_template(ortho: &OrthoImage) -> GrayImage {
-    let valid: Vec<f32> = ortho
-        .image
-        .data
-        .iter()
-        .zip(&ortho.valid)
-        .filter(|(_, &ok)| ok != 0)
-        .map(|(&g, _)| g)
-        .collect();
-    let mean = valid.iter().map(|&g| f64::from(g)).sum::<f64>() / valid.len().max(1) as f64;
-    let mut img = ortho.image.clone();
-    for (g, &ok) in img.data.iter_mut().zip(&ortho.valid) {
-        if ok == 0 {
-            *g = mean as f32;
-        }
+fn rejected(reason: impl Into<String>, matches: usize, inliers: usize) -> Rejection {
+    Rejection {
+        reason: reason.into(),
+        matches,
+        inliers,
     }
-    img
 }
 
 /// Register `ortho` (recording `recording_id`) in the orthophoto tile `photo` (id `photo_id`, placed by
@@ -77,76 +55,218 @@ pub fn register_translation(
     photo_transform: &GeoTransform,
     p: &OrthophotoParams,
 ) -> Result<TransformOutcome, PyramidError> {
-    let reject = |reason: String| TransformOutcome::Rejected {
-        recording_id: recording_id.to_string(),
-        aerial_id: photo_id.to_string(),
-        reason,
-        matches: 0,
-        inliers: 0,
-    };
     let nominal = nominal_transform(&ortho.georef, photo_transform);
-    let gsd_m = ortho.georef.gsd_m;
-    let m = (p.max_offset_m / gsd_m).ceil() as usize;
+    let t = &p.transform;
+    let margin_px = t.max_localisation_error_m / ortho.georef.gsd_m + 4.0;
+    let size = (ortho.image.width, ortho.image.height);
+    let found = match AerialWindow::read(photo, size, &nominal, margin_px)? {
+        Some(win) => find_translation(ortho, &win, &nominal, photo_transform, t),
+        None => Err(rejected(
+            "the orthophoto does not cover the recording",
+            0,
+            0,
+        )),
+    };
+    Ok(match found {
+        Ok((ortho_to_aerial, matches, inliers, offset)) => {
+            TransformOutcome::Accepted(InitialTransform {
+                recording_id: recording_id.to_string(),
+                aerial_id: photo_id.to_string(),
+                ortho_to_aerial,
+                matches,
+                inliers,
+                centre_offset_m: offset[0].hypot(offset[1]),
+                centre_offset_world_m: offset,
+                reused_from: None,
+            })
+        }
+        Err(r) => TransformOutcome::Rejected {
+            recording_id: recording_id.to_string(),
+            aerial_id: photo_id.to_string(),
+            reason: r.reason,
+            matches: r.matches,
+            inliers: r.inliers,
+        },
+    })
+}
+
+/// The translation of the module documentation in the orthophoto window `win`: the transform ortho px → full
+/// orthophoto px, the matches, the inliers and the offset (east, north) of the recording, m.
+fn find_translation(
+    ortho: &OrthoImage,
+    win: &AerialWindow,
+    nominal: &Similarity2,
+    photo_transform: &GeoTransform,
+    t: &TransformParams,
+) -> Result<(Similarity2, usize, usize, [f64; 2]), Rejection> {
+    let scale = win.window.scale();
+    // The matching window, in pixels of the orthophoto level the ortho meets (≈ ortho pixels).
+    let window_px = t.max_localisation_error_m / (photo_transform.pixel_m * scale);
+    let pairs = matched_keypoints(ortho, win, t, window_px)?;
+    let n_matches = pairs.len();
+    let threshold_px = t.ransac_threshold_px * scale;
+    let c = translation_consensus(&pairs, nominal, threshold_px).ok_or_else(|| {
+        rejected(
+            format!("{n_matches} matches, no translation consensus"),
+            n_matches,
+            0,
+        )
+    })?;
+    let n = c.inliers.len();
+    if n < t.min_inliers {
+        return Err(rejected(
+            format!(
+                "{n_matches} matches, a consensus of {n} inliers < {}",
+                t.min_inliers
+            ),
+            n_matches,
+            n,
+        ));
+    }
+    if (n as f64) < t.min_consensus_margin * c.runner_up as f64 {
+        return Err(rejected(
+            format!(
+                "{n_matches} matches: ambiguous translation ({n} inliers, a competing one has {})",
+                c.runner_up
+            ),
+            n_matches,
+            n,
+        ));
+    }
+    let nfa = false_alarms(n_matches, n, t.ransac_threshold_px, window_px);
+    if nfa > t.max_false_alarms {
+        return Err(rejected(
+            format!(
+                "{n_matches} matches: a consensus of {n} is what chance gives (expected {nfa:.2} among \
+                 random matches > {})",
+                t.max_false_alarms
+            ),
+            n_matches,
+            n,
+        ));
+    }
+    // The ortho centre's shift in full orthophoto pixels, on the ground (north-up: v grows southwards).
+    let centre = Vector2::new(ortho.image.width as f64, ortho.image.height as f64) / 2.0;
+    let d = c.model.apply(&centre) - nominal.apply(&centre);
+    let offset = [
+        d.x * photo_transform.pixel_m,
+        -d.y * photo_transform.pixel_m,
+    ];
+    let offset_m = offset[0].hypot(offset[1]);
+    if !(offset_m <= t.max_localisation_error_m) {
+        return Err(rejected(
+            format!(
+                "centre offset {offset_m:.2} m > {} m",
+                t.max_localisation_error_m
+            ),
+            n_matches,
+            n,
+        ));
+    }
+    Ok((c.model, n_matches, n, offset))
+}
+
+/// KAZE keypoints of the Wallis-filtered ortho (off the vehicle mask) matched to those of the orthophoto
+/// window within ± `window_px` of their nominal place, as (ortho px, full orthophoto px) pairs; fewer than
+/// `min_inliers` is a rejection.
+fn matched_keypoints(
+    ortho: &OrthoImage,
+    win: &AerialWindow,
+    t: &TransformParams,
+    window_px: f64,
+) -> Result<Vec<PointPair>, Rejection> {
     let (w, h) = (ortho.image.width, ortho.image.height);
-    let Some(win) = AerialWindow::read(photo, (w, h), &nominal, m as f64 + 4.0)? else {
-        return Ok(reject("the orthophoto does not cover the recording".into()));
-    };
-    let mut search = GrayImage::filled(0, 0, 0.0);
-    let (mf, wf, hf) = (m as f64, w as f64, h as f64);
-    if !sample_aerial_on_ortho_grid(
+    if ortho.valid.len() != w * h {
+        return Err(rejected(
+            format!(
+                "the ortho image is inconsistent: {w}×{h} px, {} mask values",
+                ortho.valid.len()
+            ),
+            0,
+            0,
+        ));
+    }
+    let mm = wallis_kaze(
+        &fill_masked(ortho),
+        t,
+        t.kaze_threshold_mm,
+        "MM ortho image",
+    )
+    .map_err(|e| rejected(e, 0, 0))?;
+    let photo = wallis_kaze(
         &win.window.image,
-        &win.ortho_to_window,
-        -mf,
-        -mf,
-        w + 2 * m,
-        h + 2 * m,
-        &mut search,
-    ) {
-        return Ok(reject(format!(
-            "the orthophoto ends within {} m of the recording's ground ortho",
-            p.max_offset_m
-        )));
+        t,
+        t.kaze_threshold_aerial,
+        "orthophoto window",
+    )
+    .map_err(|e| rejected(e, 0, 0))?;
+    if mm.is_empty() || photo.is_empty() {
+        return Err(rejected(
+            format!(
+                "no KAZE keypoints in the {} (thresholds {} / {})",
+                if mm.is_empty() {
+                    "MM ortho image"
+                } else {
+                    "orthophoto window"
+                },
+                t.kaze_threshold_mm,
+                t.kaze_threshold_aerial
+            ),
+            0,
+            0,
+        ));
     }
-    let side = (p.road_template_m / gsd_m).round().max(8.0) as usize;
-    let (template, (x0, y0)) = road_template(ortho, side);
-    let search = wallis_or_same(search);
-    let Ok(loc) = locate_template(&template, &search, &PhaseCorrelationParams::default()) else {
-        return Ok(reject("phase correlation failed".into()));
-    };
-    // The template's centre is at ortho pixel (x0 + tw/2, y0 + th/2), i.e. search pixel m + that.
-    let (tw, th) = (template.width as f64, template.height as f64);
-    let dx = loc.u_px - (mf + x0 as f64 + tw / 2.0);
-    let dy = loc.v_px - (mf + y0 as f64 + th / 2.0);
-    let offset_m = dx.hypot(dy) * gsd_m;
-    if !(offset_m <= p.max_offset_m) {
-        return Ok(reject(format!(
-            "offset {offset_m:.2} m > max_offset_m {} m",
-            p.max_offset_m
-        )));
+    let len = mm.descriptor_len;
+    let (mut query, mut predicted, mut query_px) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, k) in mm.keypoints.iter().enumerate() {
+        let (u, v) = (f64::from(k.u_px), f64::from(k.v_px));
+        if near_mask(&ortho.valid, w, h, u, v, t.mask_clearance_px) {
+            continue;
+        }
+        let p = win.ortho_to_window.apply(&Vector2::new(u, v));
+        query.extend_from_slice(mm.descriptor(i));
+        predicted.push([p.x, p.y]);
+        query_px.push((u, v));
     }
-    if !(loc.peak >= p.min_peak) {
-        return Ok(reject(format!(
-            "correlation peak {:.3} < min_peak {}",
-            loc.peak, p.min_peak
-        )));
+    let train_px: Vec<[f64; 2]> = photo
+        .keypoints
+        .iter()
+        .map(|k| [f64::from(k.u_px), f64::from(k.v_px)])
+        .collect();
+    let matched = match_windowed(
+        &query,
+        &predicted,
+        &photo.descriptors,
+        &train_px,
+        len,
+        window_px,
+        t.match_ratio,
+    )
+    .map_err(|e| rejected(format!("descriptor matching failed: {e}"), 0, 0))?;
+    let pairs: Vec<PointPair> = matched
+        .iter()
+        .flatten()
+        .map(|m| {
+            let (u, v) = query_px[m.query];
+            let (pu, pv) = win
+                .window
+                .to_full(train_px[m.train][0], train_px[m.train][1]);
+            PointPair::new(u, v, pu, pv)
+        })
+        .collect();
+    if pairs.len() < t.min_inliers {
+        return Err(rejected(
+            format!(
+                "{} descriptor matches in the ±{window_px:.1} px windows < {} required ({} MM, {} orthophoto \
+                 keypoints)",
+                pairs.len(),
+                t.min_inliers,
+                predicted.len(),
+                photo.len()
+            ),
+            pairs.len(),
+            0,
+        ));
     }
-    let (a, b) = nominal.ab();
-    let tf = Similarity2::from_ab(
-        a,
-        b,
-        nominal.tx + a * dx - b * dy,
-        nominal.ty + b * dx + a * dy,
-    );
-    let c0 = ortho.georef.pixel_to_world(wf / 2.0, hf / 2.0);
-    let c1 = ortho.georef.pixel_to_world(wf / 2.0 + dx, hf / 2.0 + dy);
-    Ok(TransformOutcome::Accepted(InitialTransform {
-        recording_id: recording_id.to_string(),
-        aerial_id: photo_id.to_string(),
-        ortho_to_aerial: tf,
-        matches: 0,
-        inliers: 0,
-        centre_offset_m: offset_m,
-        centre_offset_world_m: [c1.x - c0.x, c1.y - c0.y],
-        reused_from: None,
-    }))
+    Ok(pairs)
 }

@@ -14,7 +14,8 @@ pub struct OrthophotoSummary {
     /// Recordings whose `orthophoto` node failed (counted by the engine too).
     pub failed: usize,
     pub registered: usize,
-    /// Rejected registrations by reason (the numbers in a reason stripped, so that equal causes count together).
+    /// Rejected registrations by reason (the words with numbers in a reason stripped, so that equal causes count
+    /// together).
     pub rejected: BTreeMap<String, usize>,
     /// Median registration offset of the registered recordings, m.
     pub median_offset_m: Option<f64>,
@@ -26,11 +27,12 @@ pub struct OrthophotoSummary {
     pub height_from_mm: usize,
 }
 
-/// The reason without its numbers ("offset 3.2 m > max_offset_m 3 m" → "offset m > max_offset_m m").
+/// The reason without its words that hold numbers ("58 matches, a consensus of 5 inliers < 6" → "matches, a
+/// consensus of inliers <").
 fn reason_kind(reason: &str) -> String {
     reason
         .split_whitespace()
-        .filter(|w| !w.chars().next().is_some_and(|c| c.is_ascii_digit()))
+        .filter(|w| !w.chars().any(|c| c.is_ascii_digit()))
         .collect::<Vec<_>>()
         .join(" ")
 }
