@@ -73,7 +73,7 @@ crate::serde_artifact!(IngestedImage);
 pub struct Ingest;
 
 impl Stage for Ingest {
-    crate::nodes::stage_types!(named "ingest" version "1", IngestParams => IngestedImage, inputs: RawFile);
+    crate::nodes::stage_types!(named "ingest" version "2", IngestParams => IngestedImage, inputs: RawFile);
 
     fn run(&self, p: &IngestParams, file: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         let tmp = ctx.output_dir_tmp()?;

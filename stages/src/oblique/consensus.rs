@@ -21,7 +21,9 @@
 //! per oblique image (the best score when several panoramas matched the point in the same image; the others
 //! are counted). With ≥ 2 oblique images the point is intersected from the oblique rays alone
 //! ([`crate::geometry::aerial_intersection`]); intersections with a too small angle or too large a
-//! reprojection error are rejected (the point is not emitted; counted in [`ConsensusDiagnostics`]).
+//! reprojection error are rejected (the point is not emitted; counted in [`ConsensusDiagnostics`]). An
+//! oblique observation's σ is the image's `sigma_px` in pixels of the pyramid level its patches were made at
+//! (`PatchMatch::level`), so it means the same distance on the façade whatever the frame's pixel count.
 //!
 //! Output order is deterministic: correspondences in input order (sets, then matches), control points by
 //! `point_id`, aerial observations by `image_id`.
@@ -43,7 +45,7 @@ use crate::params::{Params, StageId};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("oblique", "2");
+pub const STAGE: StageId = StageId::new("oblique", "3");
 
 /// What happens to the matches of a set smaller than `min_set_size` (`"keep"` or `"drop"` in a workflow).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -311,6 +313,7 @@ fn control_points(
             })
             .collect();
         let (point_world, covariance_m2) = if aerial.len() >= 2 {
+            // σ in full-resolution pixels: the image's σ in pixels of the level the patches were made at.
             let cams: Vec<(FrameCamera, f64)> = aerial
                 .iter()
                 .map(|o| {
@@ -320,7 +323,8 @@ fn control_points(
                     } else {
                         p.default_oblique_sigma_px
                     };
-                    (FrameCamera::from_aerial(row), sigma)
+                    let level = per_image[o.image_id.as_str()].matched.level.min(30);
+                    (FrameCamera::from_aerial(row), sigma * (1u64 << level) as f64)
                 })
                 .collect();
             let obs: Vec<PixelObservation> = aerial

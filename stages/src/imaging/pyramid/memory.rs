@@ -64,7 +64,7 @@ impl MemoryPyramid {
             .collect();
         // Grey = sample / 65535 whatever the largest value (the image's own 0..1 scale).
         Self {
-            layout,
+            layout: done.layout,
             white: u16::MAX,
             tiles,
         }
