@@ -250,7 +250,7 @@ pub fn aerial_control_points(
         let mm_z = tp.point_world[2];
         let candidates: Vec<Candidate> = list
             .iter()
-            .filter_map(|(row, obs, level)| candidate(row, (obs, *level), mm_z, p))
+            .filter_map(|(row, obs, level)| candidate(row, (*obs, *level), mm_z, p))
             .collect();
         let kept = consistent_subset(candidates, p.k_sigma);
         let (kept, point) = match kept.len() {
