@@ -492,7 +492,11 @@ fn refinement_of(row: &AerialImage, obs: &[(String, (f64, f64))]) -> AerialRefin
 }
 
 /// [`refinement_of`] with the tie points located at pyramid level `level`.
-fn refinement_at(row: &AerialImage, obs: &[(String, (f64, f64))], level: usize) -> AerialRefinement {
+fn refinement_at(
+    row: &AerialImage,
+    obs: &[(String, (f64, f64))],
+    level: usize,
+) -> AerialRefinement {
     AerialRefinement {
         recording_id: "rec".into(),
         aerial_id: row.image_id.clone(),
@@ -608,7 +612,10 @@ fn a_control_point_located_at_a_coarser_level_has_the_precision_of_that_level() 
     for i in 0..3 {
         for j in 0..3 {
             let (a, b) = (coarse[i][j], at_level_2[i][j]);
-            assert!((a - b).abs() <= 1e-9 * a.abs().max(1e-12), "({i}, {j}): {a} vs {b}");
+            assert!(
+                (a - b).abs() <= 1e-9 * a.abs().max(1e-12),
+                "({i}, {j}): {a} vs {b}"
+            );
         }
     }
     // Located at full resolution, the same frames give 4× tighter points.

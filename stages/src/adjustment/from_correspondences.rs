@@ -179,7 +179,12 @@ pub fn build_block(
     // σ of each recording's panorama observations, full-resolution pixels (pixels of its detail level).
     let sigma_px: Vec<f64> = (0..block.recordings.len())
         .map(|r| {
-            let level = inputs.pano_detail_level.get(r).copied().unwrap_or(0).min(30);
+            let level = inputs
+                .pano_detail_level
+                .get(r)
+                .copied()
+                .unwrap_or(0)
+                .min(30);
             config.pano_sigma_px * (1u64 << level) as f64
         })
         .collect();

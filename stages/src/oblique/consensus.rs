@@ -324,7 +324,10 @@ fn control_points(
                         p.default_oblique_sigma_px
                     };
                     let level = per_image[o.image_id.as_str()].matched.level.min(30);
-                    (FrameCamera::from_aerial(row), sigma * (1u64 << level) as f64)
+                    (
+                        FrameCamera::from_aerial(row),
+                        sigma * (1u64 << level) as f64,
+                    )
                 })
                 .collect();
             let obs: Vec<PixelObservation> = aerial

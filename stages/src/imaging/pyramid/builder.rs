@@ -259,8 +259,7 @@ impl<S: Sample, K: TileSink> Chain<S, K> {
 /// Whether rows `a` and `b` (a pair of rows of one level, even length) hold one value per 2 × 2 block.
 fn blocks_repeat<S: Sample>(a: &[S], b: &[S]) -> bool {
     a.len() == b.len()
-        && a
-            .chunks_exact(2)
+        && a.chunks_exact(2)
             .zip(b.chunks_exact(2))
             .all(|(x, y)| x[0] == x[1] && y[0] == y[1] && x[0] == y[0])
 }
@@ -452,7 +451,8 @@ mod tests {
         assert_eq!(built(160, 96, |c, r| texture(c / 4, r / 4)).detail_level, 2);
         assert_eq!(built(80, 48, |c, r| texture(c / 2, r / 2)).detail_level, 1);
         // One pixel off the repetition, or an odd size: every level holds detail.
-        let spoiled = |c: usize, r: usize| texture(c / 4, r / 4).wrapping_add(u8::from((c, r) == (5, 7)));
+        let spoiled =
+            |c: usize, r: usize| texture(c / 4, r / 4).wrapping_add(u8::from((c, r) == (5, 7)));
         assert_eq!(built(160, 96, spoiled).detail_level, 0);
         assert_eq!(built(159, 96, |c, r| texture(c / 4, r / 4)).detail_level, 0);
     }
