@@ -429,6 +429,7 @@ mod tests {
 
     /// The pyramid file of `w × h` samples `at(col, row)`, reopened: its layout as read back.
     fn built(w: usize, h: usize, at: impl Fn(usize, usize) -> u8) -> PyramidLayout {
+        use super::super::TileSource;
         let dir = tempfile::tempdir().unwrap();
         let dest = dir.path().join("p.pyr");
         let mut b = PyramidBuilder::create(&dest, w, h, SampleDepth::U8, 16).unwrap();
@@ -444,7 +445,6 @@ mod tests {
 
     #[test]
     fn an_image_enlarged_by_pixel_repetition_has_the_detail_level_of_its_original() {
-        use super::super::TileSource;
         let texture = |c: usize, r: usize| ((c * 37 + r * 91 + (c * r) % 13) % 251) as u8;
         assert_eq!(built(40, 24, texture).detail_level, 0);
         // Each pixel repeated 4 × 4 times: levels 0 and 1 only repeat level 2.
