@@ -80,13 +80,14 @@ pub fn add_adjust(
             Some(o) => (o.clouds.clone(), o.result.into_iter().collect()),
             None => (Vec::new(), Vec::new()),
         };
+        let pano_images: Vec<_> = items.iter().map(|i| i.pano_image).collect();
         let report = b.add(
             AdjustStage,
             config.sources.label(),
             config,
             (
                 snap,
-                panos.clone(),
+                pano_images,
                 optional_all(&windows),
                 optional_all(&control),
                 optional_all(&clouds),

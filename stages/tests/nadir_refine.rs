@@ -490,6 +490,15 @@ fn observe(row: &AerialImage, p: &Vector3<f64>) -> (f64, f64) {
 }
 
 fn refinement_of(row: &AerialImage, obs: &[(String, (f64, f64))]) -> AerialRefinement {
+    refinement_at(row, obs, 0)
+}
+
+/// [`refinement_of`] with the tie points located at pyramid level `level`.
+fn refinement_at(
+    row: &AerialImage,
+    obs: &[(String, (f64, f64))],
+    level: usize,
+) -> AerialRefinement {
     AerialRefinement {
         recording_id: "rec".into(),
         aerial_id: row.image_id.clone(),
@@ -510,6 +519,7 @@ fn refinement_of(row: &AerialImage, obs: &[(String, (f64, f64))]) -> AerialRefin
                 },
                 predicted_u_px: *u,
                 predicted_v_px: *v,
+                level,
             })
             .collect(),
     }
@@ -631,6 +641,50 @@ fn control_points_in_the_campaign_frame_are_free_of_map_scale_and_curvature() {
     ));
     assert!(in_frame < 1e-3, "tangent frame: {in_frame} m");
     assert!(in_map > 0.01, "map coordinates: {in_map} m");
+}
+
+/// `row` as a frame `factor` times finer: the same footprint in `factor`² as many pixels.
+fn finer(row: &AerialImage, factor: f64) -> AerialImage {
+    AerialImage {
+        focal_px: row.focal_px * factor,
+        cx_px: row.cx_px * factor,
+        cy_px: row.cy_px * factor,
+        width_px: (f64::from(row.width_px) * factor) as u32,
+        height_px: (f64::from(row.height_px) * factor) as u32,
+        ..row.clone()
+    }
+}
+
+#[test]
+fn a_control_point_located_at_a_coarser_level_has_the_precision_of_that_level() {
+    let truth = Vector3::new(91_997.3, 437_004.1, 1.35);
+    let window = window_of(&[truth]);
+    let control = |rows: &[AerialImage], level: usize| {
+        let refs: Vec<AerialRefinement> = rows
+            .iter()
+            .map(|r| refinement_at(r, &[("rec#0".to_string(), observe(r, &truth))], level))
+            .collect();
+        let pairs: Vec<(&AerialImage, &AerialRefinement)> = rows.iter().zip(&refs).collect();
+        let cps = aerial_control_points(&window, &pairs, &ControlParams::default());
+        assert_eq!(cps.len(), 1);
+        cps[0].covariance_m2.unwrap()
+    };
+    let rows = nadir_cameras();
+    let fine: Vec<AerialImage> = rows.iter().map(|r| finer(r, 4.0)).collect();
+    // 2.5 cm frames whose points were located at their 10 cm level (2): σ on the ground as at 10 cm.
+    let (coarse, at_level_2) = (control(&rows, 0), control(&fine, 2));
+    for i in 0..3 {
+        for j in 0..3 {
+            let (a, b) = (coarse[i][j], at_level_2[i][j]);
+            assert!(
+                (a - b).abs() <= 1e-9 * a.abs().max(1e-12),
+                "({i}, {j}): {a} vs {b}"
+            );
+        }
+    }
+    // Located at full resolution, the same frames give 4× tighter points.
+    let at_level_0 = control(&fine, 0);
+    assert!((coarse[0][0] / at_level_0[0][0] - 16.0).abs() < 1e-6);
 }
 
 #[test]

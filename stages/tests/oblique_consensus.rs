@@ -37,6 +37,7 @@ fn patch_match(point_id: &str, object: [f64; 3], t: [f64; 3], oblique: &str) -> 
         score: 0.5,
         real_resolution_ratio: 1.0,
         rejected_coarse: false,
+        level: 0,
     }
 }
 

@@ -86,6 +86,7 @@ fn scene() -> Scene {
             score: 0.7,
             real_resolution_ratio: 1.0,
             rejected_coarse: false,
+            level: 0,
         });
         sparse.push(SparsePoint {
             side,
@@ -243,6 +244,7 @@ fn pano_match(rec: &Recording, u: f64, v: f64, px: [f64; 2]) -> PatchMatch {
         score: 1.0,
         real_resolution_ratio: 1.0,
         rejected_coarse: false,
+        level: 0,
     }
 }
 

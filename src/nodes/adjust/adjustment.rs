@@ -4,9 +4,9 @@
 //! before/after (thesis 3.5.3: check points triangulated from their panorama observations with the recorded
 //! and the adjusted poses, two-view and multi-view). Check points are never used as control.
 
-use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RawFile, RunResult, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage, StageError};
+use crate::nodes::campaign::ingest::IngestedImage;
 use crate::nodes::campaign::load::CampaignSnapshot;
-use crate::nodes::campaign::panorama_sizes::pano_sizes;
 use crate::nodes::oblique::consensus::ObliqueOutput;
 use serde::{Deserialize, Serialize};
 use skytie_stages::adjustment::campaign_checkpoints::{compare_checkpoints, CheckPointComparison};
@@ -176,14 +176,15 @@ fn spread(mut values: Vec<f64>) -> serde_json::Value {
     serde_json::json!({"median": at(0.5), "p95": at(0.95), "max": values.last()})
 }
 
-/// The adjustment node. Inputs: snapshot, panorama files (snapshot order), the nadir windows' tie points and
+/// The adjustment node. Inputs: snapshot, ingested panoramas (snapshot order: their sizes and detail levels),
+/// the nadir windows' tie points and
 /// the recordings' aerial control points, the oblique chain's sparse clouds (MM tie points) and its consensus
 /// output (oblique control points) — empty lists for a source that is not used.
 pub struct AdjustStage;
 
 impl Stage for AdjustStage {
     crate::nodes::stage_types!(skytie_stages::adjustment::from_correspondences::STAGE, AdjustConfig => AdjustReport,
-        inputs: (Handle<CampaignSnapshot>, Vec<RawFile>, Vec<Optional<MmWindowMatch>>, Vec<Optional<RecordingControl>>, Vec<Optional<SparseCloud>>, Vec<Optional<ObliqueOutput>>));
+        inputs: (Handle<CampaignSnapshot>, Vec<Handle<IngestedImage>>, Vec<Optional<MmWindowMatch>>, Vec<Optional<RecordingControl>>, Vec<Optional<SparseCloud>>, Vec<Optional<ObliqueOutput>>));
 
     fn run(&self, config: &AdjustConfig, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (snap, panos, windows, control, clouds, oblique) = inputs;
@@ -191,7 +192,20 @@ impl Stage for AdjustStage {
         let (windows, control, clouds, oblique) =
             (flat(windows), flat(control), flat(clouds), flat(oblique));
         let c = &snap.campaign;
-        let sizes = pano_sizes(&panos)?;
+        let sizes: Vec<(u32, u32)> = panos
+            .iter()
+            .map(|p| {
+                let size = (u32::try_from(p.width), u32::try_from(p.height));
+                match size {
+                    (Ok(w), Ok(h)) => Ok((w, h)),
+                    _ => Err(StageError::new(format!(
+                        "{}: {} × {} px is too large for a panorama",
+                        p.source, p.width, p.height
+                    ))),
+                }
+            })
+            .collect::<Result<_, _>>()?;
+        let detail_levels: Vec<usize> = panos.iter().map(|p| p.detail_level as usize).collect();
         let tie_points: Vec<MmTiePoint> = windows
             .iter()
             .flat_map(|w| w.tie_points.iter().cloned())
@@ -213,6 +227,7 @@ impl Stage for AdjustStage {
         let inputs = AdjustInputs {
             recordings: &c.recordings,
             pano_size_px: &sizes,
+            pano_detail_level: &detail_levels,
             tie_points: &tie_points,
             control: &control_points,
             nadir: &c.nadir,

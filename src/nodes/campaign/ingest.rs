@@ -59,6 +59,10 @@ pub struct IngestedImage {
     /// The sample value that maps to grey 1.0.
     pub white: u16,
     pub levels: u32,
+    /// The finest level holding detail of its own (`PyramidLayout::detail_level`; 0 unless the image was
+    /// enlarged by pixel repetition).
+    #[serde(default)]
+    pub detail_level: u32,
     /// Absolute path of the pyramid file in the cache.
     pub pyramid_path: String,
     /// blake3 of the pyramid's header and tile hashes.
@@ -73,7 +77,7 @@ crate::serde_artifact!(IngestedImage);
 pub struct Ingest;
 
 impl Stage for Ingest {
-    crate::nodes::stage_types!(named "ingest" version "1", IngestParams => IngestedImage, inputs: RawFile);
+    crate::nodes::stage_types!(named "ingest" version "2", IngestParams => IngestedImage, inputs: RawFile);
 
     fn run(&self, p: &IngestParams, file: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         let tmp = ctx.output_dir_tmp()?;
@@ -88,6 +92,7 @@ impl Stage for Ingest {
             depth: layout.depth,
             white: done.pyramid.white,
             levels: layout.levels() as u32,
+            detail_level: layout.detail_level as u32,
             pyramid_path: ctx
                 .output_dir()
                 .join(PYRAMID_FILE)

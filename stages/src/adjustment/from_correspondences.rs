@@ -36,6 +36,10 @@ pub struct AdjustInputs<'a> {
     pub recordings: &'a [Recording],
     /// Panorama (width, height) in pixels, one per recording.
     pub pano_size_px: &'a [(u32, u32)],
+    /// The detail level of each recording's panorama (`PyramidLayout::detail_level`: 0 unless it was enlarged
+    /// by pixel repetition), one per recording, or empty for 0 everywhere. `pano_sigma_px` is in pixels of
+    /// that level, so a panorama enlarged 2^l times is weighted like the original.
+    pub pano_detail_level: &'a [usize],
     /// MM–MM tie points (nadir matching and/or the oblique sparse cloud).
     pub tie_points: &'a [MmTiePoint],
     /// Aerial control points (nadir and/or oblique).
@@ -178,7 +182,19 @@ pub fn build_block(
     let mut points: Vec<BlockPoint> = Vec::new();
     let mut point_index: HashMap<String, usize> = HashMap::new();
     let mut counts = BuildCounts::default();
-    let sigma_px = config.pano_sigma_px;
+    // σ of each recording's panorama observations, full-resolution pixels (pixels of its detail level).
+    let sigma_px: Vec<f64> = (0..block.recordings.len())
+        .map(|r| {
+            let level = inputs
+                .pano_detail_level
+                .get(r)
+                .copied()
+                .unwrap_or(0)
+                .min(30);
+            config.pano_sigma_px * (1u64 << level) as f64
+        })
+        .collect();
+    let sigma_px = sigma_px.as_slice();
     let resolve =
         |owner: &str, image_id: &str| resolve_recording(&recording_index, owner, image_id);
 
@@ -404,7 +420,7 @@ fn resolve_recording(
 fn add_tie_point(
     tp: &MmTiePoint,
     resolve: &impl Fn(&str, &str) -> Result<usize, AdjustError>,
-    sigma_px: f64,
+    sigma_px: &[f64],
     block: &mut Block,
     points: &mut Vec<BlockPoint>,
     point_index: &mut HashMap<String, usize>,
@@ -432,14 +448,15 @@ fn add_tie_point(
     Ok(())
 }
 
-/// A tie-point unknown `id` at `initial` (world, m) with its panorama observations (recording, u, v in px).
+/// A tie-point unknown `id` at `initial` (world, m) with its panorama observations (recording, u, v in px);
+/// `sigma_px` per recording.
 fn add_point(
     block: &mut Block,
     points: &mut Vec<BlockPoint>,
     id: &str,
     initial: Vector3<f64>,
     pano: Vec<(usize, f64, f64)>,
-    sigma_px: f64,
+    sigma_px: &[f64],
 ) {
     let p = points.len();
     for &(recording, u_px, v_px) in &pano {
@@ -448,7 +465,7 @@ fn add_point(
             point: p,
             u_px,
             v_px,
-            sigma_px,
+            sigma_px: sigma_px[recording],
         });
     }
     block.points_initial_world.push(initial);
@@ -543,7 +560,7 @@ fn initial_point(
     block: &Block,
     pano: &[(usize, f64, f64)],
     fallback: Option<[f64; 3]>,
-    sigma_px: f64,
+    sigma_px: &[f64],
 ) -> Option<Vector3<f64>> {
     if pano.len() >= 2 {
         let rays: Vec<_> = pano
@@ -552,7 +569,7 @@ fn initial_point(
             .collect();
         let sigmas: Vec<f64> = pano
             .iter()
-            .map(|&(r, _, _)| block.recordings[r].camera.angular_sigma_rad(sigma_px))
+            .map(|&(r, _, _)| block.recordings[r].camera.angular_sigma_rad(sigma_px[r]))
             .collect();
         if let Ok(t) = triangulate_rays(&rays, &sigmas) {
             return Some(t.point_world);

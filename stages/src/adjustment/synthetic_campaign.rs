@@ -66,6 +66,7 @@ impl SyntheticCampaign {
         super::AdjustInputs {
             recordings: &self.recordings,
             pano_size_px: &self.pano_size_px,
+            pano_detail_level: &[],
             tie_points: &self.tie_points,
             control: &self.control,
             nadir: &self.nadir,

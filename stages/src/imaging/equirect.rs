@@ -6,6 +6,11 @@
 //! The level of a sample follows the mip-map rule ([`level_for`]): the finest level whose pixel is not
 //! smaller than the footprint of the output pixel, so that a product at a coarser resolution than the
 //! panorama averages the panorama's pixels instead of picking some of them (aliasing).
+//!
+//! A level finer than the panorama's detail level ([`crate::imaging::pyramid::PyramidLayout::detail_level`])
+//! is never sampled: such levels only repeat the detail level's pixels (a panorama enlarged by pixel
+//! repetition), so they are read from the detail level, which samples the panorama at its real angular
+//! resolution — exactly as the panorama it was enlarged from.
 
 use super::bilinear_many::sample_bilinear_many;
 use super::border::Border;
@@ -65,6 +70,8 @@ pub struct PanoramaLevels {
     pub height_px: usize,
     /// Band of level `l` at index `l` (levels not read are `None`).
     bands: Vec<Option<PanoramaBand>>,
+    /// The finest level sampled (the source's detail level): finer levels are read from it.
+    detail_level: usize,
 }
 
 impl PanoramaLevels {
@@ -79,14 +86,25 @@ impl PanoramaLevels {
         Self::read_bands(source, &bands)
     }
 
-    /// Reads the band of full-resolution rows [v0, v1) (one pixel of margin, clipped) at each listed level.
+    /// Reads the band of full-resolution rows [v0, v1) (one pixel of margin, clipped) at each listed level;
+    /// a level finer than the source's detail level is read from the detail level (rows of several such
+    /// levels merged).
     pub fn read_bands(
         source: &dyn TileSource,
         wanted: &[(usize, (f64, f64))],
     ) -> Result<Self, PyramidError> {
         let layout = source.layout();
+        let detail_level = layout.detail_level.min(layout.levels() - 1);
+        let mut merged: Vec<(usize, (f64, f64))> = Vec::with_capacity(wanted.len());
+        for &(level, rows) in wanted.iter().filter(|(l, _)| *l < layout.levels()) {
+            let level = level.max(detail_level);
+            match merged.iter_mut().find(|(l, _)| *l == level) {
+                Some((_, r)) => *r = (r.0.min(rows.0), r.1.max(rows.1)),
+                None => merged.push((level, rows)),
+            }
+        }
         let mut bands: Vec<Option<PanoramaBand>> = vec![None; layout.levels()];
-        for &(level, (v0, v1)) in wanted.iter().filter(|(l, _)| *l < layout.levels()) {
+        for &(level, (v0, v1)) in &merged {
             let (lw, lh) = layout.level_sizes[level];
             let s = (1u64 << level) as f64;
             let top = ((v0 / s).floor() - 1.0).clamp(0.0, lh as f64 - 1.0) as usize;
@@ -103,6 +121,7 @@ impl PanoramaLevels {
             width_px: layout.width,
             height_px: layout.height,
             bands,
+            detail_level,
         })
     }
 
@@ -114,17 +133,25 @@ impl PanoramaLevels {
             level_height: img.height,
             image: img.clone(),
         })];
+        let mut detail_level = 0;
         if max_level > 0 && img.width > 1 && img.height > 1 {
             let pyramid = MemoryPyramid::from_gray(img);
             let coarser = Self::read(&pyramid, (0.0, img.height as f64), 1..=max_level)
                 .expect("an in-memory pyramid reads without errors");
             bands.extend(coarser.bands.into_iter().skip(1));
+            detail_level = coarser.detail_level.min(max_level);
         }
         Self {
             width_px: img.width,
             height_px: img.height,
             bands,
+            detail_level,
         }
+    }
+
+    /// The finest level sampled: the source's detail level (module documentation).
+    pub fn detail_level(&self) -> usize {
+        self.detail_level
     }
 
     /// The coarsest level read.
@@ -132,8 +159,10 @@ impl PanoramaLevels {
         self.bands.iter().rposition(Option::is_some).unwrap_or(0)
     }
 
-    /// The band used for `level`: that level, or the nearest finer one that was read.
+    /// The band used for `level`: that level (the detail level for a finer one), or the nearest finer one
+    /// that was read.
     pub fn band(&self, level: usize) -> &PanoramaBand {
+        let level = level.max(self.detail_level);
         self.bands[..=level.min(self.bands.len() - 1)]
             .iter()
             .rev()

@@ -22,6 +22,12 @@
 //! and the point and its covariance are converted back to map coordinates, so the map projection's scale and
 //! the earth's curvature do not enter the control point (`crs::error_budget`).
 //!
+//! **Precision at the working level.** An observation is as precise as the pixels it was located in: the
+//! refinement locates a tie point at a level of the aerial image's pyramid (`AerialMatch::level`; a 2.5 cm
+//! frame at its 10 cm level), so its σ is the row's `sigma_px` in pixels of that level, `sigma_px · 2^level`
+//! full-resolution pixels — σ on the ground is `sigma_px` times the GSD actually used, whatever the frame's
+//! pixel count.
+//!
 //! Points seen in one aerial image are kept with `point_world: None` (a bundle with fixed aerial orientation
 //! can still use them). Output order: the window's tie-point order; observations sorted by aerial `image_id`.
 
@@ -39,7 +45,7 @@ use nalgebra::{Matrix3, Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("control", "2");
+pub const STAGE: StageId = StageId::new("control", "3");
 
 crate::params! {
     /// Parameters of [`aerial_control_points`].
@@ -71,17 +77,19 @@ struct Candidate {
 
 fn candidate(
     row: &AerialImage,
-    obs: &AerialObservation,
+    (obs, level): (&AerialObservation, usize),
     mm_z: f64,
     p: &ControlParams,
     frame: &MapFrame,
 ) -> Option<Candidate> {
     let camera = frame.camera_to_local(&FrameCamera::from_aerial(row)).ok()?;
-    let sigma_px = if row.sigma_px.is_finite() && row.sigma_px > 0.0 {
+    let sigma_level_px = if row.sigma_px.is_finite() && row.sigma_px > 0.0 {
         row.sigma_px
     } else {
         0.5
     };
+    // σ in full-resolution pixels: `sigma_px` pixels of the level the point was located at.
+    let sigma_px = sigma_level_px * (1u64 << level.min(30)) as f64;
     let ray = camera.pixel_ray(obs.u_px, obs.v_px);
     if !ray.dir_world.iter().all(|v| v.is_finite()) {
         return None;
@@ -231,8 +239,8 @@ pub fn aerial_control_points_in(
         .enumerate()
         .map(|(i, tp)| (tp.id.as_str(), i))
         .collect();
-    // Per tie point: (aerial row, observation), at most one per aerial image (best score).
-    let mut per_point: Vec<Vec<(&AerialImage, &AerialObservation)>> =
+    // Per tie point: (aerial row, observation, level located at), at most one per aerial image (best score).
+    let mut per_point: Vec<Vec<(&AerialImage, &AerialObservation, usize)>> =
         vec![Vec::new(); window.tie_points.len()];
     for (row, refinement) in refinements {
         if refinement.recording_id != window.recording_id {
@@ -247,10 +255,10 @@ pub fn aerial_control_points_in(
                 continue;
             }
             let list = &mut per_point[i];
-            match list.iter_mut().find(|(r, _)| r.image_id == row.image_id) {
-                Some(slot) if obs.score > slot.1.score => *slot = (*row, obs),
+            match list.iter_mut().find(|(r, _, _)| r.image_id == row.image_id) {
+                Some(slot) if obs.score > slot.1.score => *slot = (*row, obs, m.level),
                 Some(_) => {}
-                None => list.push((*row, obs)),
+                None => list.push((*row, obs, m.level)),
             }
         }
     }
@@ -262,7 +270,7 @@ pub fn aerial_control_points_in(
         };
         let candidates: Vec<Candidate> = list
             .iter()
-            .filter_map(|(row, obs)| candidate(row, obs, mm_local.z, p, frame))
+            .filter_map(|(row, obs, level)| candidate(row, (*obs, *level), mm_local.z, p, frame))
             .collect();
         let kept = consistent_subset(candidates, p.k_sigma);
         let (kept, point) = match kept.len() {

@@ -47,7 +47,7 @@ use nalgebra::{Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("refine", "7");
+pub const STAGE: StageId = StageId::new("refine", "8");
 
 /// Taper applied before the Fourier transform (serialisable mirror of [`WindowKind`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -420,6 +420,7 @@ pub fn refine_in_image(
                 },
                 predicted_u_px: predicted.x,
                 predicted_v_px: predicted.y,
+                level: aerial_window.window.level,
             })
         })
         .collect();
@@ -502,6 +503,7 @@ mod tests {
             },
             predicted_u_px: 1000.0,
             predicted_v_px: 2000.0,
+            level: 0,
         }
     }
 

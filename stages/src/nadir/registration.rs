@@ -105,6 +105,10 @@ pub struct AerialMatch {
     /// The location predicted by the initial transform (full aerial pixels), before refinement.
     pub predicted_u_px: f64,
     pub predicted_v_px: f64,
+    /// The pyramid level of the aerial image the tie point was located at (its pixels are 2^level full
+    /// pixels): the observation's precision is the image's `sigma_px` in pixels of this level.
+    #[serde(default)]
+    pub level: usize,
 }
 
 /// All refined correspondences of one (recording, aerial image).

@@ -21,7 +21,9 @@
 //! per oblique image (the best score when several panoramas matched the point in the same image; the others
 //! are counted). With ≥ 2 oblique images the point is intersected from the oblique rays alone
 //! ([`crate::geometry::aerial_intersection`]); intersections with a too small angle or too large a
-//! reprojection error are rejected (the point is not emitted; counted in [`ConsensusDiagnostics`]).
+//! reprojection error are rejected (the point is not emitted; counted in [`ConsensusDiagnostics`]). An
+//! oblique observation's σ is the image's `sigma_px` in pixels of the pyramid level its patches were made at
+//! (`PatchMatch::level`), so it means the same distance on the façade whatever the frame's pixel count.
 //!
 //! Output order is deterministic: correspondences in input order (sets, then matches), control points by
 //! `point_id`, aerial observations by `image_id`.
@@ -323,6 +325,7 @@ fn control_points(
             })
             .collect();
         let (point_world, covariance_m2) = if aerial.len() >= 2 {
+            // σ in full-resolution pixels: the image's σ in pixels of the level the patches were made at.
             let cams: Result<Vec<(FrameCamera, f64)>, _> = aerial
                 .iter()
                 .map(|o| {
@@ -332,9 +335,11 @@ fn control_points(
                     } else {
                         p.default_oblique_sigma_px
                     };
+                    let level = per_image[o.image_id.as_str()].matched.level.min(30);
+                    let sigma_full_px = sigma * (1u64 << level) as f64;
                     frame
                         .camera_to_local(&FrameCamera::from_aerial(row))
-                        .map(|c| (c, sigma))
+                        .map(|c| (c, sigma_full_px))
                 })
                 .collect();
             let Ok(cams) = cams else {

@@ -124,18 +124,20 @@ pub const MAX_SUPERSAMPLING: usize = 4;
 /// panorama centre average over the panorama pixels it covers (one pixel of level l spans
 /// `range · 2π · 2^l / W` metres at right angles): the finest level, at most `max_level`, where at most
 /// [`MAX_SUPERSAMPLING`] sub-samples per axis do (a panorama several times finer than the patch is read from
-/// a coarser level instead of sampled more densely).
+/// a coarser level instead of sampled more densely). Levels finer than `detail_level` (the panorama's,
+/// [`PanoramaLevels::detail_level`]) only repeat its pixels and are not considered.
 pub fn panorama_sampling(
     spacing_m: f64,
     range_m: f64,
     pano_width_px: u32,
-    max_level: usize,
+    (detail_level, max_level): (usize, usize),
 ) -> (usize, usize) {
+    let detail_level = detail_level.min(max_level);
     let footprint_m = range_m * std::f64::consts::TAU / f64::from(pano_width_px.max(1));
     if !(footprint_m > 0.0) {
-        return (0, 1);
+        return (detail_level, 1);
     }
-    for level in 0..=max_level {
+    for level in detail_level..=max_level {
         let k = (spacing_m / (footprint_m * (1u64 << level) as f64))
             .ceil()
             .max(1.0);
@@ -162,7 +164,8 @@ pub fn fill_from_panorama(
     let sx = pano.width_px as f64 / f64::from(cam.width_px);
     let sy = pano.height_px as f64 / f64::from(cam.height_px);
     let range_m = (grid.centre_world - cam.center_world).norm();
-    let (level, k) = panorama_sampling(grid.spacing_m, range_m, cam.width_px, pano.max_level());
+    let levels = (pano.detail_level(), pano.max_level());
+    let (level, k) = panorama_sampling(grid.spacing_m, range_m, cam.width_px, levels);
     let offsets: Vec<f64> = (0..k).map(|j| (j as f64 + 0.5) / k as f64).collect();
     for row in 0..n {
         for col in 0..n {
@@ -301,13 +304,13 @@ mod supersampling_tests {
     #[test]
     fn sub_samples_and_levels_follow_the_panorama_footprint() {
         // 1600-px panorama: a pixel spans 2π·10/1600 ≈ 3.9 cm at 10 m.
-        assert_eq!(panorama_sampling(0.10, 10.0, 1600, 5), (0, 3));
-        assert_eq!(panorama_sampling(0.03, 10.0, 1600, 5), (0, 1));
+        assert_eq!(panorama_sampling(0.10, 10.0, 1600, (0, 5)), (0, 3));
+        assert_eq!(panorama_sampling(0.03, 10.0, 1600, (0, 5)), (0, 1));
         // 0.20 m needs 6 sub-samples at level 0: level 1 with 3.
-        assert_eq!(panorama_sampling(0.20, 10.0, 1600, 5), (1, 3));
-        assert_eq!(panorama_sampling(0.20, 10.0, 1600, 0), (0, 4)); // capped
-        assert_eq!(panorama_sampling(0.10, 0.0, 1600, 5), (0, 1));
+        assert_eq!(panorama_sampling(0.20, 10.0, 1600, (0, 5)), (1, 3));
+        assert_eq!(panorama_sampling(0.20, 10.0, 1600, (0, 0)), (0, 4)); // capped
+        assert_eq!(panorama_sampling(0.10, 0.0, 1600, (0, 5)), (0, 1));
         // The same panorama 4× as wide: two levels up, the same sub-samples.
-        assert_eq!(panorama_sampling(0.10, 10.0, 6400, 5), (2, 3));
+        assert_eq!(panorama_sampling(0.10, 10.0, 6400, (0, 5)), (2, 3));
     }
 }

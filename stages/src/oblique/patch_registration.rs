@@ -53,7 +53,7 @@ use search::{mi_search, ncc_search, Found};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("patches", "7");
+pub const STAGE: StageId = StageId::new("patches", "8");
 
 /// Stable 64-bit FNV-1a hash of the strings (separated), for per-item seeds.
 fn stable_hash(parts: &[&str]) -> u64 {
@@ -342,7 +342,7 @@ pub fn register_patches(
             })
         })
         .collect();
-    let level = inputs::oblique_level(&points, p, oblique_img.layout().levels());
+    let level = inputs::oblique_level(&points, p, oblique_img.layout());
     let window = inputs::oblique_window(oblique_img, &frame_cam, &points, p, level)?;
     let Some(window) = window else {
         let mut stats = PatchStats {
@@ -471,6 +471,7 @@ fn register_with(
                 score,
                 real_resolution_ratio: ratio,
                 rejected_coarse: rejected[k],
+                level: ctx.oblique.level,
             })
         })
         .collect();

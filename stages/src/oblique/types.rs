@@ -182,6 +182,10 @@ pub struct PatchMatch {
     pub real_resolution_ratio: f64,
     /// Rejected by the 2-D median consensus after the coarse level (4.4.7); such matches skip the fine level.
     pub rejected_coarse: bool,
+    /// The pyramid level of the oblique image the patches were made at (its pixels are 2^level full
+    /// pixels): the observation's precision is the image's `sigma_px` in pixels of this level.
+    #[serde(default)]
+    pub level: usize,
 }
 
 /// Counts of one (panorama × oblique image) registration set (for metrics).

@@ -39,6 +39,9 @@ struct Level<S> {
     pending: Vec<S>,
     has_pending: bool,
     reduced: Vec<S>,
+    /// Every 2 × 2 block of this level seen so far holds one value: the level repeats the next one's pixels
+    /// (false for an odd width or height).
+    repeats_next: bool,
 }
 
 impl<S: Sample> Level<S> {
@@ -55,6 +58,7 @@ impl<S: Sample> Level<S> {
             pending: Vec::with_capacity(width),
             has_pending: false,
             reduced: Vec::with_capacity(width.div_ceil(2)),
+            repeats_next: width % 2 == 0 && height % 2 == 0,
         }
     }
 
@@ -142,6 +146,7 @@ impl<S: Sample, K: TileSink> Chain<S, K> {
             return Ok(());
         }
         lv.has_pending = false;
+        lv.repeats_next = lv.repeats_next && blocks_repeat(&lv.pending, row);
         let mut reduced = std::mem::take(&mut lv.reduced);
         reduce_rows(&lv.pending, row, &mut reduced);
         let result = self.push_at(level + 1, &reduced);
@@ -226,6 +231,12 @@ impl<S: Sample, K: TileSink> Chain<S, K> {
             SampleDepth::U8 => 255,
             SampleDepth::U16 => white_for(self.max_sample),
         };
+        // The detail level: how many levels from the finest on repeat the next one's pixels.
+        let levels = self.levels.len();
+        self.layout.detail_level = self.levels[..levels - 1]
+            .iter()
+            .take_while(|lv| lv.repeats_next)
+            .count();
         let header = self.layout.encode_header(white);
         let mut table = Vec::with_capacity(self.layout.hash_table_len());
         for h in &self.hashes {
@@ -243,6 +254,14 @@ impl<S: Sample, K: TileSink> Chain<S, K> {
             sink: self.sink,
         })
     }
+}
+
+/// Whether rows `a` and `b` (a pair of rows of one level, even length) hold one value per 2 × 2 block.
+fn blocks_repeat<S: Sample>(a: &[S], b: &[S]) -> bool {
+    a.len() == b.len()
+        && a.chunks_exact(2)
+            .zip(b.chunks_exact(2))
+            .all(|(x, y)| x[0] == x[1] && y[0] == y[1] && x[0] == y[0])
 }
 
 /// A completed chain: what the file's header and hash table hold, and the sink the tiles went to.
@@ -406,5 +425,35 @@ mod tests {
         b.push_row_u8(&[1; 10]).unwrap();
         assert!(b.push_row_u8(&[1; 10]).is_err());
         assert!(b.push_row_u8(&[1; 9]).is_err());
+    }
+
+    /// The pyramid file of `w × h` samples `at(col, row)`, reopened: its layout as read back.
+    fn built(w: usize, h: usize, at: impl Fn(usize, usize) -> u8) -> PyramidLayout {
+        use super::super::TileSource;
+        let dir = tempfile::tempdir().unwrap();
+        let dest = dir.path().join("p.pyr");
+        let mut b = PyramidBuilder::create(&dest, w, h, SampleDepth::U8, 16).unwrap();
+        for r in 0..h {
+            let row: Vec<u8> = (0..w).map(|c| at(c, r)).collect();
+            b.push_row_u8(&row).unwrap();
+        }
+        let summary = b.finish().unwrap();
+        let opened = super::super::TiledPyramid::open(&dest, &summary.index_hash).unwrap();
+        assert_eq!(opened.layout(), &summary.layout);
+        summary.layout
+    }
+
+    #[test]
+    fn an_image_enlarged_by_pixel_repetition_has_the_detail_level_of_its_original() {
+        let texture = |c: usize, r: usize| ((c * 37 + r * 91 + (c * r) % 13) % 251) as u8;
+        assert_eq!(built(40, 24, texture).detail_level, 0);
+        // Each pixel repeated 4 × 4 times: levels 0 and 1 only repeat level 2.
+        assert_eq!(built(160, 96, |c, r| texture(c / 4, r / 4)).detail_level, 2);
+        assert_eq!(built(80, 48, |c, r| texture(c / 2, r / 2)).detail_level, 1);
+        // One pixel off the repetition, or an odd size: every level holds detail.
+        let spoiled =
+            |c: usize, r: usize| texture(c / 4, r / 4).wrapping_add(u8::from((c, r) == (5, 7)));
+        assert_eq!(built(160, 96, spoiled).detail_level, 0);
+        assert_eq!(built(159, 96, |c, r| texture(c / 4, r / 4)).detail_level, 0);
     }
 }

@@ -7,6 +7,12 @@
 //! level's right or bottom edge repeats the edge pixel, so every tile has the same size and its offset follows
 //! from its index. Level `l + 1` halves level `l` (rounding up): level-`l` pixel `(c, r)` covers level-0 pixels
 //! `[c·2^l, (c + 1)·2^l) × [r·2^l, (r + 1)·2^l)`, so continuous coordinates scale exactly by `2^l`.
+//!
+//! The header also records the image's **detail level** ([`PyramidLayout::detail_level`]): the finest level
+//! that holds detail of its own. It is 0 for a photograph; for an image enlarged by pixel repetition (every
+//! pixel of level `l` repeated 2^l × 2^l times) it is `l`, because the levels below it only repeat its pixels.
+//! Stages never sample an image finer than its detail level, so such an image is read exactly like the one
+//! it was enlarged from.
 
 use std::fmt;
 
@@ -75,6 +81,9 @@ pub struct PyramidLayout {
     pub tile_side: usize,
     /// (width, height) of every level, level 0 first.
     pub level_sizes: Vec<(usize, usize)>,
+    /// The finest level holding detail of its own (module documentation): each level below it is its pixels
+    /// repeated 2 × 2 times. 0 unless the builder found such repetition.
+    pub detail_level: usize,
     /// Index of the first tile of every level, and the total tile count last.
     first_tile: Vec<usize>,
 }
@@ -106,6 +115,7 @@ impl PyramidLayout {
             depth,
             tile_side,
             level_sizes,
+            detail_level: 0,
             first_tile,
         };
         // Every offset must fit a u64 (and this machine's file offsets).
@@ -183,6 +193,7 @@ impl PyramidLayout {
         h[25..29].copy_from_slice(&(self.tile_side as u32).to_le_bytes());
         h[29..31].copy_from_slice(&white.to_le_bytes());
         h[31] = self.levels() as u8;
+        h[32] = self.detail_level as u8;
         h
     }
 
@@ -209,7 +220,20 @@ impl PyramidLayout {
         if white == 0 {
             return Err("white level 0".into());
         }
-        Ok((layout, white))
+        let detail_level = usize::from(h[32]);
+        if detail_level >= layout.levels() {
+            return Err(format!(
+                "header says detail level {detail_level} of {} levels",
+                layout.levels()
+            ));
+        }
+        Ok((
+            Self {
+                detail_level,
+                ..layout
+            },
+            white,
+        ))
     }
 }
 
@@ -291,8 +315,17 @@ mod tests {
         );
         let (back, white) = PyramidLayout::decode_header(&l.encode_header(4095)).unwrap();
         assert_eq!((back, white), (l.clone(), 4095));
+        let detailed = PyramidLayout {
+            detail_level: 2,
+            ..l.clone()
+        };
+        let (back, _) = PyramidLayout::decode_header(&detailed.encode_header(255)).unwrap();
+        assert_eq!(back.detail_level, 2);
         let mut bad = l.encode_header(1);
         bad[31] = 9;
+        assert!(PyramidLayout::decode_header(&bad).is_err());
+        let mut bad = l.encode_header(1);
+        bad[32] = 6;
         assert!(PyramidLayout::decode_header(&bad).is_err());
         assert!(PyramidLayout::decode_header(&[0u8; 64]).is_err());
     }

@@ -64,7 +64,7 @@ impl MemoryPyramid {
         // Grey = sample / 65535 whatever the largest value (the image's own 0..1 scale).
         Self {
             header: PyramidHeader {
-                layout,
+                layout: done.layout,
                 white: u16::MAX,
             },
             tiles,

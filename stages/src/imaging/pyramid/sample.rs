@@ -2,7 +2,7 @@
 //! the next level.
 
 /// A stored sample type.
-pub trait Sample: Copy + Default + Send + Sync + 'static {
+pub trait Sample: Copy + Default + PartialEq + Send + Sync + 'static {
     /// Bytes per sample in the file.
     const BYTES: usize;
     /// Average of four samples, rounded to nearest (halves up).

@@ -6,7 +6,9 @@ use super::PatchParams;
 use crate::geometry::frame::FrameCamera;
 use crate::geometry::panorama::PanoramaCamera;
 use crate::imaging::equirect::PanoramaLevels;
-use crate::imaging::pyramid::{footprint_level, PyramidError, ScaledWindow, TileSource};
+use crate::imaging::pyramid::{
+    footprint_level, PyramidError, PyramidLayout, ScaledWindow, TileSource,
+};
 use crate::oblique::patch::panorama_sampling;
 use crate::oblique::types::{FacadePlane, ObliqueView, SparsePoint};
 use nalgebra::Vector3;
@@ -30,17 +32,21 @@ fn reach_m(p: &PatchParams) -> f64 {
 }
 
 /// The pyramid level of the oblique image the patches are made at: the coarsest whose resolution at the
-/// finest candidate does not exceed `registration_resolution_m`.
-pub fn oblique_level(points: &[PointInPlane], p: &PatchParams, levels: usize) -> usize {
+/// finest candidate does not exceed `registration_resolution_m`, and not finer than the image's detail level
+/// (`layout.detail_level`: levels below it only repeat its pixels, so an image enlarged by pixel repetition
+/// is registered like the image it was enlarged from, even when that is coarser than
+/// `registration_resolution_m`).
+pub fn oblique_level(points: &[PointInPlane], p: &PatchParams, layout: &PyramidLayout) -> usize {
+    let detail_level = layout.detail_level.min(layout.levels() - 1);
     let finest = points
         .iter()
         .map(|c| c.view.resolution_m)
         .filter(|r| r.is_finite() && *r > 0.0)
         .fold(f64::INFINITY, f64::min);
     if !finest.is_finite() {
-        return 0;
+        return detail_level;
     }
-    footprint_level(finest, p.registration_resolution_m, levels)
+    footprint_level(finest, p.registration_resolution_m, layout.levels()).max(detail_level)
 }
 
 /// The window of the oblique image at `level` covering the patches of every point (`Ok(None)` when they all
@@ -108,7 +114,7 @@ pub fn panorama_bands(
     p: &PatchParams,
     oblique_scale: f64,
 ) -> Result<PanoramaLevels, PyramidError> {
-    let max_level = source.layout().levels() - 1;
+    let levels = (source.layout().detail_level, source.layout().levels() - 1);
     let rows_per_rad = f64::from(cam.height_px) / std::f64::consts::PI;
     let r = reach_m(p);
     let mut rows: BTreeMap<usize, (f64, f64)> = BTreeMap::new();
@@ -127,7 +133,7 @@ pub fn panorama_bands(
             grid_spacing(p.fine_extent_m, spacing),
             grid_spacing(p.single_extent_m, spacing),
         ] {
-            let (level, _) = panorama_sampling(sp, range, cam.width_px, max_level);
+            let (level, _) = panorama_sampling(sp, range, cam.width_px, levels);
             let e = rows
                 .entry(level)
                 .or_insert((f64::INFINITY, f64::NEG_INFINITY));
