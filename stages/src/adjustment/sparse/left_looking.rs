@@ -139,9 +139,9 @@ fn updated(symbolic: &Symbolic, diagonal: &[Block], lower: &[Block], task: &Task
         }
         let (columns, positions) = symbolic.row(j);
         for (&k, &p_jk) in columns.iter().zip(positions) {
-            let l_jk_t = lower[p_jk].transpose();
+            let l_jk = &lower[p_jk];
             if let Some(d) = diag.as_mut() {
-                *d -= lower[p_jk] * l_jk_t;
+                block4::sub_mul_transpose(d, l_jk, l_jk);
             }
             // Column k's rows after j are stored right after L(j, k).
             let tail_start = p_jk + 1;
@@ -151,7 +151,11 @@ fn updated(symbolic: &Symbolic, diagonal: &[Block], lower: &[Block], task: &Task
                 if i >= end {
                     break;
                 }
-                blocks[place[i] as usize] -= lower[tail_start + b] * l_jk_t;
+                block4::sub_mul_transpose(
+                    &mut blocks[place[i] as usize],
+                    &lower[tail_start + b],
+                    l_jk,
+                );
             }
         }
     });
