@@ -77,21 +77,6 @@ pub fn right_solve_lower_transpose(a: &Block, l: &Block) -> Block {
     x
 }
 
-/// `acc −= a·bᵀ`, unrolled and inlined (the inner kernel of the factorisation); each product is summed over
-/// the inner index in ascending order before it is subtracted, as the matrix product `a * b.transpose()` does.
-#[inline(always)]
-pub fn sub_mul_transpose(acc: &mut Block, a: &Block, b: &Block) {
-    let (a, b) = (a.as_slice(), b.as_slice());
-    let acc = acc.as_mut_slice();
-    // Column-major: element (r, c) is at 4·c + r.
-    for c in 0..4 {
-        for r in 0..4 {
-            let p = a[r] * b[c] + a[4 + r] * b[4 + c] + a[8 + r] * b[8 + c] + a[12 + r] * b[12 + c];
-            acc[4 * c + r] -= p;
-        }
-    }
-}
-
 /// L⁻¹ of a lower-triangular block.
 pub fn invert_lower(l: &Block) -> Block {
     let mut inv = Block::zeros();
@@ -131,9 +116,6 @@ mod tests {
         let x = right_solve_lower_transpose(&m, &l);
         assert!((x * l.transpose() - m).amax() < 1e-12);
         assert!((invert_lower(&l) * l - Block::identity()).amax() < 1e-13);
-        let mut acc = m;
-        sub_mul_transpose(&mut acc, &a, &l);
-        assert_eq!(acc, m - a * l.transpose());
     }
 
     #[test]

@@ -139,9 +139,9 @@ fn updated(symbolic: &Symbolic, diagonal: &[Block], lower: &[Block], task: &Task
         }
         let (columns, positions) = symbolic.row(j);
         for (&k, &p_jk) in columns.iter().zip(positions) {
-            let l_jk = &lower[p_jk];
+            let l_jk_t = lower[p_jk].transpose();
             if let Some(d) = diag.as_mut() {
-                block4::sub_mul_transpose(d, l_jk, l_jk);
+                *d -= lower[p_jk] * l_jk_t;
             }
             // Column k's rows after j are stored right after L(j, k).
             let tail_start = p_jk + 1;
@@ -151,11 +151,7 @@ fn updated(symbolic: &Symbolic, diagonal: &[Block], lower: &[Block], task: &Task
                 if i >= end {
                     break;
                 }
-                block4::sub_mul_transpose(
-                    &mut blocks[place[i] as usize],
-                    &lower[tail_start + b],
-                    l_jk,
-                );
+                blocks[place[i] as usize] -= lower[tail_start + b] * l_jk_t;
             }
         }
     });
