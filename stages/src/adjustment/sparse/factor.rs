@@ -1,6 +1,6 @@
-//! Block sparse Cholesky factor A = L·Lᵀ on the structure of a [`Symbolic`] analysis: the values (assembled
-//! matrix, then factor), the numeric factorisation (left-looking and level-parallel,
-//! [`super::left_looking`]; the result does not depend on the thread count) and solves with the factor.
+//! Numeric block sparse Cholesky factorisation A = L·Lᵀ on the structure of a [`Symbolic`] analysis
+//! (right-looking: each finished column updates the later columns it couples), and solves with the factor.
+//! Sequential and in a fixed order, so the result does not depend on the thread count.
 
 use super::block4::{self, Block, BlockVector};
 use super::symbolic::{Slot, Symbolic};
@@ -57,11 +57,44 @@ impl Factor {
         &self.lower[k]
     }
 
-    /// Replaces the assembled matrix by its Cholesky factor ([`super::left_looking`], parallel and
-    /// bit-identical whatever the thread count). On a failing pivot the values are left partially factorised
-    /// and the first failing pivot of the column order is named in the caller's numbering.
+    /// Replaces the assembled matrix by its Cholesky factor. On a failing pivot the values are left
+    /// partially factorised and the pivot is named in the caller's numbering.
     pub fn factorize(&mut self, symbolic: &Symbolic) -> Result<(), Pivot> {
-        super::left_looking::factorize(symbolic, &mut self.diagonal, &mut self.lower)
+        let reference: Vec<[f64; 4]> = self
+            .diagonal
+            .iter()
+            .map(|d| [d[(0, 0)], d[(1, 1)], d[(2, 2)], d[(3, 3)]])
+            .collect();
+        for (j, reference) in reference.iter().enumerate() {
+            let ljj =
+                block4::cholesky(&self.diagonal[j], reference).map_err(|component| Pivot {
+                    block: symbolic.perm()[j],
+                    component,
+                })?;
+            self.diagonal[j] = ljj;
+            let start = symbolic.column_start(j);
+            let rows = symbolic.column(j);
+            for k in start..start + rows.len() {
+                self.lower[k] = block4::right_solve_lower_transpose(&self.lower[k], &ljj);
+            }
+            // Update the later columns: A(i1, i2) −= L(i1, j)·L(i2, j)ᵀ for i1 ≥ i2 in column j. The rows
+            // after i2 in column j are a subset of column i2's rows, both ascending: one merge walk finds them.
+            for (a, &i2) in rows.iter().enumerate() {
+                let l2t = self.lower[start + a].transpose();
+                let diag_update = self.lower[start + a] * l2t;
+                self.diagonal[i2] -= diag_update;
+                let mut target = symbolic.column_positions(i2);
+                for (b, &i1) in rows.iter().enumerate().skip(a + 1) {
+                    let k = target
+                        .find(|&(_, row)| row == i1)
+                        .expect("the fill of column j lies in L's structure")
+                        .0;
+                    let update = self.lower[start + b] * l2t;
+                    self.lower[k] -= update;
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Solves A·x = b in place with the factor (`b` in the caller's block numbering).

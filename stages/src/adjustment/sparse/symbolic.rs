@@ -4,10 +4,7 @@
 //! (T. A. Davis, *Direct Methods for Sparse Linear Systems*, SIAM 2006, chapter 4).
 //!
 //! Numbering: "old" indices are the caller's (recordings); "new" ones are positions in the fill-reducing
-//! order (`perm[new] = old`). The factor's strictly lower blocks are stored by column; their row form (which
-//! earlier columns each row of L holds) and the height of every column in the elimination tree are kept for
-//! the left-looking, level-parallel numeric factorisation ([`super::factor`]): columns of equal height are
-//! never ancestors of one another, so they can be computed at the same time.
+//! order (`perm[new] = old`). The factor's strictly lower blocks are stored by column.
 
 use super::csr::Csr;
 
@@ -35,12 +32,6 @@ pub struct Symbolic {
     parent: Vec<usize>,
     /// Rows (new numbering, ascending) of the strictly lower blocks of each column.
     columns: Csr,
-    /// Row i of L: the columns k < i of its strictly lower blocks, ascending.
-    row_columns: Csr,
-    /// Row i of L: the storage positions of those blocks (same order as `row_columns`).
-    row_positions: Csr,
-    /// Level h: the columns (ascending) of height h in the elimination tree (leaves have height 0).
-    levels: Csr,
 }
 
 impl Symbolic {
@@ -70,41 +61,12 @@ impl Symbolic {
         );
         let parent = elimination_tree(&rows);
         let columns = factor_columns(&rows, &parent);
-        let by_row = |value: fn(usize, usize) -> usize| {
-            let columns = &columns;
-            Csr::from_pairs(
-                n,
-                (0..n).flat_map(move |k| {
-                    columns
-                        .row(k)
-                        .iter()
-                        .enumerate()
-                        .map(move |(a, &i)| (i, value(k, columns.row_start(k) + a)))
-                }),
-            )
-        };
-        let row_columns = by_row(|k, _| k);
-        let row_positions = by_row(|_, position| position);
-        let levels = height_levels(&parent);
         Self {
             perm,
             inverse,
             parent,
             columns,
-            row_columns,
-            row_positions,
-            levels,
         }
-    }
-
-    /// Columns k < i (ascending) of the strictly lower blocks of row `i` of L, and their storage positions.
-    pub fn row(&self, i: usize) -> (&[usize], &[usize]) {
-        (self.row_columns.row(i), self.row_positions.row(i))
-    }
-
-    /// The columns grouped by height in the elimination tree, lowest first; each group ascending.
-    pub fn levels(&self) -> &Csr {
-        &self.levels
     }
 
     /// Number of block rows.
@@ -192,19 +154,6 @@ fn elimination_tree(rows: &Csr) -> Vec<usize> {
     parent
 }
 
-/// Columns grouped by their height in the elimination tree (a leaf has height 0, a parent one more than its
-/// highest child). A parent has a larger index than its children, so one ascending pass sets every height.
-fn height_levels(parent: &[usize]) -> Csr {
-    let mut height = vec![0usize; parent.len()];
-    for j in 0..parent.len() {
-        if parent[j] != NONE {
-            height[parent[j]] = height[parent[j]].max(height[j] + 1);
-        }
-    }
-    let levels = height.iter().max().map_or(0, |h| h + 1);
-    Csr::from_pairs(levels, height.iter().enumerate().map(|(j, &h)| (h, j)))
-}
-
 /// Strictly lower structure of L by column: row i of L is the union of the elimination-tree paths from each
 /// j of row i of A up to i (the row subtree, Davis 2006, 4.2); visiting rows in order fills each column
 /// ascending.
@@ -275,12 +224,6 @@ mod tests {
             assert_eq!(reversed.parent(j), Some(n - 1));
         }
         assert_eq!(reversed.parent(n - 1), None);
-        // Row form and levels: the hub (new n − 1) holds every other column; all others are leaves.
-        assert_eq!(reversed.row(n - 1).0, &[0, 1, 2, 3]);
-        assert_eq!(reversed.row(n - 1).1, &[0, 1, 2, 3]);
-        assert_eq!(reversed.levels().row(0), &[0, 1, 2, 3]);
-        assert_eq!(reversed.levels().row(1), &[4]);
-        assert_eq!(natural.levels().rows(), n);
         assert_eq!(reversed.slot(0, 0), Some(Slot::Diagonal(n - 1)));
         // Old (1, 0) is new (3, 4): stored transposed at (4, 3).
         assert_eq!(reversed.slot(1, 0), Some(Slot::Upper(3)));
