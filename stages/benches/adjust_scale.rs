@@ -101,10 +101,16 @@ fn main() {
         adj.termination,
         peak_rss_mib(),
     );
-    if let Some(path) = args.iter().find_map(|a| a.strip_prefix("--write-positions=")) {
+    if let Some(path) = args
+        .iter()
+        .find_map(|a| a.strip_prefix("--write-positions="))
+    {
         std::fs::write(path, positions_text(&adj)).expect("write the positions file");
     }
-    if let Some(path) = args.iter().find_map(|a| a.strip_prefix("--compare-positions=")) {
+    if let Some(path) = args
+        .iter()
+        .find_map(|a| a.strip_prefix("--compare-positions="))
+    {
         let text = std::fs::read_to_string(path).expect("read the positions file");
         compare_positions(&text, &adj);
     }
@@ -147,9 +153,17 @@ fn positions_text(adj: &skytie_stages::adjustment::Adjustment) -> String {
 fn compare_positions(text: &str, adj: &skytie_stages::adjustment::Adjustment) {
     let rows: Vec<Vec<f64>> = text
         .lines()
-        .map(|l| l.split_whitespace().map(|v| v.parse().expect("a number")).collect())
+        .map(|l| {
+            l.split_whitespace()
+                .map(|v| v.parse().expect("a number"))
+                .collect()
+        })
         .collect();
-    assert_eq!(rows.len(), adj.recordings.len(), "positions file of another block");
+    assert_eq!(
+        rows.len(),
+        adj.recordings.len(),
+        "positions file of another block"
+    );
     let (mut dp, mut ds) = (0.0f64, 0.0f64);
     for (row, r) in rows.iter().zip(&adj.recordings) {
         for k in 0..3 {
