@@ -5,6 +5,9 @@
 //! adjustment times, LM iterations, the peak resident memory (VmHWM) and the RMS horizontal error before and
 //! after. `--structure` also prints the size of the reduced camera matrix and of its sparse factor.
 //! Run through `benches/adjust_scale.sh` for the 10⁴ / 10⁵ / 10⁶ table.
+//! `--write-positions=FILE` writes the adjusted positions and their a-priori σ (one line per recording, full
+//! precision); `--compare-positions=FILE` prints the largest difference to such a file in millimetres (to
+//! check that a change of the solver leaves the result unchanged).
 
 use skytie_stages::adjustment::layout::ReducedStructure;
 use skytie_stages::adjustment::prepared::{Prepared, Rejected};
@@ -98,6 +101,19 @@ fn main() {
         adj.termination,
         peak_rss_mib(),
     );
+    if let Some(path) = args
+        .iter()
+        .find_map(|a| a.strip_prefix("--write-positions="))
+    {
+        std::fs::write(path, positions_text(&adj)).expect("write the positions file");
+    }
+    if let Some(path) = args
+        .iter()
+        .find_map(|a| a.strip_prefix("--compare-positions="))
+    {
+        let text = std::fs::read_to_string(path).expect("read the positions file");
+        compare_positions(&text, &adj);
+    }
     if args.iter().any(|a| a == "--structure") {
         drop(adj);
         print_structure(b, &options);
@@ -119,5 +135,45 @@ fn print_structure(b: &Block, options: &AdjustOptions) {
     println!(
         "factor: longest column {} blocks, {updates} block updates per factorisation",
         lens.iter().max().unwrap_or(&0)
+    );
+}
+
+/// One line per recording: x y z σx σy σz (world, metres), shortest round-trip formatting.
+fn positions_text(adj: &skytie_stages::adjustment::Adjustment) -> String {
+    adj.recordings
+        .iter()
+        .map(|r| {
+            let (p, s) = (r.position_world, r.sigma_a_priori_m);
+            format!("{} {} {} {} {} {}\n", p.x, p.y, p.z, s.x, s.y, s.z)
+        })
+        .collect()
+}
+
+/// Prints the largest position and σ difference (mm) between `text` (from [`positions_text`]) and `adj`.
+fn compare_positions(text: &str, adj: &skytie_stages::adjustment::Adjustment) {
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .map(|l| {
+            l.split_whitespace()
+                .map(|v| v.parse().expect("a number"))
+                .collect()
+        })
+        .collect();
+    assert_eq!(
+        rows.len(),
+        adj.recordings.len(),
+        "positions file of another block"
+    );
+    let (mut dp, mut ds) = (0.0f64, 0.0f64);
+    for (row, r) in rows.iter().zip(&adj.recordings) {
+        for k in 0..3 {
+            dp = dp.max((row[k] - r.position_world[k]).abs());
+            ds = ds.max((row[3 + k] - r.sigma_a_priori_m[k]).abs());
+        }
+    }
+    println!(
+        "compared with the positions file: max position difference {:.3e} mm, max sigma difference {:.3e} mm",
+        dp * 1e3,
+        ds * 1e3
     );
 }

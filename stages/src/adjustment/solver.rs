@@ -3,9 +3,10 @@
 //! ([`super::schur`]).
 //!
 //! Convergence (reported as [`Termination`]): an accepted step whose largest component is below
-//! `step_tolerance`, or whose relative cost decrease is below `relative_cost_tolerance`; a zero cost; the
-//! iteration limit; or the damping limit (no decreasing step found: the estimate is at a minimum to machine
-//! precision).
+//! `step_tolerance`, or whose relative cost decrease is below `relative_cost_tolerance`; a rejected step that
+//! raises the cost by less than `relative_cost_tolerance` (the estimate is at the minimum to the precision of
+//! the cost: the previous estimate is kept); a zero cost; the iteration limit; or the damping limit (no
+//! decreasing step found). A rejected step raises the damping tenfold and at least to its initial value.
 
 use super::error::AdjustError;
 use super::linearization::linearize;
@@ -19,12 +20,20 @@ const MAX_LAMBDA: f64 = 1e16;
 /// Smallest damping kept after successful steps.
 const MIN_LAMBDA: f64 = 1e-12;
 
+/// The damping after a rejected step: ten times larger, and at least the initial damping. A damping far
+/// below the initial one barely changes the step (the diagonal is scaled by 1 + λ), so raising it tenfold
+/// from there would repeat nearly the same rejected step several times over.
+fn raised(lambda: f64, initial_lambda: f64) -> f64 {
+    (lambda * 10.0).max(initial_lambda)
+}
+
 /// Why a solve stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Termination {
     /// The largest parameter update fell below `step_tolerance`.
     StepSize,
-    /// The relative cost decrease fell below `relative_cost_tolerance`.
+    /// The relative cost change of a step fell below `relative_cost_tolerance` (a decrease, or an increase
+    /// within it: then the step was not taken).
     CostChange,
     /// The cost is exactly zero.
     ZeroCost,
@@ -89,11 +98,16 @@ pub fn solve(
                         }
                         break;
                     }
-                    lambda *= 10.0;
+                    if new_cost - cost <= lm.relative_cost_tolerance * cost {
+                        // The step changes the cost by less than the tolerance, only upwards: the estimate
+                        // is at the minimum to the precision of the cost; more damping would only repeat this.
+                        break 'outer Termination::CostChange;
+                    }
+                    lambda = raised(lambda, lm.initial_lambda);
                 }
                 Err(failure) => {
                     last_failure = Some(failure);
-                    lambda *= 10.0;
+                    lambda = raised(lambda, lm.initial_lambda);
                 }
             }
             if lambda > MAX_LAMBDA {
