@@ -74,15 +74,16 @@ mod tests {
     use skytie_stages::campaign::Recording;
 
     fn campaign(ids: &[&str]) -> Campaign {
-        let mut c = Campaign::default();
-        c.recordings = ids
-            .iter()
-            .map(|id| Recording {
-                image_id: (*id).to_owned(),
-                ..Recording::default()
-            })
-            .collect();
-        c
+        Campaign {
+            recordings: ids
+                .iter()
+                .map(|id| Recording {
+                    image_id: (*id).to_owned(),
+                    ..Recording::default()
+                })
+                .collect(),
+            ..Campaign::default()
+        }
     }
 
     #[test]

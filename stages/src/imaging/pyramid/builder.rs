@@ -58,7 +58,7 @@ impl<S: Sample> Level<S> {
             pending: Vec::with_capacity(width),
             has_pending: false,
             reduced: Vec::with_capacity(width.div_ceil(2)),
-            repeats_next: width % 2 == 0 && height % 2 == 0,
+            repeats_next: width.is_multiple_of(2) && height.is_multiple_of(2),
         }
     }
 
