@@ -63,16 +63,7 @@ impl Stage for OrthophotoStage {
             sigma_m: p.sigma_m,
             dtm: dtm.first().map(|d| (d.as_ref(), p.dtm_sigma_m)),
         };
-        // The neighbours' orthos come in the window's neighbour order (`window.pairs`).
-        let neighbours: Vec<NeighbourOrtho> = window
-            .pairs
-            .iter()
-            .zip(&neighbour_orthos)
-            .map(|(pair, o)| NeighbourOrtho {
-                recording_id: &pair.to_id,
-                ortho: o,
-            })
-            .collect();
+        let neighbours = NeighbourOrtho::of_window(&window, &neighbour_orthos);
         orthophoto_control(&ortho, &window, &neighbours, &input, &p.route)
             .map_err(|e| StageError::new(format!("orthophoto {}: {e}", p.tile.file)))
     }

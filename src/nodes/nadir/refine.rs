@@ -25,16 +25,7 @@ impl Stage for RefineStage {
 
     fn run(&self, p: &RefineParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (ortho, aerial_file, aerial, outcome, window, neighbour_orthos) = inputs;
-        // The neighbours' orthos come in the window's neighbour order (`window.pairs`).
-        let neighbours: Vec<NeighbourOrtho> = window
-            .pairs
-            .iter()
-            .zip(&neighbour_orthos)
-            .map(|(pair, o)| NeighbourOrtho {
-                recording_id: &pair.to_id,
-                ortho: o,
-            })
-            .collect();
+        let neighbours = NeighbourOrtho::of_window(&window, &neighbour_orthos);
         locate_with_accepted(&outcome, &window, &aerial, &aerial_file, |t, image| {
             refine_in_aerial(&ortho, image, &aerial, t, &window, &neighbours, p)
         })

@@ -23,7 +23,7 @@
 use super::aerial_patch::{aerial_ground_similarity, extract_patch, level_of_scale, AerialPatch};
 use super::ortho::{OrthoGeoref, OrthoImage};
 use super::registration::{InitialTransform, TransformOutcome};
-use super::translation_consensus::{false_alarms, translation_consensus};
+use super::translation_consensus::{consensus_doubt, translation_consensus};
 use crate::campaign::{AerialImage, Recording};
 use crate::estimators::{mix_seed, ransac_filtered, RansacParams};
 use crate::features::kaze::{detect_and_describe, Features, KazeParams};
@@ -640,27 +640,9 @@ fn similarity_by_translation_consensus(
         },
     )?;
     let n = c.inliers.len();
-    if (n as f64) < p.min_consensus_margin * c.runner_up as f64 {
-        return Err(rejected(
-            format!(
-                "{n_matches} matches: ambiguous translation ({n} inliers, a competing one has {})",
-                c.runner_up
-            ),
-            n_matches,
-            n,
-        ));
-    }
-    let nfa = false_alarms(n_matches, n, p.ransac_threshold_px, window_px);
-    if nfa > p.max_false_alarms {
-        return Err(rejected(
-            format!(
-                "{n_matches} matches: a consensus of {n} is what chance gives (expected {nfa:.2} among \
-                 random matches > {})",
-                p.max_false_alarms
-            ),
-            n_matches,
-            n,
-        ));
+    let limits = (p.min_consensus_margin, p.max_false_alarms);
+    if let Some(reason) = consensus_doubt(&c, n_matches, limits, p.ransac_threshold_px, window_px) {
+        return Err(rejected(reason, n_matches, n));
     }
     Ok((c.model, n))
 }

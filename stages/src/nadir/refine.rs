@@ -300,6 +300,24 @@ pub struct NeighbourOrtho<'a> {
     pub ortho: &'a OrthoImage,
 }
 
+impl<'a> NeighbourOrtho<'a> {
+    /// The neighbours of `window` with their orthos, given in the window's neighbour order (`window.pairs`).
+    pub fn of_window<O: std::ops::Deref<Target = OrthoImage>>(
+        window: &'a MmWindowMatch,
+        orthos: &'a [O],
+    ) -> Vec<Self> {
+        window
+            .pairs
+            .iter()
+            .zip(orthos)
+            .map(|(pair, o)| NeighbourOrtho {
+                recording_id: &pair.to_id,
+                ortho: o,
+            })
+            .collect()
+    }
+}
+
 /// Locate every tie point of `window` in one aerial nadir image by phase correlation (thesis 3.4.5.3).
 ///
 /// `mm_ortho` must be the ortho image of the window's detecting recording (`window.recording_id`) at about the

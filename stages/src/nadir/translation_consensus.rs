@@ -61,6 +61,33 @@ pub fn false_alarms(n: usize, k: usize, threshold_px: f64, window_px: f64) -> f6
     n as f64 * tail
 }
 
+/// Why the consensus `c` of `n_matches` matches is not accepted, if it is not: a competing translation has more
+/// than `1 / min_margin` of its support (ambiguous content), or a consensus of its size among matches spread over
+/// the ±`window_px` window is what chance gives (more than `max_false_alarms` false alarms, [`false_alarms`]
+/// with `threshold_px`).
+pub fn consensus_doubt(
+    c: &TranslationConsensus,
+    n_matches: usize,
+    (min_margin, max_false_alarms): (f64, f64),
+    threshold_px: f64,
+    window_px: f64,
+) -> Option<String> {
+    let n = c.inliers.len();
+    if (n as f64) < min_margin * c.runner_up as f64 {
+        return Some(format!(
+            "{n_matches} matches: ambiguous translation ({n} inliers, a competing one has {})",
+            c.runner_up
+        ));
+    }
+    let nfa = false_alarms(n_matches, n, threshold_px, window_px);
+    (nfa > max_false_alarms).then(|| {
+        format!(
+            "{n_matches} matches: a consensus of {n} is what chance gives (expected {nfa:.2} among \
+             random matches > {max_false_alarms})"
+        )
+    })
+}
+
 fn members(offsets: &[Vector2<f64>], t: &Vector2<f64>, threshold_px: f64) -> (Vec<usize>, f64) {
     let t2 = threshold_px * threshold_px;
     let mut idx = Vec::new();

@@ -17,7 +17,7 @@ use crate::imaging::pyramid::{PyramidError, TileSource};
 use crate::matching::descriptor_match::match_windowed;
 use crate::nadir::aerial_patch::AerialWindow;
 use crate::nadir::initial_transform::{fill_masked, near_mask, wallis_kaze, TransformParams};
-use crate::nadir::translation_consensus::{false_alarms, translation_consensus};
+use crate::nadir::translation_consensus::{consensus_doubt, translation_consensus};
 use crate::nadir::{InitialTransform, OrthoGeoref, OrthoImage, TransformOutcome};
 use nalgebra::Vector2;
 
@@ -123,27 +123,9 @@ fn find_translation(
             n,
         ));
     }
-    if (n as f64) < t.min_consensus_margin * c.runner_up as f64 {
-        return Err(rejected(
-            format!(
-                "{n_matches} matches: ambiguous translation ({n} inliers, a competing one has {})",
-                c.runner_up
-            ),
-            n_matches,
-            n,
-        ));
-    }
-    let nfa = false_alarms(n_matches, n, t.ransac_threshold_px, window_px);
-    if nfa > t.max_false_alarms {
-        return Err(rejected(
-            format!(
-                "{n_matches} matches: a consensus of {n} is what chance gives (expected {nfa:.2} among \
-                 random matches > {})",
-                t.max_false_alarms
-            ),
-            n_matches,
-            n,
-        ));
+    let limits = (t.min_consensus_margin, t.max_false_alarms);
+    if let Some(reason) = consensus_doubt(&c, n_matches, limits, t.ransac_threshold_px, window_px) {
+        return Err(rejected(reason, n_matches, n));
     }
     // The ortho centre's shift in full orthophoto pixels, on the ground (north-up: v grows southwards).
     let centre = Vector2::new(ortho.image.width as f64, ortho.image.height as f64) / 2.0;
