@@ -317,14 +317,15 @@ pub fn initial_transform(
     ))
 }
 
-/// Why a transform was rejected, with the matches and inliers it had got to by then.
-struct Rejection {
-    reason: String,
-    matches: usize,
-    inliers: usize,
+/// Why a transform (or an orthophoto registration) was rejected, with the matches and inliers it had got to by
+/// then.
+pub(crate) struct Rejection {
+    pub(crate) reason: String,
+    pub(crate) matches: usize,
+    pub(crate) inliers: usize,
 }
 
-fn rejected(reason: impl Into<String>, matches: usize, inliers: usize) -> Rejection {
+pub(crate) fn rejected(reason: impl Into<String>, matches: usize, inliers: usize) -> Rejection {
     Rejection {
         reason: reason.into(),
         matches,

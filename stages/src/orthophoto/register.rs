@@ -16,7 +16,9 @@ use crate::imaging::georef::GeoTransform;
 use crate::imaging::pyramid::{PyramidError, TileSource};
 use crate::matching::descriptor_match::match_windowed;
 use crate::nadir::aerial_patch::AerialWindow;
-use crate::nadir::initial_transform::{fill_masked, near_mask, wallis_kaze, TransformParams};
+use crate::nadir::initial_transform::{
+    fill_masked, near_mask, rejected, wallis_kaze, Rejection, TransformParams,
+};
 use crate::nadir::translation_consensus::{consensus_doubt, translation_consensus};
 use crate::nadir::{InitialTransform, OrthoGeoref, OrthoImage, TransformOutcome};
 use nalgebra::Vector2;
@@ -28,21 +30,6 @@ pub fn nominal_transform(georef: &OrthoGeoref, photo: &GeoTransform) -> Similari
     let (u0, v0) = photo.world_to_pixel(p0.x, p0.y);
     let (u1, v1) = photo.world_to_pixel(p1.x, p1.y);
     Similarity2::from_ab(u1 - u0, v1 - v0, u0, v0)
-}
-
-/// Why a registration was rejected, with the matches and inliers it had got to by then.
-struct Rejection {
-    reason: String,
-    matches: usize,
-    inliers: usize,
-}
-
-fn rejected(reason: impl Into<String>, matches: usize, inliers: usize) -> Rejection {
-    Rejection {
-        reason: reason.into(),
-        matches,
-        inliers,
-    }
 }
 
 /// Register `ortho` (recording `recording_id`) in the orthophoto tile `photo` (id `photo_id`, placed by
