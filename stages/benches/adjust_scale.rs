@@ -9,23 +9,16 @@
 //! precision); `--compare-positions=FILE` prints the largest difference to such a file in millimetres (to
 //! check that a change of the solver leaves the result unchanged).
 
+#[path = "peer_support/mod.rs"]
+mod peer_support;
+
+use peer_support::peak_rss_mib;
 use skytie_stages::adjustment::layout::ReducedStructure;
 use skytie_stages::adjustment::prepared::{Prepared, Rejected};
 use skytie_stages::adjustment::residuals::State;
 use skytie_stages::adjustment::synthetic_streets::StreetBlockSpec;
 use skytie_stages::adjustment::{adjust, AdjustOptions, Block};
 use std::time::Instant;
-
-fn peak_rss_mib() -> f64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
-        })
-        .map_or(f64::NAN, |kib| kib / 1024.0)
-}
 
 fn rms_xy(
     positions: impl Iterator<Item = nalgebra::Vector3<f64>>,

@@ -8,22 +8,15 @@
 //! `oblique-linear` run the per-image scans the indexes replace, for comparison. Run through
 //! `benches/outputs_scale.sh` for the 10⁴ / 10⁵ table.
 
+#[path = "peer_support/mod.rs"]
+mod peer_support;
+
+use peer_support::peak_rss_mib;
 use skytie_stages::export::synthetic_outputs::{write_outputs, OutputsSpec};
 use skytie_stages::nadir::aerial_overlap::{overlapping_nadir, NadirOverlap};
 use skytie_stages::oblique::candidates::{candidate_oblique, ObliqueCandidates};
 use std::path::PathBuf;
 use std::time::Instant;
-
-fn peak_rss_mib() -> f64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
-        })
-        .map_or(f64::NAN, |kib| kib / 1024.0)
-}
 
 /// Façade search distance and height of the oblique defaults, metres.
 const FACADE_M: (f64, f64) = (20.0, 15.0);

@@ -1,5 +1,5 @@
 //! Helpers shared by the peer-comparison benches (`phasecorr`, `ortho`, `mi`, `daisy_agast`) and `imaging`: the
-//! folder the identical inputs go to, thread CPU time, median timers and a minimal `.npy` writer. Included with
+//! folder the identical inputs go to, thread CPU time, peak memory, median timers and a minimal `.npy` writer. Included with
 //! `#[path = "peer_support/mod.rs"] mod peer_support;` (not a bench target of its own).
 
 #![allow(dead_code)]
@@ -76,4 +76,16 @@ pub fn write_npy_f32(path: &Path, rows: usize, cols: usize, data: &[f32]) {
         bytes.extend_from_slice(&v.to_le_bytes());
     }
     std::fs::write(path, bytes).expect("write .npy");
+}
+
+/// The process' peak resident memory so far (`VmHWM`), MiB; NaN where `/proc` does not say.
+pub fn peak_rss_mib() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+        })
+        .map_or(f64::NAN, |kib| kib / 1024.0)
 }

@@ -333,6 +333,64 @@ pub(crate) fn rejected(reason: impl Into<String>, matches: usize, inliers: usize
     }
 }
 
+/// MM keypoints to be matched with windowed descriptor matching: their descriptors, ortho pixels and
+/// predicted positions in the other image's window.
+#[derive(Default)]
+pub(crate) struct WindowedQuery {
+    descriptors: Vec<f32>,
+    ortho_px: Vec<(f64, f64)>,
+    predicted_px: Vec<[f64; 2]>,
+}
+
+impl WindowedQuery {
+    /// Adds a keypoint with its descriptor, its ortho pixel and its predicted (window) pixel.
+    pub(crate) fn push(&mut self, descriptor: &[f32], ortho_px: (f64, f64), predicted: (f64, f64)) {
+        self.descriptors.extend_from_slice(descriptor);
+        self.ortho_px.push(ortho_px);
+        self.predicted_px.push([predicted.0, predicted.1]);
+    }
+
+    /// How many keypoints were added.
+    pub(crate) fn len(&self) -> usize {
+        self.ortho_px.len()
+    }
+
+    /// The keypoints matched to `train`'s within ±`window_px` of their predictions (Lowe `ratio`), each as a
+    /// pair (ortho pixel → full pixel of the other image, through `to_full` from window pixels).
+    pub(crate) fn match_pairs(
+        &self,
+        train: &Features,
+        window_px: f64,
+        ratio: f32,
+        to_full: impl Fn(f64, f64) -> (f64, f64),
+    ) -> Result<Vec<PointPair>, Rejection> {
+        let train_px: Vec<[f64; 2]> = train
+            .keypoints
+            .iter()
+            .map(|k| [f64::from(k.u_px), f64::from(k.v_px)])
+            .collect();
+        let matched = match_windowed(
+            &self.descriptors,
+            &self.predicted_px,
+            &train.descriptors,
+            &train_px,
+            train.descriptor_len,
+            window_px,
+            ratio,
+        )
+        .map_err(|e| rejected(format!("descriptor matching failed: {e}"), 0, 0))?;
+        Ok(matched
+            .iter()
+            .flatten()
+            .map(|m| {
+                let (u, v) = self.ortho_px[m.query];
+                let (fu, fv) = to_full(train_px[m.train][0], train_px[m.train][1]);
+                PointPair::new(u, v, fu, fv)
+            })
+            .collect())
+    }
+}
+
 /// [`initial_transform`] once the aerial patch is read (`None`: the footprint misses the image).
 fn transform_with_patch(
     rec: &Recording,
@@ -530,55 +588,26 @@ fn matched_keypoints(
         &mm_ortho.georef,
         (mm_ortho.image.width, mm_ortho.image.height),
     );
-    let len = mm_features.descriptor_len;
-    let mut query_idx: Vec<usize> = Vec::with_capacity(mm_features.len());
-    let mut predicted: Vec<[f64; 2]> = Vec::with_capacity(mm_features.len());
+    let mut query = WindowedQuery::default();
     for (i, k) in mm_features.keypoints.iter().enumerate() {
         let (u, v) = (f64::from(k.u_px), f64::from(k.v_px));
         if near_mask(&mm_ortho.valid, w, h, u, v, p.mask_clearance_px) {
             continue;
         }
         if let Some((au, av)) = cam.project_world(&georef.pixel_to_world(u, v)) {
-            let (pu, pv) = patch.to_patch(au, av);
-            query_idx.push(i);
-            predicted.push([pu, pv]);
+            query.push(mm_features.descriptor(i), (u, v), patch.to_patch(au, av));
         }
     }
-    let mut query: Vec<f32> = Vec::with_capacity(query_idx.len() * len);
-    for &i in &query_idx {
-        query.extend_from_slice(mm_features.descriptor(i));
-    }
-    let train_px: Vec<[f64; 2]> = aerial_features
-        .keypoints
-        .iter()
-        .map(|k| [f64::from(k.u_px), f64::from(k.v_px)])
-        .collect();
-    let matched = match_windowed(
-        &query,
-        &predicted,
-        &aerial_features.descriptors,
-        &train_px,
-        len,
-        window_px,
-        p.match_ratio,
-    )
-    .map_err(|e| rejected(format!("descriptor matching failed: {e}"), 0, 0))?;
-    let pairs: Vec<PointPair> = matched
-        .iter()
-        .flatten()
-        .map(|m| {
-            let k = &mm_features.keypoints[query_idx[m.query]];
-            let (au, av) = patch.to_full(train_px[m.train][0], train_px[m.train][1]);
-            PointPair::new(f64::from(k.u_px), f64::from(k.v_px), au, av)
-        })
-        .collect();
+    let pairs = query.match_pairs(&aerial_features, window_px, p.match_ratio, |u, v| {
+        patch.to_full(u, v)
+    })?;
     let n_matches = pairs.len();
     if n_matches < p.min_inliers {
         return Err(rejected(
             format!(
                 "{n_matches} descriptor matches in the ±{window_px:.1} px windows < {} required ({} MM, {} aerial keypoints)",
                 p.min_inliers,
-                query_idx.len(),
+                query.len(),
                 aerial_features.len()
             ),
             n_matches,

@@ -14,10 +14,9 @@ use super::OrthophotoParams;
 use crate::geometry::{PointPair, Similarity2};
 use crate::imaging::georef::GeoTransform;
 use crate::imaging::pyramid::{PyramidError, TileSource};
-use crate::matching::descriptor_match::match_windowed;
 use crate::nadir::aerial_patch::AerialWindow;
 use crate::nadir::initial_transform::{
-    fill_masked, near_mask, rejected, wallis_kaze, Rejection, TransformParams,
+    fill_masked, near_mask, rejected, wallis_kaze, Rejection, TransformParams, WindowedQuery,
 };
 use crate::nadir::translation_consensus::{consensus_doubt, translation_consensus};
 use crate::nadir::{InitialTransform, OrthoGeoref, OrthoImage, TransformOutcome};
@@ -185,44 +184,18 @@ fn matched_keypoints(
             0,
         ));
     }
-    let len = mm.descriptor_len;
-    let (mut query, mut predicted, mut query_px) = (Vec::new(), Vec::new(), Vec::new());
+    let mut query = WindowedQuery::default();
     for (i, k) in mm.keypoints.iter().enumerate() {
         let (u, v) = (f64::from(k.u_px), f64::from(k.v_px));
         if near_mask(&ortho.valid, w, h, u, v, t.mask_clearance_px) {
             continue;
         }
         let p = win.ortho_to_window.apply(&Vector2::new(u, v));
-        query.extend_from_slice(mm.descriptor(i));
-        predicted.push([p.x, p.y]);
-        query_px.push((u, v));
+        query.push(mm.descriptor(i), (u, v), (p.x, p.y));
     }
-    let train_px: Vec<[f64; 2]> = photo
-        .keypoints
-        .iter()
-        .map(|k| [f64::from(k.u_px), f64::from(k.v_px)])
-        .collect();
-    let matched = match_windowed(
-        &query,
-        &predicted,
-        &photo.descriptors,
-        &train_px,
-        len,
-        window_px,
-        t.match_ratio,
-    )
-    .map_err(|e| rejected(format!("descriptor matching failed: {e}"), 0, 0))?;
-    let pairs: Vec<PointPair> = matched
-        .iter()
-        .flatten()
-        .map(|m| {
-            let (u, v) = query_px[m.query];
-            let (pu, pv) = win
-                .window
-                .to_full(train_px[m.train][0], train_px[m.train][1]);
-            PointPair::new(u, v, pu, pv)
-        })
-        .collect();
+    let pairs = query.match_pairs(&photo, window_px, t.match_ratio, |u, v| {
+        win.window.to_full(u, v)
+    })?;
     if pairs.len() < t.min_inliers {
         return Err(rejected(
             format!(
@@ -230,7 +203,7 @@ fn matched_keypoints(
                  keypoints)",
                 pairs.len(),
                 t.min_inliers,
-                predicted.len(),
+                query.len(),
                 photo.len()
             ),
             pairs.len(),
