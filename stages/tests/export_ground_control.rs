@@ -89,6 +89,7 @@ fn control() -> Vec<AerialControlPoint> {
         u_px: u,
         v_px: v,
         score: 0.9,
+        sigma_px: None,
     };
     vec![
         AerialControlPoint {

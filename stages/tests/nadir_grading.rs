@@ -63,6 +63,7 @@ fn a_shifted_aerial_observation_is_graded_wrong_and_listed() {
                 u_px: u + shift_u,
                 v_px: v,
                 score: 0.9,
+                sigma_px: None,
             },
             predicted_u_px: u,
             predicted_v_px: v,

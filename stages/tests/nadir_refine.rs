@@ -516,6 +516,7 @@ fn refinement_at(
                     u_px: *u,
                     v_px: *v,
                     score: 0.5,
+                    sigma_px: None,
                 },
                 predicted_u_px: *u,
                 predicted_v_px: *v,

@@ -189,6 +189,7 @@ fn grade_counts_before_and_after_consensus_per_side() {
             u_px: 0.0,
             v_px: 0.0,
             score: 1.0,
+            sigma_px: None,
         }],
         point_world: Some([x.x + 0.03, x.y, x.z + 0.04]),
         covariance_m2: None,

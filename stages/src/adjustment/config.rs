@@ -91,8 +91,9 @@ crate::params! {
         control_weighting: ControlWeighting = ControlWeighting::Fixed;
         /// σ of an aerial control point per axis with `control_weighting = "fixed"` (thesis: 0.10 m).
         control_sigma_m: f64 = DEFAULT_CONTROL_SIGMA_M, unit "m", above 0.0;
-        /// Put the aerial pixel observations into the bundle (aerial orientation fixed) instead of
-        /// aerial-triangulated control points, so points seen in a single aerial image count too.
+        /// Put the aerial pixel observations into the bundle (aerial orientation fixed; σ of the pyramid
+        /// level each was located at) instead of aerial-triangulated control points, so points seen in a
+        /// single aerial image count too; `false` is the thesis' scheme, `default.toml` sets `true`.
         aerial_observations: bool = false;
         /// Robust loss on the observations: `none`, `huber` or `cauchy`.
         loss: LossKind = LossKind::None;

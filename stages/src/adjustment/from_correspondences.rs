@@ -27,7 +27,7 @@ use std::collections::HashMap;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("adjust", "4");
+pub const STAGE: StageId = StageId::new("adjust", "5");
 
 /// The inputs of one adjustment.
 #[derive(Clone, Copy, Debug)]
@@ -218,7 +218,7 @@ pub fn build_block(
         let mut aerial = Vec::with_capacity(cp.aerial.len());
         for a in &cp.aerial {
             let idx = cameras.index_of(inputs, a.kind, &a.image_id, &owner)?;
-            aerial.push((idx, a.u_px, a.v_px));
+            aerial.push((idx, a.u_px, a.v_px, a.sigma_px));
         }
         let p = match point_index.get(&cp.tie_point_id) {
             Some(&p) => p,
@@ -254,7 +254,9 @@ pub fn build_block(
         if points[p].kind != PointKind::Control {
             points[p].kind = kind;
         }
-        points[p].aerial.extend(aerial.iter().copied());
+        points[p]
+            .aerial
+            .extend(aerial.iter().map(|&(camera, u, v, _)| (camera, u, v)));
         if config.aerial_observations && cp.map.is_none() {
             add_aerial_observations(&mut block, &cameras.rows, p, &aerial, &mut counts);
         } else if let Some(xyz) = cp
@@ -477,17 +479,18 @@ fn add_point(
     });
 }
 
-/// A control point's aerial pixels as observations of point `p` in the bundle (aerial orientations fixed);
-/// an observation whose camera does not see the point's initial position is skipped and counted.
+/// A control point's aerial pixels as observations of point `p` in the bundle (aerial orientations fixed),
+/// each with its own σ (the level it was located at) or else its image's `sigma_px`; an observation whose
+/// camera does not see the point's initial position is skipped and counted.
 fn add_aerial_observations(
     block: &mut Block,
     rows: &[&AerialImage],
     p: usize,
-    aerial: &[(usize, f64, f64)],
+    aerial: &[(usize, f64, f64, Option<f64>)],
     counts: &mut BuildCounts,
 ) {
     let initial = block.points_initial_world[p];
-    for &(camera, u_px, v_px) in aerial {
+    for &(camera, u_px, v_px, sigma_px) in aerial {
         if FrameCamera::from_aerial(rows[camera])
             .project_world(&initial)
             .is_none()
@@ -501,7 +504,9 @@ fn add_aerial_observations(
             point: p,
             u_px,
             v_px,
-            sigma_px: rows[camera].sigma_px,
+            sigma_px: sigma_px
+                .filter(|s| s.is_finite() && *s > 0.0)
+                .unwrap_or(rows[camera].sigma_px),
         });
     }
     counts.control_as_aerial_observations += usize::from(!aerial.is_empty());

@@ -219,6 +219,7 @@ impl SyntheticCampaignSpec {
                             u_px: u,
                             v_px: v,
                             score: 1.0,
+                            sigma_px: None,
                         });
                     }
                 }

@@ -27,6 +27,11 @@ pub struct AerialObservation {
     pub v_px: f64,
     /// Matching quality of this observation (phase-correlation peak or NCC/MI score; higher is better).
     pub score: f64,
+    /// σ of this observation in full-resolution pixels when the stage that located it knows it better than
+    /// the image's `sigma_px` (a point located at pyramid level l is `sigma_px · 2^l` full pixels precise);
+    /// `None`: the image's `sigma_px`.
+    #[serde(default)]
+    pub sigma_px: Option<f64>,
 }
 
 /// A point matched across 2–3 adjacent panoramas (thesis 3.4.4) and triangulated from them (3.4.4.5).

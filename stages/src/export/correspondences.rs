@@ -85,6 +85,7 @@ mod tests {
                 u_px: 100.125,
                 v_px: 200.0,
                 score: 0.9,
+                sigma_px: None,
             }],
             point_world: None,
             covariance_m2: None,

@@ -221,6 +221,7 @@ impl OutputsSpec {
                         u_px: u,
                         v_px: v,
                         score: 0.9,
+                        sigma_px: None,
                     })
                     .collect(),
                 point_world: (aerial.len() >= 2).then(|| point_world.into()),

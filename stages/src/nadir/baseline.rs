@@ -42,7 +42,7 @@ use nalgebra::{Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("baseline", "5");
+pub const STAGE: StageId = StageId::new("baseline", "6");
 
 crate::params! {
     /// Parameters of [`baseline_matches`]; thesis 2.2.3 values as defaults.
@@ -236,6 +236,7 @@ pub fn baseline_matches(
                     u_px: k[0],
                     v_px: k[1],
                     score: m.score as f64,
+                    sigma_px: None,
                 };
                 (
                     true,

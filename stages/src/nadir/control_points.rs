@@ -45,7 +45,7 @@ use nalgebra::{Matrix3, Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("control", "3");
+pub const STAGE: StageId = StageId::new("control", "4");
 
 crate::params! {
     /// Parameters of [`aerial_control_points`].
@@ -285,7 +285,13 @@ pub fn aerial_control_points_in(
             map: None,
             tie_point_id: tp.id.clone(),
             mm: tp.observations.clone(),
-            aerial: kept.into_iter().map(|c| c.observation).collect(),
+            aerial: kept
+                .into_iter()
+                .map(|c| AerialObservation {
+                    sigma_px: Some(c.sigma_px),
+                    ..c.observation
+                })
+                .collect(),
             point_world: point.as_ref().map(|(x, _)| to_array(x)),
             covariance_m2: point.as_ref().map(|(_, c)| {
                 [

@@ -47,7 +47,7 @@ use nalgebra::{Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("refine", "8");
+pub const STAGE: StageId = StageId::new("refine", "9");
 
 /// Taper applied before the Fourier transform (serialisable mirror of [`WindowKind`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -435,6 +435,7 @@ pub fn refine_in_image(
                     u_px: observed.x,
                     v_px: observed.y,
                     score: peak,
+                    sigma_px: None,
                 },
                 predicted_u_px: predicted.x,
                 predicted_v_px: predicted.y,
@@ -518,6 +519,7 @@ mod tests {
                 u_px: 1000.0 + shift.0,
                 v_px: 2000.0 + shift.1,
                 score: 0.9,
+                sigma_px: None,
             },
             predicted_u_px: 1000.0,
             predicted_v_px: 2000.0,

@@ -47,7 +47,7 @@ use crate::params::{Params, StageId};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("oblique", "3");
+pub const STAGE: StageId = StageId::new("oblique", "4");
 
 /// What happens to the matches of a set smaller than `min_set_size` (`"keep"` or `"drop"` in a workflow).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -322,6 +322,7 @@ fn control_points(
                 u_px: c.matched.oblique_px[0],
                 v_px: c.matched.oblique_px[1],
                 score: c.matched.score,
+                sigma_px: None,
             })
             .collect();
         let (point_world, covariance_m2) = if aerial.len() >= 2 {
