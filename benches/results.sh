@@ -209,6 +209,8 @@ main_runs = [r for r in runs if not r["route"]]
 route_runs = [r for r in runs if r["route"]]
 
 def table(rows, runs=main_runs):
+    if not runs:
+        return
     w("| | " + " | ".join(r["label"] for r in runs) + " | `metrics.json` key |")
     w("|---|" + "---|" * len(runs) + "---|")
     for title, key, kind, *guard in rows:
