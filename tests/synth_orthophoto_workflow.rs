@@ -58,16 +58,30 @@ fn synth_table_orthophoto_keys_generate_the_cli_campaign() {
         .find(|g| files_under(g, &[]) == cli_files)
         .unwrap_or_else(|| panic!("no generated campaign equals `skytie synth`'s: {generated:?}"));
     let files = files_under(node, &[]);
-    for expected in ["orthophoto/ortho_0.tif", "orthophoto/dtm_0.tif", "truth/orthophoto.toml"] {
-        assert!(files.contains_key(expected), "{expected} missing: {:?}", files.keys());
+    for expected in [
+        "orthophoto/ortho_0.tif",
+        "orthophoto/dtm_0.tif",
+        "truth/orthophoto.toml",
+    ] {
+        assert!(
+            files.contains_key(expected),
+            "{expected} missing: {:?}",
+            files.keys()
+        );
     }
+    // The nadir camera table stays (empty of frames); no nadir image is written.
     assert!(
-        !files.keys().any(|f| f.starts_with("aerial/nadir")),
+        !files
+            .keys()
+            .any(|f| f.starts_with("aerial/nadir/") && !f.ends_with(".csv")),
         "nadir frames written although without_nadir = true: {:?}",
         files.keys()
     );
     let toml = String::from_utf8(files["campaign.toml"].clone()).unwrap();
-    assert!(toml.contains("[orthophoto]") && toml.contains("[dtm]"), "{toml}");
+    assert!(
+        toml.contains("[orthophoto]") && toml.contains("[dtm]"),
+        "{toml}"
+    );
     // σ per axis = error / √2.
     assert!(toml.contains("sigma_m = 0.0212"), "{toml}");
 }
@@ -79,7 +93,10 @@ fn synth_table_orthophoto_keys_without_a_gsd_are_refused() {
         ("orthophoto_error_m = 0.03", "orthophoto_error_m"),
         ("without_nadir = true", "without_nadir"),
         ("orthophoto_gsd_m = 0.005", "orthophoto_gsd_m"),
-        ("orthophoto_gsd_m = 0.1\northophoto_error_m = -1.0", "orthophoto_error_m"),
+        (
+            "orthophoto_gsd_m = 0.1\northophoto_error_m = -1.0",
+            "orthophoto_error_m",
+        ),
     ] {
         let wf = write_workflow(tmp.path(), keys);
         let (code, text) = exit_and_output(
@@ -93,6 +110,9 @@ fn synth_table_orthophoto_keys_without_a_gsd_are_refused() {
                 .arg("--quiet"),
         );
         assert!(code != 0 && code != 3, "`{keys}` accepted: {text}");
-        assert!(text.contains(named), "`{keys}`: the error does not name {named}: {text}");
+        assert!(
+            text.contains(named),
+            "`{keys}`: the error does not name {named}: {text}"
+        );
     }
 }

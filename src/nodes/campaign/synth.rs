@@ -156,7 +156,8 @@ impl SynthParams {
             let needs_gsd = |key: &str| {
                 Violation::new(
                     key,
-                    "set without an orthophoto; give orthophoto_gsd_m (e.g. 0.1) or remove it".to_string(),
+                    "set without an orthophoto; give orthophoto_gsd_m (e.g. 0.1) or remove it"
+                        .to_string(),
                 )
             };
             if self.orthophoto_error_m != 0.0 {
