@@ -14,6 +14,7 @@ use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
 use serde::{Deserialize, Serialize};
 use skytie_stages::params::Violation;
 use skytie_stages::synth::generate::{RenderIdentity, RENDER_STAGE, STAGE};
+use skytie_stages::synth::orthophoto::OrthophotoOptions;
 use skytie_stages::synth::output::{aerial_format_from, parse_size_px};
 use skytie_stages::synth::profile::{
     AerialEoParams, ComponentParams, EpochParams, InsParams, LensParams, OutageParams,
@@ -55,6 +56,15 @@ skytie_stages::params! {
         render_max_width_px: u32 = 0, unit "px";
         /// Write the campaign at its render size (the demo-size twin of a real-size preset).
         at_render_size: bool = false;
+        /// Also write an orthophoto of this GSD and a 1 m DTM (GeoTIFFs under `orthophoto/`, declared in
+        /// `campaign.toml`), as `skytie synth --orthophoto-gsd`; 0 = no orthophoto.
+        orthophoto_gsd_m: f64 = 0.0, unit "m", min 0.0, max 1.0;
+        /// RMS planimetric error (2-D) of the orthophoto: a known smooth warp, as `--orthophoto-error`; needs
+        /// `orthophoto_gsd_m`.
+        orthophoto_error_m: f64 = 0.0, unit "m", min 0.0, max 5.0;
+        /// Leave the nadir frames out (the orthophoto is the only nadir source), as `--without-nadir`; needs
+        /// `orthophoto_gsd_m`.
+        without_nadir: bool = false;
         /// `[synth.thesis]`: constant offset + noise (thesis 3.5.1.2).
         thesis: ThesisParams = ThesisParams::default(), section;
         /// `[synth.outage]`: GNSS outage drift.
@@ -129,11 +139,40 @@ impl SynthParams {
             o.sizes.render_max_width_px = Some(self.render_max_width_px);
         }
         o.sizes.at_render_size = self.at_render_size;
+        o.orthophoto = self.orthophoto()?;
         o.params().map_err(|e| match e {
             SynthError::InvalidOption { option, message } => Violation::new(option, message),
             other => Violation::new("preset", other.to_string()),
         })?;
         Ok(o)
+    }
+}
+
+impl SynthParams {
+    /// The orthophoto options of `orthophoto_gsd_m`, `orthophoto_error_m` and `without_nadir`: none when the
+    /// GSD is 0, an error naming the key when the other two are set without it.
+    fn orthophoto(&self) -> Result<Option<OrthophotoOptions>, Violation> {
+        if self.orthophoto_gsd_m == 0.0 {
+            let needs_gsd = |key: &str| {
+                Violation::new(
+                    key,
+                    "set without an orthophoto; give orthophoto_gsd_m (e.g. 0.1) or remove it"
+                        .to_string(),
+                )
+            };
+            if self.orthophoto_error_m != 0.0 {
+                return Err(needs_gsd("orthophoto_error_m"));
+            }
+            if self.without_nadir {
+                return Err(needs_gsd("without_nadir"));
+            }
+            return Ok(None);
+        }
+        Ok(Some(OrthophotoOptions {
+            gsd_m: self.orthophoto_gsd_m,
+            error_m: self.orthophoto_error_m,
+            without_nadir: self.without_nadir,
+        }))
     }
 }
 

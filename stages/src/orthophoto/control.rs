@@ -5,9 +5,11 @@
 //! panoramas (flagged [`HeightSource::MmGround`] and counted). Its covariance is diagonal: σ_xy² = (stated
 //! orthophoto accuracy)² + (`match_sigma_px` · working pixel size)², σ_z = the DTM's stated accuracy or
 //! `mm_height_sigma_m`. The whole route of one recording — initial transform ([`super::register`]),
-//! refinement with the parallax check against the window's neighbours (`nadir::refine`), control points — is
+//! refinement with the parallax check against the window's neighbours (`nadir::refine`) and weak peaks kept
+//! where the corrections agree ([`super::corroborate`]), control points — is
 //! [`orthophoto_control`].
 
+use super::corroborate::corroborated;
 use super::dtm::Dtm;
 use super::register::register_translation;
 use super::OrthophotoParams;
@@ -17,7 +19,8 @@ use crate::correspondence::{AerialControlPoint, HeightSource, MapControl};
 use crate::imaging::pyramid::{PyramidError, TileSource};
 use crate::nadir::refine::{refine_in_image, NeighbourOrtho};
 use crate::nadir::{
-    AerialRefinement, MmWindowMatch, OrthoImage, RecordingControl, TransformOutcome,
+    AerialRefinement, InitialTransform, MmWindowMatch, OrthoImage, RecordingControl,
+    TransformOutcome,
 };
 use serde::{Deserialize, Serialize};
 
@@ -44,6 +47,40 @@ pub struct OrthophotoInput<'a> {
     pub sigma_m: f64,
     /// The DTM and its stated height accuracy, m.
     pub dtm: Option<(&'a Dtm, f64)>,
+}
+
+/// The tie points of `window` located in the orthophoto: the refinement with its peak threshold lowered to
+/// `corroborated_min_peak`, then the weak peaks kept only where the located corrections agree
+/// ([`corroborated`]), then the refinement's `min_located` rule. Weak peaks dropped count as
+/// `shift_inconsistent`.
+fn refine_corroborated(
+    ortho: &OrthoImage,
+    photo: &OrthophotoInput,
+    t: &InitialTransform,
+    window: &MmWindowMatch,
+    neighbours: &[NeighbourOrtho],
+    p: &OrthophotoParams,
+) -> Result<AerialRefinement, PyramidError> {
+    let mut relaxed = p.refine.clone();
+    relaxed.min_peak = p.corroborated_min_peak.min(p.refine.min_peak);
+    relaxed.min_located = 1;
+    let image = (photo.tile.file.as_str(), AerialKind::Nadir);
+    let mut r = refine_in_image(ortho, photo.pixels, image, t, window, neighbours, &relaxed)?;
+    let scale = r.matches.first().map_or(1.0, |m| (1u64 << m.level) as f64);
+    let c = corroborated(
+        std::mem::take(&mut r.matches),
+        p.refine.min_peak,
+        p.corroboration_px,
+        p.min_corroborating,
+        scale,
+    );
+    r.shift_inconsistent += c.weak_dropped;
+    r.matches = c.kept;
+    if r.matches.len() < p.refine.min_located {
+        r.unconfirmed = r.matches.len();
+        r.matches.clear();
+    }
+    Ok(r)
 }
 
 /// The orthophoto route for the recording of `window`, whose ground ortho `ortho` was made north-up at the
@@ -83,15 +120,7 @@ pub fn orthophoto_control(
     let TransformOutcome::Accepted(t) = &transform else {
         return Ok(out);
     };
-    out.refinement = refine_in_image(
-        ortho,
-        photo.pixels,
-        (file, AerialKind::Nadir),
-        t,
-        window,
-        neighbours,
-        &p.refine,
-    )?;
+    out.refinement = refine_corroborated(ortho, photo, t, window, neighbours, p)?;
     let sigma_xy_m = photo.sigma_m.hypot(p.match_sigma_px * ortho.georef.gsd_m);
     for m in &out.refinement.matches {
         let Some(k) = window

@@ -6,6 +6,7 @@
 //! point becomes a control point whose XY comes from the orthophoto and Z from the DTM ([`control`]).
 
 pub mod control;
+pub mod corroborate;
 pub mod dtm;
 pub mod register;
 pub mod summary;
@@ -40,5 +41,13 @@ crate::params! {
         mm_height_sigma_m: f64 = 0.5, unit "m", min 0.001, max 100.0;
         /// The phase-correlation refinement of the tie points in the orthophoto (thesis 3.4.5.3).
         refine: RefineParams = RefineParams::default(), section;
+        /// Smallest correlation peak of a tie point kept because its correction agrees with the recording's other
+        /// located tie points ([`corroborate`]): a template partly hidden in the orthophoto (tree crowns) peaks
+        /// below `refine.min_peak` at its correct place. Equal to `refine.min_peak` = no relaxation.
+        corroborated_min_peak: f64 = 0.5, min 0.0, below 1.0;
+        /// Radius around the agreed correction within which a weak peak is corroborated, working pixels.
+        corroboration_px: f64 = 1.0, unit "px", min 0.0, max 10.0;
+        /// Fewest located tie points (weak or strong) that must agree on the correction for weak ones to be kept.
+        min_corroborating: usize = 3, min 2, max 100;
     }
 }
