@@ -281,7 +281,9 @@ fn verify_problems(m1: &serde_json::Value, m4: &serde_json::Value) -> Vec<String
             let (a, b) = (sigma(m1), sigma(m4));
             println!("{table}.overall.sigma_mean_m[{axis}]: {a:?} vs {b:?}");
             if !matches!((a, b), (Some(a), Some(b)) if (a - b).abs() <= 0.001) {
-                problems.push(format!("{table}.overall.sigma_mean_m[{axis}]: {a:?} vs {b:?}"));
+                problems.push(format!(
+                    "{table}.overall.sigma_mean_m[{axis}]: {a:?} vs {b:?}"
+                ));
             }
         }
     }

@@ -132,7 +132,12 @@ pub fn add_adjust(
                 VerifyStage,
                 "adjusted",
                 config,
-                (snap, pano_images, optional_all(&nadir.control), vec![report]),
+                (
+                    snap,
+                    pano_images,
+                    optional_all(&nadir.control),
+                    vec![report],
+                ),
             )?;
             b.metrics(v, "verify_adjusted", verify_metrics);
             out.verification_adjusted = Some(v);

@@ -51,9 +51,7 @@ fn aerial_row(rec: &Recording, scale: u32) -> AerialImage {
 /// A random texture of `width × height` grey values, each repeated `repeat × repeat` times.
 fn texture(width: usize, height: usize, repeat: usize, seed: u64) -> GrayImage {
     let mut rng = SplitMix64::new(seed);
-    let base: Vec<f32> = (0..width * height)
-        .map(|_| rng.next_f64() as f32)
-        .collect();
+    let base: Vec<f32> = (0..width * height).map(|_| rng.next_f64() as f32).collect();
     let (w, h) = (width * repeat, height * repeat);
     let data = (0..w * h)
         .map(|i| base[(i / w / repeat) * width + (i % w) / repeat])
@@ -102,7 +100,10 @@ fn a_pixel_repeated_frame_gives_the_same_aerial_ortho_as_the_original() {
         .zip(&b.image.data)
         .map(|(x, y)| (x - y).abs())
         .fold(0.0f32, f32::max);
-    assert!(max_diff < 1e-5, "ortho grey values differ by up to {max_diff}");
+    assert!(
+        max_diff < 1e-5,
+        "ortho grey values differ by up to {max_diff}"
+    );
     let c = ortho_project_whole(&panorama, &rec, &finer);
     assert_ne!(a.georef.width_px, c.georef.width_px);
 }
