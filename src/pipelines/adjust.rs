@@ -52,7 +52,7 @@ pub fn add_adjust(
             wf.path.display()
         )));
     }
-    let panos: Vec<RawFile> = items.iter().map(|i| i.pano.clone()).collect();
+    let pano_images: Vec<_> = items.iter().map(|i| i.pano_image).collect();
     if on(stage::ADJUST) {
         let config: AdjustConfig = cx.params(stage::ADJUST)?;
         let use_nadir = matches!(config.sources, Sources::Nadir | Sources::Combined);
@@ -80,14 +80,13 @@ pub fn add_adjust(
             Some(o) => (o.clouds.clone(), o.result.into_iter().collect()),
             None => (Vec::new(), Vec::new()),
         };
-        let pano_images: Vec<_> = items.iter().map(|i| i.pano_image).collect();
         let report = b.add(
             AdjustStage,
             config.sources.label(),
             config,
             (
                 snap,
-                pano_images,
+                pano_images.clone(),
                 optional_all(&windows),
                 optional_all(&control),
                 optional_all(&clouds),
@@ -121,7 +120,7 @@ pub fn add_adjust(
             config.clone(),
             (
                 snap,
-                panos.clone(),
+                pano_images.clone(),
                 optional_all(&nadir.control),
                 Vec::new(),
             ),
@@ -133,7 +132,12 @@ pub fn add_adjust(
                 VerifyStage,
                 "adjusted",
                 config,
-                (snap, panos, optional_all(&nadir.control), vec![report]),
+                (
+                    snap,
+                    pano_images,
+                    optional_all(&nadir.control),
+                    vec![report],
+                ),
             )?;
             b.metrics(v, "verify_adjusted", verify_metrics);
             out.verification_adjusted = Some(v);

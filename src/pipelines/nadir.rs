@@ -240,7 +240,7 @@ impl NadirChain<'_, '_> {
                 OrthoForAerial,
                 &label,
                 self.ortho_base.clone(),
-                (item.row, item.pano_image, aerial),
+                (item.row, item.pano_image, aerial, aerial_file),
             )?;
             if !self.cx.on(stage::TRANSFORM) {
                 continue;
@@ -299,7 +299,7 @@ impl NadirChain<'_, '_> {
                                 OrthoForAerial,
                                 &pair_label(&n.recording.image_id, &p.aerial_id),
                                 self.ortho_base.clone(),
-                                (n.row, n.pano_image, p.aerial),
+                                (n.row, n.pano_image, p.aerial, p.aerial_file),
                             )
                         })
                         .collect::<Result<Vec<_>, _>>()?;

@@ -3,12 +3,12 @@
 //! pass/fail flag against a tolerance. The node verifies the recorded positions (no adjustment given: the
 //! thesis' verification without adjusting) or, given the adjustment's result, the adjusted ones.
 
-use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RawFile, RunResult, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage, StageError};
 use crate::nodes::adjust::adjustment::AdjustReport;
+use crate::nodes::campaign::ingest::IngestedImage;
 use crate::nodes::campaign::load::CampaignSnapshot;
-use crate::nodes::campaign::panorama_sizes::pano_sizes;
 use skytie_stages::adjustment::from_correspondences::RunRecording;
-use skytie_stages::adjustment::verify::{verify, Verification, VerifyConfig};
+use skytie_stages::adjustment::verify::{verify_with_detail_levels, Verification, VerifyConfig};
 use skytie_stages::campaign::Recording;
 use skytie_stages::correspondence::AerialControlPoint;
 use skytie_stages::nadir::RecordingControl;
@@ -39,17 +39,29 @@ pub fn verify_metrics(v: &Verification) -> serde_json::Value {
     })
 }
 
-/// The verification node. Inputs: the campaign, its panoramas, the aerial control points, and no or one
-/// adjustment whose poses replace the recorded ones.
+/// The verification node. Inputs: the campaign, its ingested panoramas (snapshot order: their sizes and detail
+/// levels), the aerial control points, and no or one adjustment whose poses replace the recorded ones.
 pub struct VerifyStage;
 
 impl Stage for VerifyStage {
     crate::nodes::stage_types!(skytie_stages::adjustment::verify::STAGE, VerifyConfig => Verification,
-        inputs: (Handle<CampaignSnapshot>, Vec<RawFile>, Vec<Optional<RecordingControl>>, Vec<Handle<AdjustReport>>));
+        inputs: (Handle<CampaignSnapshot>, Vec<Handle<IngestedImage>>, Vec<Optional<RecordingControl>>, Vec<Handle<AdjustReport>>));
 
     fn run(&self, config: &VerifyConfig, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let (snap, panos, control, adjusted) = inputs;
-        let sizes = pano_sizes(&panos)?;
+        let mut sizes = Vec::with_capacity(panos.len());
+        for p in &panos {
+            match (u32::try_from(p.width), u32::try_from(p.height)) {
+                (Ok(w), Ok(h)) => sizes.push((w, h)),
+                _ => {
+                    return Err(StageError::new(format!(
+                        "{}: {} × {} px is too large for a panorama",
+                        p.source, p.width, p.height
+                    )))
+                }
+            }
+        }
+        let detail_levels: Vec<usize> = panos.iter().map(|p| p.detail_level as usize).collect();
         let points: Vec<AerialControlPoint> = control
             .iter()
             .flatten()
@@ -59,7 +71,8 @@ impl Stage for VerifyStage {
             Some(report) => adjusted_recordings(&snap.campaign.recordings, report),
             None => snap.campaign.recordings.clone(),
         };
-        verify(&recordings, &sizes, &points, config).map_err(StageError::new)
+        verify_with_detail_levels(&recordings, &sizes, &detail_levels, &points, config)
+            .map_err(StageError::new)
     }
 }
 

@@ -96,14 +96,15 @@ impl Stage for DetectVehicle {
 }
 
 /// The whole panorama at the pyramid level the detection needs (`detection_level`): the grid's samples are a
-/// few degrees apart, so a 12k panorama is read at a fraction of its size.
+/// few degrees apart, so a 12k panorama is read at a fraction of its size (and an enlarged copy at the size it
+/// was enlarged from).
 fn read_for_detection(
     pano: &IngestedImage,
     p: &VehicleDetectParams,
 ) -> Result<GrayImage, StageError> {
     let pyramid = image_tiles::open(pano)?;
     let layout = pyramid.layout();
-    let level = detection_level(layout.width, layout.levels(), p);
+    let level = detection_level(layout, p);
     let whole = [0.0, 0.0, layout.width as f64, layout.height as f64];
     match ScaledWindow::read(&pyramid, level, whole) {
         Ok(Some(w)) => Ok(w.image),

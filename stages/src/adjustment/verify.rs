@@ -27,7 +27,7 @@ use std::path::Path;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("verify", "4");
+pub const STAGE: StageId = StageId::new("verify", "5");
 
 crate::params! {
     /// Parameters of a verification (the verify node's params).
@@ -49,7 +49,9 @@ crate::params! {
         min_points: usize = 3, min 1;
         /// A segment fails only when an offset exceeds its tolerance by more than this many σ of the mean.
         confidence_k: f64 = 2.0, min 0.0;
-        /// σ of a panorama observation (weights the MM triangulation).
+        /// σ of a panorama observation (weights the MM triangulation), in pixels of the panorama's detail
+        /// level (`PyramidLayout::detail_level`; full-resolution pixels unless the panorama was enlarged by
+        /// pixel repetition), as the adjustment's `pano_sigma_px`.
         pano_sigma_px: f64 = 1.0, unit "px", above 0.0;
     }
 }
@@ -152,10 +154,25 @@ fn segment_of_recordings(recordings: &[Recording], config: &VerifyConfig) -> Vec
 }
 
 /// Compares aerial control points with their MM triangulation from the recorded poses, per segment.
-/// `recordings` in trajectory (time) order, `pano_size_px` one per recording.
+/// `recordings` in trajectory (time) order, `pano_size_px` one per recording; every panorama at detail level 0
+/// ([`verify_with_detail_levels`]).
 pub fn verify(
     recordings: &[Recording],
     pano_size_px: &[(u32, u32)],
+    control: &[AerialControlPoint],
+    config: &VerifyConfig,
+) -> Result<Verification, String> {
+    verify_with_detail_levels(recordings, pano_size_px, &[], control, config)
+}
+
+/// [`verify`] with the detail level of each recording's panorama (`pano_detail_level`, one per recording, or
+/// empty for 0 everywhere): a panorama observation's σ is `pano_sigma_px` pixels of that level, i.e.
+/// `pano_sigma_px · 2^level` full-resolution pixels, so a panorama enlarged by pixel repetition weighs its
+/// observations like the panorama it was enlarged from.
+pub fn verify_with_detail_levels(
+    recordings: &[Recording],
+    pano_size_px: &[(u32, u32)],
+    pano_detail_level: &[usize],
     control: &[AerialControlPoint],
     config: &VerifyConfig,
 ) -> Result<Verification, String> {
@@ -169,10 +186,26 @@ pub fn verify(
             recordings.len()
         ));
     }
+    if !(pano_detail_level.is_empty() || pano_detail_level.len() == recordings.len()) {
+        return Err(format!(
+            "{} panorama detail levels for {} recordings; pass one per recording, or none",
+            pano_detail_level.len(),
+            recordings.len()
+        ));
+    }
     let cameras: Vec<PanoramaCamera> = recordings
         .iter()
         .zip(pano_size_px)
         .map(|(r, &(w, h))| PanoramaCamera::from_recording(r, w, h))
+        .collect();
+    // σ of each recording's panorama observations, radians.
+    let angular_sigma_rad: Vec<f64> = cameras
+        .iter()
+        .enumerate()
+        .map(|(r, cam)| {
+            let level = pano_detail_level.get(r).copied().unwrap_or(0).min(30);
+            cam.angular_sigma_rad(config.pano_sigma_px * (1u64 << level) as f64)
+        })
         .collect();
     let index: HashMap<&str, usize> = recordings
         .iter()
@@ -199,7 +232,7 @@ pub fn verify(
         for o in &cp.mm {
             if let Some(&r) = index.get(o.image_id.as_str()) {
                 rays.push(cameras[r].pixel_ray(o.u_px, o.v_px));
-                sigmas.push(cameras[r].angular_sigma_rad(config.pano_sigma_px));
+                sigmas.push(angular_sigma_rad[r]);
                 let d = (cameras[r].center_world - aerial).norm();
                 if nearest.is_none_or(|(best, _)| d < best) {
                     nearest = Some((d, r));

@@ -10,9 +10,11 @@
 //!
 //! Working resolution: an aerial image finer than `OrthoParams::registration_gsd_m` is registered at a level of
 //! its pyramid — the coarsest whose GSD does not exceed that ([`working_level`]) — and the ortho is made at that
-//! level's GSD, so a 2.5 cm frame is matched exactly like the same frame taken at 10 cm. The aerial side is read
-//! as a window of that level ([`extract_patch`], [`AerialWindow`]); measurements are returned in full-resolution
-//! aerial pixels.
+//! level's GSD, so a 2.5 cm frame is matched exactly like the same frame taken at 10 cm. The level is never finer
+//! than the frame's detail level (`PyramidLayout::detail_level`, [`ortho_params_for_aerial_image`]): a frame
+//! enlarged by pixel repetition is registered at the level it was enlarged from, even where that is coarser than
+//! `registration_gsd_m`, exactly like the original. The aerial side is read as a window of that level
+//! ([`extract_patch`], [`AerialWindow`]); measurements are returned in full-resolution aerial pixels.
 
 use super::ortho::{OrthoGeoref, OrthoParams};
 use crate::geometry::{FrameCamera, Similarity2};
@@ -23,7 +25,7 @@ use nalgebra::{Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("ortho_aerial", "4");
+pub const STAGE: StageId = StageId::new("ortho_aerial", "5");
 
 /// Step of the finite differences of the projection Jacobian, metres on the ground.
 const JACOBIAN_STEP_M: f64 = 1.0;
@@ -96,23 +98,33 @@ pub fn level_of_scale(ortho_to_aerial_scale: f64) -> usize {
     ortho_to_aerial_scale.log2().round().max(0.0) as usize
 }
 
-/// `base` with the GSD set to the aerial GSD at `foot_world` (at the working level, [`working_level`]) and the
-/// rotation set so that the ortho image's axes are aligned with the aerial image's axes (thesis 3.4.5.2: "the
-/// resolution of the projected MM images is set to match the aerial images' resolution"). If the foot point
-/// does not project into the camera, `base` is returned unchanged (such an image does not overlap the
-/// recording; see `aerial_overlap`).
+/// [`ortho_params_for_aerial_image`] for a frame whose every level holds detail of its own (detail level 0,
+/// any photograph).
 pub fn ortho_params_for_aerial(
     cam: &FrameCamera,
     foot_world: [f64; 3],
     base: &OrthoParams,
 ) -> OrthoParams {
+    ortho_params_for_aerial_image(cam, foot_world, base, 0)
+}
+
+/// `base` with the GSD set to the aerial GSD at `foot_world` (at the working level, [`working_level`], but not
+/// finer than the frame's `detail_level`) and the rotation set so that the ortho image's axes are aligned with
+/// the aerial image's axes (thesis 3.4.5.2: "the resolution of the projected MM images is set to match the
+/// aerial images' resolution"). If the foot point does not project into the camera, `base` is returned
+/// unchanged (such an image does not overlap the recording; see `aerial_overlap`).
+pub fn ortho_params_for_aerial_image(
+    cam: &FrameCamera,
+    foot_world: [f64; 3],
+    base: &OrthoParams,
+    detail_level: usize,
+) -> OrthoParams {
     match aerial_ground_similarity(cam, foot_world) {
         Some((gsd_m, rotation_deg)) => {
-            let level = working_level(
-                gsd_m,
-                base.registration_gsd_m,
-                (cam.width_px, cam.height_px),
-            );
+            let size = (cam.width_px, cam.height_px);
+            let levels = level_count(size.0, size.1);
+            let level = working_level(gsd_m, base.registration_gsd_m, size)
+                .max(detail_level.min(levels - 1));
             OrthoParams {
                 gsd_m: gsd_m * (1u64 << level) as f64,
                 rotation_deg,

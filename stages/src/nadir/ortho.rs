@@ -43,8 +43,9 @@ crate::params! {
         /// `ortho_aerial` only: the coarsest GSD the MM↔aerial registration works at. An aerial image finer than
         /// this is registered at the coarsest level of its pyramid whose GSD does not exceed it (a 2.5 cm frame
         /// at 10 cm), and the ortho is made at that GSD; coarser images at their own GSD (thesis 3.4.5.2 works at
-        /// the aerial images' 10 cm). Default 0.12 m: 10 cm frames and their GSD's variation across the frame
-        /// stay at full resolution.
+        /// the aerial images' 10 cm); an image enlarged by pixel repetition never finer than the level it was
+        /// enlarged from (its detail level). Default 0.12 m: 10 cm frames and their GSD's variation across the
+        /// frame stay at full resolution.
         registration_gsd_m: f64 = 0.12, unit "m", min 0.001, max 10.0;
     }
     check(p, v) {

@@ -18,6 +18,7 @@ use super::vehicle_mask::VehicleMask;
 use crate::campaign::Recording;
 use crate::geometry::PanoramaCamera;
 use crate::imaging::border::Border;
+use crate::imaging::pyramid::PyramidLayout;
 use crate::imaging::sample::sample_bilinear;
 use crate::imaging::GrayImage;
 use crate::params::{describe, Params, StageId, Violation};
@@ -27,7 +28,7 @@ use serde::{Deserialize, Serialize};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("vehicle", "2");
+pub const STAGE: StageId = StageId::new("vehicle", "3");
 
 crate::params! {
     /// Parameters of [`detect_vehicle`].
@@ -221,16 +222,20 @@ fn fit_box(
     })
 }
 
-/// The pyramid level of a panorama `full_width_px` wide (with `levels` levels) that the detection reads: the
-/// coarsest whose pixel is at most a third of the finer grid step (each grid cell averages 3 × 3 samples).
-pub fn detection_level(full_width_px: usize, levels: usize, p: &VehicleDetectParams) -> usize {
+/// The pyramid level of a panorama (pyramid `layout`) that the detection reads: the coarsest whose pixel is at
+/// most a third of the finer grid step (each grid cell averages 3 × 3 samples), but never finer than the
+/// panorama's detail level (`PyramidLayout::detail_level`): the levels below it only repeat its pixels, and
+/// sampled bilinearly they would give other values than the panorama that was enlarged, so an enlarged copy
+/// would find another vehicle box than its original.
+pub fn detection_level(layout: &PyramidLayout, p: &VehicleDetectParams) -> usize {
+    let levels = layout.levels();
     let pixel_deg = p.azimuth_step_deg.min(p.depression_step_deg) / 3.0;
     let needed_width_px = 360.0 / pixel_deg;
     let mut level = 0;
-    while level + 1 < levels && (full_width_px >> (level + 1)) as f64 >= needed_width_px {
+    while level + 1 < levels && (layout.width >> (level + 1)) as f64 >= needed_width_px {
         level += 1;
     }
-    level
+    level.max(layout.detail_level.min(levels.saturating_sub(1)))
 }
 
 /// The vehicle of the panoramas `views` (recording with its recorded heading and orientation, grey image); the
@@ -335,6 +340,21 @@ mod tests {
         assert!((m.rear_m - 1.3).abs() < 0.01, "{m:?}");
         assert!((m.half_width_m - 0.7).abs() < 0.01, "{m:?}");
         assert!(fit_box(&vec![None; 180], 2.0, 0.4, 0.0).is_none());
+    }
+
+    #[test]
+    fn the_detection_level_follows_the_grid_step_but_not_below_the_detail_level() {
+        let p = VehicleDetectParams::default(); // 1° depression step: pixels of at most 1/3°, 1080 px wide
+        let layout = |w: usize, detail_level: usize| PyramidLayout {
+            detail_level,
+            ..PyramidLayout::new(w, w / 2, crate::imaging::pyramid::SampleDepth::U8, 256).unwrap()
+        };
+        assert_eq!(detection_level(&layout(1024, 0), &p), 0);
+        assert_eq!(detection_level(&layout(8192, 0), &p), 2);
+        // A 1024-px panorama enlarged 4× by pixel repetition is read at the level it was enlarged from, not
+        // at its 2048-px level, whose pixels only repeat the original's.
+        assert_eq!(detection_level(&layout(4096, 0), &p), 1);
+        assert_eq!(detection_level(&layout(4096, 2), &p), 2);
     }
 
     #[test]
