@@ -24,7 +24,7 @@ use crate::params::StageId;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("orthophoto", "3");
+pub const STAGE: StageId = StageId::new("orthophoto", "4");
 
 crate::params! {
     /// Parameters of the orthophoto route (registration, refinement and control points).
