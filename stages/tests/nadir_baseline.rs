@@ -182,12 +182,7 @@ fn baseline_locates_isolated_corners_by_ncc_and_snaps_to_the_keypoints() {
     let p = BaselineParams::default();
     p.validate().unwrap();
     // The initial transform is off by a few pixels (well inside the ±12 px of a 16-in-40 search).
-    let off = Similarity2 {
-        scale: 1.0,
-        rotation_rad: 0.004,
-        tx: 3.2,
-        ty: -2.1,
-    };
+    let off = Similarity2::new(1.0, 0.004, 3.2, -2.1);
     let r = matches(&s, off.compose(&s.truth), &p);
     println!("tried {} matched {}", r.tried, r.matches.len());
     assert_eq!(r.tried, s.window.tie_points.len());

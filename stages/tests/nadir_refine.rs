@@ -189,12 +189,7 @@ fn errors_of_px(
 fn refinement_recovers_a_subpixel_offset_under_radiometric_change_and_noise() {
     let pair = make_pair(11, 0.01);
     // The initial transform is off by (0.83, −0.61) aerial px and slightly in rotation/scale.
-    let off = Similarity2 {
-        scale: 1.002,
-        rotation_rad: 0.003,
-        tx: 0.83,
-        ty: -0.61,
-    };
+    let off = Similarity2::new(1.002, 0.003, 0.83, -0.61);
     let initial = off.compose(&pair.truth);
     let p = params_at_peak_05();
     p.validate().unwrap();
@@ -236,12 +231,7 @@ fn refinement_handles_larger_offsets_within_the_margin() {
     // Same scene as the ~1 px test, so only the offset size changes. (Seed 5's texture gives 0.16 px RMS at
     // this offset: the accuracy depends on the texture, see the report.)
     let pair = make_pair(11, 0.01);
-    let off = Similarity2 {
-        scale: 1.0,
-        rotation_rad: 0.0,
-        tx: -4.4,
-        ty: 3.7,
-    };
+    let off = Similarity2::new(1.0, 0.0, -4.4, 3.7);
     let r = refine(
         &pair,
         &pair.aerial,

@@ -38,12 +38,7 @@ pub fn render_ortho(georef: &OrthoGeoref, ground: impl Fn(f64, f64) -> f64) -> G
 
 /// The similarity from ortho pixels to aerial pixels that the pair's aerial image is rendered with.
 pub fn true_similarity() -> Similarity2 {
-    Similarity2 {
-        scale: 0.97,
-        rotation_rad: 0.21,
-        tx: 143.37,
-        ty: 61.81,
-    }
+    Similarity2::new(0.97, 0.21, 143.37, 61.81)
 }
 
 /// The aerial image seen through `truth`: `value(col, row, x_m, y_m)` gives the grey value of the aerial
