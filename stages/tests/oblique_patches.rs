@@ -8,6 +8,7 @@ use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::correspondence::{MmTiePoint, PanoObservation};
 use skytie_stages::geometry::frame::FrameCamera;
 use skytie_stages::geometry::panorama::PanoramaCamera;
+use skytie_stages::geometry::Ray;
 use skytie_stages::imaging::equirect::PanoramaLevels;
 use skytie_stages::imaging::pyramid::{MemoryPyramid, ScaledWindow};
 use skytie_stages::imaging::GrayImage;
@@ -87,23 +88,22 @@ fn oblique_image() -> AerialImage {
 fn render_panorama(rec: &Recording) -> GrayImage {
     let (w, h) = (1600usize, 800usize);
     let cam = PanoramaCamera::from_recording(rec, w as u32, h as u32);
-    let mut img = GrayImage::filled(w, h, 0.0);
-    for r in 0..h {
-        for c in 0..w {
-            let ray = cam.pixel_ray(c as f64 + 0.5, r as f64 + 0.5);
-            img.set(c, r, trace(&ray.origin_world, &ray.dir_world));
-        }
-    }
-    img
+    render((w, h), |u, v| cam.pixel_ray(u, v))
 }
 
 fn render_oblique(a: &AerialImage) -> GrayImage {
     let cam = FrameCamera::from_aerial(a);
-    let (w, h) = (a.width_px as usize, a.height_px as usize);
+    render((a.width_px as usize, a.height_px as usize), |u, v| {
+        cam.pixel_ray(u, v)
+    })
+}
+
+/// The `(w, h)` image of the scene traced along `pixel_ray` of each pixel centre.
+fn render((w, h): (usize, usize), pixel_ray: impl Fn(f64, f64) -> Ray) -> GrayImage {
     let mut img = GrayImage::filled(w, h, 0.0);
     for r in 0..h {
         for c in 0..w {
-            let ray = cam.pixel_ray(c as f64 + 0.5, r as f64 + 0.5);
+            let ray = pixel_ray(c as f64 + 0.5, r as f64 + 0.5);
             img.set(c, r, trace(&ray.origin_world, &ray.dir_world));
         }
     }
