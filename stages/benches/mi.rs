@@ -27,7 +27,6 @@ use std::path::Path;
 
 use imaging_support::{radiometric, SplitMix64, Texture};
 use skytie_stages::estimators::one_plus_one::OnePlusOneParams;
-use skytie_stages::imaging::GrayImage;
 use skytie_stages::matching::mattes_mi::MiRegistration;
 use skytie_stages::oblique::patch_registration::search::mi_search;
 

@@ -19,7 +19,6 @@ use peer_support::{median_round_ms, peer_dir};
 use std::path::Path;
 
 use imaging_support::{radiometric, SplitMix64, Texture};
-use skytie_stages::imaging::GrayImage;
 use skytie_stages::matching::phase_correlation::{
     phase_correlate, PhaseCorrelationParams, PhaseCorrelator,
 };

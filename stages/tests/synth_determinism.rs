@@ -121,7 +121,7 @@ fn tiny_is_byte_identical_across_runs_and_thread_counts() {
     let first = header.lines().next().unwrap();
     for col in RECORDING_COLUMNS.iter().chain(&["sigma_xy", "sigma_z"]) {
         assert!(
-            first.split(',').any(|c| c == col),
+            first.split(',').any(|c| c == *col),
             "column {col} missing in {first}"
         );
     }

@@ -30,12 +30,14 @@ impl SizeOptions {
             option: option.into(),
             message,
         };
-        if let Some((f, (w, h))) = size_factor("nadir_px", self.nadir_px, p.nadir.width_px)? {
+        if let Some((w, h)) = self.nadir_px {
+            let f = size_factor("nadir_px", (w, h), p.nadir.width_px)?;
             p.nadir.gsd_m /= f;
             p.nadir.corner_distortion_px *= f;
             (p.nadir.width_px, p.nadir.height_px) = (w, h);
         }
-        if let Some((f, (w, h))) = size_factor("oblique_px", self.oblique_px, p.oblique.width_px)? {
+        if let Some((w, h)) = self.oblique_px {
+            let f = size_factor("oblique_px", (w, h), p.oblique.width_px)?;
             p.oblique.gsd_center_m /= f;
             p.oblique.corner_distortion_px *= f;
             (p.oblique.width_px, p.oblique.height_px) = (w, h);
@@ -75,20 +77,13 @@ fn at_render_size(p: &mut PresetParams) {
 }
 
 /// The factor by which the option `option`'s requested image size `(w, h)` enlarges a camera `width_px`
-/// wide, with the size; `None` without a request, an error for sides outside [16, 2^20].
-fn size_factor(
-    option: &str,
-    requested: Option<(u32, u32)>,
-    width_px: u32,
-) -> Result<Option<(f64, (u32, u32))>, SynthError> {
-    let Some((w, h)) = requested else {
-        return Ok(None);
-    };
+/// wide; an error for sides outside [16, 2^20].
+fn size_factor(option: &str, (w, h): (u32, u32), width_px: u32) -> Result<f64, SynthError> {
     if !(16..=1 << 20).contains(&w) || !(16..=1 << 20).contains(&h) {
         return Err(SynthError::InvalidOption {
             option: option.into(),
             message: format!("{w} × {h}; give sides in [16, 1048576]"),
         });
     }
-    Ok(Some((f64::from(w) / f64::from(width_px), (w, h))))
+    Ok(f64::from(w) / f64::from(width_px))
 }
