@@ -20,6 +20,11 @@ fn setup() -> (
     (dir, cache, items)
 }
 
+/// The toy summary of `count` numbers adding up to `sum`.
+fn summary(sum: f64, count: u64) -> ToySummary {
+    ToySummary { sum, count }
+}
+
 #[test]
 fn first_run_executes_all_and_second_identical_run_executes_nothing() {
     let (_d, cache, items) = setup();
@@ -28,26 +33,14 @@ fn first_run_executes_all_and_second_identical_run_executes_nothing() {
     let o1 = run(&cache, &dag, Mode::Run);
     assert_eq!(executed(&o1), (4, 4, 1));
     assert_eq!(o1.cached(), 0);
-    assert_eq!(
-        *o1.get(h).unwrap(),
-        ToySummary {
-            sum: 20.0,
-            count: 4
-        }
-    );
+    assert_eq!(*o1.get(h).unwrap(), summary(20.0, 4));
     let (dag, h) = toy_dag(&items, &cfg);
     let o2 = run(&cache, &dag, Mode::Run);
     assert_eq!(o2.executed(), 0);
     assert_eq!(o2.cached(), 9);
     assert!(o2.warnings.is_empty(), "{:?}", o2.warnings);
     // The requested output is loaded from the cache.
-    assert_eq!(
-        *o2.get(h).unwrap(),
-        ToySummary {
-            sum: 20.0,
-            count: 4
-        }
-    );
+    assert_eq!(*o2.get(h).unwrap(), summary(20.0, 4));
 }
 
 #[test]
@@ -119,13 +112,7 @@ fn adding_one_item_reruns_only_the_nodes_that_involve_it() {
     let o = run(&cache, &dag, Mode::Run);
     assert_eq!(executed(&o), (1, 1, 1));
     assert_eq!(o.cached(), 8);
-    assert_eq!(
-        *o.get(h).unwrap(),
-        ToySummary {
-            sum: 40.0,
-            count: 5
-        }
-    );
+    assert_eq!(*o.get(h).unwrap(), summary(40.0, 5));
     let new: Vec<_> = o
         .reports
         .iter()
@@ -197,13 +184,7 @@ fn corrupt_or_truncated_artifacts_warn_once_and_are_recomputed() {
     assert_eq!(o2.warnings.len(), 1, "{:?}", o2.warnings);
     assert!(o2.warnings[0].contains("toy_sum"), "{}", o2.warnings[0]);
     assert_eq!(executed(&o2), (0, 0, 1));
-    assert_eq!(
-        *o2.get(h).unwrap(),
-        ToySummary {
-            sum: 20.0,
-            count: 4
-        }
-    );
+    assert_eq!(*o2.get(h).unwrap(), summary(20.0, 4));
     // Truncate one scale artifact, then change the sum so it needs the scale values: the truncated one is
     // recomputed (with a warning), the others are loaded.
     let scale_path = store.object_path(&key_of("toy_scale[item_002]"));

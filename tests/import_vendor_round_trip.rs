@@ -15,7 +15,7 @@ mod cli;
 use cli::{run_finished, run_ok, skytie};
 use nalgebra::Matrix3;
 use skytie_stages::campaign::source::read_source;
-use skytie_stages::campaign::{read_campaign, AerialImage, Campaign};
+use skytie_stages::campaign::{read_campaign, AerialImage, Campaign, Recording};
 use skytie_stages::crs::geoid::GeoidGrid;
 use skytie_stages::export::SBET_ADJUSTED;
 use skytie_stages::geometry::{opk_to_matrix, panorama_rotation};
@@ -32,17 +32,32 @@ fn distance_m(a: [f64; 3], b: [f64; 3]) -> f64 {
     (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt()
 }
 
+/// Centre and camera → world rotation of an aerial image.
+fn aerial_pose(c: &AerialImage) -> ([f64; 3], Matrix3<f64>) {
+    let r = opk_to_matrix(c.omega_deg, c.phi_deg, c.kappa_deg);
+    ([c.x, c.y, c.z], r)
+}
+
+/// Centre and panorama → world rotation of a recording.
+fn panorama_pose(c: &Recording) -> ([f64; 3], Matrix3<f64>) {
+    let r = panorama_rotation(c.yaw_deg, c.pitch_deg, c.roll_deg);
+    ([c.x, c.y, c.z], r)
+}
+
+/// `got` within 1 mm and 0.0001° of `orig`, their (centre, camera → world rotation) given by `pose`.
+fn assert_pose<T>(orig: &T, got: &T, pose: impl Fn(&T) -> ([f64; 3], Matrix3<f64>), what: &str) {
+    let ((c_orig, r_orig), (c_got, r_got)) = (pose(orig), pose(got));
+    let d = distance_m(c_orig, c_got);
+    assert!(d <= 1e-3, "{what}: centre off by {d} m");
+    let a = angle_between_deg(&r_orig, &r_got);
+    assert!(a <= 1e-4, "{what}: attitude off by {a}°");
+}
+
 fn assert_aerial(orig: &[AerialImage], got: &[AerialImage], what: &str) {
     assert_eq!(orig.len(), got.len(), "{what}: image count");
     for (o, g) in orig.iter().zip(got) {
         assert_eq!((&o.image_id, &o.file), (&g.image_id, &g.file), "{what}");
-        let d = distance_m([o.x, o.y, o.z], [g.x, g.y, g.z]);
-        assert!(d <= 1e-3, "{what} {}: centre off by {d} m", o.image_id);
-        let a = angle_between_deg(
-            &opk_to_matrix(o.omega_deg, o.phi_deg, o.kappa_deg),
-            &opk_to_matrix(g.omega_deg, g.phi_deg, g.kappa_deg),
-        );
-        assert!(a <= 1e-4, "{what} {}: attitude off by {a}°", o.image_id);
+        assert_pose(o, g, aerial_pose, &format!("{what} {}", o.image_id));
         let interior = |c: &AerialImage| {
             [
                 c.focal_px, c.cx_px, c.cy_px, c.k1, c.k2, c.k3, c.k4, c.p1, c.p2, c.b1, c.b2,
@@ -69,13 +84,7 @@ fn assert_same_campaign(orig: &Campaign, got: &Campaign) {
     assert_eq!(orig.recordings.len(), got.recordings.len());
     for (o, g) in orig.recordings.iter().zip(&got.recordings) {
         assert_eq!((&o.image_id, &o.file), (&g.image_id, &g.file));
-        let d = distance_m([o.x, o.y, o.z], [g.x, g.y, g.z]);
-        assert!(d <= 1e-3, "{}: centre off by {d} m", o.image_id);
-        let a = angle_between_deg(
-            &panorama_rotation(o.yaw_deg, o.pitch_deg, o.roll_deg),
-            &panorama_rotation(g.yaw_deg, g.pitch_deg, g.roll_deg),
-        );
-        assert!(a <= 1e-4, "{}: panorama attitude off by {a}°", o.image_id);
+        assert_pose(o, g, panorama_pose, &format!("{} (panorama)", o.image_id));
         let dh = (o.heading_deg - g.heading_deg + 180.0).rem_euclid(360.0) - 180.0;
         assert!(dh.abs() <= 1e-4, "{}: heading off by {dh}°", o.image_id);
         assert!((o.time_s - g.time_s).abs() < 1e-6, "{}: time", o.image_id);

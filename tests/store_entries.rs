@@ -196,29 +196,17 @@ fn another_store_format_version_is_reported_once_per_handle_then_silent() {
 fn records_round_trip_and_damaged_records_read_as_absent() {
     let dir = tempfile::tempdir().unwrap();
     let store = Store::open(dir.path()).unwrap();
-    assert_eq!(store.get_record("last-key", "ortho[rec 0012]"), None);
-    store
-        .put_record("last-key", "ortho[rec 0012]", b"abc")
-        .unwrap();
-    store
-        .put_record("last-key", "ortho[rec 0013]", b"")
-        .unwrap();
-    assert_eq!(
-        store.get_record("last-key", "ortho[rec 0012]").as_deref(),
-        Some(&b"abc"[..])
-    );
-    assert_eq!(
-        store.get_record("last-key", "ortho[rec 0013]").as_deref(),
-        Some(&b""[..])
-    );
+    // The record `name` of the namespace "last-key", and writing it.
+    let get = |name: &str| store.get_record("last-key", name);
+    let put = |name: &str, bytes: &[u8]| store.put_record("last-key", name, bytes).unwrap();
+    assert_eq!(get("ortho[rec 0012]"), None);
+    put("ortho[rec 0012]", b"abc");
+    put("ortho[rec 0013]", b"");
+    assert_eq!(get("ortho[rec 0012]").as_deref(), Some(&b"abc"[..]));
+    assert_eq!(get("ortho[rec 0013]").as_deref(), Some(&b""[..]));
     assert_eq!(store.get_record("provenance", "ortho[rec 0012]"), None);
-    store
-        .put_record("last-key", "ortho[rec 0012]", b"replaced")
-        .unwrap();
-    assert_eq!(
-        store.get_record("last-key", "ortho[rec 0012]").as_deref(),
-        Some(&b"replaced"[..])
-    );
+    put("ortho[rec 0012]", b"replaced");
+    assert_eq!(get("ortho[rec 0012]").as_deref(), Some(&b"replaced"[..]));
     // Damage the record file: it reads as absent; a new put heals it.
     let ns = dir.path().join("records/last-key");
     let name_hash = blake3::hash(b"ortho[rec 0012]").to_hex().to_string();
@@ -227,16 +215,11 @@ fn records_round_trip_and_damaged_records_read_as_absent() {
     let last = b.len() - 1;
     b[last] ^= 0xFF;
     fs::write(&p, &b).unwrap();
-    assert_eq!(store.get_record("last-key", "ortho[rec 0012]"), None);
+    assert_eq!(get("ortho[rec 0012]"), None);
     fs::write(&p, &b[..10]).unwrap();
-    assert_eq!(store.get_record("last-key", "ortho[rec 0012]"), None);
-    store
-        .put_record("last-key", "ortho[rec 0012]", b"again")
-        .unwrap();
-    assert_eq!(
-        store.get_record("last-key", "ortho[rec 0012]").as_deref(),
-        Some(&b"again"[..])
-    );
+    assert_eq!(get("ortho[rec 0012]"), None);
+    put("ortho[rec 0012]", b"again");
+    assert_eq!(get("ortho[rec 0012]").as_deref(), Some(&b"again"[..]));
     // Namespaces are plain folder names.
     for bad in ["", "../x", "a/b", ".hidden", "sp ace"] {
         assert!(

@@ -10,7 +10,7 @@ mod tool_cli;
 use skytie_stages::imaging::io::{load_gray, save_gray};
 use skytie_stages::imaging::resample::{warp_affine, Interpolation};
 use skytie_stages::imaging::{gaussian_blur, GrayImage};
-use tool_cli::{csv_rows, s, stripe_campaign, texture, tool, tool_ok};
+use tool_cli::{bright_rectangle, csv_rows, s, stripe_campaign, texture, tool, tool_ok};
 
 /// `w × h` crop of `img` with its top-left corner at (`x0`, `y0`).
 fn crop(img: &GrayImage, x0: usize, y0: usize, w: usize, h: usize) -> GrayImage {
@@ -156,13 +156,7 @@ fn kaze_finds_the_same_keypoints_on_an_integer_shifted_copy() {
 #[test]
 fn forstner_locates_the_corners_of_a_rectangle() {
     let dir = tempfile::tempdir().unwrap();
-    // Pixels 25..=54 × 20..=39 bright, blurred: corners at (25, 20), (55, 20), (25, 40), (55, 40).
-    let mut img = GrayImage::filled(80, 60, 0.2);
-    for r in 20..40 {
-        for c in 25..55 {
-            img.set(c, r, 0.8);
-        }
-    }
+    let img = bright_rectangle(0.2);
     let png = dir.path().join("rect.png");
     save_gray(&png, &gaussian_blur(&img, 1.0)).unwrap();
     let csv = dir.path().join("corners.csv");

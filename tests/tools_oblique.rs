@@ -10,18 +10,12 @@ use skytie_stages::features::daisy::{describe_points, DaisyParams};
 use skytie_stages::imaging::io::{load_gray, load_rgb, save_gray};
 use skytie_stages::imaging::resample::{warp_affine, Interpolation};
 use skytie_stages::imaging::GrayImage;
-use tool_cli::{csv_rows, s, stripe_campaign, texture, tool, tool_ok};
+use tool_cli::{bright_rectangle, csv_rows, s, stripe_campaign, texture, tool, tool_ok};
 
 #[test]
 fn agast_finds_the_corners_of_a_rectangle() {
     let dir = tempfile::tempdir().unwrap();
-    // Pixels 25..=54 × 20..=39 bright: the rectangle's corners are (25, 20), (55, 20), (25, 40), (55, 40).
-    let mut img = GrayImage::filled(80, 60, 0.1);
-    for r in 20..40 {
-        for c in 25..55 {
-            img.set(c, r, 0.8);
-        }
-    }
+    let img = bright_rectangle(0.1);
     let (png, out) = (dir.path().join("rect.png"), dir.path().join("corners.csv"));
     save_gray(&png, &img).unwrap();
     let stdout = tool_ok(&["agast", s(&png), "--threshold", "20", "--out", s(&out)]);

@@ -5,29 +5,24 @@
 use crate::workflow::{Workflow, WorkflowError};
 use std::path::Path;
 
+/// `(file name, text)` of each named file of `workflows/`, compiled into the binary.
+macro_rules! workflow_files {
+    ($($name:literal),* $(,)?) => {
+        &[$(($name, include_str!(concat!("../../workflows/", $name)))),*]
+    };
+}
+
 /// Every shipped workflow file: (file name, text).
-pub const BUILT_IN: &[(&str, &str)] = &[
-    (
-        "adjust-sweep.toml",
-        include_str!("../../workflows/adjust-sweep.toml"),
-    ),
-    ("default.toml", include_str!("../../workflows/default.toml")),
-    (
-        "nadir-baseline.toml",
-        include_str!("../../workflows/nadir-baseline.toml"),
-    ),
-    ("nadir.toml", include_str!("../../workflows/nadir.toml")),
-    (
-        "oblique-sweep.toml",
-        include_str!("../../workflows/oblique-sweep.toml"),
-    ),
-    ("oblique.toml", include_str!("../../workflows/oblique.toml")),
-    (
-        "orthophoto.toml",
-        include_str!("../../workflows/orthophoto.toml"),
-    ),
-    ("paper.toml", include_str!("../../workflows/paper.toml")),
-    ("tiny.toml", include_str!("../../workflows/tiny.toml")),
+pub const BUILT_IN: &[(&str, &str)] = workflow_files![
+    "adjust-sweep.toml",
+    "default.toml",
+    "nadir-baseline.toml",
+    "nadir.toml",
+    "oblique-sweep.toml",
+    "oblique.toml",
+    "orthophoto.toml",
+    "paper.toml",
+    "tiny.toml",
 ];
 
 /// The workflow `spec` names: an existing file, else a built-in workflow.

@@ -331,13 +331,13 @@ pub fn write_outputs(
         for v in &variants {
             let vs = Summary::of(session.reports().filter(|r| r.variants.contains(v)));
             let mut vdoc = vs.to_json(wall_seconds, warnings);
-            add_sections(
-                &mut vdoc,
+            let sections = || {
                 session
                     .metrics()
                     .filter(|(var, _, _)| var == v)
-                    .map(|(_, ns, val)| (ns.as_str(), val)),
-            );
+                    .map(|(_, ns, val)| (ns.as_str(), val))
+            };
+            add_sections(&mut vdoc, sections());
             write_json(
                 &out_dir.join("variants").join(v).join("metrics.json"),
                 &vdoc,
@@ -345,13 +345,7 @@ pub fn write_outputs(
             per_variant.push((v.clone(), vdoc));
             // sweep.csv: the contributed sections.
             let mut row = serde_json::json!({});
-            add_sections(
-                &mut row,
-                session
-                    .metrics()
-                    .filter(|(var, _, _)| var == v)
-                    .map(|(_, ns, val)| (ns.as_str(), val)),
-            );
+            add_sections(&mut row, sections());
             rows.push((v.clone(), row));
         }
         skytie_util::fsutil::atomic_write(&out_dir.join("sweep.csv"), sweep_csv(&rows).as_bytes())?;

@@ -55,7 +55,7 @@ pub struct NadirHandles {
 
 /// Which nadir stages the workflow enables; an enabled stage whose upstream is not enabled is an error.
 pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
-    let on = |s: &str| wf.stages.iter().any(|x| x == s);
+    let on = |s: &str| wf.enables(s);
     let Some(last) = NADIR_STAGES
         .iter()
         .rposition(|s| on(s) && *s != stage::GRADE_NADIR)

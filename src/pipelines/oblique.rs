@@ -44,7 +44,7 @@ pub struct ObliqueHandles {
 
 /// Whether the workflow enables the oblique chain; an enabled stage whose upstream is not enabled is an error.
 pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
-    let on = |s: &str| wf.stages.iter().any(|x| x == s);
+    let on = |s: &str| wf.enables(s);
     let Some(last) = OBLIQUE_STAGES.iter().rposition(|s| on(s)) else {
         return Ok(false);
     };

@@ -230,7 +230,7 @@ fn add_variant(
     seeds: &mut ShardSeeds,
 ) -> Result<VariantExports, PipelineError> {
     let snap = campaign.add_snapshot(b)?;
-    let ortho_on = wf.stages.iter().any(|s| s == stage::ORTHO);
+    let ortho_on = wf.enables(stage::ORTHO);
     let mut items = Vec::new();
     for rec in &campaign.snapshot.campaign.recordings {
         let label = format!("rec {}", rec.image_id);

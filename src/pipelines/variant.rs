@@ -39,7 +39,7 @@ pub struct VariantContext<'a> {
 impl VariantContext<'_> {
     /// Whether the workflow enables `stage`.
     pub fn on(&self, stage: &str) -> bool {
-        self.wf.stages.iter().any(|x| x == stage)
+        self.wf.enables(stage)
     }
 
     /// The truth files of the evaluation node `grade_stage`, when it is enabled and the campaign has

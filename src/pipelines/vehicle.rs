@@ -31,7 +31,7 @@ pub fn detect(
     session: &mut Session<'_>,
     c: &LoadedCampaign<'_>,
 ) -> Result<Option<VehicleDetection>, PipelineError> {
-    let ortho_on = wf.stages.iter().any(|s| s == stage::ORTHO);
+    let ortho_on = wf.enables(stage::ORTHO);
     let base: OrthoParams = wf.params(stage::ORTHO, "default").map_err(wf_err)?;
     if !ortho_on || !base.vehicle.detect || !base.vehicle.enabled {
         return Ok(None);

@@ -128,12 +128,14 @@ fn names(sets: &[ResultSet]) -> Vec<String> {
     sets.iter().map(|s| s.name.clone()).collect()
 }
 
+/// Whether any variant has the numeric metric at `path`.
+fn any_has(sets: &[ResultSet], path: &str) -> bool {
+    sets.iter().any(|s| num_at(&s.metrics, path).is_some())
+}
+
 /// Table 2-10 structure and the correct / wrong tie-point chart, when variants have graded nadir metrics.
 fn nadir_tables(b: &mut Builder, page: &mut Page, sets: &[ResultSet]) -> Result<(), String> {
-    if !sets
-        .iter()
-        .any(|s| num_at(&s.metrics, "nadir.correct_tie_points").is_some())
-    {
+    if !any_has(sets, "nadir.correct_tie_points") {
         return Ok(());
     }
     page.subheading("Nadir matching per variant (Table 2-10)");
@@ -205,10 +207,7 @@ fn nadir_tables(b: &mut Builder, page: &mut Page, sets: &[ResultSet]) -> Result<
 
 /// Oblique inliers / outliers / non-matchable per variant (Figs 4.12, 4.14, 4.19; Table 4-2 structure).
 fn oblique_tables(b: &mut Builder, page: &mut Page, sets: &[ResultSet]) -> Result<(), String> {
-    if !sets
-        .iter()
-        .any(|s| num_at(&s.metrics, OBLIQUE_INLIERS).is_some())
-    {
+    if !any_has(sets, OBLIQUE_INLIERS) {
         return Ok(());
     }
     page.subheading("Oblique registration per variant (Tables 4-2…4-8)");

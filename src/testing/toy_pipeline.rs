@@ -67,7 +67,7 @@ impl Pipeline for ToyPipeline {
                 "toy campaign: cannot list items: {e} (expected a folder items/ of *.txt)"
             ))
         })?;
-        let scale_enabled = wf.stages.iter().any(|s| s == "toy_scale");
+        let scale_enabled = wf.enables("toy_scale");
         let mut b = DagBuilder::new();
         for variant in wf.variants() {
             b.set_variant(&variant);

@@ -61,6 +61,11 @@ pub struct Workflow {
 }
 
 impl Workflow {
+    /// Whether the workflow's `stages` list enables `stage`.
+    pub fn enables(&self, stage: &str) -> bool {
+        self.stages.iter().any(|s| s == stage)
+    }
+
     /// Reads and checks a workflow file (and the files it includes).
     pub fn load(path: &Path) -> Result<Workflow, WorkflowError> {
         let bytes = std::fs::read(path).map_err(|e| {

@@ -21,13 +21,12 @@ mod imaging_support;
 #[path = "peer_support/mod.rs"]
 mod peer_support;
 
+use peer_support::shifted_pair::ShiftedPair;
 use peer_support::{median_round_ms, peer_dir};
 use std::path::Path;
 
 use imaging_support::{radiometric, SplitMix64, Texture};
 use skytie_stages::estimators::one_plus_one::OnePlusOneParams;
-use skytie_stages::imaging::io::{load_gray, save_gray};
-use skytie_stages::imaging::GrayImage;
 use skytie_stages::matching::mattes_mi::MiRegistration;
 use skytie_stages::oblique::patch_registration::search::mi_search;
 
@@ -42,15 +41,8 @@ const WINDOW_PX: f64 = 8.0;
 /// Random fixed samples of the sampled setting.
 const SAMPLES: usize = 2000;
 
-struct Pair {
-    fixed: GrayImage,
-    moving: GrayImage,
-    tx_px: f64,
-    ty_px: f64,
-}
-
 /// Writes the pairs as PNGs and returns them as re-loaded (8-bit quantised) images.
-fn make_pairs(dir: &Path) -> Vec<Pair> {
+fn make_pairs(dir: &Path) -> Vec<ShiftedPair> {
     let tex = Texture::new(512, 64, 42);
     let mut rng = SplitMix64(7);
     (0..PAIRS)
@@ -63,24 +55,23 @@ fn make_pairs(dir: &Path) -> Vec<Pair> {
             let a = tex.render(SIZE_PX, SIZE_PX, x0, y0, 0.0, 0.0);
             let b = tex.render(SIZE_PX, SIZE_PX, x0, y0, tx, ty);
             let b = radiometric(&b, 0.6, 0.25, 0.7, 0.01, 1000 + k as u64);
-            let (pa, pb) = (
-                dir.join(format!("mi_{k}_fixed.png")),
-                dir.join(format!("mi_{k}_moving.png")),
-            );
-            save_gray(&pa, &a).expect("write PNG");
-            save_gray(&pb, &b).expect("write PNG");
-            Pair {
-                fixed: load_gray(&pa).expect("re-load PNG"),
-                moving: load_gray(&pb).expect("re-load PNG"),
-                tx_px: tx,
-                ty_px: ty,
-            }
+            ShiftedPair::written(
+                dir,
+                [format!("mi_{k}_fixed.png"), format!("mi_{k}_moving.png")],
+                &a,
+                &b,
+                (tx, ty),
+            )
         })
         .collect()
 }
 
 /// Median over `reps` rounds of the mean thread CPU time per pair (ms) of `f` on every pair.
-fn median_ms_per_call(pairs: &[Pair], reps: usize, mut f: impl FnMut(usize, &Pair)) -> f64 {
+fn median_ms_per_call(
+    pairs: &[ShiftedPair],
+    reps: usize,
+    mut f: impl FnMut(usize, &ShiftedPair),
+) -> f64 {
     median_round_ms(reps, || {
         for (k, p) in pairs.iter().enumerate() {
             f(k, p);
@@ -97,9 +88,9 @@ fn es(k: usize) -> OnePlusOneParams {
     }
 }
 
-fn register(p: &Pair, k: usize, samples: Option<usize>) -> MiRegistration {
+fn register(p: &ShiftedPair, k: usize, samples: Option<usize>) -> MiRegistration {
     mi_search(
-        &p.fixed,
+        &p.reference,
         &p.moving,
         BINS,
         samples,

@@ -14,27 +14,19 @@ mod imaging_support;
 #[path = "peer_support/mod.rs"]
 mod peer_support;
 
+use peer_support::shifted_pair::ShiftedPair;
 use peer_support::{median_round_ms, peer_dir};
 use std::path::Path;
 
 use imaging_support::{radiometric, SplitMix64, Texture};
-use skytie_stages::imaging::io::{load_gray, save_gray};
-use skytie_stages::imaging::GrayImage;
 use skytie_stages::matching::phase_correlation::{
     phase_correlate, PhaseCorrelationParams, PhaseCorrelator,
 };
 
 const PAIRS: usize = 20;
 
-struct Pair {
-    reference: GrayImage,
-    moving: GrayImage,
-    tx_px: f64,
-    ty_px: f64,
-}
-
 /// Writes the pairs of one size as PNGs and returns them as re-loaded (8-bit quantised) images.
-fn make_pairs(size: usize, dir: &Path) -> Vec<Pair> {
+fn make_pairs(size: usize, dir: &Path) -> Vec<ShiftedPair> {
     let tex = Texture::new(512, 128, 42);
     let mut rng = SplitMix64(size as u64);
     (0..PAIRS)
@@ -44,24 +36,22 @@ fn make_pairs(size: usize, dir: &Path) -> Vec<Pair> {
             let a = tex.render(size, size, x0, y0, 0.0, 0.0);
             let b = tex.render(size, size, x0, y0, tx, ty);
             let b = radiometric(&b, 0.6, 0.25, 0.7, 0.01, (size * 1000 + k) as u64);
-            let (pa, pb) = (
-                dir.join(format!("pc{size}_{k}_ref.png")),
-                dir.join(format!("pc{size}_{k}_mov.png")),
-            );
-            save_gray(&pa, &a).expect("write PNG");
-            save_gray(&pb, &b).expect("write PNG");
-            Pair {
-                reference: load_gray(&pa).expect("re-load PNG"),
-                moving: load_gray(&pb).expect("re-load PNG"),
-                tx_px: tx,
-                ty_px: ty,
-            }
+            ShiftedPair::written(
+                dir,
+                [
+                    format!("pc{size}_{k}_ref.png"),
+                    format!("pc{size}_{k}_mov.png"),
+                ],
+                &a,
+                &b,
+                (tx, ty),
+            )
         })
         .collect()
 }
 
 /// Median over `reps` rounds of the mean time per pair (ms; thread CPU time, else wall) of `f` on every pair.
-fn median_ms_per_call(pairs: &[Pair], reps: usize, mut f: impl FnMut(&Pair)) -> f64 {
+fn median_ms_per_call(pairs: &[ShiftedPair], reps: usize, mut f: impl FnMut(&ShiftedPair)) -> f64 {
     median_round_ms(reps, || pairs.iter().for_each(&mut f)) / pairs.len() as f64
 }
 

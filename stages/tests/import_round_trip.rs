@@ -161,11 +161,24 @@ fn import(dir: &Path, config: &str) -> Campaign {
 const CAMPAIGN: &str =
     "[campaign]\nname = \"round trip\"\ncrs = \"EPSG:28992+5709\"\ngeoid_separation_m = 43.25\n";
 
+/// Four aerial rows `<prefix>0` … `<prefix>3` (see [`aerial`]).
+fn four_aerials(prefix: &str, oblique: bool, extended: bool) -> Vec<AerialImage> {
+    (0..4)
+        .map(|i| aerial(&format!("{prefix}{i}"), i, oblique, extended))
+        .collect()
+}
+
+/// The campaign of one `[[aerial]]` table of `kind` and `format` in `dir`, its further keys in `keys`.
+fn import_aerial(dir: &Path, kind: &str, format: &str, keys: &str) -> Campaign {
+    import(
+        dir,
+        &format!("{CAMPAIGN}[[aerial]]\nkind = \"{kind}\"\nformat = \"{format}\"\n{keys}"),
+    )
+}
+
 #[test]
 fn pix4d_round_trip() {
-    let rows: Vec<AerialImage> = (0..4)
-        .map(|i| aerial(&format!("n{i}"), i, false, false))
-        .collect();
+    let rows = four_aerials("n", false, false);
     let dir = with_images(&rows);
     export_pix4d(
         &rows,
@@ -176,15 +189,13 @@ fn pix4d_round_trip() {
         "proj",
     )
     .unwrap();
-    let got = import(dir.path(), &format!("{CAMPAIGN}[[aerial]]\nkind = \"nadir\"\nformat = \"pix4d\"\norientations = \"proj_calibrated_external_camera_parameters.txt\"\ninternals = \"proj_pix4d_calibrated_internal_camera_parameters.cam\"\nimages = \"images\"\ncrs = \"EPSG:28992+5709\"\nimage_width_px = 6000\nimage_height_px = 4000\n"));
+    let got = import_aerial(dir.path(), "nadir", "pix4d", "orientations = \"proj_calibrated_external_camera_parameters.txt\"\ninternals = \"proj_pix4d_calibrated_internal_camera_parameters.cam\"\nimages = \"images\"\ncrs = \"EPSG:28992+5709\"\nimage_width_px = 6000\nimage_height_px = 4000\n");
     assert_aerial_equal(&rows, &got.nadir, "pix4d");
 }
 
 #[test]
 fn metashape_xml_round_trip_through_earth_centred_chunk() {
-    let rows: Vec<AerialImage> = (0..4)
-        .map(|i| aerial(&format!("o{i}"), i, true, true))
-        .collect();
+    let rows = four_aerials("o", true, true);
     let dir = with_images(&rows);
     export_metashape_xml(
         &rows,
@@ -193,15 +204,18 @@ fn metashape_xml_round_trip_through_earth_centred_chunk() {
         &dir.path().join("cameras.xml"),
     )
     .unwrap();
-    let got = import(dir.path(), &format!("{CAMPAIGN}[[aerial]]\nkind = \"oblique\"\nformat = \"metashape-xml\"\norientations = \"cameras.xml\"\nimages = \"images\"\n"));
+    let got = import_aerial(
+        dir.path(),
+        "oblique",
+        "metashape-xml",
+        "orientations = \"cameras.xml\"\nimages = \"images\"\n",
+    );
     assert_aerial_equal(&rows, &got.oblique, "metashape-xml");
 }
 
 #[test]
 fn metashape_opk_and_generic_lists_round_trip() {
-    let rows: Vec<AerialImage> = (0..4)
-        .map(|i| aerial(&format!("n{i}"), i, false, true))
-        .collect();
+    let rows = four_aerials("n", false, true);
     let camera = "[aerial.camera]\nfocal_px = 10000.5\ncx_px = 3000.25\ncy_px = 2001.75\nwidth_px = 6000\nheight_px = 4000\nk1 = -0.12\nk2 = 0.03\nk3 = 0.004\nk4 = -0.0005\np1 = 2e-4\np2 = -1e-4\nb1 = 0.8\nb2 = -0.3\n";
     // Metashape ω-φ-κ export.
     let dir = with_images(&rows);
@@ -213,7 +227,12 @@ fn metashape_opk_and_generic_lists_round_trip() {
         &dir.path().join("opk.txt"),
     )
     .unwrap();
-    let got = import(dir.path(), &format!("{CAMPAIGN}[[aerial]]\nkind = \"nadir\"\nformat = \"metashape-opk\"\norientations = \"opk.txt\"\nimages = \"images\"\n{camera}"));
+    let got = import_aerial(
+        dir.path(),
+        "nadir",
+        "metashape-opk",
+        &format!("orientations = \"opk.txt\"\nimages = \"images\"\n{camera}"),
+    );
     assert_aerial_equal(&rows, &got.nadir, "metashape-opk");
     // A classical AT list: semicolons, no header, gon, yaw-pitch-roll, columns by position.
     let layout = OpkListFormat::at_list();
@@ -227,7 +246,12 @@ fn metashape_opk_and_generic_lists_round_trip() {
     )
     .unwrap();
     let layout_toml = "[aerial.layout]\ndelimiter = \"semicolon\"\nheader = false\nangle_unit = \"gon\"\nattitude = \"yaw-pitch-roll\"\n[aerial.layout.columns]\nimage = \"1\"\nx = \"2\"\ny = \"3\"\nz = \"4\"\nangles = [\"5\", \"6\", \"7\"]\n";
-    let got = import(dir.path(), &format!("{CAMPAIGN}[[aerial]]\nkind = \"nadir\"\nformat = \"opk-list\"\norientations = \"at.txt\"\nimages = \"images\"\n{layout_toml}{camera}"));
+    let got = import_aerial(
+        dir.path(),
+        "nadir",
+        "opk-list",
+        &format!("orientations = \"at.txt\"\nimages = \"images\"\n{layout_toml}{camera}"),
+    );
     assert_aerial_equal(&rows, &got.nadir, "opk-list");
 }
 

@@ -2,9 +2,8 @@
 //! count) and NCC template matching of MM-ortho templates in aerial windows, on a synthetic marking pattern
 //! whose aerial image is a similarity-transformed, radiometrically changed copy.
 
-use nalgebra::{Vector2, Vector3};
+use nalgebra::Vector2;
 use skytie_stages::campaign::AerialImage;
-use skytie_stages::correspondence::{MmTiePoint, PanoObservation};
 use skytie_stages::geometry::Similarity2;
 use skytie_stages::imaging::pyramid::MemoryPyramid;
 use skytie_stages::imaging::GrayImage;
@@ -12,8 +11,14 @@ use skytie_stages::nadir::aerial_patch::AerialWindow;
 use skytie_stages::nadir::baseline::{
     baseline_matches, isolated_aerial_keypoints, BaselineParams, KdTree2,
 };
-use skytie_stages::nadir::{InitialTransform, MmWindowMatch, OrthoGeoref, OrthoImage, OrthoParams};
+use skytie_stages::nadir::{AerialRefinement, MmWindowMatch, OrthoImage};
 use skytie_stages::params::Params;
+use support::ortho_pair::{
+    initial_transform, ortho_georef, render_aerial, render_ortho, tie_index, true_aerial_px,
+    true_similarity, window_at, FOOT_WORLD,
+};
+
+mod support;
 
 /// Bright axis-aligned squares (world metres) on a grey road with smooth (blurred) edges.
 struct Markings {
@@ -72,83 +77,22 @@ struct Scene {
 }
 
 fn scene() -> Scene {
-    let foot = [92_000.0, 437_000.0, 1.2];
+    let foot = FOOT_WORLD;
     let m = Markings::new([foot[0], foot[1]]);
-    let georef = OrthoGeoref::new(
-        foot,
-        &OrthoParams {
-            gsd_m: 0.10,
-            rotation_deg: 30.0,
-            ..OrthoParams::default()
-        },
-    );
+    let georef = ortho_georef(foot);
     let (w, h) = (georef.width_px, georef.height_px);
-    let mut image = GrayImage::filled(w, h, 0.0);
-    for r in 0..h {
-        for c in 0..w {
-            let p = georef.pixel_to_world(c as f64 + 0.5, r as f64 + 0.5);
-            image.set(c, r, m.at(p.x, p.y) as f32);
-        }
-    }
     let ortho = OrthoImage {
-        image,
+        image: render_ortho(&georef, |x_m, y_m| m.at(x_m, y_m)),
         valid: vec![1; w * h],
         georef: georef.clone(),
     };
-    let truth = Similarity2 {
-        scale: 0.97,
-        rotation_rad: 0.21,
-        tx: 143.37,
-        ty: 61.81,
-    };
-    let inv = truth.inverse();
-    let (aw, ah) = (400usize, 360usize);
-    let mut aerial = GrayImage::filled(aw, ah, 0.0);
-    for r in 0..ah {
-        for c in 0..aw {
-            let o = inv.apply(&Vector2::new(c as f64 + 0.5, r as f64 + 0.5));
-            let p = georef.pixel_to_world(o.x, o.y);
-            // Different sensor: gain, offset, gamma, a faint deterministic texture.
-            let texture = 0.01 * ((0.7 * c as f64).sin() * (0.9 * r as f64).cos());
-            aerial.set(
-                c,
-                r,
-                (0.1 + 0.7 * m.at(p.x, p.y).powf(0.8) + texture) as f32,
-            );
-        }
-    }
-    let corners = m.corners();
-    let isolated_tie_points = 12;
-    let tie_points: Vec<MmTiePoint> = corners
-        .iter()
-        .enumerate()
-        .map(|(i, c)| MmTiePoint {
-            id: format!("rec#{i}"),
-            observations: vec![
-                PanoObservation {
-                    image_id: "rec".into(),
-                    u_px: 1.0,
-                    v_px: 1.0,
-                },
-                PanoObservation {
-                    image_id: "rec2".into(),
-                    u_px: 2.0,
-                    v_px: 2.0,
-                },
-            ],
-            point_world: [c[0], c[1], foot[2]],
-            covariance_m2: [[1e-4, 0.0, 0.0], [0.0, 1e-4, 0.0], [0.0, 0.0, 1e-4]],
-            max_angle_deg: 10.0,
-        })
-        .collect();
-    let window = MmWindowMatch {
-        recording_id: "rec".into(),
-        pairs: vec![],
-        corners_detected: corners.len(),
-        ground_world: corners.iter().map(|c| [c[0], c[1], foot[2]]).collect(),
-        neighbour_ground_world: Vec::new(),
-        tie_points,
-    };
+    let truth = true_similarity();
+    let aerial = render_aerial(&georef, &truth, |c, r, x_m, y_m| {
+        // Different sensor: gain, offset, gamma, a faint deterministic texture.
+        let texture = 0.01 * ((0.7 * c as f64).sin() * (0.9 * r as f64).cos());
+        0.1 + 0.7 * m.at(x_m, y_m).powf(0.8) + texture
+    });
+    let window = window_at(m.corners().iter().map(|c| [c[0], c[1], foot[2]]).collect());
     // A nadir camera whose GSD at the ground is 0.1 m (only the GSD is used by the isolation test).
     let row = AerialImage::ideal(
         "aer",
@@ -163,30 +107,25 @@ fn scene() -> Scene {
         truth,
         window,
         row,
-        isolated_tie_points,
+        isolated_tie_points: 12,
     }
 }
 
-fn transform(t: Similarity2) -> InitialTransform {
-    InitialTransform {
-        recording_id: "rec".into(),
-        aerial_id: "aer".into(),
-        ortho_to_aerial: t,
-        matches: 0,
-        inliers: 0,
-        centre_offset_m: 0.0,
-        centre_offset_world_m: [0.0, 0.0],
-        reused_from: None,
-    }
+/// `baseline_matches` of the scene's window from the initial similarity `initial`.
+fn matches(s: &Scene, initial: Similarity2, p: &BaselineParams) -> AerialRefinement {
+    baseline_matches(
+        &s.ortho,
+        &MemoryPyramid::from_gray(&s.aerial),
+        &s.row,
+        &initial_transform(initial),
+        &s.window,
+        p,
+    )
+    .unwrap()
 }
 
-fn true_aerial_px(s: &Scene, i: usize) -> Vector2<f64> {
-    let g = s.window.ground_world[i];
-    let (u, v) = s
-        .ortho
-        .georef
-        .world_to_pixel(&Vector3::new(g[0], g[1], g[2]));
-    s.truth.apply(&Vector2::new(u, v))
+fn true_aerial_px_of(s: &Scene, i: usize) -> Vector2<f64> {
+    true_aerial_px(&s.ortho.georef, &s.truth, s.window.ground_world[i])
 }
 
 #[test]
@@ -194,7 +133,7 @@ fn kd_tree_isolation_keeps_corners_of_isolated_markings_only() {
     let s = scene();
     let p = BaselineParams::default();
     // The window `baseline_matches` reads: the footprint grown by half the isolation box.
-    let tf = transform(s.truth).ortho_to_aerial;
+    let tf = s.truth;
     let size = (s.ortho.image.width, s.ortho.image.height);
     let margin = p.isolation_box_m / 2.0 / 0.1 / tf.scale;
     let pyramid = MemoryPyramid::from_gray(&s.aerial);
@@ -204,7 +143,7 @@ fn kd_tree_isolation_keeps_corners_of_isolated_markings_only() {
     let kps = isolated_aerial_keypoints(&window, 0.1, &p);
     // Every kept keypoint is near a corner of an isolated square, and every such corner has a keypoint.
     let near = |k: &[f64; 2], i: usize| {
-        let t = true_aerial_px(&s, i);
+        let t = true_aerial_px_of(&s, i);
         (k[0] - t.x).hypot(k[1] - t.y) < 1.0
     };
     for k in &kps {
@@ -243,29 +182,16 @@ fn baseline_locates_isolated_corners_by_ncc_and_snaps_to_the_keypoints() {
     let p = BaselineParams::default();
     p.validate().unwrap();
     // The initial transform is off by a few pixels (well inside the ±12 px of a 16-in-40 search).
-    let off = Similarity2 {
-        scale: 1.0,
-        rotation_rad: 0.004,
-        tx: 3.2,
-        ty: -2.1,
-    };
-    let r = baseline_matches(
-        &s.ortho,
-        &MemoryPyramid::from_gray(&s.aerial),
-        &s.row,
-        &transform(off.compose(&s.truth)),
-        &s.window,
-        &p,
-    )
-    .unwrap();
+    let off = Similarity2::new(1.0, 0.004, 3.2, -2.1);
+    let r = matches(&s, off.compose(&s.truth), &p);
     println!("tried {} matched {}", r.tried, r.matches.len());
     assert_eq!(r.tried, s.window.tie_points.len());
     let mut located = vec![false; s.window.tie_points.len()];
     let mut max_err = 0.0f64;
     for m in &r.matches {
-        let i: usize = m.tie_point_id.split('#').nth(1).unwrap().parse().unwrap();
+        let i = tie_index(&m.tie_point_id);
         located[i] = true;
-        let t = true_aerial_px(&s, i);
+        let t = true_aerial_px_of(&s, i);
         let e = (m.observation.u_px - t.x).hypot(m.observation.v_px - t.y);
         max_err = max_err.max(e);
         assert!(m.observation.score >= p.min_ncc);
@@ -284,15 +210,7 @@ fn baseline_locates_isolated_corners_by_ncc_and_snaps_to_the_keypoints() {
         "{located:?}"
     );
     // Deterministic.
-    let again = baseline_matches(
-        &s.ortho,
-        &MemoryPyramid::from_gray(&s.aerial),
-        &s.row,
-        &transform(off.compose(&s.truth)),
-        &s.window,
-        &p,
-    )
-    .unwrap();
+    let again = matches(&s, off.compose(&s.truth), &p);
     assert_eq!(r, again);
 }
 

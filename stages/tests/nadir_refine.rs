@@ -4,7 +4,7 @@
 
 use nalgebra::{Matrix3, Vector2, Vector3};
 use skytie_stages::campaign::{AerialImage, Recording};
-use skytie_stages::correspondence::{AerialObservation, MmTiePoint, PanoObservation};
+use skytie_stages::correspondence::{AerialObservation, PanoObservation};
 use skytie_stages::geometry::{FrameCamera, PanoramaCamera, PointPair, Similarity2};
 use skytie_stages::imaging::pyramid::MemoryPyramid;
 use skytie_stages::imaging::GrayImage;
@@ -13,11 +13,16 @@ use skytie_stages::nadir::control_points::{
 };
 use skytie_stages::nadir::refine::{refine_in_aerial, RefineParams};
 use skytie_stages::nadir::{
-    AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch, OrthoGeoref, OrthoImage,
-    OrthoParams,
+    AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch, OrthoImage, OrthoParams,
 };
 use skytie_stages::params::Params;
 use skytie_stages::rng::SplitMix64;
+use support::ortho_pair::{
+    initial_transform, ortho_georef, render_aerial, render_ortho, tie_index, tie_point,
+    true_aerial_px, true_similarity, window_at, FOOT_WORLD,
+};
+
+mod support;
 
 // ---------------------------------------------------------------------------------------------------------
 // Helpers
@@ -67,27 +72,6 @@ fn aerial_row(id: &str, w: u32, h: u32) -> AerialImage {
     AerialImage::ideal(id, [0.0, 0.0, 4470.0], [0.0, 0.0, 0.0], 44700.0, [w, h])
 }
 
-fn tie_point(id: &str, p: [f64; 3]) -> MmTiePoint {
-    MmTiePoint {
-        id: id.into(),
-        observations: vec![
-            PanoObservation {
-                image_id: "rec".into(),
-                u_px: 1.0,
-                v_px: 2.0,
-            },
-            PanoObservation {
-                image_id: "rec2".into(),
-                u_px: 3.0,
-                v_px: 4.0,
-            },
-        ],
-        point_world: p,
-        covariance_m2: [[1e-4, 0.0, 0.0], [0.0, 1e-4, 0.0], [0.0, 0.0, 1e-4]],
-        max_angle_deg: 10.0,
-    }
-}
-
 /// The synthetic pair of the refinement tests: an MM ortho image of `texture` (10 cm, rotated 30°), an aerial
 /// image that is the same texture seen through the similarity `truth` (ortho px → aerial px), photometrically
 /// changed (gain, offset, gamma) and noisy, and a grid of tie points.
@@ -104,104 +88,94 @@ fn make_pair(seed: u64, noise_sigma: f64) -> Pair {
 
 fn make_pair_g(seed: u64, noise_sigma: f64, gamma: f64) -> Pair {
     let texture = Texture::new(seed);
-    let params = OrthoParams {
-        gsd_m: 0.10,
-        rotation_deg: 30.0,
-        ..OrthoParams::default()
-    };
-    let georef = OrthoGeoref::new([92_000.0, 437_000.0, 1.2], &params);
-    let (w, h) = (georef.width_px, georef.height_px);
-    let mut image = GrayImage::filled(w, h, 0.0);
-    for r in 0..h {
-        for c in 0..w {
-            let p = georef.pixel_to_world(c as f64 + 0.5, r as f64 + 0.5);
-            image.set(c, r, texture.at(p.x, p.y) as f32);
-        }
-    }
+    let georef = ortho_georef(FOOT_WORLD);
+    let image = render_ortho(&georef, |x_m, y_m| texture.at(x_m, y_m));
     // Vehicle mask: a block left of the centre.
+    let (w, h) = (georef.width_px, georef.height_px);
     let mut valid = vec![1u8; w * h];
     for r in h / 2 - 20..h / 2 + 20 {
         for c in w / 2 - 40..w / 2 - 10 {
             valid[r * w + c] = 0;
         }
     }
-    let ortho = OrthoImage {
-        image,
-        valid,
-        georef: georef.clone(),
-    };
-    let truth = Similarity2 {
-        scale: 0.97,
-        rotation_rad: 0.21,
-        tx: 143.37,
-        ty: 61.81,
-    };
-    let inv = truth.inverse();
-    let (aw, ah) = (400usize, 360usize);
+    let truth = true_similarity();
     let mut rng = SplitMix64::new(seed ^ 0xa5a5);
-    let mut aerial = GrayImage::filled(aw, ah, 0.0);
-    for r in 0..ah {
-        for c in 0..aw {
-            let o = inv.apply(&Vector2::new(c as f64 + 0.5, r as f64 + 0.5));
-            let p = georef.pixel_to_world(o.x, o.y);
-            let g = texture.at(p.x, p.y).clamp(0.0, 1.0);
-            let v = 0.15 + 0.6 * g.powf(gamma) + noise_sigma * normal(&mut rng);
-            aerial.set(c, r, v as f32);
-        }
-    }
-    let mut tie_points = Vec::new();
+    let aerial = render_aerial(&georef, &truth, |_, _, x_m, y_m| {
+        let g = texture.at(x_m, y_m).clamp(0.0, 1.0);
+        0.15 + 0.6 * g.powf(gamma) + noise_sigma * normal(&mut rng)
+    });
     let mut ground_world = Vec::new();
     for j in 0..9 {
         for i in 0..9 {
             let u = 30.3 + i as f64 * 19.1;
             let v = 28.7 + j as f64 * 19.3;
             let p = georef.pixel_to_world(u, v);
-            let id = format!("rec#{}", tie_points.len());
-            tie_points.push(tie_point(&id, [p.x, p.y, p.z]));
             ground_world.push([p.x, p.y, p.z]);
         }
     }
     Pair {
-        ortho,
+        ortho: OrthoImage {
+            image,
+            valid,
+            georef,
+        },
         aerial,
         truth,
-        window: MmWindowMatch {
-            recording_id: "rec".into(),
-            pairs: vec![],
-            corners_detected: tie_points.len(),
-            tie_points,
-            ground_world,
-            neighbour_ground_world: Vec::new(),
-        },
+        window: window_at(ground_world),
     }
 }
 
-fn transform(t: Similarity2) -> InitialTransform {
-    InitialTransform {
-        recording_id: "rec".into(),
-        aerial_id: "aer".into(),
-        ortho_to_aerial: t,
-        matches: 0,
-        inliers: 0,
-        centre_offset_m: 0.0,
-        centre_offset_world_m: [0.0, 0.0],
-        reused_from: None,
-    }
+/// Refines the tie points of `pair`'s window in the 400 × 360 px `aerial` image "aer", starting from the
+/// similarity `initial` (ortho px → aerial px).
+fn refine(
+    pair: &Pair,
+    aerial: &GrayImage,
+    initial: Similarity2,
+    params: &RefineParams,
+) -> AerialRefinement {
+    refine_window(pair, &pair.window, aerial, initial, params)
+}
+
+/// [`refine`] of any window over `pair`'s ortho image.
+fn refine_window(
+    pair: &Pair,
+    window: &MmWindowMatch,
+    aerial: &GrayImage,
+    initial: Similarity2,
+    params: &RefineParams,
+) -> AerialRefinement {
+    refine_in_aerial(
+        &pair.ortho,
+        &MemoryPyramid::from_gray(aerial),
+        &aerial_row("aer", 400, 360),
+        &initial_transform(initial),
+        window,
+        &[],
+        params,
+    )
+    .unwrap()
 }
 
 /// RMS distance (aerial px) of the matches from the truth, and the largest one.
 fn errors_px(pair: &Pair, refinement: &AerialRefinement) -> (f64, f64) {
+    errors_of_px(pair, refinement, |m| {
+        (m.observation.u_px, m.observation.v_px)
+    })
+}
+
+/// RMS distance (aerial px) of each match's position `at` from the truth, and the largest one.
+fn errors_of_px(
+    pair: &Pair,
+    refinement: &AerialRefinement,
+    at: impl Fn(&AerialMatch) -> (f64, f64),
+) -> (f64, f64) {
     let mut sum = 0.0;
     let mut max = 0.0f64;
     for m in &refinement.matches {
-        let i: usize = m.tie_point_id.split('#').nth(1).unwrap().parse().unwrap();
-        let g = pair.window.ground_world[i];
-        let (u, v) = pair
-            .ortho
-            .georef
-            .world_to_pixel(&Vector3::new(g[0], g[1], g[2]));
-        let t = pair.truth.apply(&Vector2::new(u, v));
-        let e = (m.observation.u_px - t.x).hypot(m.observation.v_px - t.y);
+        let g = pair.window.ground_world[tie_index(&m.tie_point_id)];
+        let t = true_aerial_px(&pair.ortho.georef, &pair.truth, g);
+        let (u_px, v_px) = at(m);
+        let e = (u_px - t.x).hypot(v_px - t.y);
         sum += e * e;
         max = max.max(e);
     }
@@ -215,40 +189,12 @@ fn errors_px(pair: &Pair, refinement: &AerialRefinement) -> (f64, f64) {
 fn refinement_recovers_a_subpixel_offset_under_radiometric_change_and_noise() {
     let pair = make_pair(11, 0.01);
     // The initial transform is off by (0.83, −0.61) aerial px and slightly in rotation/scale.
-    let off = Similarity2 {
-        scale: 1.002,
-        rotation_rad: 0.003,
-        tx: 0.83,
-        ty: -0.61,
-    };
+    let off = Similarity2::new(1.002, 0.003, 0.83, -0.61);
     let initial = off.compose(&pair.truth);
-    let row = aerial_row("aer", 400, 360);
     let p = params_at_peak_05();
     p.validate().unwrap();
-    let r = refine_in_aerial(
-        &pair.ortho,
-        &MemoryPyramid::from_gray(&pair.aerial),
-        &row,
-        &transform(initial),
-        &pair.window,
-        &[],
-        &p,
-    )
-    .unwrap();
-    let (rms_before, _) = {
-        let mut s = 0.0;
-        for m in &r.matches {
-            let i: usize = m.tie_point_id.split('#').nth(1).unwrap().parse().unwrap();
-            let g = pair.window.ground_world[i];
-            let (u, v) = pair
-                .ortho
-                .georef
-                .world_to_pixel(&Vector3::new(g[0], g[1], g[2]));
-            let t = pair.truth.apply(&Vector2::new(u, v));
-            s += (m.predicted_u_px - t.x).powi(2) + (m.predicted_v_px - t.y).powi(2);
-        }
-        ((s / r.matches.len() as f64).sqrt(), 0.0)
-    };
+    let r = refine(&pair, &pair.aerial, initial, &p);
+    let (rms_before, _) = errors_of_px(&pair, &r, |m| (m.predicted_u_px, m.predicted_v_px));
     let (rms, max) = errors_px(&pair, &r);
     println!(
         "tried {} matched {} rms before {rms_before:.3} px after {rms:.4} px max {max:.4} px",
@@ -270,21 +216,12 @@ fn refinement_recovers_a_subpixel_offset_under_radiometric_change_and_noise() {
         assert!(m.observation.score >= p.min_peak);
     }
     // Deterministic, in tie-point order.
-    let again = refine_in_aerial(
-        &pair.ortho,
-        &MemoryPyramid::from_gray(&pair.aerial),
-        &row,
-        &transform(initial),
-        &pair.window,
-        &[],
-        &p,
-    )
-    .unwrap();
+    let again = refine(&pair, &pair.aerial, initial, &p);
     assert_eq!(r, again);
     let ids: Vec<usize> = r
         .matches
         .iter()
-        .map(|m| m.tie_point_id.split('#').nth(1).unwrap().parse().unwrap())
+        .map(|m| tie_index(&m.tie_point_id))
         .collect();
     assert!(ids.windows(2).all(|w| w[0] < w[1]));
 }
@@ -294,23 +231,13 @@ fn refinement_handles_larger_offsets_within_the_margin() {
     // Same scene as the ~1 px test, so only the offset size changes. (Seed 5's texture gives 0.16 px RMS at
     // this offset: the accuracy depends on the texture, see the report.)
     let pair = make_pair(11, 0.01);
-    let off = Similarity2 {
-        scale: 1.0,
-        rotation_rad: 0.0,
-        tx: -4.4,
-        ty: 3.7,
-    };
-    let row = aerial_row("aer", 400, 360);
-    let r = refine_in_aerial(
-        &pair.ortho,
-        &MemoryPyramid::from_gray(&pair.aerial),
-        &row,
-        &transform(off.compose(&pair.truth)),
-        &pair.window,
-        &[],
+    let off = Similarity2::new(1.0, 0.0, -4.4, 3.7);
+    let r = refine(
+        &pair,
+        &pair.aerial,
+        off.compose(&pair.truth),
         &params_at_peak_05(),
-    )
-    .unwrap();
+    );
     let (rms, _) = errors_px(&pair, &r);
     assert!(r.matches.len() >= 70, "{}", r.matches.len());
     assert!(rms < 0.1, "rms {rms}");
@@ -320,17 +247,7 @@ fn refinement_handles_larger_offsets_within_the_margin() {
 fn unrelated_aerial_content_gives_weak_peaks_that_are_rejected() {
     let pair = make_pair(3, 0.0);
     let other = make_pair(99, 0.0);
-    let row = aerial_row("aer", 400, 360);
-    let r = refine_in_aerial(
-        &pair.ortho,
-        &MemoryPyramid::from_gray(&other.aerial),
-        &row,
-        &transform(pair.truth),
-        &pair.window,
-        &[],
-        &params_at_peak_05(),
-    )
-    .unwrap();
+    let r = refine(&pair, &other.aerial, pair.truth, &params_at_peak_05());
     println!("unrelated: {} of {} accepted", r.matches.len(), r.tried);
     assert!(r.tried > 70);
     assert!(
@@ -343,62 +260,33 @@ fn unrelated_aerial_content_gives_weak_peaks_that_are_rejected() {
 #[test]
 fn tie_points_outside_the_aerial_image_are_not_tried_and_bad_transforms_give_nothing() {
     let pair = make_pair(4, 0.0);
-    let row = aerial_row("aer", 400, 360);
     let far = Similarity2 {
         tx: pair.truth.tx + 5000.0,
         ..pair.truth
     };
     let p = params_at_peak_05();
-    let r = refine_in_aerial(
-        &pair.ortho,
-        &MemoryPyramid::from_gray(&pair.aerial),
-        &row,
-        &transform(far),
-        &pair.window,
-        &[],
-        &p,
-    )
-    .unwrap();
+    let r = refine(&pair, &pair.aerial, far, &p);
     assert_eq!((r.tried, r.matches.len()), (0, 0));
     let nan = Similarity2 {
         scale: f64::NAN,
         ..pair.truth
     };
-    let r = refine_in_aerial(
-        &pair.ortho,
-        &MemoryPyramid::from_gray(&pair.aerial),
-        &row,
-        &transform(nan),
-        &pair.window,
-        &[],
-        &p,
-    )
-    .unwrap();
+    let r = refine(&pair, &pair.aerial, nan, &p);
     assert_eq!((r.tried, r.matches.len()), (0, 0));
 }
 
 #[test]
 fn a_tie_point_located_alone_in_an_image_is_not_kept_unless_min_located_is_1() {
     let pair = make_pair(11, 0.01);
-    let row = aerial_row("aer", 400, 360);
     let p = params_at_peak_05();
-    let all = refine_in_aerial(
-        &pair.ortho,
-        &MemoryPyramid::from_gray(&pair.aerial),
-        &row,
-        &transform(pair.truth),
-        &pair.window,
-        &[],
-        &p,
-    )
-    .unwrap();
+    let all = refine(&pair, &pair.aerial, pair.truth, &p);
     assert_eq!(all.unconfirmed, 0);
     // Keep only the window's first two locatable tie points.
     let keep: Vec<usize> = all
         .matches
         .iter()
         .take(2)
-        .map(|m| m.tie_point_id.split('#').nth(1).unwrap().parse().unwrap())
+        .map(|m| tie_index(&m.tie_point_id))
         .collect();
     let window_of_ids = |ids: &[usize]| {
         let mut w = pair.window.clone();
@@ -415,16 +303,7 @@ fn a_tie_point_located_alone_in_an_image_is_not_kept_unless_min_located_is_1() {
             min_located,
             ..p.clone()
         };
-        refine_in_aerial(
-            &pair.ortho,
-            &MemoryPyramid::from_gray(&pair.aerial),
-            &row,
-            &transform(pair.truth),
-            &window_of_ids(ids),
-            &[],
-            &q,
-        )
-        .unwrap()
+        refine_window(&pair, &window_of_ids(ids), &pair.aerial, pair.truth, &q)
     };
     let two = run(&keep, 2);
     assert_eq!((two.tried, two.matches.len(), two.unconfirmed), (2, 2, 0));
@@ -527,18 +406,7 @@ fn refinement_at(
 }
 
 fn window_of(points: &[Vector3<f64>]) -> MmWindowMatch {
-    MmWindowMatch {
-        recording_id: "rec".into(),
-        pairs: vec![],
-        corners_detected: points.len(),
-        tie_points: points
-            .iter()
-            .enumerate()
-            .map(|(i, p)| tie_point(&format!("rec#{i}"), [p.x, p.y, p.z]))
-            .collect(),
-        ground_world: points.iter().map(|p| [p.x, p.y, p.z]).collect(),
-        neighbour_ground_world: Vec::new(),
-    }
+    window_at(points.iter().map(|p| [p.x, p.y, p.z]).collect())
 }
 
 #[test]
@@ -973,12 +841,7 @@ mod e2e {
                     let t = InitialTransform {
                         recording_id: rec.image_id.clone(),
                         aerial_id: row.image_id.clone(),
-                        ortho_to_aerial: true_transform(&ortho, truth, &cam),
-                        matches: 0,
-                        inliers: 0,
-                        centre_offset_m: 0.0,
-                        centre_offset_world_m: [0.0, 0.0],
-                        reused_from: None,
+                        ..initial_transform(true_transform(&ortho, truth, &cam))
                     };
                     let r = refine_in_aerial(
                         &ortho,
@@ -994,7 +857,7 @@ mod e2e {
                     stats.tried += r.tried;
                     stats.located += r.matches.len();
                     for m in &r.matches {
-                        let i: usize = m.tie_point_id.split('#').nth(1).unwrap().parse().unwrap();
+                        let i = tie_index(&m.tie_point_id);
                         let (tu, tv) = cam.project_world(&truth_points[i]).unwrap();
                         let e = (m.observation.u_px - tu).hypot(m.observation.v_px - tv);
                         stats.observation_errors_px.push(e);
@@ -1015,7 +878,7 @@ mod e2e {
                         continue;
                     };
                     any = true;
-                    let i: usize = cp.tie_point_id.split('#').nth(1).unwrap().parse().unwrap();
+                    let i = tie_index(&cp.tie_point_id);
                     let t = truth_points[i];
                     stats.control_points += 1;
                     stats

@@ -4,16 +4,16 @@
 mod support;
 
 use nalgebra::Vector3;
-use skytie_stages::campaign::Recording;
+use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::correspondence::{MmTiePoint, PanoObservation};
 use skytie_stages::crs::MapFrame;
 use skytie_stages::geometry::FrameCamera;
 use skytie_stages::oblique::consensus::{
-    consensus, consensus_with_diagnostics, ConsensusParams, SmallSetPolicy,
+    consensus, consensus_with_diagnostics, ConsensusDiagnostics, ConsensusParams, SmallSetPolicy,
 };
 use skytie_stages::oblique::{
-    PatchMatch, PatchRegistrationSet, PatchStats, SparseCloud, SparseCloudStats, SparsePoint,
-    StreetSide,
+    ObliqueResult, PatchMatch, PatchRegistrationSet, PatchStats, SparseCloud, SparseCloudStats,
+    SparsePoint, StreetSide,
 };
 use skytie_stages::params::Params;
 use skytie_stages::rng::SplitMix64;
@@ -80,6 +80,24 @@ fn constructed_set(recording: &str, seed: u64) -> (PatchRegistrationSet, Vec<boo
     (set(recording, "o1", matches), good)
 }
 
+/// The consensus with default parameters in Cartesian map coordinates, with its diagnostics.
+fn consensus_by_default(
+    sets: &[PatchRegistrationSet],
+    clouds: &[SparseCloud],
+    recordings: &[Recording],
+    oblique: &[AerialImage],
+) -> (ObliqueResult, ConsensusDiagnostics) {
+    consensus_with_diagnostics(
+        sets,
+        clouds,
+        recordings,
+        oblique,
+        &[],
+        &ConsensusParams::default(),
+        &MapFrame::Cartesian,
+    )
+}
+
 #[test]
 fn consensus_keeps_exactly_the_twenty_inliers() {
     let (s, good) = constructed_set("r1", 7);
@@ -122,15 +140,7 @@ fn coarse_rejected_matches_do_not_enter() {
     s.matches[0].rejected_coarse = true;
     s.matches[2].rejected_coarse = true; // an outlier
     let recs = vec![street_recording("r1", 1, 102.0)];
-    let (r, d) = consensus_with_diagnostics(
-        &[s],
-        &[],
-        &recs,
-        &[],
-        &[],
-        &ConsensusParams::default(),
-        &MapFrame::Cartesian,
-    );
+    let (r, d) = consensus_by_default(&[s], &[], &recs, &[]);
     assert_eq!(r.stats.correspondences, 23);
     assert_eq!(r.stats.kept, 19);
     assert_eq!(d.coarse_rejected, 2);
@@ -289,15 +299,7 @@ fn control_points_from_two_oblique_cameras_triangulate_to_under_a_millimetre() {
     let recs: Vec<Recording> = (0..3)
         .map(|i| street_recording(&format!("r{i}"), i, 102.0))
         .collect();
-    let (r, d) = consensus_with_diagnostics(
-        &sets,
-        &clouds,
-        &recs,
-        &images,
-        &[],
-        &ConsensusParams::default(),
-        &MapFrame::Cartesian,
-    );
+    let (r, d) = consensus_by_default(&sets, &clouds, &recs, &images);
     assert_eq!(r.stats.kept, 7);
     assert_eq!(d.duplicate_observations, 1);
     assert_eq!(r.control.len(), 3);
@@ -312,15 +314,7 @@ fn control_points_from_two_oblique_cameras_triangulate_to_under_a_millimetre() {
         assert!(cov[0][0] > 0.0 && cov[0][0] < 0.1);
     }
     // One oblique image only: a single-image point without coordinates.
-    let (r, _) = consensus_with_diagnostics(
-        &sets[..1],
-        &clouds,
-        &recs,
-        &images,
-        &[],
-        &ConsensusParams::default(),
-        &MapFrame::Cartesian,
-    );
+    let (r, _) = consensus_by_default(&sets[..1], &clouds, &recs, &images);
     assert_eq!(
         (r.stats.control_points, r.stats.single_image_points),
         (0, 3)

@@ -8,6 +8,7 @@ use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::correspondence::{MmTiePoint, PanoObservation};
 use skytie_stages::geometry::frame::FrameCamera;
 use skytie_stages::geometry::panorama::PanoramaCamera;
+use skytie_stages::geometry::Ray;
 use skytie_stages::imaging::equirect::PanoramaLevels;
 use skytie_stages::imaging::pyramid::{MemoryPyramid, ScaledWindow};
 use skytie_stages::imaging::GrayImage;
@@ -87,23 +88,22 @@ fn oblique_image() -> AerialImage {
 fn render_panorama(rec: &Recording) -> GrayImage {
     let (w, h) = (1600usize, 800usize);
     let cam = PanoramaCamera::from_recording(rec, w as u32, h as u32);
-    let mut img = GrayImage::filled(w, h, 0.0);
-    for r in 0..h {
-        for c in 0..w {
-            let ray = cam.pixel_ray(c as f64 + 0.5, r as f64 + 0.5);
-            img.set(c, r, trace(&ray.origin_world, &ray.dir_world));
-        }
-    }
-    img
+    render((w, h), |u, v| cam.pixel_ray(u, v))
 }
 
 fn render_oblique(a: &AerialImage) -> GrayImage {
     let cam = FrameCamera::from_aerial(a);
-    let (w, h) = (a.width_px as usize, a.height_px as usize);
+    render((a.width_px as usize, a.height_px as usize), |u, v| {
+        cam.pixel_ray(u, v)
+    })
+}
+
+/// The `(w, h)` image of the scene traced along `pixel_ray` of each pixel centre.
+fn render((w, h): (usize, usize), pixel_ray: impl Fn(f64, f64) -> Ray) -> GrayImage {
     let mut img = GrayImage::filled(w, h, 0.0);
     for r in 0..h {
         for c in 0..w {
-            let ray = cam.pixel_ray(c as f64 + 0.5, r as f64 + 0.5);
+            let ray = pixel_ray(c as f64 + 0.5, r as f64 + 0.5);
             img.set(c, r, trace(&ray.origin_world, &ray.dir_world));
         }
     }
@@ -187,14 +187,7 @@ const ON_FACADE: [(f64, f64, f64); 6] = [
 
 #[test]
 fn patch_grid_pixel_convention_and_shift_sign() {
-    let g = PatchGrid::new(
-        [10.0, 20.0, 30.0],
-        [1.0, 0.0, 0.0],
-        [0.0, 0.0, 1.0],
-        6.0,
-        0.1,
-    )
-    .unwrap();
+    let g = upright_grid([10.0, 20.0, 30.0], 6.0, 0.1);
     assert_eq!(g.size_px, 60);
     assert!((g.world_at(30.0, 30.0) - Vector3::new(10.0, 20.0, 30.0)).norm() < 1e-12);
     // One pixel right = +s along axis_u; one pixel down = −s along axis_v.
@@ -207,6 +200,19 @@ fn patch_grid_pixel_convention_and_shift_sign() {
     let s = g.shifted([1.0, -2.0]);
     assert!((s.centre_world - Vector3::new(11.0, 20.0, 28.0)).norm() < 1e-12);
     assert!(PatchGrid::new([0.0; 3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], 6.0, 0.0).is_none());
+}
+
+/// A patch grid on a façade facing ±y: `extent_m` wide along +x and high along +z around `centre_world`, with
+/// pixels of `gsd_m`.
+fn upright_grid(centre_world: [f64; 3], extent_m: f64, gsd_m: f64) -> PatchGrid {
+    PatchGrid::new(
+        centre_world,
+        [1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        extent_m,
+        gsd_m,
+    )
+    .unwrap()
 }
 
 #[test]
@@ -225,14 +231,7 @@ fn patches_of_a_textured_facade_from_two_cameras_agree_and_resolution_ratio_foll
         (u - 500.0).abs() < 1.0 && (v - 500.0).abs() < 50.0,
         "({u}, {v})"
     );
-    let grid = PatchGrid::new(
-        [X0, FACADE_Y, 8.0],
-        [1.0, 0.0, 0.0],
-        [0.0, 0.0, 1.0],
-        4.0,
-        0.1,
-    )
-    .unwrap();
+    let grid = upright_grid([X0, FACADE_Y, 8.0], 4.0, 0.1);
     let pano = PanoramaLevels::from_image(&pano, 3);
     let obl_img = ScaledWindow::whole(obl_img);
     let mm = fill_from_panorama(&grid, &pano_cam, &pano);
@@ -255,25 +254,11 @@ fn patches_of_a_textured_facade_from_two_cameras_agree_and_resolution_ratio_foll
     assert!(diff_ob / n < 6.0, "oblique patch mean |Δ| {}", diff_ob / n);
     // Real-resolution ratio: the façade footprint of an oblique pixel is ≈ 0.058 m across × 0.082 m up; a
     // grid at 0.2 m assigns a distinct pixel to every grid pixel, a grid at 0.02 m reuses pixels ≈ 12 times.
-    let coarse = PatchGrid::new(
-        [X0, FACADE_Y, 8.0],
-        [1.0, 0.0, 0.0],
-        [0.0, 0.0, 1.0],
-        4.0,
-        0.2,
-    )
-    .unwrap();
+    let coarse = upright_grid([X0, FACADE_Y, 8.0], 4.0, 0.2);
     let (r_coarse, inside) = real_resolution_ratio(&coarse, &cam_o, &obl_img);
     assert_eq!(r_coarse, 1.0);
     assert_eq!(inside, 1.0);
-    let fine = PatchGrid::new(
-        [X0, FACADE_Y, 8.0],
-        [1.0, 0.0, 0.0],
-        [0.0, 0.0, 1.0],
-        4.0,
-        0.02,
-    )
-    .unwrap();
+    let fine = upright_grid([X0, FACADE_Y, 8.0], 4.0, 0.02);
     let (r_fine, _) = real_resolution_ratio(&fine, &cam_o, &obl_img);
     let expected = 0.02 * 0.02 / (0.0586 * 0.0829);
     assert!((r_fine - expected).abs() < 0.03, "{r_fine} vs {expected}");
@@ -281,14 +266,7 @@ fn patches_of_a_textured_facade_from_two_cameras_agree_and_resolution_ratio_foll
     let filled = fill_from_frame(&fine, &cam_o, &obl_img);
     assert_eq!(filled.real_resolution_ratio(), r_fine);
     // Grid outside the image: no data.
-    let away = PatchGrid::new(
-        [X0 + 500.0, FACADE_Y, 8.0],
-        [1.0, 0.0, 0.0],
-        [0.0, 0.0, 1.0],
-        4.0,
-        0.1,
-    )
-    .unwrap();
+    let away = upright_grid([X0 + 500.0, FACADE_Y, 8.0], 4.0, 0.1);
     assert_eq!(fill_from_frame(&away, &cam_o, &obl_img).valid_pixels, 0);
 }
 

@@ -3,6 +3,7 @@
 //! regenerating over a previous synthetic campaign replaces it, while a foreign folder is refused; a generation
 //! resumed from the render store of an interrupted one gives the same folder.
 
+use skytie_stages::campaign::RECORDING_COLUMNS;
 use skytie_stages::synth::render_store::RenderStore;
 use skytie_stages::synth::{
     generate, generate_resumable, Preset, SynthError, SynthOptions, SynthSummary,
@@ -118,20 +119,9 @@ fn tiny_is_byte_identical_across_runs_and_thread_counts() {
     );
     let header = String::from_utf8(t1[Path::new("mm/recordings.csv")].clone()).unwrap();
     let first = header.lines().next().unwrap();
-    for col in [
-        "image_id",
-        "file",
-        "time",
-        "x",
-        "y",
-        "z",
-        "heading",
-        "camera_height",
-        "sigma_xy",
-        "sigma_z",
-    ] {
+    for col in RECORDING_COLUMNS.iter().chain(&["sigma_xy", "sigma_z"]) {
         assert!(
-            first.split(',').any(|c| c == col),
+            first.split(',').any(|c| c == *col),
             "column {col} missing in {first}"
         );
     }

@@ -1,5 +1,5 @@
 //! Shared helpers of the tests that drive `skytie tool …` (tools_nadir, tools_oblique): the command and its
-//! output, CSV rows, a band-limited test texture and a one-recording stripe campaign.
+//! output, CSV rows, a band-limited test texture, a bright rectangle and a one-recording stripe campaign.
 #![allow(dead_code)]
 
 use skytie_stages::imaging::io::save_rgb;
@@ -51,6 +51,18 @@ pub fn csv_rows(path: &Path, header_prefix: &str) -> Vec<Vec<String>> {
 pub fn texture(w: usize, h: usize, sigma_px: f32, seed: u64) -> GrayImage {
     let mut img = band_limited_noise(w, h, sigma_px, seed);
     img.data.iter_mut().for_each(|v| *v = 0.1 + 0.8 * *v);
+    img
+}
+
+/// An 80×60 image of `background` grey with pixels 25..=54 × 20..=39 at 0.8: a rectangle whose corners are
+/// (25, 20), (55, 20), (25, 40), (55, 40).
+pub fn bright_rectangle(background: f32) -> GrayImage {
+    let mut img = GrayImage::filled(80, 60, background);
+    for r in 20..40 {
+        for c in 25..55 {
+            img.set(c, r, 0.8);
+        }
+    }
     img
 }
 

@@ -97,24 +97,14 @@ struct ViewCounts {
 
 impl ViewCounts {
     fn add(&mut self, v: Verdict) -> Rgb {
-        match v {
-            Verdict::Correct => {
-                self.correct += 1;
-                GREEN
-            }
-            Verdict::Wrong => {
-                self.wrong += 1;
-                RED
-            }
-            Verdict::Ungraded => {
-                self.ungraded += 1;
-                YELLOW
-            }
-            Verdict::NonMatchable => {
-                self.non_matchable += 1;
-                BLUE
-            }
-        }
+        let (count, colour) = match v {
+            Verdict::Correct => (&mut self.correct, GREEN),
+            Verdict::Wrong => (&mut self.wrong, RED),
+            Verdict::Ungraded => (&mut self.ungraded, YELLOW),
+            Verdict::NonMatchable => (&mut self.non_matchable, BLUE),
+        };
+        *count += 1;
+        colour
     }
 }
 
@@ -643,22 +633,20 @@ fn oblique_view(
     if pairs.is_empty() {
         return Err("no control point seen in both images".into());
     }
-    let lb = bbox(
-        &pairs
+    let positions_px = |left: bool| -> Vec<(f64, f64)> {
+        pairs
             .iter()
-            .map(|(m, _, _)| (m.u_px, m.v_px))
-            .collect::<Vec<_>>(),
-        60.0,
-        200.0,
-    );
-    let rb = bbox(
-        &pairs
-            .iter()
-            .map(|(_, a, _)| (a.u_px, a.v_px))
-            .collect::<Vec<_>>(),
-        40.0,
-        120.0,
-    );
+            .map(|(m, a, _)| {
+                if left {
+                    (m.u_px, m.v_px)
+                } else {
+                    (a.u_px, a.v_px)
+                }
+            })
+            .collect()
+    };
+    let lb = bbox(&positions_px(true), 60.0, 200.0);
+    let rb = bbox(&positions_px(false), 40.0, 120.0);
     let (ls, rs) = (HEIGHT / lb.3, HEIGHT / rb.3);
     let pano_path = ctx.campaign.root.join("mm/panoramas").join(&rec.file);
     let left = crop_of(ctx.images, &pano_path, lb, ls)?;

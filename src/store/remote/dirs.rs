@@ -157,13 +157,10 @@ pub(crate) fn download(
     if target.is_dir() {
         return Ok(Ok(()));
     }
-    let files = match parse_manifest(manifest) {
-        Ok(f) => f,
+    let (tmp, result) = match fill_scratch(remote, key, manifest, dirs_root, "fetch") {
+        Ok(filled) => filled,
         Err(reason) => return Ok(Err(reason)),
     };
-    let tmp = dirs_root.join(format!(".fetch-{key}-{}", std::process::id()));
-    let _ = fs::remove_dir_all(&tmp);
-    let result = fill(remote, key, &files, &tmp);
     match result {
         Ok(Ok(())) => {
             if fs::rename(&tmp, &target).is_err() {
@@ -184,12 +181,26 @@ pub(crate) fn download(
     }
 }
 
-fn fill(
+/// The outcome of downloading a folder's files: `Ok(Err(reason))` when the remote copy is damaged.
+type Filled = Result<Result<(), String>, StoreError>;
+
+/// The files of `manifest` downloaded into the fresh scratch folder `<root>/.<tag>-<key>-<pid>`: that folder
+/// and the download's outcome, or why the manifest cannot be used.
+fn fill_scratch(
     remote: &Remote,
     key: &NodeKey,
-    files: &[ManifestFile],
-    tmp: &Path,
-) -> Result<Result<(), String>, StoreError> {
+    manifest: &[u8],
+    root: &Path,
+    tag: &str,
+) -> Result<(PathBuf, Filled), String> {
+    let files = parse_manifest(manifest)?;
+    let tmp = root.join(format!(".{tag}-{key}-{}", std::process::id()));
+    let _ = fs::remove_dir_all(&tmp);
+    let result = fill(remote, key, &files, &tmp);
+    Ok((tmp, result))
+}
+
+fn fill(remote: &Remote, key: &NodeKey, files: &[ManifestFile], tmp: &Path) -> Filled {
     for f in files {
         let path = tmp.join(&f.rel);
         if let Some(parent) = path.parent() {
@@ -220,13 +231,10 @@ pub(crate) fn check(
     manifest: &[u8],
     scratch_root: &Path,
 ) -> Result<Option<String>, StoreError> {
-    let files = match parse_manifest(manifest) {
-        Ok(f) => f,
+    let (tmp, result) = match fill_scratch(remote, key, manifest, scratch_root, "verify") {
+        Ok(filled) => filled,
         Err(reason) => return Ok(Some(reason)),
     };
-    let tmp = scratch_root.join(format!(".verify-{key}-{}", std::process::id()));
-    let _ = fs::remove_dir_all(&tmp);
-    let result = fill(remote, key, &files, &tmp);
     let _ = fs::remove_dir_all(&tmp);
     Ok(result?.err())
 }

@@ -4,6 +4,8 @@
 
 #![allow(dead_code)]
 
+pub mod shifted_pair;
+
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

@@ -30,7 +30,7 @@ pub use read::{
     read_campaign, read_sourced, sort_problems, CampaignError, SourceRows, SourcedCampaign,
 };
 pub use read_aerial::read_aerial_csv;
-pub use read_recordings::read_recordings_csv;
+pub use read_recordings::{read_recordings_csv, RECORDING_COLUMNS};
 pub use time::{format_time_iso, parse_time_s};
 pub use write::{
     write_aerial_cameras_csv, write_campaign_toml, write_checkpoints_csv, write_observations_csv,

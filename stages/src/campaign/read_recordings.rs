@@ -9,7 +9,8 @@ use super::time::parse_time_s;
 use super::unique::{keep_unique, Sourced};
 use std::path::Path;
 
-pub(crate) const RECORDING_COLUMNS: &[&str] = &[
+/// The required columns of a recordings table, in the order the writers put them.
+pub const RECORDING_COLUMNS: &[&str] = &[
     "image_id",
     "file",
     "time",

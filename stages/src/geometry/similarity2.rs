@@ -18,14 +18,19 @@ pub struct Similarity2 {
 }
 
 impl Similarity2 {
+    /// The similarity with this scale, counter-clockwise rotation (radians) and translation.
+    pub fn new(scale: f64, rotation_rad: f64, tx: f64, ty: f64) -> Self {
+        Self {
+            scale,
+            rotation_rad,
+            tx,
+            ty,
+        }
+    }
+
     /// The identity transform.
     pub fn identity() -> Self {
-        Self {
-            scale: 1.0,
-            rotation_rad: 0.0,
-            tx: 0.0,
-            ty: 0.0,
-        }
+        Self::new(1.0, 0.0, 0.0, 0.0)
     }
 
     /// From the linear parameters `a = s cos θ`, `b = s sin θ` and the translation.

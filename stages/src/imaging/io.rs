@@ -107,28 +107,32 @@ fn save_dynamic(
 
 /// Save as 8-bit RGB (format from the extension; JPEG at `jpeg_quality`).
 pub fn save_rgb(path: &Path, img: &RgbImage, jpeg_quality: u8) -> Result<(), ImageIoError> {
-    let raw: Vec<u8> = img.data.iter().map(|&v| to_u8(v)).collect();
-    let buf =
-        image::RgbImage::from_raw(img.width as u32, img.height as u32, raw).ok_or_else(|| {
-            err(
-                path,
-                "internal: RGB buffer size does not match its dimensions",
-            )
-        })?;
+    let buf = quantised(path, img.width, img.height, &img.data, "RGB")?;
     save_dynamic(path, image::DynamicImage::ImageRgb8(buf), jpeg_quality)
 }
 
 /// Save as 8-bit grey (format from the extension; JPEG at quality 95).
 pub fn save_gray(path: &Path, img: &GrayImage) -> Result<(), ImageIoError> {
-    let raw: Vec<u8> = img.data.iter().map(|&v| to_u8(v)).collect();
-    let buf =
-        image::GrayImage::from_raw(img.width as u32, img.height as u32, raw).ok_or_else(|| {
-            err(
-                path,
-                "internal: grey buffer size does not match its dimensions",
-            )
-        })?;
+    let buf = quantised(path, img.width, img.height, &img.data, "grey")?;
     save_dynamic(path, image::DynamicImage::ImageLuma8(buf), 95)
+}
+
+/// `data` (row-major samples of a `width × height` image of pixel type `P`) quantised to 8 bits for writing
+/// to `path`; `what` names the pixel type in the error.
+fn quantised<P: image::Pixel<Subpixel = u8>>(
+    path: &Path,
+    width: usize,
+    height: usize,
+    data: &[f32],
+    what: &str,
+) -> Result<image::ImageBuffer<P, Vec<u8>>, ImageIoError> {
+    let raw: Vec<u8> = data.iter().map(|&v| to_u8(v)).collect();
+    image::ImageBuffer::from_raw(width as u32, height as u32, raw).ok_or_else(|| {
+        err(
+            path,
+            format!("internal: {what} buffer size does not match its dimensions"),
+        )
+    })
 }
 
 #[cfg(test)]

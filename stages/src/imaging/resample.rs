@@ -155,14 +155,14 @@ pub fn resize(
 ) -> GrayImage {
     let sx = src.width as f64 / out_width.max(1) as f64;
     let sy = src.height as f64 / out_height.max(1) as f64;
-    remap(
+    // Every output pixel centre maps inside the source rectangle, so the fill value is never used.
+    warp_affine(
         src,
+        [sx, 0.0, 0.0, 0.0, sy, 0.0],
         out_width,
         out_height,
         interp,
-        Border::Reflect,
         0.0,
-        |c, r| Some(((c as f64 + 0.5) * sx, (r as f64 + 0.5) * sy)),
     )
 }
 

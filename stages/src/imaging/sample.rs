@@ -74,20 +74,26 @@ fn bilinear_interior(data: &[f32], width: usize, x: f64, y: f64) -> f32 {
     top + (bottom - top) * fy
 }
 
+/// The pixel-index cell holding (u_px, v_px): its corner (floor of u − 0.5, v − 0.5) and the fractions of the
+/// position within it; `None` for an empty image or a non-finite position.
+#[inline(always)]
+fn cell_of(img: &GrayImage, u_px: f64, v_px: f64) -> Option<((isize, isize), (f64, f64))> {
+    if img.width == 0 || img.height == 0 || !u_px.is_finite() || !v_px.is_finite() {
+        return None;
+    }
+    let (x, y) = (u_px - 0.5, v_px - 0.5);
+    let (x0f, y0f) = (floor_fast(x), floor_fast(y));
+    Some(((x0f as isize, y0f as isize), (x - x0f, y - y0f)))
+}
+
 /// [`sample_bilinear`] for positions near or beyond the border (and non-finite ones).
 #[cold]
 #[inline(never)]
 fn sample_bilinear_border(img: &GrayImage, u_px: f64, v_px: f64, border: Border) -> f32 {
-    if img.width == 0 || img.height == 0 || !u_px.is_finite() || !v_px.is_finite() {
+    let Some(((x0, y0), (fx, fy))) = cell_of(img, u_px, v_px) else {
         return empty_value(border);
-    }
-    let x = u_px - 0.5;
-    let y = v_px - 0.5;
-    let x0f = floor_fast(x);
-    let y0f = floor_fast(y);
-    let fx = (x - x0f) as f32;
-    let fy = (y - y0f) as f32;
-    let (x0, y0) = (x0f as isize, y0f as isize);
+    };
+    let (fx, fy) = (fx as f32, fy as f32);
     let w = img.width as isize;
     let h = img.height as isize;
     let (p00, p10, p01, p11) = if x0 >= 0 && y0 >= 0 && x0 + 1 < w && y0 + 1 < h {
@@ -122,16 +128,11 @@ pub fn keys_weights(t: f64) -> [f64; 4] {
 
 /// Bicubic (Keys, a = −0.5) interpolation at (u_px, v_px). Not bounded by the neighbours (may overshoot).
 pub fn sample_bicubic(img: &GrayImage, u_px: f64, v_px: f64, border: Border) -> f32 {
-    if img.width == 0 || img.height == 0 || !u_px.is_finite() || !v_px.is_finite() {
+    let Some(((x0, y0), (fx, fy))) = cell_of(img, u_px, v_px) else {
         return empty_value(border);
-    }
-    let x = u_px - 0.5;
-    let y = v_px - 0.5;
-    let x0f = floor_fast(x);
-    let y0f = floor_fast(y);
-    let wx = keys_weights(x - x0f);
-    let wy = keys_weights(y - y0f);
-    let (x0, y0) = (x0f as isize, y0f as isize);
+    };
+    let wx = keys_weights(fx);
+    let wy = keys_weights(fy);
     let inside = x0 >= 1 && y0 >= 1 && x0 + 2 < img.width as isize && y0 + 2 < img.height as isize;
     let mut acc = 0.0f64;
     for (j, wyj) in wy.iter().enumerate() {

@@ -60,11 +60,7 @@ impl Converter {
     /// Ellipsoidal heights are first taken to ETRS89 through the datum shift (a source on another datum has
     /// its own ellipsoid), then reduced by the geoid separation there.
     pub fn position(&self, a: f64, b: f64, h_m: f64) -> Result<(f64, f64, f64), ConvertError> {
-        let (x, y) = if self.same_horizontal {
-            (a, b)
-        } else {
-            self.forward.apply(a, b)?
-        };
+        let (x, y) = self.across(&self.forward, a, b)?;
         let z = match self.heights {
             HeightConversion::Identity => h_m,
             _ => {
@@ -73,6 +69,21 @@ impl Converter {
             }
         };
         Ok((x, y, z))
+    }
+
+    /// A horizontal pair taken across `t` (one direction between source and campaign), or unchanged when both
+    /// share the horizontal CRS.
+    fn across(
+        &self,
+        t: &HorizontalTransform,
+        a: f64,
+        b: f64,
+    ) -> Result<(f64, f64), TransformError> {
+        if self.same_horizontal {
+            Ok((a, b))
+        } else {
+            t.apply(a, b)
+        }
     }
 
     /// Grid azimuth (campaign, degrees) of the source's north direction at a source native pair.
@@ -153,11 +164,7 @@ impl Inverse {
 
     /// The inverse transformation of a campaign point (see [`Inverse::position`]).
     fn approximate(&self, x: f64, y: f64, z: f64) -> Result<(f64, f64, f64), ConvertError> {
-        let (a, b) = if self.forward.same_horizontal {
-            (x, y)
-        } else {
-            self.backward.apply(x, y)?
-        };
+        let (a, b) = self.forward.across(&self.backward, x, y)?;
         let h = match self.heights {
             HeightConversion::Identity => z,
             _ => {

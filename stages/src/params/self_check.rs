@@ -67,3 +67,12 @@ where
     spec_problems(name, &P::specs(), &mut out);
     out
 }
+
+/// Panics listing every problem of `P`'s declaration (see [`declaration_problems`]); for tests.
+pub fn assert_declaration_sound<P>()
+where
+    P: Params + Serialize + DeserializeOwned + PartialEq + Debug,
+{
+    let problems = declaration_problems::<P>();
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}

@@ -214,34 +214,40 @@ fn write_error_free(
     if let Some(o) = &plan.orthophoto {
         write_orthophotos(plan, o, root, &path)?;
     }
-    for rel in ["mm/recordings.csv", "truth/recordings.csv"] {
+    let write = |rel: &str, f: &dyn Fn(&Path) -> std::io::Result<()>| {
         let path = root.join(rel);
-        cw::write_recordings_csv(&path, &truth.recordings).map_err(io(path))?;
+        f(&path).map_err(io(path))
+    };
+    for rel in ["mm/recordings.csv", "truth/recordings.csv"] {
+        write(rel, &|p| cw::write_recordings_csv(p, &truth.recordings))?;
     }
-    let path = root.join("aerial/nadir/cameras.csv");
-    cw::write_aerial_cameras_csv(&path, &truth.nadir).map_err(io(path))?;
-    let path = root.join("aerial/oblique/cameras.csv");
-    cw::write_aerial_cameras_csv(&path, &truth.oblique).map_err(io(path))?;
-    let checkpoints: Vec<_> = plan
-        .areas
-        .iter()
-        .flat_map(|a| a.control.checkpoints.iter().cloned())
+    write("aerial/nadir/cameras.csv", &|p| {
+        cw::write_aerial_cameras_csv(p, &truth.nadir)
+    })?;
+    write("aerial/oblique/cameras.csv", &|p| {
+        cw::write_aerial_cameras_csv(p, &truth.oblique)
+    })?;
+    let controls = || plan.areas.iter().map(|a| &a.control);
+    let checkpoints: Vec<_> = controls()
+        .flat_map(|c| c.checkpoints.iter().cloned())
         .collect();
-    let path = root.join("control/checkpoints.csv");
-    cw::write_checkpoints_csv(&path, &checkpoints).map_err(io(path))?;
-    let observations: Vec<_> = plan
-        .areas
-        .iter()
-        .flat_map(|a| a.control.observations.iter().cloned())
+    write("control/checkpoints.csv", &|p| {
+        cw::write_checkpoints_csv(p, &checkpoints)
+    })?;
+    let observations: Vec<_> = controls()
+        .flat_map(|c| c.observations.iter().cloned())
         .collect();
-    let path = root.join("control/observations.csv");
-    cw::write_observations_csv(&path, &observations).map_err(io(path))?;
+    write("control/observations.csv", &|p| {
+        cw::write_observations_csv(p, &observations)
+    })?;
     let none = Profile::none();
     let readme = readme(name, plan.seed, &none, &none.apply(plan.seed, &truth));
-    let path = root.join("truth/README.md");
-    crate::fsutil::atomic_write(&path, readme.as_bytes()).map_err(io(path))?;
-    let path = root.join(SCENE_TRUTH_FILE);
-    crate::fsutil::atomic_write(&path, plan.scene_truth.to_toml().as_bytes()).map_err(io(path))?;
+    write("truth/README.md", &|p| {
+        crate::fsutil::atomic_write(p, readme.as_bytes())
+    })?;
+    write(SCENE_TRUTH_FILE, &|p| {
+        crate::fsutil::atomic_write(p, plan.scene_truth.to_toml().as_bytes())
+    })?;
     Ok((rays, reused))
 }
 

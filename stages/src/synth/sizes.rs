@@ -30,27 +30,14 @@ impl SizeOptions {
             option: option.into(),
             message,
         };
-        let size_ok = |(w, h): (u32, u32)| w >= 16 && h >= 16 && w <= 1 << 20 && h <= 1 << 20;
         if let Some((w, h)) = self.nadir_px {
-            if !size_ok((w, h)) {
-                return Err(bad(
-                    "nadir_px",
-                    format!("{w} × {h}; give sides in [16, 1048576]"),
-                ));
-            }
-            let f = f64::from(w) / f64::from(p.nadir.width_px);
+            let f = size_factor("nadir_px", (w, h), p.nadir.width_px)?;
             p.nadir.gsd_m /= f;
             p.nadir.corner_distortion_px *= f;
             (p.nadir.width_px, p.nadir.height_px) = (w, h);
         }
         if let Some((w, h)) = self.oblique_px {
-            if !size_ok((w, h)) {
-                return Err(bad(
-                    "oblique_px",
-                    format!("{w} × {h}; give sides in [16, 1048576]"),
-                ));
-            }
-            let f = f64::from(w) / f64::from(p.oblique.width_px);
+            let f = size_factor("oblique_px", (w, h), p.oblique.width_px)?;
             p.oblique.gsd_center_m /= f;
             p.oblique.corner_distortion_px *= f;
             (p.oblique.width_px, p.oblique.height_px) = (w, h);
@@ -87,4 +74,16 @@ fn at_render_size(p: &mut PresetParams) {
     p.panorama_width_px /= k;
     p.observation_sigma_px /= f64::from(k);
     p.render_max_width_px = None;
+}
+
+/// The factor by which the option `option`'s requested image size `(w, h)` enlarges a camera `width_px`
+/// wide; an error for sides outside [16, 2^20].
+fn size_factor(option: &str, (w, h): (u32, u32), width_px: u32) -> Result<f64, SynthError> {
+    if !(16..=1 << 20).contains(&w) || !(16..=1 << 20).contains(&h) {
+        return Err(SynthError::InvalidOption {
+            option: option.into(),
+            message: format!("{w} × {h}; give sides in [16, 1048576]"),
+        });
+    }
+    Ok(f64::from(w) / f64::from(width_px))
 }

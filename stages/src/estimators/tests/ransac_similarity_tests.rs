@@ -6,12 +6,7 @@ use crate::geometry::{PointPair, Similarity2};
 use nalgebra::Vector2;
 
 fn truth() -> Similarity2 {
-    Similarity2 {
-        scale: 0.93,
-        rotation_rad: -0.35,
-        tx: 57.0,
-        ty: -21.5,
-    }
+    Similarity2::new(0.93, -0.35, 57.0, -21.5)
 }
 
 /// `n_in` correspondences of `truth()` with N(0, noise) in dst, then `n_out` random ones over the image.

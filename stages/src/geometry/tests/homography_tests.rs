@@ -120,12 +120,7 @@ fn normalisation_invariance() {
 
 #[test]
 fn similarity_converts_to_an_equal_homography() {
-    let sim = crate::geometry::Similarity2 {
-        scale: 1.2,
-        rotation_rad: 0.4,
-        tx: 3.0,
-        ty: -9.0,
-    };
+    let sim = crate::geometry::Similarity2::new(1.2, 0.4, 3.0, -9.0);
     let h = Homography::from(sim);
     let p = Vector2::new(17.0, -4.0);
     assert!((h.apply(&p).unwrap() - sim.apply(&p)).norm() < 1e-12);

@@ -5,12 +5,7 @@ use crate::rng::SplitMix64;
 use nalgebra::{Matrix2, Vector2};
 
 fn truth() -> Similarity2 {
-    Similarity2 {
-        scale: 1.37,
-        rotation_rad: 0.61,
-        tx: -412.5,
-        ty: 88.25,
-    }
+    Similarity2::new(1.37, 0.61, -412.5, 88.25)
 }
 
 fn pairs_for(sim: &Similarity2, n: usize, seed: u64, offset: f64, noise: f64) -> Vec<PointPair> {
@@ -43,12 +38,7 @@ fn assert_sim_close(a: &Similarity2, b: &Similarity2, rel: f64) {
 
 #[test]
 fn apply_by_hand() {
-    let sim = Similarity2 {
-        scale: 2.0,
-        rotation_rad: std::f64::consts::FRAC_PI_2,
-        tx: 1.0,
-        ty: -1.0,
-    };
+    let sim = Similarity2::new(2.0, std::f64::consts::FRAC_PI_2, 1.0, -1.0);
     let p = sim.apply(&Vector2::new(1.0, 0.0));
     assert!((p - Vector2::new(1.0, 1.0)).norm() < 1e-15);
     let m = sim.to_matrix();
@@ -91,12 +81,7 @@ fn degenerate_inputs_give_none() {
 #[test]
 fn inverse_and_compose() {
     let a = truth();
-    let b = Similarity2 {
-        scale: 0.8,
-        rotation_rad: -2.9,
-        tx: 10.0,
-        ty: 20.0,
-    };
+    let b = Similarity2::new(0.8, -2.9, 10.0, 20.0);
     let p = Vector2::new(123.4, -56.7);
     assert!((a.inverse().apply(&a.apply(&p)) - p).norm() < 1e-9);
     assert!((a.compose(&b).apply(&p) - a.apply(&b.apply(&p))).norm() < 1e-9);
@@ -149,12 +134,7 @@ fn normalisation_invariance() {
     // Move both point sets by (1e5, 1e5) and scale by 10: the fit is the conjugated transform.
     let pairs = pairs_for(&truth(), 40, 4, 0.0, 0.5);
     let fit = Similarity2::least_squares(&pairs).unwrap();
-    let g = Similarity2 {
-        scale: 10.0,
-        rotation_rad: 0.0,
-        tx: 1e5,
-        ty: 1e5,
-    };
+    let g = Similarity2::new(10.0, 0.0, 1e5, 1e5);
     let moved: Vec<PointPair> = pairs
         .iter()
         .map(|p| PointPair {

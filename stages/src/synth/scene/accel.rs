@@ -117,24 +117,10 @@ impl Grid {
         let py = o.y + t0 * d.y;
         let mut ix = (((px - self.bounds.min.x) / self.cell_m).max(0.0) as usize).min(self.nx - 1);
         let mut iy = (((py - self.bounds.min.y) / self.cell_m).max(0.0) as usize).min(self.ny - 1);
-        let (step_x, mut t_next_x, dt_x) = if d.x > 0.0 {
-            let bx = self.bounds.min.x + (ix + 1) as f64 * self.cell_m;
-            (1isize, (bx - o.x) * inv_d.x, self.cell_m * inv_d.x)
-        } else if d.x < 0.0 {
-            let bx = self.bounds.min.x + ix as f64 * self.cell_m;
-            (-1isize, (bx - o.x) * inv_d.x, -self.cell_m * inv_d.x)
-        } else {
-            (0, f64::INFINITY, f64::INFINITY)
-        };
-        let (step_y, mut t_next_y, dt_y) = if d.y > 0.0 {
-            let by = self.bounds.min.y + (iy + 1) as f64 * self.cell_m;
-            (1isize, (by - o.y) * inv_d.y, self.cell_m * inv_d.y)
-        } else if d.y < 0.0 {
-            let by = self.bounds.min.y + iy as f64 * self.cell_m;
-            (-1isize, (by - o.y) * inv_d.y, -self.cell_m * inv_d.y)
-        } else {
-            (0, f64::INFINITY, f64::INFINITY)
-        };
+        let (step_x, mut t_next_x, dt_x) =
+            dda_axis(self.bounds.min.x, self.cell_m, ix, o.x, d.x, inv_d.x);
+        let (step_y, mut t_next_y, dt_y) =
+            dda_axis(self.bounds.min.y, self.cell_m, iy, o.y, d.y, inv_d.y);
         let mut t_enter = t0;
         loop {
             let c = iy * self.nx + ix;
@@ -168,5 +154,21 @@ impl Grid {
                 t_next_y += dt_y;
             }
         }
+    }
+}
+
+/// One axis of the grid walk (Amanatides & Woo): the cell step (±1, 0 along a parallel ray), the ray
+/// parameter of the first cell boundary crossed from cell `i` (grid origin `min`, cells `cell_m` wide), and
+/// the parameter increment per cell, for a ray with origin `o`, direction `d` and `inv_d = 1 / d` on this axis.
+#[inline]
+fn dda_axis(min: f64, cell_m: f64, i: usize, o: f64, d: f64, inv_d: f64) -> (isize, f64, f64) {
+    if d > 0.0 {
+        let b = min + (i + 1) as f64 * cell_m;
+        (1, (b - o) * inv_d, cell_m * inv_d)
+    } else if d < 0.0 {
+        let b = min + i as f64 * cell_m;
+        (-1, (b - o) * inv_d, -cell_m * inv_d)
+    } else {
+        (0, f64::INFINITY, f64::INFINITY)
     }
 }

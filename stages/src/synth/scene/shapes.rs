@@ -308,35 +308,20 @@ mod tests {
     #[test]
     fn gable_roof_ridge_height_and_slope_normal() {
         let g = ConvexPrism::gable([0.0, 0.0], [10.0, 8.0], 10.0, 13.0, true);
-        // straight down over the ridge line (y = 4) hits at z = 13
-        let o = Vector3::new(5.0, 4.0, 50.0);
-        let (t, _) = g
-            .hit(
-                &Ray::new(o, Vector3::new(0.0, 0.0, -1.0)),
-                0.0,
-                f64::INFINITY,
-            )
-            .unwrap();
-        assert!((50.0 - t - 13.0).abs() < 1e-9);
+        // Straight down from z = 50 at (x, y): the height hit and the normal there.
+        let down = |x: f64, y: f64| {
+            let ray = Ray::new(Vector3::new(x, y, 50.0), Vector3::new(0.0, 0.0, -1.0));
+            g.hit(&ray, 0.0, f64::INFINITY).map(|(t, n)| (50.0 - t, n))
+        };
+        // over the ridge line (y = 4) the roof is at z = 13
+        let (z, _) = down(5.0, 4.0).unwrap();
+        assert!((z - 13.0).abs() < 1e-9);
         // at y = 2 (half-way down the slope) z = 11.5, normal tilted towards −y
-        let o = Vector3::new(5.0, 2.0, 50.0);
-        let (t, n) = g
-            .hit(
-                &Ray::new(o, Vector3::new(0.0, 0.0, -1.0)),
-                0.0,
-                f64::INFINITY,
-            )
-            .unwrap();
-        assert!((50.0 - t - 11.5).abs() < 1e-9);
+        let (z, n) = down(5.0, 2.0).unwrap();
+        assert!((z - 11.5).abs() < 1e-9);
         assert!(n.y < -0.5 && n.z > 0.5);
         // outside the footprint: miss
-        assert!(g
-            .hit(
-                &Ray::new(Vector3::new(11.0, 2.0, 50.0), Vector3::new(0.0, 0.0, -1.0)),
-                0.0,
-                f64::INFINITY
-            )
-            .is_none());
+        assert!(down(11.0, 2.0).is_none());
     }
 
     #[test]
@@ -360,30 +345,22 @@ mod tests {
         )
         .unwrap();
         assert!((t - 4.0).abs() < 1e-12 && (n.z + 1.0).abs() < 1e-12);
-        let (t, n) = cylinder_hit(
-            2.0,
-            0.0,
-            0.5,
-            0.0,
-            3.0,
-            &Vector3::new(0.0, 0.0, 1.0),
-            &Vector3::x(),
-            0.0,
-            f64::INFINITY,
-        )
-        .unwrap();
+        // Along +x at height z into the upright cylinder of radius 0.5 at (2, 0) from z = 0 to 3.
+        let along_x_at = |z: f64| {
+            cylinder_hit(
+                2.0,
+                0.0,
+                0.5,
+                0.0,
+                3.0,
+                &Vector3::new(0.0, 0.0, z),
+                &Vector3::x(),
+                0.0,
+                f64::INFINITY,
+            )
+        };
+        let (t, n) = along_x_at(1.0).unwrap();
         assert!((t - 1.5).abs() < 1e-12 && (n.x + 1.0).abs() < 1e-12);
-        assert!(cylinder_hit(
-            2.0,
-            0.0,
-            0.5,
-            0.0,
-            3.0,
-            &Vector3::new(0.0, 0.0, 3.5),
-            &Vector3::x(),
-            0.0,
-            f64::INFINITY
-        )
-        .is_none());
+        assert!(along_x_at(3.5).is_none());
     }
 }
