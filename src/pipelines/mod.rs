@@ -45,6 +45,7 @@ stage_names! {
     TRANSFORM = skytie_stages::nadir::initial_transform::STAGE,
     REFINE = skytie_stages::nadir::refine::STAGE,
     CONTROL = skytie_stages::nadir::control_points::STAGE,
+    ORTHOPHOTO = skytie_stages::orthophoto::STAGE,
     NADIR = skytie_stages::nadir::summary::STAGE,
     GRADE_NADIR = skytie_stages::nadir::grading::STAGE,
     ADJUST = skytie_stages::adjustment::from_correspondences::STAGE,

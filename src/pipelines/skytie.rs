@@ -39,7 +39,7 @@ use std::sync::Arc;
 pub struct SkytiePipeline;
 
 /// Stage names a workflow may enable in `stages = [...]`.
-pub const STAGES: [&str; 20] = stage::ALL;
+pub const STAGES: [&str; 21] = stage::ALL;
 
 /// Absolute form of a campaign folder (keys must not depend on the working directory's spelling).
 fn absolute(p: &Path) -> PathBuf {
