@@ -92,7 +92,8 @@ crate::params! {
         /// σ of an aerial control point per axis with `control_weighting = "fixed"` (thesis: 0.10 m).
         control_sigma_m: f64 = DEFAULT_CONTROL_SIGMA_M, unit "m", above 0.0;
         /// Put the aerial pixel observations into the bundle (aerial orientation fixed) instead of
-        /// aerial-triangulated control points, so points seen in a single aerial image count too.
+        /// aerial-triangulated control points, so points seen in a single aerial image count too; in a
+        /// projected campaign the bundle then runs in the campaign's tangent frame.
         aerial_observations: bool = false;
         /// Robust loss on the observations: `none`, `huber` or `cauchy`.
         loss: LossKind = LossKind::None;
