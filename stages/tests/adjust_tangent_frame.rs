@@ -191,6 +191,7 @@ fn aerial_observations_in_the_campaign_frame_are_free_of_map_scale_and_curvature
     assert_eq!(in_frame.build.aerial_observations_skipped, 0);
     let in_map = run(&inputs, &config).unwrap();
     let (e_frame, e_map) = (largest_error_m(&in_frame, &s), largest_error_m(&in_map, &s));
+    eprintln!("largest error: tangent frame {e_frame:.2e} m, map coordinates {e_map:.4} m");
     assert!(e_frame < 1e-3, "tangent frame: {e_frame} m");
     assert!(e_map > 0.01, "map coordinates: {e_map} m");
     // The recordings moved from their recorded positions onto the truth.
