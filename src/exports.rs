@@ -13,12 +13,12 @@ use crate::nodes::adjust::adjustment::{AdjustReport, Verdict};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::oblique::consensus::ObliqueOutput;
 use skytie_stages::adjustment::verify::{write_verification_csv, Verification};
-use skytie_stages::campaign::format_time_iso;
-use skytie_stages::correspondence::AerialControlPoint;
-use skytie_stages::export::gpkg::{run_layers, srs_for, write_geopackage, RunLayers};
 use skytie_stages::adjustment::AdjustmentRun;
+use skytie_stages::campaign::format_time_iso;
 use skytie_stages::campaign::Campaign;
+use skytie_stages::correspondence::AerialControlPoint;
 use skytie_stages::crs::{OutputsSection, SecondCrs};
+use skytie_stages::export::gpkg::{run_layers, srs_for, write_geopackage, RunLayers};
 use skytie_stages::export::second_crs_files::{SECOND_CORRECTIONS_CSV, SECOND_TRAJECTORY_CSV};
 use skytie_stages::export::{
     write_adjusted_trajectory, write_checkpoint_errors_csv, write_colmap_model,

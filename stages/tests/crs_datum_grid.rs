@@ -92,8 +92,14 @@ fn an_ntv2_grid_replaces_the_helmert_datum_shift() {
         .apply(e, n)
         .unwrap();
     // 10⁻⁸° ≈ 1 mm.
-    assert!((lat - (lat_b + SHIFT_NORTH_SEC / 3600.0)).abs() < 1e-8, "{lat} {lat_b}");
-    assert!((lon - (lon_b + SHIFT_EAST_SEC / 3600.0)).abs() < 1e-8, "{lon} {lon_b}");
+    assert!(
+        (lat - (lat_b + SHIFT_NORTH_SEC / 3600.0)).abs() < 1e-8,
+        "{lat} {lat_b}"
+    );
+    assert!(
+        (lon - (lon_b + SHIFT_EAST_SEC / 3600.0)).abs() < 1e-8,
+        "{lon} {lon_b}"
+    );
     // The Helmert parameters give something else (RD's datum shift is ≈ 100 m, not 2–3 arc-seconds).
     let (lat_h, _) = HorizontalTransform::new(&rd, &etrs89).apply(e, n).unwrap();
     assert!((lat_h - lat).abs() > 1e-4);
@@ -150,6 +156,9 @@ fn the_second_output_crs_uses_the_campaigns_datum_grid() {
         ..section
     };
     let e = SecondCrs::new("EPSG:28992", &missing, &dir).err().unwrap();
-    assert!(e.starts_with("outputs.datum_grid") && e.contains("nowhere.gsb"), "{e}");
+    assert!(
+        e.starts_with("outputs.datum_grid") && e.contains("nowhere.gsb"),
+        "{e}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -63,7 +63,10 @@ fn the_rd_origin_in_etrs89_is_within_a_metre_of_the_published_coordinates() {
     // And into ETRS89 / UTM 31N: a projected second CRS, grid axes turned by the two convergences.
     let utm = second("EPSG:28992", &section("EPSG:25831"));
     let [e, n, _] = utm.point([155_000.0, 463_000.0, 0.0]).unwrap();
-    assert!((e - 663_000.0).abs() < 5_000.0 && (n - 5_780_000.0).abs() < 5_000.0, "{e} {n}");
+    assert!(
+        (e - 663_000.0).abs() < 5_000.0 && (n - 5_780_000.0).abs() < 5_000.0,
+        "{e} {n}"
+    );
     let t = utm.turn_deg(155_000.0, 463_000.0).unwrap();
     // UTM 31N's central meridian is 3°E: its grid north lies (5.387° − 3°)·sin 52.16° ≈ 1.88° east of true
     // north there (RD's coincides with true north at its origin), so vectors turn counter-clockwise.
@@ -87,7 +90,12 @@ fn heights_are_converted_only_when_both_systems_are_known() {
     let e = SecondCrs::new("EPSG:28992", &section("EPSG:4937"), Path::new(".")).err();
     assert!(e.unwrap().contains("declares no height system"));
     // Two different orthometric systems would need two geoids.
-    let e = SecondCrs::new("EPSG:28992+5709", &section("EPSG:4258+5730"), Path::new(".")).err();
+    let e = SecondCrs::new(
+        "EPSG:28992+5709",
+        &section("EPSG:4258+5730"),
+        Path::new("."),
+    )
+    .err();
     assert!(e.unwrap().contains("converts heights only"));
     // Unknown codes are refused with the key's name.
     let e = SecondCrs::new("EPSG:28992+5709", &section("EPSG:999999"), Path::new(".")).err();
@@ -110,8 +118,14 @@ fn the_outputs_table_is_read_from_campaign_toml_and_refuses_unknown_keys() {
     let s = OutputsSection::read(&dir).unwrap();
     assert_eq!(s.also_crs.as_deref(), Some("EPSG:4937"));
     assert_eq!(s.geoid_separation_m, Some(43.0));
-    std::fs::write(&toml, "crs = \"EPSG:28992\"\n[outputs]\nalso = \"EPSG:4937\"\n").unwrap();
-    assert!(OutputsSection::read(&dir).unwrap_err().contains("[outputs]"));
+    std::fs::write(
+        &toml,
+        "crs = \"EPSG:28992\"\n[outputs]\nalso = \"EPSG:4937\"\n",
+    )
+    .unwrap();
+    assert!(OutputsSection::read(&dir)
+        .unwrap_err()
+        .contains("[outputs]"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -138,8 +152,14 @@ fn a_run_writes_its_trajectory_corrections_and_control_points_in_the_second_crs(
     assert_eq!(folder, dir.join("epsg_4258"));
     let trajectory = std::fs::read_to_string(folder.join("trajectory_adjusted.csv")).unwrap();
     let mut lines = trajectory.lines();
-    assert!(lines.next().unwrap().starts_with("# crs = EPSG:4258; z: heights as in the campaign"));
-    assert!(lines.next().unwrap().starts_with("image_id,time,time_s,lat,lon,z,"));
+    assert!(lines
+        .next()
+        .unwrap()
+        .starts_with("# crs = EPSG:4258; z: heights as in the campaign"));
+    assert!(lines
+        .next()
+        .unwrap()
+        .starts_with("image_id,time,time_s,lat,lon,z,"));
     let rows: Vec<&str> = lines.collect();
     assert_eq!(rows.len(), outputs.run.recordings.len());
     for (row, r) in rows.iter().zip(&outputs.run.recordings) {
@@ -166,5 +186,27 @@ fn a_run_writes_its_trajectory_corrections_and_control_points_in_the_second_crs(
         .count();
     assert!(n_control > 0);
     assert_eq!(control.lines().count(), n_control + 2);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_campaign_naming_an_unusable_second_crs_is_reported_when_read() {
+    let dir = std::env::temp_dir().join(format!("skytie_second_crs_read_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("campaign.toml"),
+        "name = \"t\"\ncrs = \"EPSG:28992+5709\"\n[outputs]\nalso_crs = \"EPSG:4937\"\n",
+    )
+    .unwrap();
+    let (_, problems) = skytie_stages::campaign::read_campaign(&dir).unwrap();
+    let p = problems
+        .iter()
+        .find(|p| p.field.as_deref() == Some("outputs"))
+        .expect("the [outputs] table is reported");
+    assert!(p.is_error(), "{p}");
+    assert!(
+        p.to_string().contains("campaign.toml") && p.to_string().contains("geoid"),
+        "{p}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -96,7 +96,8 @@ pub fn adjustment_to_map(adj: Adjustment, frame: &MapFrame) -> Result<Adjustment
     let mut adj = adj;
     for r in &mut adj.recordings {
         let p_map = frame.point_to_map(&r.position_world).map_err(frame_error)?;
-        r.sigma_a_priori_m = sigma_to_map(frame, &p_map, &r.sigma_a_priori_m).map_err(frame_error)?;
+        r.sigma_a_priori_m =
+            sigma_to_map(frame, &p_map, &r.sigma_a_priori_m).map_err(frame_error)?;
         if let Some(s) = r.sigma_a_posteriori_m {
             r.sigma_a_posteriori_m = Some(sigma_to_map(frame, &p_map, &s).map_err(frame_error)?);
         }

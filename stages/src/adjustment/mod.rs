@@ -56,8 +56,8 @@ pub use evaluate::{
     ViewSelection,
 };
 pub use from_correspondences::{
-    build_block, run, run_in_frame, AdjustInputs, AdjustmentRun, BlockBuild, BlockPoint, BuildCounts, PointKind,
-    RunPoint, RunRecording,
+    build_block, run, run_in_frame, AdjustInputs, AdjustmentRun, BlockBuild, BlockPoint,
+    BuildCounts, PointKind, RunPoint, RunRecording,
 };
 pub use problem::{
     AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, LmOptions,

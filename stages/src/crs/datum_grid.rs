@@ -50,13 +50,11 @@ pub fn load(path: &Path) -> Result<String, DatumGridError> {
     if loaded.contains(&key) {
         return Ok(key);
     }
-    proj4rs::nadgrids::catalog::with_catalog(|c| {
-        proj4rs::nadgrids::files::read_from_file(c, &key)
-    })
-    .map_err(|e| DatumGridError::Unreadable {
-        path: path.to_path_buf(),
-        reason: e.to_string(),
-    })?;
+    proj4rs::nadgrids::catalog::with_catalog(|c| proj4rs::nadgrids::files::read_from_file(c, &key))
+        .map_err(|e| DatumGridError::Unreadable {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
     loaded.push(key.clone());
     Ok(key)
 }

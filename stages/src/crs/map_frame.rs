@@ -129,10 +129,7 @@ impl MapFrame {
     }
 
     /// A panorama oriented in map coordinates, in this frame.
-    pub fn panorama_to_local(
-        &self,
-        camera: &PanoramaCamera,
-    ) -> Result<PanoramaCamera, FrameError> {
+    pub fn panorama_to_local(&self, camera: &PanoramaCamera) -> Result<PanoramaCamera, FrameError> {
         Ok(PanoramaCamera {
             center_world: self.point_to_local(&camera.center_world)?,
             rotation_pano_to_world: self.rotation_to_local(&camera.center_world)?

@@ -73,7 +73,9 @@ impl OutputsSection {
                 .map(Some)
                 .map_err(|e| format!("outputs.geoid_grid: {e}")),
             (None, Some(n)) if n.is_finite() => Ok(Some(GeoidModel::Constant { separation_m: n })),
-            (None, Some(n)) => Err(format!("outputs.geoid_separation_m: {n} is not a separation")),
+            (None, Some(n)) => Err(format!(
+                "outputs.geoid_separation_m: {n} is not a separation"
+            )),
             (None, None) => Ok(None),
         }
     }
@@ -192,7 +194,10 @@ impl SecondCrs {
             OutputHeights::Copied(v) => format!("heights in {v}"),
             OutputHeights::Ellipsoidal(c) => match c {
                 HeightConversion::EllipsoidalToGeoid(g) => {
-                    format!("ellipsoidal heights (campaign heights + geoid: {})", g.describe())
+                    format!(
+                        "ellipsoidal heights (campaign heights + geoid: {})",
+                        g.describe()
+                    )
                 }
                 HeightConversion::Identity => "ellipsoidal heights".to_string(),
             },
@@ -211,7 +216,10 @@ pub fn turn(de: f64, dn: f64, turn_deg: f64) -> (f64, f64) {
 pub fn turn_sigma(sigma_e: f64, sigma_n: f64, turn_deg: f64) -> (f64, f64) {
     let (s, c) = turn_deg.to_radians().sin_cos();
     let (ve, vn) = (sigma_e * sigma_e, sigma_n * sigma_n);
-    ((ve * c * c + vn * s * s).sqrt(), (ve * s * s + vn * c * c).sqrt())
+    (
+        (ve * c * c + vn * s * s).sqrt(),
+        (ve * s * s + vn * c * c).sqrt(),
+    )
 }
 
 /// The height rule of the module doc.
