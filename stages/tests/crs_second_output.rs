@@ -166,8 +166,8 @@ fn a_run_writes_its_trajectory_corrections_and_control_points_in_the_second_crs(
         let f: Vec<&str> = row.split(',').collect();
         let expected = s.point(r.adjusted_world).unwrap();
         assert_eq!(f[0], r.image_id);
-        for k in 0..3 {
-            assert_eq!(f[3 + k].parse::<f64>().unwrap(), expected[k]);
+        for (text, value) in f[3..6].iter().zip(expected) {
+            assert_eq!(text.parse::<f64>().unwrap(), value);
         }
         // A correction turned by less than 1° keeps its length.
         let d: Vec<f64> = f[9..12].iter().map(|v| v.parse().unwrap()).collect();

@@ -92,8 +92,7 @@ fn sigma_to_map(
 /// An adjustment computed in `frame`, in map coordinates: positions of recordings and points, and the
 /// recordings' σ. Yaw corrections stay as they are (a rotation about the frame's vertical is one about the
 /// map's vertical to within the tilt of the module doc).
-pub fn adjustment_to_map(adj: Adjustment, frame: &MapFrame) -> Result<Adjustment, AdjustError> {
-    let mut adj = adj;
+pub fn adjustment_to_map(mut adj: Adjustment, frame: &MapFrame) -> Result<Adjustment, AdjustError> {
     for r in &mut adj.recordings {
         let p_map = frame.point_to_map(&r.position_world).map_err(frame_error)?;
         r.sigma_a_priori_m =
