@@ -162,3 +162,20 @@ fn the_second_output_crs_uses_the_campaigns_datum_grid() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn an_import_names_its_missing_datum_grid() {
+    use skytie_stages::import::config::CampaignSection;
+    use skytie_stages::import::context::ImportContext;
+    let section = CampaignSection {
+        name: "t".into(),
+        crs: "EPSG:28992+5709".into(),
+        geoid_grid: None,
+        geoid_separation_m: Some(43.25),
+        datum_grid: Some(std::env::temp_dir().join("skytie_no_such_grid.gsb")),
+        frame: Default::default(),
+    };
+    let e = ImportContext::new(&section).err().unwrap();
+    assert_eq!(e.field.as_deref(), Some("campaign.datum_grid"));
+    assert!(e.to_string().contains("skytie_no_such_grid.gsb"), "{e}");
+}
