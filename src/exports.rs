@@ -4,21 +4,27 @@
 //! correction time series), `sbet_adjusted.out` + `sbet_adjusted_quality.csv` (the corrected SBET of a
 //! campaign imported from one), `ground_control/` (control points for OpenSfM/OpenDroneMap, Metashape and as a
 //! plain list), `skytie.gpkg` (GeoPackage layers for GIS), `trajectory.geojson`, `tie_points.ply`,
-//! `checkpoints.csv`, `verification.csv` and `verification_adjusted.csv`, `correspondences.csv` and a COLMAP
-//! text model in `colmap/`. The encoders live in `skytie_stages::export`; every file is written atomically.
+//! `checkpoints.csv`, `verification.csv` and `verification_adjusted.csv`, `correspondences.csv`, a COLMAP
+//! text model in `colmap/`, and the adjusted trajectory, corrections and control points in the campaign's
+//! second CRS (`epsg_<code>/`, when `campaign.toml` names one in `[outputs]`). The encoders live in `skytie_stages::export`; every file is written atomically.
 //! A failed export is a warning naming the file; the run's other outputs are still written.
 
 use crate::nodes::adjust::adjustment::{AdjustReport, Verdict};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::oblique::consensus::ObliqueOutput;
 use skytie_stages::adjustment::verify::{write_verification_csv, Verification};
+use skytie_stages::adjustment::AdjustmentRun;
 use skytie_stages::campaign::format_time_iso;
+use skytie_stages::campaign::Campaign;
 use skytie_stages::correspondence::AerialControlPoint;
+use skytie_stages::crs::{OutputsSection, SecondCrs};
 use skytie_stages::export::gpkg::{run_layers, srs_for, write_geopackage, RunLayers};
+use skytie_stages::export::second_crs_files::{SECOND_CORRECTIONS_CSV, SECOND_TRAJECTORY_CSV};
 use skytie_stages::export::{
     write_adjusted_trajectory, write_checkpoint_errors_csv, write_colmap_model,
     write_corrected_sbet, write_corrections_csv, write_correspondences_csv, write_ground_control,
-    write_run_geojson, write_tie_points_ply, CorrectionSeries, SBET_ADJUSTED, SBET_QUALITY_CSV,
+    write_run_geojson, write_second_crs_files, write_tie_points_ply, CorrectionSeries,
+    SecondCrsRun, SBET_ADJUSTED, SBET_QUALITY_CSV,
 };
 use skytie_stages::imaging::io::dimensions;
 use skytie_stages::nadir::RecordingControl;
@@ -120,7 +126,7 @@ fn adjusted_exports(
             CorrectionSeries::from_run(&c.recordings, run),
         ),
         verdict => {
-            withhold_adjusted_trajectory(dir, verdict, p);
+            withhold_adjusted_trajectory(dir, c, verdict, p);
             None
         }
     };
@@ -137,6 +143,7 @@ fn adjusted_exports(
             SBET_ADJUSTED,
             write_corrected_sbet(&c.root, &c.crs, series, dir),
         );
+        second_crs_exports(dir, x, run, series, groups, p);
     }
     let path = dir.join("checkpoints.csv");
     p.note("checkpoints.csv", write_checkpoint_errors_csv(&path, rows));
@@ -211,6 +218,37 @@ fn adjusted_exports(
     p.note("colmap/", colmap);
 }
 
+/// The campaign's second output CRS (`[outputs]` of `campaign.toml`), if it names one that can be used (one
+/// that cannot was reported when the campaign was read).
+fn second_crs(c: &Campaign) -> Option<SecondCrs> {
+    let section = OutputsSection::read(&c.root).ok()?;
+    SecondCrs::new(&c.crs, &section, &c.root).ok().flatten()
+}
+
+/// The adjusted trajectory, corrections and control points in the campaign's second CRS, if it names one.
+fn second_crs_exports(
+    dir: &Path,
+    x: &ExportInputs<'_>,
+    run: &AdjustmentRun,
+    series: &CorrectionSeries,
+    groups: &[(&str, &[AerialControlPoint])],
+    p: &mut Problems,
+) {
+    let c = &x.snapshot.campaign;
+    if let Some(second) = second_crs(c) {
+        let files = SecondCrsRun {
+            campaign: c,
+            run,
+            series,
+            control: groups,
+        };
+        p.note(
+            &format!("{}/", second.folder_name()),
+            write_second_crs_files(dir, &second, &files),
+        );
+    }
+}
+
 /// `skytie.gpkg`; returns the warning for a CRS that is not an EPSG code.
 fn write_gpkg(path: &Path, crs: &str, layers: &RunLayers<'_>) -> std::io::Result<Option<String>> {
     let (srs, warning) = match srs_for(crs) {
@@ -230,7 +268,7 @@ fn write_gpkg(path: &Path, crs: &str, layers: &RunLayers<'_>) -> std::io::Result
 
 /// Never present an uncorrected or worsened trajectory as the adjusted one: the files that would (and any older
 /// copies of them) are not there, and the problem list says why.
-fn withhold_adjusted_trajectory(dir: &Path, verdict: Verdict, p: &mut Problems) {
+fn withhold_adjusted_trajectory(dir: &Path, c: &Campaign, verdict: Verdict, p: &mut Problems) {
     let why = match verdict {
         Verdict::NothingCorrected => "no recording observes aerial control, nothing was corrected",
         _ => "the adjustment made the check points worse",
@@ -242,8 +280,19 @@ fn withhold_adjusted_trajectory(dir: &Path, verdict: Verdict, p: &mut Problems) 
         }
         p.warn(file, format!("not written: {why}"));
     }
-    // A corrected SBET of an earlier run into the same folder must not outlive its verdict.
-    for file in [SBET_ADJUSTED, SBET_QUALITY_CSV] {
+    // A corrected SBET or second-CRS trajectory of an earlier run into the same folder must not outlive its
+    // verdict.
+    let second: Vec<String> = second_crs(c)
+        .map(|s| {
+            [SECOND_TRAJECTORY_CSV, SECOND_CORRECTIONS_CSV]
+                .map(|f| format!("{}/{f}", s.folder_name()))
+                .to_vec()
+        })
+        .unwrap_or_default();
+    let earlier = [SBET_ADJUSTED, SBET_QUALITY_CSV]
+        .into_iter()
+        .chain(second.iter().map(String::as_str));
+    for file in earlier {
         let path = dir.join(file);
         if path.exists() {
             p.note(file, std::fs::remove_file(&path));

@@ -225,6 +225,7 @@ fn round_trip(preset: &str, seed: u32, geoid: Geoid, workflow: &str) {
         crs: "EPSG:28992+5709".into(),
         geoid_grid: None,
         geoid_separation_m: None,
+        datum_grid: None,
         // The synthetic scene is Cartesian; so is the campaign imported from its export.
         frame: orig.frame,
     };

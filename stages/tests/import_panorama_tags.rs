@@ -174,6 +174,7 @@ fn panoramas_with_tags_import_into_rd_new() {
         crs: "EPSG:28992+5709".into(),
         geoid_grid: None,
         geoid_separation_m: Some(43.25),
+        datum_grid: None,
         frame: Default::default(),
     })
     .unwrap();

@@ -134,6 +134,7 @@ fn context(geoid_separation_m: f64) -> ImportContext {
         crs: "EPSG:28992+5709".into(),
         geoid_grid: None,
         geoid_separation_m: Some(geoid_separation_m),
+        datum_grid: None,
         frame: Default::default(),
     })
     .unwrap()
@@ -291,6 +292,7 @@ fn sbet_round_trip(geoid_line: &str, geoid: Option<&GeoidGrid>) {
         crs: "EPSG:28992+5709".into(),
         geoid_grid: None,
         geoid_separation_m: None,
+        datum_grid: None,
         frame: Default::default(),
     };
     if let Some(g) = geoid {

@@ -1,20 +1,23 @@
 //! `adjust`: one global node per adjustment configuration (thesis 3.5.3, ch. 5): the MM tie points and aerial
 //! control points of the registration stages → corrected recording positions
-//! (`skytie_stages::adjustment::from_correspondences::run`), and the independent check-point evaluation
+//! (`skytie_stages::adjustment::from_correspondences::run_in_frame`; with aerial observations in the bundle, in
+//! the campaign's Cartesian frame), and the independent check-point evaluation
 //! before/after (thesis 3.5.3: check points triangulated from their panorama observations with the recorded
 //! and the adjusted poses, two-view and multi-view). Check points are never used as control.
 
 use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage, StageError};
 use crate::nodes::campaign::ingest::IngestedImage;
 use crate::nodes::campaign::load::CampaignSnapshot;
+use crate::nodes::campaign::map_frame::campaign_frame_spec;
 use crate::nodes::oblique::consensus::ObliqueOutput;
 use serde::{Deserialize, Serialize};
 use skytie_stages::adjustment::campaign_checkpoints::{compare_checkpoints, CheckPointComparison};
 use skytie_stages::adjustment::config::AdjustConfig;
 use skytie_stages::adjustment::evaluate::MULTI_VIEW_RADIUS_M;
-use skytie_stages::adjustment::from_correspondences::{run, AdjustInputs, AdjustmentRun};
+use skytie_stages::adjustment::from_correspondences::{run_in_frame, AdjustInputs, AdjustmentRun};
 use skytie_stages::adjustment::{RmseSummary, ViewSelection};
 use skytie_stages::correspondence::{AerialControlPoint, MmTiePoint};
+use skytie_stages::crs::MapFrame;
 use skytie_stages::export::{checkpoint_rows, recording_support, CheckPointRow, Support};
 use skytie_stages::nadir::{MmWindowMatch, RecordingControl};
 use skytie_stages::oblique::SparseCloud;
@@ -233,8 +236,11 @@ impl Stage for AdjustStage {
             nadir: &c.nadir,
             oblique: &c.oblique,
         };
-        let result =
-            run(&inputs, config).map_err(|e| StageError::new(format!("adjustment failed: {e}")))?;
+        // With aerial observations in the bundle, it runs in the campaign's Cartesian frame.
+        let frame = MapFrame::from_spec(&campaign_frame_spec(c).0)
+            .map_err(|e| StageError::new(format!("adjustment: {e}")))?;
+        let result = run_in_frame(&inputs, config, &frame)
+            .map_err(|e| StageError::new(format!("adjustment failed: {e}")))?;
         let compare = |selection| {
             compare_checkpoints(
                 &c.recordings,

@@ -93,7 +93,8 @@ crate::params! {
         control_sigma_m: f64 = DEFAULT_CONTROL_SIGMA_M, unit "m", above 0.0;
         /// Put the aerial pixel observations into the bundle (aerial orientation fixed; σ of the pyramid
         /// level each was located at) instead of aerial-triangulated control points, so points seen in a
-        /// single aerial image count too; `false` is the thesis' scheme, `default.toml` sets `true`.
+        /// single aerial image count too; in a projected campaign the bundle then runs in the campaign's
+        /// tangent frame. `false` is the thesis' scheme; `default.toml` sets `true`.
         aerial_observations: bool = false;
         /// Robust loss on the observations: `none`, `huber` or `cauchy`.
         loss: LossKind = LossKind::None;

@@ -12,6 +12,7 @@
 use super::adjust::{adjust, ObservationCounts};
 use super::config::{AdjustConfig, ControlWeighting};
 use super::error::AdjustError;
+use super::in_frame::{adjustment_to_map, block_to_local};
 use super::problem::{
     AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, PanoObservation,
     RelativeConstraint,
@@ -19,6 +20,7 @@ use super::problem::{
 use super::relative_noise::RelativeSigma;
 use crate::campaign::{AerialImage, AerialKind, Recording};
 use crate::correspondence::{AerialControlPoint, MmTiePoint};
+use crate::crs::MapFrame;
 use crate::geometry::{triangulate_rays, FrameCamera, PanoramaCamera};
 use crate::params::{describe, Params, StageId};
 use nalgebra::{Matrix3, Vector3};
@@ -27,7 +29,7 @@ use std::collections::HashMap;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("adjust", "5");
+pub const STAGE: StageId = StageId::new("adjust", "6");
 
 /// The inputs of one adjustment.
 #[derive(Clone, Copy, Debug)]
@@ -585,10 +587,28 @@ fn initial_point(
         .filter(|p| p.iter().all(|v| v.is_finite()))
 }
 
-/// Builds and adjusts one configuration.
+/// Builds and adjusts one configuration, taking the campaign's coordinates as a Cartesian frame.
 pub fn run(inputs: &AdjustInputs, config: &AdjustConfig) -> Result<AdjustmentRun, AdjustError> {
+    run_in_frame(inputs, config, &MapFrame::Cartesian)
+}
+
+/// Builds and adjusts one configuration of a campaign whose intersection frame is `frame`. With aerial
+/// observations in the bundle (`aerial_observations`) and a tangent frame, the block is adjusted in that frame
+/// and the results are converted back to map coordinates ([`super::in_frame`]): aerial rays hundreds of metres
+/// long are then free of the map projection's scale and the earth's curvature. Otherwise every ray of the
+/// block is a panorama ray of a few tens of metres, and the block is adjusted in map coordinates.
+pub fn run_in_frame(
+    inputs: &AdjustInputs,
+    config: &AdjustConfig,
+    frame: &MapFrame,
+) -> Result<AdjustmentRun, AdjustError> {
     let build = build_block(inputs, config)?;
-    let adj = adjust(&build.block, &build.options)?;
+    let adj = if config.aerial_observations && frame.is_tangent() {
+        let local = block_to_local(&build.block, frame)?;
+        adjustment_to_map(adjust(&local, &build.options)?, frame)?
+    } else {
+        adjust(&build.block, &build.options)?
+    };
     let recordings = build
         .recording_ids
         .iter()

@@ -12,7 +12,8 @@
 //! (Levenberg–Marquardt), [`relative_noise`] (the trajectory's relative accuracy from its own second differences),
 //! [`covariance`] (posterior σ per recording), [`adjust`](mod@adjust) (solve, reject by
 //! normalised residuals, re-solve), [`evaluate`] (check-point triangulation and RMSE), [`synthetic_block`]
-//! (known-answer test blocks). On top: [`config`] (the adjust node's params), [`from_correspondences`]
+//! (known-answer test blocks). On top: [`config`] (the adjust node's params), [`in_frame`] (a block
+//! in the campaign's tangent frame and its results back in map coordinates), [`from_correspondences`]
 //! (correspondences → block → [`AdjustmentRun`]), [`verify`] (thesis Table 5-13 verification per trajectory
 //! segment) and [`synthetic_campaign`] (a synthetic block as campaign rows and correspondences, with aerial
 //! images, for known-answer tests).
@@ -28,6 +29,7 @@ pub mod covariance;
 pub mod error;
 pub mod evaluate;
 pub mod from_correspondences;
+pub mod in_frame;
 pub mod layout;
 pub mod linearization;
 pub mod parallel;
@@ -54,8 +56,8 @@ pub use evaluate::{
     ViewSelection,
 };
 pub use from_correspondences::{
-    build_block, run, AdjustInputs, AdjustmentRun, BlockBuild, BlockPoint, BuildCounts, PointKind,
-    RunPoint, RunRecording,
+    build_block, run, run_in_frame, AdjustInputs, AdjustmentRun, BlockBuild, BlockPoint,
+    BuildCounts, PointKind, RunPoint, RunRecording,
 };
 pub use problem::{
     AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, LmOptions,

@@ -97,6 +97,19 @@ pub fn read_sourced(root: &Path) -> Result<(SourcedCampaign, Vec<Problem>), Camp
     if let Err(p) = crate::campaign::source::read_source(root) {
         problems.push(p);
     }
+    // `[outputs]` names a second CRS for the run's files: one that cannot be used is reported before any work.
+    let outputs = crate::crs::OutputsSection::read(root)
+        .and_then(|s| crate::crs::SecondCrs::new(&crs, &s, root).map(|_| ()));
+    if let Err(message) = outputs {
+        problems.push(Problem::error(
+            TOML,
+            None,
+            Some("outputs"),
+            message,
+            "fix or remove the [outputs] table (docs/outputs.md, \"Outputs in a second CRS\"); the run writes \
+             its files in the campaign CRS only",
+        ));
+    }
 
     let mut recordings = if root.join(RECORDINGS).is_file() {
         read_recording_rows(

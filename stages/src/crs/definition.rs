@@ -20,6 +20,8 @@ pub enum CrsError {
     VerticalOnGeographic3d(u32, u32),
     #[error("EPSG:{code}: the projection cannot be set up ({reason})")]
     Projection { code: u32, reason: String },
+    #[error(transparent)]
+    DatumGrid(#[from] super::datum_grid::DatumGridError),
 }
 
 /// Whether the horizontal coordinates are map coordinates or latitude/longitude.
@@ -67,6 +69,8 @@ pub struct Crs {
     pub(crate) geographic: Proj,
     /// The ellipsoid of the horizontal datum.
     pub ellipsoid: Ellipsoid,
+    /// The proj4 definition of the horizontal part (with the datum shift it uses).
+    pub(crate) definition: String,
 }
 
 impl fmt::Debug for Crs {
@@ -129,13 +133,7 @@ impl Crs {
                     .ok_or_else(|| CrsError::UnknownVertical(v, supported_vertical_list()))?,
             },
         };
-        let geographic =
-            Proj::from_proj_string(&geographic_definition(def.proj4)).map_err(|e| {
-                CrsError::Projection {
-                    code: horizontal_code,
-                    reason: e.to_string(),
-                }
-            })?;
+        let geographic = geographic_proj(horizontal_code, def.proj4)?;
         let (a, b) = proj.ellipse_parameters();
         Ok(Self {
             text: text.trim().to_string(),
@@ -145,6 +143,33 @@ impl Crs {
             proj,
             geographic,
             ellipsoid: Ellipsoid::from_axes(a, b),
+            definition: def.proj4.to_string(),
+        })
+    }
+
+    /// This CRS with its datum shift (to ETRS89/WGS84) taken from the NTv2 grid `grid` instead of the EPSG
+    /// definition's Helmert parameters ([`super::datum_grid`]): a national grid such as RDNAPTRANS's
+    /// `rdtrans2018.gsb` for RD New gives millimetres where the Helmert parameters give about a metre.
+    pub fn with_datum_grid(&self, grid: &std::path::Path) -> Result<Self, CrsError> {
+        let key = super::datum_grid::load(grid)?;
+        let mut definition: String = self
+            .definition
+            .split_whitespace()
+            .filter(|t| !t.starts_with("+towgs84=") && !t.starts_with("+nadgrids="))
+            .collect::<Vec<_>>()
+            .join(" ");
+        definition.push_str(&format!(" +nadgrids={key}"));
+        let fail = |e: proj4rs::errors::Error| CrsError::Projection {
+            code: self.horizontal_code,
+            reason: e.to_string(),
+        };
+        let proj = Proj::from_proj_string(&definition).map_err(fail)?;
+        Ok(Self {
+            text: format!("{} with datum grid {}", self.text, grid.display()),
+            proj,
+            geographic: geographic_proj(self.horizontal_code, &definition)?,
+            definition,
+            ..self.clone()
         })
     }
 
@@ -159,6 +184,7 @@ impl Crs {
             proj: self.geographic.clone(),
             geographic: self.geographic.clone(),
             ellipsoid: self.ellipsoid,
+            definition: geographic_definition(&self.definition),
         }
     }
 
@@ -166,6 +192,14 @@ impl Crs {
     pub fn is_projected(&self) -> bool {
         self.kind == HorizontalKind::Projected
     }
+}
+
+/// Latitude/longitude on the datum of the proj4 definition `proj4` of EPSG:`code`.
+fn geographic_proj(code: u32, proj4: &str) -> Result<Proj, CrsError> {
+    Proj::from_proj_string(&geographic_definition(proj4)).map_err(|e| CrsError::Projection {
+        code,
+        reason: e.to_string(),
+    })
 }
 
 /// `+proj=longlat` with the datum parameters (ellipsoid, datum, towgs84, nadgrids, prime meridian) of a

@@ -10,7 +10,7 @@
 
 use super::campaign_frame::{CampaignFrame, FrameError};
 use super::definition::Crs;
-use crate::geometry::FrameCamera;
+use crate::geometry::{FrameCamera, PanoramaCamera};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -126,6 +126,41 @@ impl MapFrame {
                 ..camera.clone()
             }),
         }
+    }
+
+    /// A panorama oriented in map coordinates, in this frame.
+    pub fn panorama_to_local(&self, camera: &PanoramaCamera) -> Result<PanoramaCamera, FrameError> {
+        Ok(PanoramaCamera {
+            center_world: self.point_to_local(&camera.center_world)?,
+            rotation_pano_to_world: self.rotation_to_local(&camera.center_world)?
+                * camera.rotation_pano_to_world,
+            ..camera.clone()
+        })
+    }
+
+    /// The rotation taking map-frame vectors at map point `at_map` into this frame (the identity for
+    /// [`MapFrame::Cartesian`]).
+    pub fn rotation_to_local(&self, at_map: &Vector3<f64>) -> Result<Matrix3<f64>, FrameError> {
+        match self {
+            MapFrame::Cartesian => Ok(Matrix3::identity()),
+            MapFrame::Tangent(f) => f.map_to_local_rotation(at_map),
+        }
+    }
+
+    /// A covariance (m²) of the map point `p_map` given in the map's axes, turned into this frame's axes.
+    pub fn covariance_to_local(
+        &self,
+        p_map: &Vector3<f64>,
+        covariance_map_m2: &Matrix3<f64>,
+    ) -> Result<Matrix3<f64>, FrameError> {
+        let r = self.rotation_to_local(p_map)?;
+        Ok(r * covariance_map_m2 * r.transpose())
+    }
+
+    /// True for the tangent frame of a projected CRS (coordinates are converted), false when the campaign's
+    /// coordinates are used as they are.
+    pub fn is_tangent(&self) -> bool {
+        matches!(self, MapFrame::Tangent(_))
     }
 
     /// A map point in this frame.

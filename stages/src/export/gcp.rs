@@ -41,12 +41,12 @@ pub struct GcpExport {
 }
 
 /// One control point ready for the writers.
-struct Gcp<'a> {
-    label: String,
-    source: &'a str,
-    point: &'a AerialControlPoint,
-    xyz: [f64; 3],
-    sigma: [f64; 3],
+pub(crate) struct Gcp<'a> {
+    pub(crate) label: String,
+    pub(crate) source: &'a str,
+    pub(crate) point: &'a AerialControlPoint,
+    pub(crate) xyz: [f64; 3],
+    pub(crate) sigma: [f64; 3],
     /// (file name, u, v) per observation, panorama observations first.
     observations: Vec<(&'a str, f64, f64)>,
 }
@@ -76,7 +76,8 @@ fn label(source: &str, id: &str) -> String {
         .collect()
 }
 
-fn collect<'a>(
+/// The control points of `groups` with an aerial triangulation, labelled, with their observations' files.
+pub(crate) fn collect<'a>(
     campaign: &'a Campaign,
     groups: &[(&'a str, &'a [AerialControlPoint])],
     out: &mut GcpExport,

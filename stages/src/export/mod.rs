@@ -6,7 +6,9 @@
 //! (CloudCompare), [`checkpoints`] `checkpoints.csv` (per-point errors before/after), [`correspondences`]
 //! `correspondences.csv` (every control point's observations), [`gcp`] ground control for OpenSfM /
 //! OpenDroneMap, Metashape and as a plain list, [`gpkg`] `skytie.gpkg` (GeoPackage layers for GIS), [`colmap`] a COLMAP text
-//! model (`cameras.txt`, `images.txt`, `points3D.txt`) with COLMAP's EQUIRECTANGULAR model for the panoramas.
+//! model (`cameras.txt`, `images.txt`, `points3D.txt`) with COLMAP's EQUIRECTANGULAR model for the panoramas;
+//! [`second_crs_files`]: the adjusted trajectory, corrections and control points also in a second CRS
+//! (`campaign.toml` `[outputs]`, [`crate::crs::second_crs`]).
 //! The CSV/GeoJSON/PLY encoders are the campaign writers ([`crate::campaign::write`]); this module maps an
 //! [`crate::adjustment::AdjustmentRun`] onto them.
 
@@ -22,6 +24,7 @@ pub mod geojson;
 pub mod gpkg;
 pub mod ply;
 pub mod sbet;
+pub mod second_crs_files;
 pub mod support;
 pub mod synthetic_outputs;
 pub mod trajectory;
@@ -40,5 +43,6 @@ pub use ply::{
     PLY_SOURCE_TIE,
 };
 pub use sbet::{write_corrected_sbet, SbetOutput, SBET_ADJUSTED, SBET_QUALITY_CSV};
+pub use second_crs_files::{write_second_crs_files, SecondCrsRun};
 pub use support::{recording_support, RecordingSupport, Support};
 pub use trajectory::{adjusted_recordings, write_adjusted_trajectory, TrajectoryExportCounts};

@@ -68,6 +68,8 @@ impl Frames {
             crs: campaign_crs.to_string(),
             geoid_grid: p.geoid_grid.as_ref().map(|g| root.join(g)),
             geoid_separation_m: p.geoid_separation_m,
+            // Forward and back use the same datum shift, so a correction (a difference) maps back alike.
+            datum_grid: None,
             frame: Default::default(),
         };
         let ctx = ImportContext::new(&section).map_err(|e| invalid(e.to_string()))?;

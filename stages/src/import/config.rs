@@ -59,6 +59,10 @@ pub struct CampaignSection {
     /// A constant separation instead of a grid, m.
     #[serde(default)]
     pub geoid_separation_m: Option<f64>,
+    /// NTv2 grid (`.gsb`) of the campaign CRS's datum shift to ETRS89/WGS84 (e.g. `rdtrans2018.gsb` for RD
+    /// New), used instead of the EPSG definition's Helmert parameters.
+    #[serde(default)]
+    pub datum_grid: Option<PathBuf>,
     /// `frame` of the campaign written (`projected`, the default, or `cartesian`; campaign-format.md).
     #[serde(default)]
     pub frame: crate::crs::CoordinateFrame,
@@ -255,6 +259,9 @@ impl ImportConfig {
             }
         };
         if let Some(g) = &mut self.campaign.geoid_grid {
+            fix(g);
+        }
+        if let Some(g) = &mut self.campaign.datum_grid {
             fix(g);
         }
         for a in &mut self.aerial {

@@ -23,6 +23,12 @@ impl ImportContext {
         if !campaign_crs.is_projected() {
             return Err(Problem::error(CONFIG, None, Some("campaign.crs"), format!("{} is geographic; a campaign needs a projected CRS (metres east/north)", section.crs), "use the projected CRS of the project area, e.g. EPSG:28992+5709 or an ETRS89 / UTM zone with a vertical CRS"));
         }
+        let campaign_crs = match &section.datum_grid {
+            Some(grid) => campaign_crs.with_datum_grid(grid).map_err(|e| {
+                Problem::error(CONFIG, None, Some("campaign.datum_grid"), e.to_string(), "")
+            })?,
+            None => campaign_crs,
+        };
         let geoid = match (&section.geoid_grid, section.geoid_separation_m) {
             (Some(_), Some(_)) => {
                 return Err(Problem::error(
