@@ -54,13 +54,22 @@ fn a_tiny_street_with_road_markings_is_corrected() {
     let mm = num(&m, &["nadir", "mm_tie_points"]);
     assert!(mm >= 80.0, "MM tie points: {mm}");
     assert!(
-        num(&m, &["nadir", "mm_tie_points_correct"]) >= 0.95 * num(&m, &["nadir", "mm_tie_points_graded"]),
+        num(&m, &["nadir", "mm_tie_points_correct"])
+            >= 0.95 * num(&m, &["nadir", "mm_tie_points_graded"]),
         "MM tie points against the truth: {}",
         m["nadir"]
     );
     assert!(num(&m, &["nadir", "tie_points"]) >= 8.0, "{}", m["nadir"]);
-    assert!(num(&m, &["nadir", "inlier_ratio"]) >= 0.97, "{}", m["nadir"]);
-    assert!(num(&m, &["nadir", "recordings_with_aerial"]) >= 2.0, "{}", m["nadir"]);
+    assert!(
+        num(&m, &["nadir", "inlier_ratio"]) >= 0.97,
+        "{}",
+        m["nadir"]
+    );
+    assert!(
+        num(&m, &["nadir", "recordings_with_aerial"]) >= 2.0,
+        "{}",
+        m["nadir"]
+    );
 
     // Adjustment (thesis ch. 5): every recording corrected, the error at least 5× smaller, none left > 0.15 m.
     let a = &m["adjust"]["combined"];
@@ -68,7 +77,10 @@ fn a_tiny_street_with_road_markings_is_corrected() {
     let before = num(a, &["recordings", "before", "rmse_2d"]);
     let after = num(a, &["recordings", "after", "rmse_2d"]);
     assert!(before > 0.7, "the deterioration must show: {before}");
-    assert!(after * 5.0 <= before, "recordings {before} → {after} m RMSE 2D");
+    assert!(
+        after * 5.0 <= before,
+        "recordings {before} → {after} m RMSE 2D"
+    );
     assert!(num(a, &["recordings", "after", "max_2d"]) <= 0.15, "{a}");
     assert!(
         num(a, &["checkpoints", "after", "2d"]) < num(a, &["checkpoints", "before", "2d"]),
