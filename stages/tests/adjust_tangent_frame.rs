@@ -122,6 +122,7 @@ fn rows(s: &Scene) -> Rows {
                     u_px,
                     v_px,
                     score: 1.0,
+                    sigma_px: None,
                 }
             })
             .collect();

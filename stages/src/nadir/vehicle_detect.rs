@@ -345,9 +345,11 @@ mod tests {
     #[test]
     fn the_detection_level_follows_the_grid_step_but_not_below_the_detail_level() {
         let p = VehicleDetectParams::default(); // 1° depression step: pixels of at most 1/3°, 1080 px wide
-        let layout = |w: usize, detail_level: usize| PyramidLayout {
-            detail_level,
-            ..PyramidLayout::new(w, w / 2, crate::imaging::pyramid::SampleDepth::U8, 256).unwrap()
+        let layout = |w: usize, detail_level: usize| {
+            let mut l = PyramidLayout::new(w, w / 2, crate::imaging::pyramid::SampleDepth::U8, 256)
+                .unwrap();
+            l.detail_level = detail_level;
+            l
         };
         assert_eq!(detection_level(&layout(1024, 0), &p), 0);
         assert_eq!(detection_level(&layout(8192, 0), &p), 2);

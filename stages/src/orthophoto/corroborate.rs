@@ -77,6 +77,7 @@ mod tests {
                 u_px: 500.0 + shift.0,
                 v_px: 700.0 + shift.1,
                 score: peak,
+                sigma_px: None,
             },
             predicted_u_px: 500.0,
             predicted_v_px: 700.0,
