@@ -68,6 +68,23 @@ struct Rows {
     recordings: Vec<Recording>,
     tie_points: Vec<MmTiePoint>,
     control: Vec<AerialControlPoint>,
+    /// Every recording's panorama size, px.
+    sizes: Vec<(u32, u32)>,
+}
+
+impl Rows {
+    /// The adjustment's inputs: these rows and the scene's nadir frames.
+    fn inputs<'a>(&'a self, s: &'a Scene) -> AdjustInputs<'a> {
+        AdjustInputs {
+            recordings: &self.recordings,
+            pano_size_px: &self.sizes,
+            pano_detail_level: &[],
+            tie_points: &self.tie_points,
+            control: &self.control,
+            nadir: &s.aerial,
+            oblique: &[],
+        }
+    }
 }
 
 fn rows(s: &Scene) -> Rows {
@@ -145,6 +162,7 @@ fn rows(s: &Scene) -> Rows {
         });
     }
     Rows {
+        sizes: vec![PANO_SIZE_PX; recordings.len()],
         recordings,
         tie_points,
         control,
@@ -170,16 +188,7 @@ fn largest_error_m(run: &AdjustmentRun, s: &Scene) -> f64 {
 fn aerial_observations_in_the_campaign_frame_are_free_of_map_scale_and_curvature() {
     let s = scene();
     let r = rows(&s);
-    let sizes = vec![PANO_SIZE_PX; r.recordings.len()];
-    let inputs = AdjustInputs {
-        recordings: &r.recordings,
-        pano_size_px: &sizes,
-        pano_detail_level: &[],
-        tie_points: &r.tie_points,
-        control: &r.control,
-        nadir: &s.aerial,
-        oblique: &[],
-    };
+    let inputs = r.inputs(&s);
     let config = AdjustConfig {
         aerial_observations: true,
         pano_sigma_px: 0.5,
@@ -222,16 +231,7 @@ fn aerial_observations_in_the_campaign_frame_are_free_of_map_scale_and_curvature
 fn without_aerial_observations_the_frame_changes_nothing() {
     let s = scene();
     let r = rows(&s);
-    let sizes = vec![PANO_SIZE_PX; r.recordings.len()];
-    let inputs = AdjustInputs {
-        recordings: &r.recordings,
-        pano_size_px: &sizes,
-        pano_detail_level: &[],
-        tie_points: &r.tie_points,
-        control: &r.control,
-        nadir: &s.aerial,
-        oblique: &[],
-    };
+    let inputs = r.inputs(&s);
     let config = AdjustConfig::default();
     assert_eq!(
         run_in_frame(&inputs, &config, &s.frame).unwrap(),

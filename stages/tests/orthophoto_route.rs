@@ -328,25 +328,53 @@ fn with_crowns(
     out
 }
 
+/// A recording at `foot` whose ortho shows the clear orthophoto texture `seed` shifted by `offset` (its position
+/// error, m), and the orthophoto with a crown of radius `crown.0` m centred `crown.1` m east of every tie
+/// point's true place ([`with_crowns`]).
+struct CrownedScene {
+    tile: RasterFile,
+    ortho: OrthoImage,
+    window: MmWindowMatch,
+    /// The tie points' true ground positions (world, m).
+    shown: Vec<[f64; 3]>,
+    pixels: MemoryPyramid,
+}
+
+fn crowned_scene(seed: u64, foot: [f64; 3], offset: [f64; 2], crown: (f64, f64)) -> CrownedScene {
+    let clear = texture(seed, PHOTO_PX);
+    let tile = photo_tile();
+    let t = tile.header.transform;
+    let ortho = ortho_at(&clear, &t, foot, offset);
+    let window = window(foot);
+    let shown: Vec<[f64; 3]> = window
+        .ground_world
+        .iter()
+        .map(|g| [g[0] + offset[0], g[1] + offset[1], g[2]])
+        .collect();
+    let photo = with_crowns(&clear, &t, &shown, crown.0, crown.1);
+    let pixels = MemoryPyramid::from_gray(&photo);
+    CrownedScene {
+        tile,
+        ortho,
+        window,
+        shown,
+        pixels,
+    }
+}
+
 #[test]
 fn tie_points_half_hidden_by_tree_crowns_are_located_where_their_corrections_agree() {
     // Tree crowns in the orthophoto cover part of every tie point's template: the correct peaks are weaker
     // than refine.min_peak (measured 0.53–0.66), and only their agreement on one correction (a translation)
     // locates them.
-    let clear = texture(31, PHOTO_PX);
-    let tile = photo_tile();
-    let t = tile.header.transform;
     let foot = [ORIGIN[0] + 30.6, ORIGIN[1] + 31.8, 1.8];
-    let offset = [0.64, 0.81];
-    let ortho = ortho_at(&clear, &t, foot, offset);
-    let w = window(foot);
-    let shown: Vec<[f64; 3]> = w
-        .ground_world
-        .iter()
-        .map(|g| [g[0] + offset[0], g[1] + offset[1], g[2]])
-        .collect();
-    let photo = with_crowns(&clear, &t, &shown, 1.1, 1.2);
-    let pixels = MemoryPyramid::from_gray(&photo);
+    let CrownedScene {
+        tile,
+        ortho,
+        window: w,
+        shown,
+        pixels,
+    } = crowned_scene(31, foot, [0.64, 0.81], (1.1, 1.2));
     let dtm = planar_dtm();
     let input = OrthophotoInput {
         tile: &tile,
@@ -403,20 +431,14 @@ fn tie_points_half_hidden_by_tree_crowns_are_located_where_their_corrections_agr
 fn weak_peaks_that_disagree_give_no_control_points() {
     // The tie points' surroundings in the orthophoto are replaced by unrelated texture under the crowns
     // entirely: any peak there is chance, scattered over the search window, and none may become control.
-    let clear = texture(41, PHOTO_PX);
-    let tile = photo_tile();
-    let t = tile.header.transform;
     let foot = [ORIGIN[0] + 31.1, ORIGIN[1] + 30.4, 1.8];
-    let offset = [-0.5, 0.7];
-    let ortho = ortho_at(&clear, &t, foot, offset);
-    let w = window(foot);
-    let shown: Vec<[f64; 3]> = w
-        .ground_world
-        .iter()
-        .map(|g| [g[0] + offset[0], g[1] + offset[1], g[2]])
-        .collect();
-    let photo = with_crowns(&clear, &t, &shown, 3.0, 0.0);
-    let pixels = MemoryPyramid::from_gray(&photo);
+    let CrownedScene {
+        tile,
+        ortho,
+        window: w,
+        pixels,
+        ..
+    } = crowned_scene(41, foot, [-0.5, 0.7], (3.0, 0.0));
     let input = OrthophotoInput {
         tile: &tile,
         pixels: &pixels,
