@@ -145,7 +145,7 @@ w(f"Measured with {os.environ['VERSION']} (commit `{os.environ['COMMIT']}`) on {
   "seed; their recorded positions carry the thesis' deterioration (0.80 m systematic + N(0, 0.10 m) per "
   "horizontal axis, thesis 3.5.1.2), and the grading compares with their `truth/`.")
 w("")
-w("The default workflow's adjustment settings (`relative_sigma_m`, `loss`, `rejection_threshold`; see "
+w("The default workflow's adjustment settings (`relative_sigma_m`, `loss`, `rejection_threshold`, `aerial_observations`; see "
   "`skytie workflows show default`) were chosen by looking at demo seeds 1–3. "
   + (f"Seed{'s' if len(held_out) > 1 else ''} {', '.join(held_out)} "
      "played no part in choosing any parameter." if held_out else ""))
