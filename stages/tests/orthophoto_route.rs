@@ -432,20 +432,15 @@ fn weak_peaks_that_disagree_give_no_control_points() {
     // The tie points' surroundings in the orthophoto are replaced by unrelated texture under the crowns
     // entirely: any peak there is chance, scattered over the search window, and none may become control.
     let foot = [ORIGIN[0] + 31.1, ORIGIN[1] + 30.4, 1.8];
-    let CrownedScene {
-        tile,
-        ortho,
-        window: w,
-        pixels,
-        ..
-    } = crowned_scene(41, foot, [-0.5, 0.7], (3.0, 0.0));
+    let scene = crowned_scene(41, foot, [-0.5, 0.7], (3.0, 0.0));
     let input = OrthophotoInput {
-        tile: &tile,
-        pixels: &pixels,
+        tile: &scene.tile,
+        pixels: &scene.pixels,
         sigma_m: 0.04,
         dtm: None,
     };
-    let out = orthophoto_control(&ortho, &w, &[], &input, &OrthophotoParams::default()).unwrap();
+    let params = OrthophotoParams::default();
+    let out = orthophoto_control(&scene.ortho, &scene.window, &[], &input, &params).unwrap();
     // The rest of the ortho still registers it; the hidden tie points give nothing.
     assert!(
         matches!(out.transform, TransformOutcome::Accepted(_)),
