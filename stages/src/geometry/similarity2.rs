@@ -33,6 +33,14 @@ impl Similarity2 {
         Self::new(1.0, 0.0, 0.0, 0.0)
     }
 
+    /// Whether the transform can map points: every parameter finite and the scale positive (above 1e-6).
+    pub fn is_usable(&self) -> bool {
+        [self.scale, self.rotation_rad, self.tx, self.ty]
+            .iter()
+            .all(|v| v.is_finite())
+            && self.scale > 1e-6
+    }
+
     /// From the linear parameters `a = s cos θ`, `b = s sin θ` and the translation.
     pub fn from_ab(a: f64, b: f64, tx: f64, ty: f64) -> Self {
         Self {

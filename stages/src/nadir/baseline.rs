@@ -139,11 +139,7 @@ pub fn baseline_matches(
 ) -> Result<AerialRefinement, PyramidError> {
     let mut result = AerialRefinement::empty(&t.recording_id, &aerial_row.image_id);
     let tf = t.ortho_to_aerial;
-    let transform_ok = [tf.scale, tf.rotation_rad, tf.tx, tf.ty]
-        .iter()
-        .all(|v| v.is_finite())
-        && tf.scale > 1e-6;
-    if !transform_ok || p.validate().is_err() {
+    if !tf.is_usable() || p.validate().is_err() {
         return Ok(result);
     }
     let foot = Vector3::from(mm_ortho.georef.foot_world);

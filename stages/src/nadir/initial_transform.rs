@@ -307,14 +307,12 @@ pub fn initial_transform(
         None => None,
     };
     let size = (aerial.layout().width, aerial.layout().height);
-    Ok(transform_with_patch(
-        rec,
-        mm_ortho,
-        size,
-        patch.as_ref(),
-        aerial_row,
-        p,
-    ))
+    Ok(
+        match find_transform(rec, mm_ortho, size, patch.as_ref(), aerial_row, p) {
+            Ok(t) => TransformOutcome::Accepted(t),
+            Err(r) => r.into_outcome(rec, aerial_row),
+        },
+    )
 }
 
 /// Why a transform (or an orthophoto registration) was rejected, with the matches and inliers it had got to by
@@ -323,6 +321,19 @@ pub(crate) struct Rejection {
     pub(crate) reason: String,
     pub(crate) matches: usize,
     pub(crate) inliers: usize,
+}
+
+impl Rejection {
+    /// The outcome of (recording `rec`, aerial image `aerial_row`) rejected for this reason.
+    fn into_outcome(self, rec: &Recording, aerial_row: &AerialImage) -> TransformOutcome {
+        TransformOutcome::Rejected {
+            recording_id: rec.image_id.clone(),
+            aerial_id: aerial_row.image_id.clone(),
+            reason: self.reason,
+            matches: self.matches,
+            inliers: self.inliers,
+        }
+    }
 }
 
 pub(crate) fn rejected(reason: impl Into<String>, matches: usize, inliers: usize) -> Rejection {
@@ -388,27 +399,6 @@ impl WindowedQuery {
                 PointPair::new(u, v, fu, fv)
             })
             .collect())
-    }
-}
-
-/// [`initial_transform`] once the aerial patch is read (`None`: the footprint misses the image).
-fn transform_with_patch(
-    rec: &Recording,
-    mm_ortho: &OrthoImage,
-    aerial_size_px: (usize, usize),
-    patch: Option<&AerialPatch>,
-    aerial_row: &AerialImage,
-    p: &TransformParams,
-) -> TransformOutcome {
-    match find_transform(rec, mm_ortho, aerial_size_px, patch, aerial_row, p) {
-        Ok(t) => TransformOutcome::Accepted(t),
-        Err(r) => TransformOutcome::Rejected {
-            recording_id: rec.image_id.clone(),
-            aerial_id: aerial_row.image_id.clone(),
-            reason: r.reason,
-            matches: r.matches,
-            inliers: r.inliers,
-        },
     }
 }
 

@@ -366,11 +366,7 @@ pub fn refine_in_image(
     let (image_id, kind) = image;
     let mut result = AerialRefinement::empty(&t.recording_id, image_id);
     let tf = t.ortho_to_aerial;
-    let transform_ok = [tf.scale, tf.rotation_rad, tf.tx, tf.ty]
-        .iter()
-        .all(|v| v.is_finite())
-        && tf.scale > 1e-6;
-    if !transform_ok || p.validate().is_err() {
+    if !tf.is_usable() || p.validate().is_err() {
         return Ok(result);
     }
     // Search windows reach the template ± the margin, re-centred once by up to the margin (`search_template`),
