@@ -74,19 +74,12 @@ pub struct TrajectoryProvenance {
 impl TrajectoryProvenance {
     /// The geoid model it names (`None` when the import used none).
     pub fn geoid(&self, root: &Path) -> Result<Option<GeoidModel>, String> {
-        match (&self.geoid_grid, self.geoid_separation_m) {
-            (Some(_), Some(_)) => {
-                Err("source.trajectory: both geoid_grid and geoid_separation_m are given".into())
-            }
-            (Some(g), None) => GeoidModel::read_gtx(&root.join(g))
-                .map(Some)
-                .map_err(|e| format!("source.trajectory.geoid_grid: {e}")),
-            (None, Some(n)) if n.is_finite() => Ok(Some(GeoidModel::Constant { separation_m: n })),
-            (None, Some(n)) => Err(format!(
-                "source.trajectory.geoid_separation_m: {n} is not a separation"
-            )),
-            (None, None) => Ok(None),
-        }
+        GeoidModel::from_keys(
+            "source.trajectory",
+            self.geoid_grid.as_deref(),
+            self.geoid_separation_m,
+            root,
+        )
     }
 
     /// Check what a run needs: a geographic CRS skytie knows, a file that exists.

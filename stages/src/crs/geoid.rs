@@ -49,6 +49,30 @@ const GTX_NO_VALUE: f32 = -88.8888;
 const GTX_HEADER_BYTES: usize = 40;
 
 impl GeoidModel {
+    /// The model a table names by its keys `geoid_grid` (a GTX file relative to `root`) or
+    /// `geoid_separation_m` (a constant): `None` when it names neither; `Err` (prefixed with the table's
+    /// `table` name) when it names both or one cannot be used.
+    pub fn from_keys(
+        table: &str,
+        grid: Option<&Path>,
+        separation_m: Option<f64>,
+        root: &Path,
+    ) -> Result<Option<Self>, String> {
+        match (grid, separation_m) {
+            (Some(_), Some(_)) => Err(format!(
+                "{table}: both geoid_grid and geoid_separation_m are given; keep one"
+            )),
+            (Some(g), None) => Self::read_gtx(&root.join(g))
+                .map(Some)
+                .map_err(|e| format!("{table}.geoid_grid: {e}")),
+            (None, Some(n)) if n.is_finite() => Ok(Some(Self::Constant { separation_m: n })),
+            (None, Some(n)) => Err(format!(
+                "{table}.geoid_separation_m: {n} is not a separation"
+            )),
+            (None, None) => Ok(None),
+        }
+    }
+
     /// Separation N at (lat, lon), metres.
     pub fn separation_m(&self, lat_deg: f64, lon_deg: f64) -> Result<f64, GeoidError> {
         match self {

@@ -65,19 +65,12 @@ impl OutputsSection {
     }
 
     fn geoid(&self, root: &Path) -> Result<Option<GeoidModel>, String> {
-        match (&self.geoid_grid, self.geoid_separation_m) {
-            (Some(_), Some(_)) => {
-                Err("outputs: both geoid_grid and geoid_separation_m are given; keep one".into())
-            }
-            (Some(g), None) => GeoidModel::read_gtx(&root.join(g))
-                .map(Some)
-                .map_err(|e| format!("outputs.geoid_grid: {e}")),
-            (None, Some(n)) if n.is_finite() => Ok(Some(GeoidModel::Constant { separation_m: n })),
-            (None, Some(n)) => Err(format!(
-                "outputs.geoid_separation_m: {n} is not a separation"
-            )),
-            (None, None) => Ok(None),
-        }
+        GeoidModel::from_keys(
+            "outputs",
+            self.geoid_grid.as_deref(),
+            self.geoid_separation_m,
+            root,
+        )
     }
 }
 
