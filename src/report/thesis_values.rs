@@ -110,37 +110,42 @@ pub fn table_4_2() -> Table {
     )
 }
 
-/// Thesis Table 5-2: adjustment with nadir correspondences only, RMSE in metres.
-pub fn table_5_2() -> Table {
+/// A table of RMSE per area before and after an adjustment, per coordinate (Tables 5-2 and 5-4).
+fn before_after_xyz(id: &str, title: &str, rows: &[&[&str]]) -> Table {
     table(
-        "thesis-table-5-2",
-        "Table 5-2: adjustment with nadir correspondences only [m]",
+        id,
+        title,
         &[
             "area", "X before", "X after", "Y before", "Y after", "Z before", "Z after",
         ],
+        rows,
+        "",
+    )
+}
+
+/// Thesis Table 5-2: adjustment with nadir correspondences only, RMSE in metres.
+pub fn table_5_2() -> Table {
+    before_after_xyz(
+        "thesis-table-5-2",
+        "Table 5-2: adjustment with nadir correspondences only [m]",
         &[
             &["1", "0.14", "0.12", "0.12", "0.11", "0.23", "0.21"],
             &["2", "0.15", "0.21", "0.52", "0.53", "0.19", "0.23"],
             &["4", "0.19", "0.19", "0.16", "0.14", "0.20", "0.24"],
         ],
-        "",
     )
 }
 
 /// Thesis Table 5-4: adjustment with oblique correspondences only, RMSE in metres.
 pub fn table_5_4() -> Table {
-    table(
+    before_after_xyz(
         "thesis-table-5-4",
         "Table 5-4: adjustment with oblique correspondences only [m]",
-        &[
-            "area", "X before", "X after", "Y before", "Y after", "Z before", "Z after",
-        ],
         &[
             &["1", "0.14", "0.13", "0.12", "0.14", "0.23", "0.23"],
             &["2", "0.15", "0.21", "0.52", "0.13", "0.19", "0.28"],
             &["3", "0.12", "0.12", "0.24", "0.22", "0.19", "0.20"],
         ],
-        "",
     )
 }
 
