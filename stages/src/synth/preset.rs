@@ -119,66 +119,51 @@ impl Preset {
             overlap_along_route: 0.5,
             corner_distortion_px: 2.0,
         };
+        // The sizes that set the presets apart; everything else is `PresetParams::common()`.
+        let sized = |panorama_width_px, max_recordings_per_route, nadir, oblique| PresetParams {
+            panorama_width_px,
+            max_recordings_per_route,
+            nadir,
+            oblique,
+            ..PresetParams::common()
+        };
         match self {
             Preset::Tiny => PresetParams {
-                panorama_width_px: 1024,
                 // Three check points along the 25 m route instead of one.
                 checkpoint_spacing_m: 8.0,
-                panorama_spp_axis: 2,
-                max_recordings_per_route: 6,
-                nadir: nadir(512, 384),
-                oblique: oblique(320, 240),
-                aerial_spp_axis: 2,
-                ..PresetParams::common()
+                ..sized(1024, 6, nadir(512, 384), oblique(320, 240))
             },
             Preset::Street => PresetParams {
                 max_recordings_per_route: STREET_RECORDINGS,
                 ..Preset::Tiny.params()
             },
-            Preset::Demo => PresetParams {
-                // 1600 × 800 (0.225°/px) instead of 2048 × 1024: measured 2.3 M primary rays/s per core of CPU
-                // time, this keeps the whole demo at ≈ 155 CPU-s, i.e. ≲ 90 s on 2 cores.
-                panorama_width_px: 1600,
-                panorama_spp_axis: 2,
-                max_recordings_per_route: 40,
-                // Sized for generation in ≲ 90 s on 2 cores (measured with the render bench).
-                nadir: nadir(1600, 1200),
-                oblique: oblique(800, 600),
-                aerial_spp_axis: 2,
-                ..PresetParams::common()
-            },
-            Preset::Paper => PresetParams {
-                panorama_width_px: 4800,
-                panorama_spp_axis: 2,
-                max_recordings_per_route: 100,
-                nadir: nadir(4000, 3000),
-                oblique: oblique(2000, 1500),
-                aerial_spp_axis: 2,
-                ..PresetParams::common()
-            },
+            // 1600 × 800 panoramas (0.225°/px) instead of 2048 × 1024: measured 2.3 M primary rays/s per core of
+            // CPU time, this keeps the whole demo at ≈ 155 CPU-s, i.e. ≲ 90 s on 2 cores; the aerial sizes too
+            // are sized for generation in ≲ 90 s on 2 cores (measured with the render bench).
+            Preset::Demo => sized(1600, 40, nadir(1600, 1200), oblique(800, 600)),
+            Preset::Paper => sized(4800, 100, nadir(4000, 3000), oblique(2000, 1500)),
             // Rendered at 2205 × 1417 (nadir, ÷ 12), 1774 × 1330 (obliques, ÷ 8) and 2048 × 1024 (panoramas, ÷ 4),
             // the aerial images at ≈ 10 cm on the ground like the demo; the footprints are the rendered images', so
             // the GSD of the real-size files is 10 cm / 12 and / 8. Twelve recordings: a 55 m street.
             Preset::Realsize => PresetParams {
-                panorama_width_px: 8192,
-                panorama_spp_axis: 2,
-                max_recordings_per_route: 12,
-                nadir: NadirPlan {
-                    gsd_m: 0.10 / 12.0,
-                    ..nadir(26460, 17004)
-                },
-                oblique: ObliquePlan {
-                    gsd_center_m: 0.10 / 8.0,
-                    corner_distortion_px: 2.0 * 8.0,
-                    ..oblique(14192, 10640)
-                },
-                aerial_spp_axis: 2,
                 render_max_width_px: Some(2400),
                 aerial_format: AerialFormat::TiledTiff {
                     compression: TiffCompression::Jpeg(92),
                     bits: 8,
                 },
-                ..PresetParams::common()
+                ..sized(
+                    8192,
+                    12,
+                    NadirPlan {
+                        gsd_m: 0.10 / 12.0,
+                        ..nadir(26460, 17004)
+                    },
+                    ObliquePlan {
+                        gsd_center_m: 0.10 / 8.0,
+                        corner_distortion_px: 2.0 * 8.0,
+                        ..oblique(14192, 10640)
+                    },
+                )
             },
         }
     }
