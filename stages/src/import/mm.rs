@@ -7,18 +7,18 @@
 
 use super::config::{MmSource, North, PanoramaOrientation, TrajectoryFormat};
 use super::context::ImportContext;
+use super::panorama_row::{panorama_row, PanoramaPlacement};
 use super::pose::{
     apply_lever_arm, body_to_ned, panorama_angles, panorama_matrix, panorama_to_enu,
 };
 use super::report::SourceReport;
-use crate::campaign::{format_time_iso, parse_time_s, Problem, Recording};
+use crate::campaign::{format_time_iso, Problem, Recording};
 use crate::crs::{Crs, Ellipsoid, GridNorth, HorizontalTransform};
 use crate::formats::events::{read_events, Event};
 use crate::formats::gps_time::gps_to_unix_s;
 use crate::formats::sbet::read_sbet;
 use crate::formats::text_table::TextTable;
 use crate::formats::trajectory_csv::{read_trajectory_csv, TrajectorySample};
-use std::path::Path;
 
 const CONFIG: &str = "import configuration";
 
@@ -301,25 +301,15 @@ fn recording(
     let north_deg = converter
         .north_azimuth_deg(plat, plon)
         .map_err(|e| e.to_string())?;
-    let stem = Path::new(&ev.image)
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| ev.image.clone());
-    let time = format_time_iso(ev.time_unix_s).ok_or("time out of range")?;
+    let placement = PanoramaPlacement {
+        xyz: (x, y, z),
+        ypr_deg: (yaw, pitch, roll),
+        heading_deg: heading_true + north_deg,
+    };
     Ok(Recording {
-        image_id: stem,
-        file: ev.image.clone(),
-        time_s: parse_time_s(&time)?,
-        time,
-        x,
-        y,
-        z,
-        heading_deg: (heading_true + north_deg).rem_euclid(360.0),
         camera_height_m: src.camera_height_m,
         sigma_xy_m: src.sigma_xy_m,
         sigma_z_m: src.sigma_z_m,
-        yaw_deg: yaw,
-        pitch_deg: pitch,
-        roll_deg: roll,
+        ..panorama_row(&ev.image, ev.time_unix_s, placement)?
     })
 }

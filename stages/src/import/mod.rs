@@ -9,6 +9,7 @@ pub mod convert;
 pub mod export;
 mod metashape;
 pub mod mm;
+mod panorama_row;
 pub mod panorama_tags;
 pub mod pose;
 pub mod report;

@@ -9,9 +9,10 @@
 
 use super::config::PanoramaTagSource;
 use super::context::ImportContext;
+use super::panorama_row::{panorama_row, PanoramaPlacement};
 use super::pose::{panorama_angles, panorama_matrix};
 use super::report::SourceReport;
-use crate::campaign::{format_time_iso, parse_time_s, Problem, Recording};
+use crate::campaign::{Problem, Recording};
 use crate::formats::image_tags::{read_image_tags, ImageTags};
 use nalgebra::Matrix3;
 use std::path::Path;
@@ -123,25 +124,16 @@ fn recording(
     let ((x, y, z), r) = place(lat, lon, alt, &panorama_matrix(heading, pitch, roll))
         .map_err(|m| ("GPSLatitude", m))?;
     let (yaw, pitch, roll) = panorama_angles(&r);
-    let time = format_time_iso(time_s).ok_or(("GPSTimeStamp", "time out of range".to_string()))?;
-    let stem = Path::new(file)
-        .file_stem()
-        .map_or_else(|| file.to_string(), |s| s.to_string_lossy().into_owned());
+    let placement = PanoramaPlacement {
+        xyz: (x, y, z),
+        ypr_deg: (yaw, pitch, roll),
+        heading_deg: yaw,
+    };
     Ok(Recording {
-        image_id: stem,
-        file: file.to_string(),
-        time_s: parse_time_s(&time).map_err(|m| ("GPSTimeStamp", m))?,
-        time,
-        x,
-        y,
-        z,
-        heading_deg: yaw.rem_euclid(360.0),
         camera_height_m: src.camera_height_m,
         sigma_xy_m: src.sigma_xy_m,
         sigma_z_m: src.sigma_z_m,
-        yaw_deg: yaw,
-        pitch_deg: pitch,
-        roll_deg: roll,
+        ..panorama_row(file, time_s, placement).map_err(|m| ("GPSTimeStamp", m))?
     })
 }
 
