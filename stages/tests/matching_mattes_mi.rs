@@ -42,6 +42,13 @@ impl Texture {
         (128.0 + 60.0 * s).clamp(0.0, 255.0)
     }
 
+    /// A texture of `size` × `size` pixels with its image as it is (unmoved, no intensity map).
+    fn with_image(seed: u64, size: usize) -> (Self, GrayImage) {
+        let tex = Self::new(seed, size as f64);
+        let image = tex.render(size, [0.0, 0.0], |v| v);
+        (tex, image)
+    }
+
     /// Image whose pixel centre (c + 0.5, r + 0.5) shows the texture at (c + 0.5 − d_x, r + 0.5 − d_y), i.e. the
     /// content moved by d, with an intensity map applied.
     fn render(&self, size: usize, d: [f64; 2], map: impl Fn(f64) -> f64) -> GrayImage {
@@ -107,8 +114,7 @@ fn mi_is_invariant_under_affine_intensity_remaps() {
 
 #[test]
 fn mi_against_independent_noise_is_small_and_shrinks_with_more_samples() {
-    let tex = Texture::new(2, 128.0);
-    let fixed = tex.render(128, [0.0, 0.0], |v| v);
+    let (_, fixed) = Texture::with_image(2, 128);
     let mut rng = SplitMix64::new(99);
     let noise = GrayImage::from_vec(
         128,
@@ -161,8 +167,7 @@ fn es_recovers_a_translation_under_a_non_monotone_remap() {
 fn mi_registration_recovers_a_subpixel_shift_of_a_gamma_changed_noisy_copy() {
     // ≤ 0.2 px.
     for (seed, d) in [(4u64, [0.6, -0.3]), (5, [-0.35, 0.8]), (6, [1.25, 0.45])] {
-        let tex = Texture::new(seed, 80.0);
-        let fixed = tex.render(80, [0.0, 0.0], |v| v);
+        let (tex, fixed) = Texture::with_image(seed, 80);
         let mut rng = SplitMix64::new(seed + 100);
         let mut moving = tex.render(80, d, |g| 255.0 * (g / 255.0).powf(0.6));
         moving
@@ -235,8 +240,7 @@ fn masked_pixels_are_skipped_on_both_images() {
 
 #[test]
 fn too_little_overlap_and_degenerate_inputs_are_errors() {
-    let tex = Texture::new(9, 32.0);
-    let fixed = tex.render(32, [0.0, 0.0], |v| v);
+    let (_, fixed) = Texture::with_image(9, 32);
     let mut metric = MattesMi::new(&fixed, &fixed, 50, None, 0).unwrap();
     // 31 px off: only one column of 32² samples overlaps (< 1/16).
     assert!(matches!(
@@ -262,8 +266,7 @@ fn too_little_overlap_and_degenerate_inputs_are_errors() {
 
 #[test]
 fn sampled_metric_is_deterministic_for_a_seed() {
-    let tex = Texture::new(10, 64.0);
-    let fixed = tex.render(64, [0.0, 0.0], |v| v);
+    let (tex, fixed) = Texture::with_image(10, 64);
     let moving = tex.render(64, [0.5, 0.5], |v| v);
     let eval = |seed| {
         MattesMi::new(&fixed, &moving, 50, Some(700), seed)
@@ -400,8 +403,7 @@ fn reference_mi_integral(fixed: &GrayImage, moving: &GrayImage, bins: usize, t: 
 /// samples over the border and onto masked moving pixels.
 #[test]
 fn integral_translations_match_the_definition() {
-    let tex = Texture::new(11, 60.0);
-    let fixed = tex.render(60, [0.0, 0.0], |v| v);
+    let (tex, fixed) = Texture::with_image(11, 60);
     let moving = tex.render(60, [2.3, -1.4], |v| (v / 255.0).powf(0.8) * 200.0 + 20.0);
     let moving_valid: Vec<bool> = (0..60 * 60)
         .map(|i| !(i % 60 > 40 && i / 60 > 35))
@@ -421,8 +423,7 @@ fn integral_translations_match_the_definition() {
 /// A huge but finite translation lands no sample (an error), neither wrapping around nor panicking.
 #[test]
 fn huge_translations_land_nothing() {
-    let tex = Texture::new(12, 32.0);
-    let fixed = tex.render(32, [0.0, 0.0], |v| v);
+    let (_, fixed) = Texture::with_image(12, 32);
     let mut metric = MattesMi::new(&fixed, &fixed, 50, None, 0).unwrap();
     for t in [
         [1e300, 0.0],
