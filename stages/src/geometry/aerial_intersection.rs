@@ -9,8 +9,7 @@
 
 use super::frame::FrameCamera;
 use super::ray::Ray;
-use super::triangulation::{triangulate_rays, TriangulationError};
-use nalgebra::{Matrix3, Vector3};
+use super::triangulation::{triangulate_rays, Triangulation, TriangulationError};
 use serde::{Deserialize, Serialize};
 
 /// One pixel measurement in an oriented frame image.
@@ -27,30 +26,26 @@ pub struct PixelObservation<'a> {
 /// The intersection of ≥ 2 pixel observations.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AerialIntersection {
-    /// Intersected point, world frame, metres.
-    pub point_world: Vector3<f64>,
-    /// A-priori covariance of the point (σ0 = 1, from the observations' σ_px), m².
-    pub covariance_m2: Matrix3<f64>,
+    /// The weighted intersection of the observations' rays: the point (world frame), its a-priori covariance
+    /// (σ0 = 1, from the observations' σ_px), the largest angle between two rays and the variance factor.
+    pub triangulation: Triangulation,
     /// Per observation (input order): ‖reprojection − observation‖ / σ_px (∞ when the point does not
     /// project into that camera, e.g. behind it).
     pub reprojection_sigma: Vec<f64>,
     /// Largest of `reprojection_sigma`.
     pub max_reprojection_sigma: f64,
-    /// Largest angle between two of the rays, degrees.
-    pub max_angle_deg: f64,
-    /// A-posteriori variance factor of the triangulation (see [`crate::geometry::Triangulation`]).
-    pub variance_factor: f64,
 }
 
 impl AerialIntersection {
     /// `point_world` as an array (the form the correspondence types store).
     pub fn point_array(&self) -> [f64; 3] {
-        [self.point_world.x, self.point_world.y, self.point_world.z]
+        let p = &self.triangulation.point_world;
+        [p.x, p.y, p.z]
     }
 
     /// `covariance_m2` as row-major nested arrays (the form the correspondence types store).
     pub fn covariance_rows(&self) -> [[f64; 3]; 3] {
-        let c = &self.covariance_m2;
+        let c = &self.triangulation.covariance_m2;
         [
             [c[(0, 0)], c[(0, 1)], c[(0, 2)]],
             [c[(1, 0)], c[(1, 1)], c[(1, 2)]],
@@ -82,12 +77,9 @@ pub fn intersect_pixel_rays(
         .collect();
     let max_reprojection_sigma = reprojection_sigma.iter().copied().fold(0.0, f64::max);
     Ok(AerialIntersection {
-        point_world: t.point_world,
-        covariance_m2: t.covariance_m2,
+        triangulation: t,
         reprojection_sigma,
         max_reprojection_sigma,
-        max_angle_deg: t.max_angle_deg,
-        variance_factor: t.variance_factor,
     })
 }
 
@@ -117,9 +109,9 @@ pub fn intersect_checked(
     limits: &IntersectionLimits,
 ) -> Result<AerialIntersection, IntersectionRejection> {
     let x = intersect_pixel_rays(observations)?;
-    if !(x.max_angle_deg >= limits.min_angle_deg) {
+    if !(x.triangulation.max_angle_deg >= limits.min_angle_deg) {
         return Err(IntersectionRejection::SmallAngle {
-            angle_deg: x.max_angle_deg,
+            angle_deg: x.triangulation.max_angle_deg,
             min_deg: limits.min_angle_deg,
         });
     }
@@ -136,6 +128,7 @@ pub fn intersect_checked(
 mod tests {
     use super::*;
     use crate::geometry::BrownDistortion;
+    use nalgebra::Vector3;
 
     /// An oblique camera 600 m east/west of the origin at 1000 m height, looking at (500 000, 5 400 000, 50).
     fn oblique(east_m: f64, kappa_deg: f64) -> FrameCamera {
@@ -183,12 +176,16 @@ mod tests {
             Vector3::new(499_990.0, 5_400_020.0, 40.0),
         ] {
             let x = intersect_pixel_rays(&[observe(&a, &p, 0.0), observe(&b, &p, 0.0)]).unwrap();
-            assert!((x.point_world - p).norm() < 1e-4, "{:?}", x.point_world - p);
+            assert!(
+                (x.triangulation.point_world - p).norm() < 1e-4,
+                "{:?}",
+                x.triangulation.point_world - p
+            );
             assert!(x.max_reprojection_sigma < 1e-3);
             assert!(
-                x.max_angle_deg > 60.0 && x.max_angle_deg < 90.0,
+                x.triangulation.max_angle_deg > 60.0 && x.triangulation.max_angle_deg < 90.0,
                 "{}",
-                x.max_angle_deg
+                x.triangulation.max_angle_deg
             );
             let c = x.covariance_rows();
             assert!(c[0][0] > 0.0 && c[1][1] > 0.0 && c[2][2] > 0.0);

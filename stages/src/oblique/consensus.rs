@@ -398,8 +398,10 @@ fn control_points(
 
 /// An intersection in `frame` as a map point and its covariance rows (`None` when the frame cannot convert it).
 fn in_map(frame: &MapFrame, x: &AerialIntersection) -> Option<([f64; 3], [[f64; 3]; 3])> {
-    let point = frame.point_to_map(&x.point_world).ok()?;
-    let c = frame.covariance_to_map(&point, &x.covariance_m2).ok()?;
+    let point = frame.point_to_map(&x.triangulation.point_world).ok()?;
+    let c = frame
+        .covariance_to_map(&point, &x.triangulation.covariance_m2)
+        .ok()?;
     let rows = [
         [c[(0, 0)], c[(0, 1)], c[(0, 2)]],
         [c[(1, 0)], c[(1, 1)], c[(1, 2)]],
