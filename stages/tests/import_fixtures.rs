@@ -4,7 +4,9 @@
 use nalgebra::Vector3;
 use skytie_stages::campaign::{read_campaign, AerialImage};
 use skytie_stages::crs::{Crs, GridNorth, HorizontalTransform};
-use skytie_stages::formats::camera_model::{CameraModel, MetashapeCalibration, Pix4dInternals};
+use skytie_stages::formats::camera_model::{
+    CameraModel, MetashapeCalibration, Pix4dInternals, Pix4dLens,
+};
 use skytie_stages::formats::sbet::{read_sbet, write_sbet, SbetRecord};
 use skytie_stages::geometry::FrameCamera;
 use skytie_stages::import::{run_import, ImportConfig};
@@ -165,20 +167,22 @@ fn metashape_model_matches_its_formula_and_round_trips() {
         assert!((u2 - us).abs() < 1e-6 && (v2 - vs).abs() < 1e-6);
     }
     let p = Pix4dInternals {
-        focal_mm: 8.8,
-        px_mm: 6.6,
-        py_mm: 4.4,
-        r1: -0.01,
-        r2: 0.02,
-        r3: 0.0,
-        t1: 1e-4,
-        t2: 0.0,
+        lens: Pix4dLens {
+            focal_mm: 8.8,
+            px_mm: 6.6,
+            py_mm: 4.4,
+            r1: -0.01,
+            r2: 0.02,
+            r3: 0.0,
+            t1: 1e-4,
+            t2: 0.0,
+        },
         pixel_size_mm: 0.0022,
         width_px: 6000,
         height_px: 4000,
     };
     let back = CameraModel::from_pix4d(&p).to_pix4d(0.0022).unwrap();
-    assert!((back.focal_mm - 8.8).abs() < 1e-12 && (back.py_mm - 4.4).abs() < 1e-12);
+    assert!((back.lens.focal_mm - 8.8).abs() < 1e-12 && (back.lens.py_mm - 4.4).abs() < 1e-12);
     assert_eq!(model.to_pix4d(0.0046).unwrap_err(), "k4");
 }
 

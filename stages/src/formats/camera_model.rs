@@ -61,9 +61,11 @@ pub struct MetashapeCalibration {
     pub p2: f64,
 }
 
-/// Pix4D's internal parameters (mm) with the pixel size (mm).
+/// Pix4D's perspective lens as a `.cam` file states it: focal length and principal point (mm, the principal
+/// point from the image's bottom-left corner), radial coefficients R1…R3 (`K1…K3` in the file) and tangential
+/// T1, T2.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Pix4dInternals {
+pub struct Pix4dLens {
     pub focal_mm: f64,
     pub px_mm: f64,
     pub py_mm: f64,
@@ -72,6 +74,12 @@ pub struct Pix4dInternals {
     pub r3: f64,
     pub t1: f64,
     pub t2: f64,
+}
+
+/// Pix4D's internal parameters: the lens (mm) with the pixel size (mm) and the image size.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Pix4dInternals {
+    pub lens: Pix4dLens,
     pub pixel_size_mm: f64,
     pub width_px: u32,
     pub height_px: u32,
@@ -118,19 +126,19 @@ impl CameraModel {
 
     /// From Pix4D's internal parameters; `None` if the model needs what Pix4D's perspective model lacks.
     pub fn from_pix4d(p: &Pix4dInternals) -> Self {
-        let s = p.pixel_size_mm;
+        let (s, lens) = (p.pixel_size_mm, &p.lens);
         Self {
-            focal_px: p.focal_mm / s,
-            cx_px: p.px_mm / s,
-            cy_px: f64::from(p.height_px) - p.py_mm / s,
+            focal_px: lens.focal_mm / s,
+            cx_px: lens.px_mm / s,
+            cy_px: f64::from(p.height_px) - lens.py_mm / s,
             width_px: p.width_px,
             height_px: p.height_px,
-            k1: p.r1,
-            k2: p.r2,
-            k3: p.r3,
+            k1: lens.r1,
+            k2: lens.r2,
+            k3: lens.r3,
             k4: 0.0,
-            p1: p.t1,
-            p2: p.t2,
+            p1: lens.t1,
+            p2: lens.t2,
             b1: 0.0,
             b2: 0.0,
         }
@@ -145,14 +153,16 @@ impl CameraModel {
             }
         }
         Ok(Pix4dInternals {
-            focal_mm: self.focal_px * pixel_size_mm,
-            px_mm: self.cx_px * pixel_size_mm,
-            py_mm: (f64::from(self.height_px) - self.cy_px) * pixel_size_mm,
-            r1: self.k1,
-            r2: self.k2,
-            r3: self.k3,
-            t1: self.p1,
-            t2: self.p2,
+            lens: Pix4dLens {
+                focal_mm: self.focal_px * pixel_size_mm,
+                px_mm: self.cx_px * pixel_size_mm,
+                py_mm: (f64::from(self.height_px) - self.cy_px) * pixel_size_mm,
+                r1: self.k1,
+                r2: self.k2,
+                r3: self.k3,
+                t1: self.p1,
+                t2: self.p2,
+            },
             pixel_size_mm,
             width_px: self.width_px,
             height_px: self.height_px,

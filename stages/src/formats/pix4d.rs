@@ -4,21 +4,15 @@
 //! camera parameters list. Followed: Pix4D support articles "How are the internal and external camera
 //! parameters defined?" (perspective lens) and the output file descriptions of Pix4Dmapper 4.x.
 
-use super::camera_model::Pix4dInternals;
+use super::camera_model::{Pix4dInternals, Pix4dLens};
 use crate::campaign::Problem;
 use std::path::Path;
 
 /// The values of a `.cam` file.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Pix4dCamFile {
-    pub focal_mm: f64,
-    pub px_mm: f64,
-    pub py_mm: f64,
-    pub k1: f64,
-    pub k2: f64,
-    pub k3: f64,
-    pub t1: f64,
-    pub t2: f64,
+    /// `F`, `Px`, `Py`, `K1…K3`, `T1`, `T2`.
+    pub lens: Pix4dLens,
     /// From the comment "assuming a sensor width of W×H mm", if present.
     pub sensor_width_mm: Option<f64>,
     pub sensor_height_mm: Option<f64>,
@@ -37,14 +31,7 @@ impl Pix4dCamFile {
             Problem::error(path, None, Some("F"), "the file does not state the sensor width its millimetres assume", "keep Pix4D's comment line '#Focal Length mm assuming a sensor width of W x H mm', or set sensor_width_mm in the import configuration")
         })?;
         Ok(Pix4dInternals {
-            focal_mm: self.focal_mm,
-            px_mm: self.px_mm,
-            py_mm: self.py_mm,
-            r1: self.k1,
-            r2: self.k2,
-            r3: self.k3,
-            t1: self.t1,
-            t2: self.t2,
+            lens: self.lens,
             pixel_size_mm: sensor / f64::from(width_px),
             width_px,
             height_px,
@@ -72,14 +59,14 @@ pub fn read_pix4d_cam(path: &Path) -> Result<Pix4dCamFile, Vec<Problem>> {
             continue; // the title line "Pix4D camera calibration file 0" and blank lines
         };
         let slot = match key {
-            "F" => &mut cam.focal_mm,
-            "Px" => &mut cam.px_mm,
-            "Py" => &mut cam.py_mm,
-            "K1" => &mut cam.k1,
-            "K2" => &mut cam.k2,
-            "K3" => &mut cam.k3,
-            "T1" => &mut cam.t1,
-            "T2" => &mut cam.t2,
+            "F" => &mut cam.lens.focal_mm,
+            "Px" => &mut cam.lens.px_mm,
+            "Py" => &mut cam.lens.py_mm,
+            "K1" => &mut cam.lens.r1,
+            "K2" => &mut cam.lens.r2,
+            "K3" => &mut cam.lens.r3,
+            "T1" => &mut cam.lens.t1,
+            "T2" => &mut cam.lens.t2,
             _ => continue,
         };
         match value.parse::<f64>() {
@@ -107,12 +94,12 @@ pub fn read_pix4d_cam(path: &Path) -> Result<Pix4dCamFile, Vec<Problem>> {
             ));
         }
     }
-    if cam.focal_mm <= 0.0 && seen[0] {
+    if cam.lens.focal_mm <= 0.0 && seen[0] {
         problems.push(Problem::error(
             path,
             None,
             Some("F"),
-            format!("{} mm is not a focal length", cam.focal_mm),
+            format!("{} mm is not a focal length", cam.lens.focal_mm),
             "give the focal length in mm, > 0",
         ));
     }
@@ -138,9 +125,10 @@ fn sensor_size(comment: &str) -> Option<(f64, f64)> {
 pub fn write_pix4d_cam(path: &Path, p: &Pix4dInternals) -> std::io::Result<()> {
     let w = p.pixel_size_mm * f64::from(p.width_px);
     let h = p.pixel_size_mm * f64::from(p.height_px);
+    let l = &p.lens;
     let text = format!(
         "Pix4D camera calibration file 0\n#Focal Length mm assuming a sensor width of {w}x{h}mm\nF {}\n#Principal Point mm\nPx {}\nPy {}\n#Symmetrical Lens Distortion Coeffs\nK1 {}\nK2 {}\nK3 {}\n#Tangential Lens Distortion Coeffs\nT1 {}\nT2 {}\n",
-        p.focal_mm, p.px_mm, p.py_mm, p.r1, p.r2, p.r3, p.t1, p.t2
+        l.focal_mm, l.px_mm, l.py_mm, l.r1, l.r2, l.r3, l.t1, l.t2
     );
     crate::fsutil::atomic_write(path, text.as_bytes())
 }
