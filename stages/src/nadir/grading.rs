@@ -16,6 +16,7 @@ use crate::estimators::median_consensus::median_in_place;
 use crate::geometry::{triangulate_rays, FrameCamera, PanoramaCamera, Ray};
 use crate::nadir::registration::AerialRefinement;
 use crate::params::StageId;
+use crate::ratio::ratio_or_zero;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
@@ -108,20 +109,12 @@ pub struct WrongCorrespondence {
 impl NadirGrade {
     /// correct / graded correspondences (0 when there are none).
     pub fn inlier_ratio(&self) -> f64 {
-        if self.tie_points == 0 {
-            0.0
-        } else {
-            self.correct_tie_points as f64 / self.tie_points as f64
-        }
+        ratio_or_zero(self.correct_tie_points, self.tie_points)
     }
 
     /// correct / graded delivered correspondences (0 when there are none).
     pub fn delivered_inlier_ratio(&self) -> f64 {
-        if self.delivered_tie_points == 0 {
-            0.0
-        } else {
-            self.delivered_correct as f64 / self.delivered_tie_points as f64
-        }
+        ratio_or_zero(self.delivered_correct, self.delivered_tie_points)
     }
 }
 

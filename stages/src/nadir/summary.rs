@@ -6,6 +6,7 @@ use super::registration::{
     AerialRefinement, MmWindowMatch, PairMethod, RecordingControl, TransformOutcome,
 };
 use crate::params::StageId;
+use crate::ratio::ratio_or_zero;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -146,11 +147,7 @@ impl NadirSummary {
 
     /// The `nadir` metrics section.
     pub fn metrics(&self) -> serde_json::Value {
-        let frac = if self.recordings == 0 {
-            0.0
-        } else {
-            self.recordings_with_aerial as f64 / self.recordings as f64
-        };
+        let frac = ratio_or_zero(self.recordings_with_aerial, self.recordings);
         serde_json::json!({
             "recordings": self.recordings,
             "recordings_with_aerial": self.recordings_with_aerial,

@@ -34,6 +34,7 @@
 //! (degenerate) are not graded and are counted in `control_points_ungraded` — the alternative, the oblique
 //! rays' own point, would compare the estimate with itself because the oblique poses are exact.
 
+use crate::ratio::ratio_or_zero;
 use std::collections::HashMap;
 
 use nalgebra::Vector3;
@@ -128,14 +129,6 @@ impl Quantiles {
             p75: at(0.75),
             p90: at(0.9),
         }
-    }
-}
-
-fn ratio(a: usize, n: usize) -> f64 {
-    if n == 0 {
-        0.0
-    } else {
-        a as f64 / n as f64
     }
 }
 
@@ -385,14 +378,14 @@ pub fn grade_oblique(
     }
     g.outliers = g.correspondences - g.inliers - non_matchable;
     g.outliers_after_consensus = kept_graded - g.inliers_after_consensus - non_matchable_kept;
-    g.inlier_ratio = ratio(g.inliers, g.inliers + g.outliers);
-    g.inlier_ratio_incl_non_matchable = ratio(g.inliers, g.correspondences);
-    g.inlier_ratio_after_consensus = ratio(
+    g.inlier_ratio = ratio_or_zero(g.inliers, g.inliers + g.outliers);
+    g.inlier_ratio_incl_non_matchable = ratio_or_zero(g.inliers, g.correspondences);
+    g.inlier_ratio_after_consensus = ratio_or_zero(
         g.inliers_after_consensus,
         g.inliers_after_consensus + g.outliers_after_consensus,
     );
     g.inlier_ratio_after_consensus_incl_non_matchable =
-        ratio(g.inliers_after_consensus, kept_graded);
+        ratio_or_zero(g.inliers_after_consensus, kept_graded);
     if scene.is_some() {
         g.non_matchable = Some(non_matchable);
         g.non_matchable_after_consensus = Some(non_matchable_kept);

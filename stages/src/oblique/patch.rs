@@ -20,6 +20,7 @@ use crate::geometry::panorama::PanoramaCamera;
 use crate::imaging::equirect::PanoramaLevels;
 use crate::imaging::pyramid::ScaledWindow;
 use crate::imaging::GrayImage;
+use crate::ratio::ratio_or_zero;
 use nalgebra::Vector3;
 
 /// A square grid of `size_px × size_px` pixels, `spacing_m` apart, in the plane spanned by `axis_u`, `axis_v`,
@@ -206,11 +207,7 @@ impl FramePatch {
     /// grid resolves every image pixel once, smaller when several grid pixels read the same image pixel (the
     /// grid is finer on the façade than the image). 0 without data.
     pub fn real_resolution_ratio(&self) -> f64 {
-        if self.valid_pixels == 0 {
-            0.0
-        } else {
-            self.distinct_image_pixels as f64 / self.valid_pixels as f64
-        }
+        ratio_or_zero(self.distinct_image_pixels, self.valid_pixels)
     }
 
     /// Fraction of the grid with data.
