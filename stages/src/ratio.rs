@@ -10,14 +10,3 @@ pub fn ratio_or_zero(part: usize, whole: usize) -> f64 {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_share_of_nothing_is_zero() {
-        assert_eq!(ratio_or_zero(0, 0), 0.0);
-        assert_eq!(ratio_or_zero(3, 0), 0.0);
-        assert_eq!(ratio_or_zero(3, 4), 0.75);
-    }
-}
