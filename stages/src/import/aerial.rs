@@ -7,7 +7,7 @@ use super::report::SourceReport;
 use super::source_pose::{missing, SourcePose};
 use crate::campaign::{AerialImage, Problem};
 use crate::formats::camera_model::CameraModel;
-use crate::formats::opk_list::{read_opk_list, OpkListFormat};
+use crate::formats::opk_list::{read_opk_list, OpkListFormat, PoseRow};
 use crate::formats::pix4d::read_pix4d_cam;
 use crate::geometry::matrix_to_opk;
 use std::path::Path;
@@ -68,6 +68,31 @@ fn format_name(f: AerialFormat) -> &'static str {
     }
 }
 
+/// The rows of `src`'s orientation list in `layout`, counted as read with the rows that have problems.
+fn read_rows(
+    src: &AerialSource,
+    layout: &OpkListFormat,
+    report: &mut SourceReport,
+) -> Vec<PoseRow> {
+    let (rows, problems) = read_opk_list(&src.orientations, layout);
+    report.read = rows.len() + problems.iter().filter(|p| p.row.is_some()).count();
+    report.problems.extend(problems);
+    rows
+}
+
+/// The poses of `rows`, every image taken with `camera`, and the CRS `src` declares for them.
+fn with_camera(
+    src: &AerialSource,
+    rows: Vec<PoseRow>,
+    camera: CameraModel,
+) -> (Vec<SourcePose>, Option<String>) {
+    let poses = rows
+        .into_iter()
+        .map(|pose| SourcePose { pose, camera })
+        .collect();
+    (poses, src.crs.clone())
+}
+
 fn read_list(
     src: &AerialSource,
     layout: &OpkListFormat,
@@ -77,15 +102,8 @@ fn read_list(
         report.problems.push(missing(&src.orientations, "camera", "give the interior orientation in [aerial.camera] (focal_px, cx_px, cy_px, width_px, height_px, distortion)"));
         return None;
     };
-    let (rows, problems) = read_opk_list(&src.orientations, layout);
-    report.read = rows.len() + problems.iter().filter(|p| p.row.is_some()).count();
-    report.problems.extend(problems);
-    Some((
-        rows.into_iter()
-            .map(|pose| SourcePose { pose, camera })
-            .collect(),
-        src.crs.clone(),
-    ))
+    let rows = read_rows(src, layout, report);
+    Some(with_camera(src, rows, camera))
 }
 
 fn read_pix4d(
@@ -107,9 +125,7 @@ fn read_pix4d(
             return None;
         }
     };
-    let (rows, problems) = read_opk_list(&src.orientations, &OpkListFormat::pix4d());
-    report.read = rows.len() + problems.iter().filter(|p| p.row.is_some()).count();
-    report.problems.extend(problems);
+    let rows = read_rows(src, &OpkListFormat::pix4d(), report);
     let size = match (src.image_width_px, src.image_height_px) {
         (Some(w), Some(h)) => Some((w, h)),
         _ => rows
@@ -136,12 +152,7 @@ fn read_pix4d(
         "Pix4D internals: pixel size {:.6} mm ({} px wide), f = {:.3} px, principal point ({:.3}, {:.3}) px from the top-left corner",
         internals.pixel_size_mm, w, camera.focal_px, camera.cx_px, camera.cy_px
     ));
-    Some((
-        rows.into_iter()
-            .map(|pose| SourcePose { pose, camera })
-            .collect(),
-        src.crs.clone(),
-    ))
+    Some(with_camera(src, rows, camera))
 }
 
 fn convert_poses(
