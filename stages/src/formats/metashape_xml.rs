@@ -340,24 +340,14 @@ pub fn write_metashape_xml(path: &Path, doc: &MetashapeDocument) -> std::io::Res
     }
     s.push_str("    </sensors>\n    <cameras>\n");
     for (i, c) in doc.cameras.iter().enumerate() {
-        let m: Vec<String> = c
-            .transform
-            .transpose()
-            .iter()
-            .map(|v| v.to_string())
-            .collect();
-        let _ = write!(s, "      <camera id=\"{i}\" sensor_id=\"{}\" label=\"{}\">\n        <transform>{}</transform>\n      </camera>\n", c.sensor_id, c.label, m.join(" "));
+        let m = space_separated(c.transform.transpose().iter());
+        let _ = write!(s, "      <camera id=\"{i}\" sensor_id=\"{}\" label=\"{}\">\n        <transform>{m}</transform>\n      </camera>\n", c.sensor_id, c.label);
     }
     s.push_str("    </cameras>\n");
     if let Some(t) = &doc.chunk_transform {
-        let r: Vec<String> = t
-            .rotation
-            .transpose()
-            .iter()
-            .map(|v| v.to_string())
-            .collect();
-        let tr: Vec<String> = t.translation.iter().map(|v| v.to_string()).collect();
-        let _ = write!(s, "    <transform>\n      <rotation locked=\"false\">{}</rotation>\n      <translation locked=\"false\">{}</translation>\n      <scale locked=\"false\">{}</scale>\n    </transform>\n", r.join(" "), tr.join(" "), t.scale);
+        let r = space_separated(t.rotation.transpose().iter());
+        let tr = space_separated(t.translation.iter());
+        let _ = write!(s, "    <transform>\n      <rotation locked=\"false\">{r}</rotation>\n      <translation locked=\"false\">{tr}</translation>\n      <scale locked=\"false\">{}</scale>\n    </transform>\n", t.scale);
     }
     if let Some(w) = &doc.reference_wkt {
         let _ = writeln!(s, "    <reference>{}</reference>", xml_escape(w));
@@ -427,4 +417,14 @@ fn child_element<'a, 'input>(
     name: &str,
 ) -> Option<roxmltree::Node<'a, 'input>> {
     n.children().find(|c| c.has_tag_name(name))
+}
+
+/// Numbers as XML element text: separated by single spaces, each in Rust's shortest round-trip form (a matrix
+/// passed as its transpose's elements comes out row by row, as Metashape writes it).
+fn space_separated<'a>(values: impl IntoIterator<Item = &'a f64>) -> String {
+    values
+        .into_iter()
+        .map(|v| v.to_string())
+        .collect::<Vec<_>>()
+        .join(" ")
 }
