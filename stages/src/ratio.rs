@@ -9,4 +9,3 @@ pub fn ratio_or_zero(part: usize, whole: usize) -> f64 {
         part as f64 / whole as f64
     }
 }
-
