@@ -19,7 +19,7 @@ use crate::campaign::{CheckPoint, Recording};
 use crate::correspondence::AerialControlPoint;
 use crate::export::checkpoints::CheckPointRow;
 use crate::export::corrections::CorrectionSeries;
-use crate::export::support::recording_support;
+use crate::adjustment::support::recording_support;
 use std::collections::HashMap;
 
 /// Everything the layers are made of.
