@@ -121,7 +121,11 @@ fn second_crs_matches_the_campaign_crs(adjusted_rd: &str, folder: &std::path::Pa
         .unwrap_or_else(|e| panic!("{}: {e}", folder.display()));
     assert!(text.starts_with("# crs = EPSG:25831"), "{text}");
     for file in ["corrections.csv", "control_points.csv"] {
-        assert!(folder.join(file).is_file(), "{file} in {}", folder.display());
+        assert!(
+            folder.join(file).is_file(),
+            "{file} in {}",
+            folder.display()
+        );
     }
     let rd = csv_rows(adjusted_rd);
     let utm = csv_rows(&text);
@@ -132,17 +136,28 @@ fn second_crs_matches_the_campaign_crs(adjusted_rd: &str, folder: &std::path::Pa
     for (a, b) in rd.iter().zip(&utm) {
         assert_eq!(a["image_id"], b["image_id"]);
         let (e, n) = (f(b, "x"), f(b, "y"));
-        assert!((500_000.0..700_000.0).contains(&e) && (5_700_000.0..5_850_000.0).contains(&n), "{b:?}");
+        assert!(
+            (500_000.0..700_000.0).contains(&e) && (5_700_000.0..5_850_000.0).contains(&n),
+            "{b:?}"
+        );
         let moved_rd = f(a, "dx_m").hypot(f(a, "dy_m"));
         let moved_utm = f(b, "de_m").hypot(f(b, "dn_m"));
         assert!((moved_rd - moved_utm).abs() < 1e-6, "{a:?} vs {b:?}");
-        assert!((f(a, "z") - f(b, "z")).abs() < 1e-9, "no vertical CRS: heights copied");
+        assert!(
+            (f(a, "z") - f(b, "z")).abs() < 1e-9,
+            "no vertical CRS: heights copied"
+        );
     }
     for k in 1..rd.len() {
         let d = |rows: &[std::collections::HashMap<String, String>]| {
             (f(&rows[k], "x") - f(&rows[k - 1], "x")).hypot(f(&rows[k], "y") - f(&rows[k - 1], "y"))
         };
         // The two projections' scale factors differ by a few 10⁻⁴ at most.
-        assert!((d(&rd) - d(&utm)).abs() < 1e-3 * d(&rd), "{} vs {}", d(&rd), d(&utm));
+        assert!(
+            (d(&rd) - d(&utm)).abs() < 1e-3 * d(&rd),
+            "{} vs {}",
+            d(&rd),
+            d(&utm)
+        );
     }
 }

@@ -13,11 +13,11 @@ use super::adjust::{adjust, ObservationCounts};
 use super::config::{AdjustConfig, ControlWeighting};
 use super::error::AdjustError;
 use super::in_frame::{adjustment_to_map, block_to_local};
+use super::off_control_sigma::{widen_off_control_sigma, OffControlSigma};
 use super::problem::{
     AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, PanoObservation,
     RelativeConstraint,
 };
-use super::off_control_sigma::{widen_off_control_sigma, OffControlSigma};
 use super::relative_noise::RelativeSigma;
 use crate::campaign::{AerialImage, AerialKind, Recording};
 use crate::correspondence::{AerialControlPoint, MmTiePoint};

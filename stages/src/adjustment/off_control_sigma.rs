@@ -226,7 +226,10 @@ mod tests {
         for b in &v {
             assert!(b.pairs >= MIN_PAIRS_PER_BIN);
             // Non-decreasing by construction; and of the order of σ² (E[Δ²] = 2σ²).
-            assert!(b.gamma_xy_m2 > 0.3 * sigma * sigma && b.gamma_xy_m2 < 3.0 * sigma * sigma, "{b:?}");
+            assert!(
+                b.gamma_xy_m2 > 0.3 * sigma * sigma && b.gamma_xy_m2 < 3.0 * sigma * sigma,
+                "{b:?}"
+            );
         }
         assert!(v.windows(2).all(|w| w[1].gamma_xy_m2 >= w[0].gamma_xy_m2));
     }
@@ -285,12 +288,18 @@ mod tests {
             if i % 2 == 0 {
                 assert_eq!(rec.sigma_m, [0.1; 3]);
             } else {
-                assert!(rec.sigma_m[0] > 0.12 && rec.sigma_m[0] < 0.5, "{:?}", rec.sigma_m);
+                assert!(
+                    rec.sigma_m[0] > 0.12 && rec.sigma_m[0] < 0.5,
+                    "{:?}",
+                    rec.sigma_m
+                );
                 assert_eq!(rec.sigma_m[2], 0.1, "no vertical difference, no widening");
             }
         }
 
-        let recs = (0..5).map(|i| recording(i, 5.0 * i as f64, [0.8, 0.0, 0.0])).collect();
+        let recs = (0..5)
+            .map(|i| recording(i, 5.0 * i as f64, [0.8, 0.0, 0.0]))
+            .collect();
         let mut r = run(config, recs, vec![point(PointKind::Control, &[2])]);
         let report = widen_off_control_sigma(&mut r, &vec![(Some(1.0), None); 5]);
         assert!(report.variogram.is_empty());
