@@ -9,6 +9,8 @@
 //! tie points located (all correct), 5 of 6 recordings with their own aerial evidence, recordings 0.785 →
 //! 0.066 m RMSE 2D (worst 0.101 m), check points 0.738 → 0.508 m (of its 3 check points the one behind the
 //! first recording is intersected from two nearly parallel rays, so the check points say little here).
+//! The campaign also asks for its outputs in a second CRS (`[outputs] also_crs`), checked against the run's
+//! campaign-CRS trajectory.
 
 #[path = "support/cli.rs"]
 mod cli;
@@ -36,6 +38,11 @@ fn a_tiny_street_with_road_markings_is_corrected() {
             .args(["--panorama-width", "2048", "--out"])
             .arg(&camp),
     );
+    // The campaign also asks for its outputs in ETRS89 / UTM zone 31N ([outputs], docs/outputs.md).
+    let toml_path = camp.join("campaign.toml");
+    let mut toml = std::fs::read_to_string(&toml_path).unwrap();
+    toml.push_str("\n[outputs]\nalso_crs = \"EPSG:25831\"\n");
+    std::fs::write(&toml_path, toml).unwrap();
     let out = dir.join("out");
     // Exit 0: the run corrected the trajectory and delivered it.
     run_ok(
@@ -88,4 +95,69 @@ fn a_tiny_street_with_road_markings_is_corrected() {
     );
     let adjusted = std::fs::read_to_string(out.join("trajectory_adjusted.csv")).unwrap();
     assert_eq!(adjusted.lines().count(), 7, "6 recordings + header");
+    second_crs_matches_the_campaign_crs(&adjusted, &out.join("epsg_25831"));
+}
+
+/// Rows of a CSV (first line = header) as maps from column name to value; `#` lines skipped.
+fn csv_rows(text: &str) -> Vec<std::collections::HashMap<String, String>> {
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    lines
+        .map(|l| {
+            header
+                .iter()
+                .zip(l.split(','))
+                .map(|(h, v)| (h.to_string(), v.to_string()))
+                .collect()
+        })
+        .collect()
+}
+
+/// The second-CRS trajectory holds every recording, in UTM 31N where this RD New street lies (around
+/// 51.9° N, 3.9° E), with the same distances between recordings and corrections of the same length (a
+/// rotation by the difference of the two grids' convergence) as the campaign-CRS trajectory.
+fn second_crs_matches_the_campaign_crs(adjusted_rd: &str, folder: &std::path::Path) {
+    let text = std::fs::read_to_string(folder.join("trajectory_adjusted.csv"))
+        .unwrap_or_else(|e| panic!("{}: {e}", folder.display()));
+    assert!(text.starts_with("# crs = EPSG:25831"), "{text}");
+    for file in ["corrections.csv", "control_points.csv"] {
+        assert!(
+            folder.join(file).is_file(),
+            "{file} in {}",
+            folder.display()
+        );
+    }
+    let rd = csv_rows(adjusted_rd);
+    let utm = csv_rows(&text);
+    assert_eq!(rd.len(), utm.len());
+    let f = |r: &std::collections::HashMap<String, String>, k: &str| -> f64 {
+        r[k].parse().unwrap_or_else(|_| panic!("{k} in {r:?}"))
+    };
+    for (a, b) in rd.iter().zip(&utm) {
+        assert_eq!(a["image_id"], b["image_id"]);
+        let (e, n) = (f(b, "x"), f(b, "y"));
+        assert!(
+            (500_000.0..700_000.0).contains(&e) && (5_700_000.0..5_850_000.0).contains(&n),
+            "{b:?}"
+        );
+        let moved_rd = f(a, "dx_m").hypot(f(a, "dy_m"));
+        let moved_utm = f(b, "de_m").hypot(f(b, "dn_m"));
+        assert!((moved_rd - moved_utm).abs() < 1e-6, "{a:?} vs {b:?}");
+        assert!(
+            (f(a, "z") - f(b, "z")).abs() < 1e-9,
+            "no vertical CRS: heights copied"
+        );
+    }
+    for k in 1..rd.len() {
+        let d = |rows: &[std::collections::HashMap<String, String>]| {
+            (f(&rows[k], "x") - f(&rows[k - 1], "x")).hypot(f(&rows[k], "y") - f(&rows[k - 1], "y"))
+        };
+        // The two projections' scale factors differ by a few 10⁻⁴ at most.
+        assert!(
+            (d(&rd) - d(&utm)).abs() < 1e-3 * d(&rd),
+            "{} vs {}",
+            d(&rd),
+            d(&utm)
+        );
+    }
 }

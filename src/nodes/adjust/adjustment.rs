@@ -90,6 +90,7 @@ impl AdjustReport {
             "redundancy": r.redundancy,
             "build": r.build,
             "relative_sigma": r.relative_sigma,
+            "off_control_sigma": r.off_control_sigma,
             "trajectory": recording_metrics(r),
             "verdict": self.verdict().label(),
         }})

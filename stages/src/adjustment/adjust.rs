@@ -27,7 +27,8 @@ pub struct AdjustedRecording {
     pub yaw_correction_deg: f64,
     /// A-priori σ (σ0 = 1) of x, y, z, metres (0 for fixed coordinates).
     pub sigma_a_priori_m: Vector3<f64>,
-    /// A-posteriori σ (scaled by σ̂0) of x, y, z, metres; `None` without redundancy.
+    /// A-posteriori σ of x, y, z, metres: the a-priori σ scaled by σ̂0 when σ̂0 > 1, never below the a-priori
+    /// σ ([`posterior_scale`]); `None` without redundancy.
     pub sigma_a_posteriori_m: Option<Vector3<f64>>,
     /// A-priori σ of the yaw correction, degrees (0 if not estimated).
     pub sigma_yaw_a_priori_deg: f64,
@@ -177,7 +178,7 @@ pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, Adju
                 position_world: origin.to_world(&state.centers_local[c]),
                 yaw_correction_deg: state.yaw_correction_rad[c].to_degrees(),
                 sigma_a_priori_m: sigma,
-                sigma_a_posteriori_m: cov.variance_factor.map(|f| sigma * f.sqrt()),
+                sigma_a_posteriori_m: cov.variance_factor.map(|f| sigma * posterior_scale(f)),
                 sigma_yaw_a_priori_deg: m[(3, 3)].max(0.0).sqrt().to_degrees(),
             }
         })
@@ -254,4 +255,12 @@ fn pano_normalised(prep: &Prepared, i: usize, state: &State) -> f64 {
         &state.points_local[o.point],
     )
     .map_or(f64::INFINITY, |(r, _, _)| r.amax() * o.whitening)
+}
+
+/// The factor from a-priori to a-posteriori σ for the variance factor σ̂0²: `max(σ̂0, 1)`. A variance factor
+/// above 1 says the observations scatter more than their a-priori σ, and the precision is scaled down with it;
+/// one below 1 comes mostly from the robust loss and the rejection rounds, which leave only the residuals
+/// that fit — it does not show that the recordings are better than the a-priori model, so σ is not shrunk.
+pub fn posterior_scale(variance_factor: f64) -> f64 {
+    variance_factor.max(1.0).sqrt()
 }

@@ -119,6 +119,11 @@ crate::params! {
         /// consecutive recordings); absent = estimated from the recorded trajectory itself (cross-track second
         /// differences, `adjustment::relative_noise`).
         relative_sigma_m: Option<f64> = None, unit "m", above 0.0;
+        /// Huber threshold of the relative constraints, in σ units: a step between consecutive recordings that
+        /// differs from the recorded one by more than this many σ (a jump when GNSS is re-acquired, drift
+        /// during an outage, an error turning with the vehicle) is released linearly instead of
+        /// quadratically, so the aerial evidence can correct it; absent = plain least squares.
+        relative_huber_threshold: Option<f64> = Some(3.0), above 0.0;
         /// Consecutive recordings farther apart than this are not linked (a gap in the trajectory).
         relative_max_gap_m: f64 = 15.0, unit "m", above 0.0;
         /// Estimate a yaw correction per recording.
@@ -160,6 +165,10 @@ impl AdjustConfig {
                 LossKind::Cauchy => RobustLoss::Cauchy {
                     scale: self.loss_scale,
                 },
+            },
+            relative_loss: match self.relative_huber_threshold {
+                Some(threshold) => RobustLoss::Huber { threshold },
+                None => RobustLoss::Squared,
             },
             rejection_threshold: self.rejection_threshold,
             max_rejection_rounds: self.max_rejection_rounds,

@@ -13,6 +13,7 @@ use super::adjust::{adjust, ObservationCounts};
 use super::config::{AdjustConfig, ControlWeighting};
 use super::error::AdjustError;
 use super::in_frame::{adjustment_to_map, block_to_local};
+use super::off_control_sigma::{widen_off_control_sigma, OffControlSigma};
 use super::problem::{
     AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, PanoObservation,
     RelativeConstraint,
@@ -29,7 +30,7 @@ use std::collections::HashMap;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("adjust", "6");
+pub const STAGE: StageId = StageId::new("adjust", "7");
 
 /// The inputs of one adjustment.
 #[derive(Clone, Copy, Debug)]
@@ -163,6 +164,10 @@ pub struct AdjustmentRun {
     /// The σ of the relative constraints between consecutive recordings (used by them when they are on, and
     /// by the corrections' interpolation between recordings always).
     pub relative_sigma: RelativeSigma,
+    /// How the σ of recordings without aerial control of their own was widened
+    /// ([`super::off_control_sigma`]); their `sigma_m` already includes it.
+    #[serde(default)]
+    pub off_control_sigma: OffControlSigma,
 }
 
 /// Builds the block of one configuration.
@@ -620,7 +625,7 @@ pub fn run_in_frame(
                 None => (a.sigma_a_priori_m, false),
             };
             let yaw_scale = match (posterior, adj.variance_factor) {
-                (true, Some(f)) => f.sqrt(),
+                (true, Some(f)) => super::adjust::posterior_scale(f),
                 _ => 1.0,
             };
             RunRecording {
@@ -645,7 +650,13 @@ pub fn run_in_frame(
         })
         .collect();
     let rejected_total = adj.rejected.pano + adj.rejected.control + adj.rejected.aerial;
-    Ok(AdjustmentRun {
+    let priors: Vec<(Option<f64>, Option<f64>)> = build
+        .block
+        .recordings
+        .iter()
+        .map(|r| (r.prior_sigma_xy_m, r.prior_sigma_z_m))
+        .collect();
+    let mut run = AdjustmentRun {
         config: config.clone(),
         recordings,
         points,
@@ -661,5 +672,8 @@ pub fn run_in_frame(
         rejection_rounds: adj.rounds.len(),
         build: build.counts,
         relative_sigma: build.relative_sigma,
-    })
+        off_control_sigma: OffControlSigma::default(),
+    };
+    run.off_control_sigma = widen_off_control_sigma(&mut run, &priors);
+    Ok(run)
 }

@@ -172,15 +172,17 @@ fn add_relative_terms(
     for i in 0..prep.relative.len() {
         let (a, b, sigma) = prep.relative[i];
         let r = prep.relative_residual(i, state);
-        let inv2 = 1.0 / (sigma * sigma);
+        // IRLS: residual and Jacobian scaled by √ρ'(s) of the constraint's loss.
+        let w = prep.relative_loss.weight(r.norm_squared());
+        let inv2 = w / (sigma * sigma);
         let mut block = Matrix4::zeros();
         for axis in 0..prep.position_axes() {
             camera_diag[a][(axis, axis)] += inv2;
             camera_diag[b][(axis, axis)] += inv2;
             block[(axis, axis)] = -inv2;
             // J_a = −I/σ, J_b = I/σ.
-            camera_rhs[a][axis] += r[axis] / sigma;
-            camera_rhs[b][axis] -= r[axis] / sigma;
+            camera_rhs[a][axis] += w * r[axis] / sigma;
+            camera_rhs[b][axis] -= w * r[axis] / sigma;
         }
         camera_off.push(block);
     }

@@ -2,8 +2,9 @@
 //! cost (thesis 5.4: the adjustment model; 5.7: residual weighting).
 //!
 //! Whitening: every residual is divided by its a-priori standard deviation, so the cost is
-//! `½·Σ ρ(‖r_obs‖²)` over panorama, aerial-image and control-point observations (robust loss ρ) plus `½·Σ ‖r‖²` over the
-//! priors and relative constraints. Panorama residuals are additionally multiplied by the thesis 5.7 weighting
+//! `½·Σ ρ(‖r_obs‖²)` over panorama, aerial-image and control-point observations (robust loss ρ) plus
+//! `½·Σ ρ_rel(‖r‖²)` over the relative constraints (their own loss, Huber by default) and `½·Σ ‖r‖²` over the
+//! priors. Panorama residuals are additionally multiplied by the thesis 5.7 weighting
 //! factor, fixed per solve from the distances at the start of the solve.
 
 use super::aerial::FixedFrameCamera;
@@ -56,6 +57,8 @@ pub struct PreparedAerial {
 pub struct Prepared {
     pub parameterization: Parameterization,
     pub loss: RobustLoss,
+    /// Loss on the relative constraints.
+    pub relative_loss: RobustLoss,
     pub horizontal_only: bool,
     /// Recorded pano→world rotations R0.
     pub rotations0: Vec<Matrix3<f64>>,
@@ -223,6 +226,7 @@ impl Prepared {
         Ok(Self {
             parameterization: Parameterization::from_options(options),
             loss: options.loss,
+            relative_loss: options.relative_loss,
             horizontal_only: options.horizontal_only,
             rotations0,
             recorded_local,
@@ -353,12 +357,17 @@ impl Prepared {
                 None => return f64::INFINITY,
             }
         }
-        total += self.gaussian_terms(state);
+        total += self.prior_terms_sum(state);
+        for i in 0..self.relative.len() {
+            total += self
+                .relative_loss
+                .rho(self.relative_residual(i, state).norm_squared());
+        }
         0.5 * total
     }
 
-    /// Σ‖r‖² of the priors, yaw priors and relative constraints (never robustified).
-    fn gaussian_terms(&self, state: &State) -> f64 {
+    /// Σ‖r‖² of the priors and yaw priors (never robustified).
+    fn prior_terms_sum(&self, state: &State) -> f64 {
         let mut total = 0.0;
         for c in 0..self.recorded_local.len() {
             for (_, r, _) in self.prior_terms(c, state) {
@@ -368,16 +377,16 @@ impl Prepared {
                 total += (state.yaw_correction_rad[c] / s).powi(2);
             }
         }
-        for i in 0..self.relative.len() {
-            total += self.relative_residual(i, state).norm_squared();
-        }
         total
     }
 
     /// Squared-residual sum Σ‖r‖² of the active observations without robust loss (for σ̂0²), and the number of
     /// residual components.
     pub fn plain_sum_of_squares(&self, state: &State) -> (f64, usize) {
-        let mut total = self.gaussian_terms(state);
+        let mut total = self.prior_terms_sum(state);
+        for i in 0..self.relative.len() {
+            total += self.relative_residual(i, state).norm_squared();
+        }
         let mut count = 0usize;
         total += ordered_sum(self.pano.len(), |i| {
             let r = self.pano[i]

@@ -132,6 +132,10 @@ pub struct AdjustOptions {
     pub weighting: ResidualWeighting,
     /// Loss on panorama and control-point residuals (IRLS inside LM).
     pub loss: RobustLoss,
+    /// Loss on the relative constraints between consecutive recordings (IRLS inside LM): Huber releases a
+    /// step of the recorded trajectory that the aerial evidence contradicts (a jump when GNSS is re-acquired,
+    /// drift during an outage) linearly instead of quadratically.
+    pub relative_loss: RobustLoss,
     /// Reject observations whose |normalised residual| exceeds this and re-solve (`None` = no rejection).
     pub rejection_threshold: Option<f64>,
     /// Largest number of rejection rounds (re-solves after rejections).
@@ -147,6 +151,7 @@ impl Default for AdjustOptions {
             yaw_prior_sigma_deg: None,
             weighting: ResidualWeighting::default(),
             loss: RobustLoss::Squared,
+            relative_loss: RobustLoss::Squared,
             rejection_threshold: None,
             max_rejection_rounds: 10,
             lm: LmOptions::default(),
@@ -341,6 +346,7 @@ impl AdjustOptions {
         }
         self.weighting.validate()?;
         self.loss.validate()?;
+        self.relative_loss.validate()?;
         Ok(())
     }
 }

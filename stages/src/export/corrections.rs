@@ -16,7 +16,7 @@
 //! interpolated, but flagged [`SampleKind::Gap`]. Yaw uses the same model with `yaw_prior_sigma_deg` when
 //! yaw is estimated, and is exactly 0 otherwise.
 
-use super::support::{recording_support, Support};
+use crate::adjustment::support::{recording_support, Support};
 use crate::adjustment::AdjustmentRun;
 use crate::campaign::Recording;
 use serde::{Deserialize, Serialize};
@@ -69,7 +69,7 @@ pub struct Correction {
 pub struct SeriesRecording {
     pub image_id: String,
     pub correction: Correction,
-    /// Linked-group index ([`super::support::linked_groups`]).
+    /// Linked-group index ([`crate::adjustment::support::linked_groups`]).
     pub group: usize,
     /// Linked to the next recording by the adjustment (same group).
     pub linked_to_next: bool,

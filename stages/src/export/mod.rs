@@ -18,17 +18,17 @@ pub mod corrections;
 pub mod corrections_csv;
 pub mod correspondences;
 #[cfg(test)]
-mod fixture;
+pub(crate) mod fixture;
 pub mod gcp;
 pub mod geojson;
 pub mod gpkg;
 pub mod ply;
 pub mod sbet;
 pub mod second_crs_files;
-pub mod support;
 pub mod synthetic_outputs;
 pub mod trajectory;
 
+pub use crate::adjustment::support::{recording_support, RecordingSupport, Support};
 pub use checkpoints::{
     checkpoint_rows, write_checkpoint_errors_csv, CheckPointRow, CHECKPOINTS_CSV_HEADER,
 };
@@ -44,5 +44,4 @@ pub use ply::{
 };
 pub use sbet::{write_corrected_sbet, SbetOutput, SBET_ADJUSTED, SBET_QUALITY_CSV};
 pub use second_crs_files::{write_second_crs_files, SecondCrsRun};
-pub use support::{recording_support, RecordingSupport, Support};
 pub use trajectory::{adjusted_recordings, write_adjusted_trajectory, TrajectoryExportCounts};

@@ -13,13 +13,13 @@
 //! reference), i.e. what was added.
 
 use super::writer::{FieldType, Geometry, GeometryType, Layer, Value};
+use crate::adjustment::support::recording_support;
 use crate::adjustment::verify::Verification;
 use crate::adjustment::AdjustmentRun;
 use crate::campaign::{CheckPoint, Recording};
 use crate::correspondence::AerialControlPoint;
 use crate::export::checkpoints::CheckPointRow;
 use crate::export::corrections::CorrectionSeries;
-use crate::export::support::recording_support;
 use std::collections::HashMap;
 
 /// Everything the layers are made of.
