@@ -7,6 +7,7 @@
 //! per-observation array of a linearisation is indexed by position, so a point's observations are
 //! contiguous and a recording's are listed in `by_recording`.
 
+use super::sparse::csr::sort_unique_tail;
 use super::sparse::ordering::fill_reducing;
 use super::sparse::{Csr, Slot, Symbolic};
 
@@ -102,15 +103,7 @@ impl ReducedStructure {
                 let (a, b) = relative[k];
                 index.push(a.min(b));
             }
-            index[first..].sort_unstable();
-            let mut kept = first;
-            for k in first..index.len() {
-                if kept == first || index[k] != index[kept - 1] {
-                    index[kept] = index[k];
-                    kept += 1;
-                }
-            }
-            index.truncate(kept);
+            sort_unique_tail(&mut index, first);
             index.push(r);
             start.push(index.len());
         }

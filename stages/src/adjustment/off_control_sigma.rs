@@ -20,6 +20,7 @@
 
 use super::from_correspondences::AdjustmentRun;
 use super::support::{recording_support, Support};
+use crate::estimators::median_consensus::median_in_place;
 use serde::{Deserialize, Serialize};
 
 /// Bins of the variogram hold at least this many pairs of controlled recordings (smaller bins merge).
@@ -67,16 +68,6 @@ fn along_track_m(run: &AdjustmentRun) -> Vec<f64> {
     s
 }
 
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        0.5 * (values[n / 2 - 1] + values[n / 2])
-    }
-}
-
 /// The empirical semivariogram of `corrections` (m) at along-track positions `s_m`; empty when fewer than
 /// [`MIN_PAIRS_PER_BIN`] pairs fall in the first bin.
 pub fn correction_variogram(s_m: &[f64], corrections: &[[f64; 3]]) -> Vec<VariogramBin> {
@@ -85,7 +76,7 @@ pub fn correction_variogram(s_m: &[f64], corrections: &[[f64; 3]]) -> Vec<Variog
         return Vec::new();
     }
     let mut steps: Vec<f64> = s_m.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
-    let width_m = (2.0 * median(&mut steps)).max(1.0);
+    let width_m = (2.0 * median_in_place(&mut steps).unwrap_or(0.0)).max(1.0);
     // (lag, Δx² + Δy², Δz²) per bin.
     let mut bins: Vec<Vec<(f64, f64, f64)>> = vec![Vec::new(); MAX_BINS];
     for i in 0..n {
@@ -110,8 +101,8 @@ pub fn correction_variogram(s_m: &[f64], corrections: &[[f64; 3]]) -> Vec<Variog
         let mut xy: Vec<f64> = pending.iter().map(|p| p.1).collect();
         let mut z: Vec<f64> = pending.iter().map(|p| p.2).collect();
         // Δx² + Δy² ~ 2γ·χ²₂ and Δz² ~ 2γ_z·χ²₁ for Gaussian differences.
-        let gamma_xy = median(&mut xy) / (2.0 * CHI2_2_MEDIAN);
-        let gamma_z = median(&mut z) / (2.0 * CHI2_1_MEDIAN);
+        let gamma_xy = median_in_place(&mut xy).unwrap_or(0.0) / (2.0 * CHI2_2_MEDIAN);
+        let gamma_z = median_in_place(&mut z).unwrap_or(0.0) / (2.0 * CHI2_1_MEDIAN);
         let (prev_xy, prev_z) = out
             .last()
             .map_or((0.0, 0.0), |b| (b.gamma_xy_m2, b.gamma_z_m2));

@@ -15,6 +15,7 @@
 //! [`DEFAULT_RELATIVE_SIGMA_M`] of a healthy GNSS/INS trajectory is used and the result says so.
 
 use crate::campaign::Recording;
+use crate::estimators::median_consensus::median_in_place;
 use serde::{Deserialize, Serialize};
 
 /// Relative σ assumed when the trajectory is too short to estimate it, m (a healthy GNSS/INS trajectory).
@@ -115,19 +116,9 @@ fn cross_track_second_differences(recordings: &[Recording], max_gap_m: f64) -> V
 
 /// Median of |v − median(v)| (`values` not empty).
 fn median_absolute_deviation(mut values: Vec<f64>) -> f64 {
-    let centre = median(&mut values);
+    let centre = median_in_place(&mut values).unwrap_or(0.0);
     let mut deviations: Vec<f64> = values.iter().map(|v| (v - centre).abs()).collect();
-    median(&mut deviations)
-}
-
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        0.5 * (values[n / 2 - 1] + values[n / 2])
-    }
+    median_in_place(&mut deviations).unwrap_or(0.0)
 }
 
 #[cfg(test)]

@@ -71,6 +71,20 @@ impl Csr {
     }
 }
 
+/// Sorts `index[first..]` and removes repeated values from it (the row being assembled at the end of a CSR
+/// index array).
+pub fn sort_unique_tail(index: &mut Vec<usize>, first: usize) {
+    index[first..].sort_unstable();
+    let mut kept = first;
+    for k in first..index.len() {
+        if kept == first || index[k] != index[kept - 1] {
+            index[kept] = index[k];
+            kept += 1;
+        }
+    }
+    index.truncate(kept);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

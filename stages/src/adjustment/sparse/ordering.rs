@@ -5,7 +5,7 @@
 //! street driven twice, crossings and loops couple recordings far apart in time, and the natural order
 //! would then fill the factor between them.
 
-use super::csr::Csr;
+use super::csr::{sort_unique_tail, Csr};
 
 /// The ordering `perm[new] = old` for the symmetric pattern whose strictly lower part is `lower` (old
 /// numbering). Deterministic; falls back to the natural order if AMD rejects the pattern (it cannot for a
@@ -44,15 +44,7 @@ fn sorted_unique(c: &Csr) -> Csr {
     for r in 0..c.rows() {
         let first = index.len();
         index.extend_from_slice(c.row(r));
-        index[first..].sort_unstable();
-        let mut kept = first;
-        for k in first..index.len() {
-            if kept == first || index[k] != index[kept - 1] {
-                index[kept] = index[k];
-                kept += 1;
-            }
-        }
-        index.truncate(kept);
+        sort_unique_tail(&mut index, first);
         start.push(index.len());
     }
     Csr::from_parts(start, index)
