@@ -36,11 +36,18 @@ fn a_pixel_repeated_orthophoto_gives_the_original_orthophotos_ortho() {
         let gsd_m = ORIGINAL_GSD_M / factor as f64;
         let detail = pyramid.layout().detail_level;
         let alone = working_level(gsd_m, base.registration_gsd_m, size);
-        (ortho_params_for_orthophoto(&base, gsd_m, size, detail), detail, gsd_m * (1u64 << alone) as f64)
+        (
+            ortho_params_for_orthophoto(&base, gsd_m, size, detail),
+            detail,
+            gsd_m * (1u64 << alone) as f64,
+        )
     };
     let (original, detail, _) = made_for(1);
     assert_eq!(detail, 0);
-    assert_eq!((original.gsd_m, original.rotation_deg), (ORIGINAL_GSD_M, 0.0));
+    assert_eq!(
+        (original.gsd_m, original.rotation_deg),
+        (ORIGINAL_GSD_M, 0.0)
+    );
     for (factor, expected_detail) in [(4, 2), (8, 3)] {
         let (copy, detail, working_alone_gsd_m) = made_for(factor);
         assert_eq!(detail, expected_detail, "{factor}× copy");
@@ -54,6 +61,9 @@ fn a_pixel_repeated_orthophoto_gives_the_original_orthophotos_ortho() {
             copy.gsd_m,
             original.gsd_m
         );
-        assert_eq!(copy, original, "{factor}× copy: every other ortho parameter is the workflow's");
+        assert_eq!(
+            copy, original,
+            "{factor}× copy: every other ortho parameter is the workflow's"
+        );
     }
 }

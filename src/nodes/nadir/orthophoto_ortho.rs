@@ -40,7 +40,12 @@ impl Stage for OrthoForOrthophoto {
     crate::nodes::stage_types!(STAGE, OrthophotoOrthoParams => OrthoImage,
         inputs: (Handle<Recording>, Handle<IngestedImage>, Handle<IngestedImage>));
 
-    fn run(&self, p: &OrthophotoOrthoParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+    fn run(
+        &self,
+        p: &OrthophotoOrthoParams,
+        inputs: InputsOf<Self>,
+        _: &NodeCtx,
+    ) -> RunResult<Self> {
         let (rec, pano, photo) = inputs;
         let size_px = (
             u32::try_from(photo.width).unwrap_or(u32::MAX),
