@@ -5,17 +5,20 @@
 #
 # Usage: benches/results.sh [WORK_DIR]
 #   WORK_DIR   where caches, outputs and logs go (default: a new temporary folder; it is emptied first)
-#   SEEDS      demo seeds for the default workflow (default "1 4 5"; seed 1 is the README's main job)
+#   SEEDS      demo seeds for the default workflow (default "1 4 5"; seed 1 is the README's main job; "" = none)
 #   ORTHO_SEEDS  demo seeds for the orthophoto route and, on the same scene, the frame route with the same
 #              workflow (default "3 4 5"; seed 2 was used to choose the route's parameters; "" = none)
+#   ORTHO_ROUTES  which of the two runs per orthophoto seed (default "ortho frames"; "ortho" = the orthophoto
+#              route only)
 #
 # Needs: cargo, python3 (standard library only), GNU time (/usr/bin/time) for wall time and peak memory.
 # Takes about 2 minutes per demo seed on 2 cores, plus the release build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 REPO="$(pwd)"
-SEEDS="${SEEDS:-1 4 5}"
+SEEDS="${SEEDS-1 4 5}"
 ORTHO_SEEDS="${ORTHO_SEEDS-3 4 5}"
+ORTHO_ROUTES="${ORTHO_ROUTES-ortho frames}"
 WORK="${1:-$(mktemp -d -t skytie-results-XXXXXX)}"
 rm -rf "$WORK" && mkdir -p "$WORK"
 WORK="$(cd "$WORK" && pwd)"
@@ -73,7 +76,7 @@ done
 # frames) and the frame route on the same scene (the same workflow, the campaign generated with nadir frames and
 # without the orthophoto).
 for seed in $ORTHO_SEEDS; do
-    for route in ortho frames; do
+    for route in $ORTHO_ROUTES; do
         label="$route-seed$seed"
         mkdir -p "$WORK/$label"
         cp "$REPO/workflows/orthophoto.toml" "$WORK/$label/orthophoto.toml"

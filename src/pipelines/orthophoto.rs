@@ -1,7 +1,7 @@
 //! The orthophoto route in the nadir part of the `skytie` pipeline, for campaigns that declare an orthophoto
 //! (`campaign.toml` `[orthophoto]`): per tile the orthophoto ingested into its pyramid, the DTM tiles loaded
 //! once (cropped to the recordings' area), per recording a north-up ground ortho at the orthophoto's working
-//! resolution and the `orthophoto` node (registration, tie points, control points), whose control points join
+//! resolution (never finer than the orthophoto's detail level, `orthophoto_ortho`) and the `orthophoto` node (registration, tie points, control points), whose control points join
 //! the frames' (when the campaign has both, the adjustment takes both, each with its own σ).
 
 use super::wf_err;
@@ -10,14 +10,13 @@ use crate::nodes::campaign::ingest::{ingest_file, IngestedImage};
 use crate::nodes::campaign::load::CampaignSnapshot;
 use crate::nodes::campaign::summary::SummaryParams;
 use crate::nodes::nadir::dtm::{DtmParams, LoadDtm};
-use crate::nodes::nadir::ortho::OrthoProject;
 use crate::nodes::nadir::orthophoto::{OrthophotoNodeParams, OrthophotoStage};
+use crate::nodes::nadir::orthophoto_ortho::{OrthoForOrthophoto, OrthophotoOrthoParams};
 use crate::nodes::nadir::orthophoto_points::OrthophotoPoints;
 use crate::nodes::nadir::orthophoto_summary::SummarizeOrthophoto;
 use crate::workflow::Workflow;
 use skytie_stages::campaign::orthophoto::{OrthophotoSource, DEFAULT_DTM_SIGMA_M};
 use skytie_stages::campaign::Recording;
-use skytie_stages::nadir::aerial_patch::working_level;
 use skytie_stages::nadir::{MmWindowMatch, OrthoParams, RecordingControl};
 use skytie_stages::orthophoto::{Dtm, OrthophotoControl, OrthophotoParams, OrthophotoSummary};
 use std::collections::BTreeMap;
@@ -117,21 +116,15 @@ impl<'a> OrthophotoRoute<'a> {
                 h
             }
         };
-        let h = &tile.header;
-        let level = working_level(
-            h.transform.pixel_m,
-            self.ortho_base.registration_gsd_m,
-            (h.width_px, h.height_px),
-        );
-        let ortho_params = OrthoParams {
-            gsd_m: h.transform.pixel_m * (1u64 << level) as f64,
-            rotation_deg: 0.0,
-            ..self.ortho_base.clone()
+        let ortho_params = OrthophotoOrthoParams {
+            base: self.ortho_base.clone(),
+            pixel_m: tile.header.transform.pixel_m,
         };
         let mut orthos = Vec::with_capacity(members.len());
         for &(m, row, pano) in members {
             let label = format!("rec {} × {}", m.image_id, tile.file);
-            orthos.push(b.add(OrthoProject, &label, ortho_params.clone(), (row, pano))?);
+            let inputs = (row, pano, image);
+            orthos.push(b.add(OrthoForOrthophoto, &label, ortho_params.clone(), inputs)?);
         }
         let label = format!("rec {} × {}", r.image_id, tile.file);
         let params = OrthophotoNodeParams {

@@ -11,6 +11,7 @@ pub mod options;
 pub mod ortho;
 pub mod ortho_aerial;
 pub mod orthophoto;
+pub mod orthophoto_ortho;
 pub mod orthophoto_points;
 pub mod orthophoto_summary;
 pub mod refine;

@@ -3,14 +3,16 @@
 //! control point. Its XY is the orthophoto pixel through the tile's geotransform; its Z is interpolated in the
 //! DTM, or — without a DTM, or where the DTM has no value — the tie point's height triangulated from the
 //! panoramas (flagged [`HeightSource::MmGround`] and counted). Its covariance is diagonal: σ_xy² = (stated
-//! orthophoto accuracy)² + (`match_sigma_px` · working pixel size)², σ_z = the DTM's stated accuracy or
-//! `mm_height_sigma_m`. The whole route of one recording — initial transform ([`super::register`]),
+//! orthophoto accuracy)² + (matching σ · working pixel size)², the matching σ from the peak
+//! ([`super::precision`]: `match_sigma_px` for a strong peak, more for a weak one), σ_z = the DTM's stated
+//! accuracy or `mm_height_sigma_m`. The whole route of one recording — initial transform ([`super::register`]),
 //! refinement with the parallax check against the window's neighbours (`nadir::refine`) and weak peaks kept
 //! where the corrections agree ([`super::corroborate`]), control points — is
 //! [`orthophoto_control`].
 
 use super::corroborate::corroborated;
 use super::dtm::Dtm;
+use super::precision::{match_sigma_px, WeakPeakSigma};
 use super::register::register_translation;
 use super::OrthophotoParams;
 use crate::campaign::orthophoto::RasterFile;
@@ -121,7 +123,19 @@ pub fn orthophoto_control(
         return Ok(out);
     };
     out.refinement = refine_corroborated(ortho, photo, t, window, neighbours, p)?;
-    let sigma_xy_m = photo.sigma_m.hypot(p.match_sigma_px * ortho.georef.gsd_m);
+    let min_peak = p.refine.min_peak;
+    let growth = WeakPeakSigma {
+        min_peak,
+        match_sigma_px: p.match_sigma_px,
+        exponent: p.weak_sigma_exponent,
+        correlated: p.weak_peaks_correlated,
+    };
+    let weak = out
+        .refinement
+        .matches
+        .iter()
+        .filter(|m| !(m.observation.score >= min_peak))
+        .count();
     for m in &out.refinement.matches {
         let Some(k) = window
             .tie_points
@@ -151,6 +165,8 @@ pub fn orthophoto_control(
             HeightSource::Dtm => out.height_from_dtm += 1,
             HeightSource::MmGround => out.height_from_mm += 1,
         }
+        let sigma_px = match_sigma_px(m.observation.score, &growth, weak);
+        let sigma_xy_m = photo.sigma_m.hypot(sigma_px * ortho.georef.gsd_m);
         let (vxy, vz) = (sigma_xy_m * sigma_xy_m, sigma_z_m * sigma_z_m);
         out.control.points.push(AerialControlPoint {
             tie_point_id: tp.id.clone(),

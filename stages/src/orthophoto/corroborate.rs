@@ -4,10 +4,14 @@
 //! predicted) up to a fraction of a pixel, while a wrong peak falls anywhere in the ± `search_margin_px` search
 //! window. A template partly hidden in the orthophoto (a tree crown over the road, a car parked in the
 //! aerial epoch) correlates weaker than `min_peak` at its correct place; such a weak peak is kept when it lies
-//! within `corroboration_px` of the correction most located tie points agree on and at least
-//! `min_corroborating` tie points (weak or strong) agree there. A chance peak meets one given pixel disc of
-//! radius r in a (2m + 1)² window with probability ≈ πr²/(2m + 1)² (0.5 % for r = 1, m = 12), so agreeing weak
-//! peaks are not chance. Strong peaks (≥ `min_peak`) keep the refinement's own shift-consistency check.
+//! within `corroboration_px` of the recording's agreed correction and at least `min_corroborating` tie points
+//! (weak or strong) agree there. A chance peak meets one given pixel disc of radius r in a (2m + 1)² window
+//! with probability ≈ πr²/(2m + 1)² (0.5 % for r = 1, m = 12), so agreeing weak peaks are not chance.
+//!
+//! The agreed correction is the median of the strong peaks' corrections (≥ `min_peak`) when the recording has
+//! any, else the median of all: weak peaks under the same crowns are displaced alike (the visible part of each
+//! template pulls its peak the same way), so several of them can agree with each other a few pixels away from
+//! the strong ones, and outnumber them. Strong peaks keep the refinement's own shift-consistency check.
 
 use crate::estimators::median_consensus::median_consensus;
 use crate::nadir::AerialMatch;
@@ -32,8 +36,8 @@ pub struct Corroboration {
 
 /// The matches to keep among `matches` (one recording, one orthophoto): every one with a peak ≥ `min_peak`,
 /// and those with a weaker peak whose correction lies within `radius_px` (working pixels; `scale` full pixels
-/// each) of the median correction of all matches, when at least `min_agreeing` matches lie there. The order of
-/// `matches` is kept.
+/// each) of the agreed correction — the median correction of the strong matches, or of all matches when none
+/// is strong — when at least `min_agreeing` matches lie there. The order of `matches` is kept.
 pub fn corroborated(
     matches: Vec<AerialMatch>,
     min_peak: f64,
@@ -41,20 +45,33 @@ pub fn corroborated(
     min_agreeing: usize,
     scale: f64,
 ) -> Corroboration {
-    let n_weak = matches
-        .iter()
-        .filter(|m| !(m.observation.score >= min_peak))
-        .count();
+    let strong = |m: &AerialMatch| m.observation.score >= min_peak;
+    let n_weak = matches.iter().filter(|m| !strong(m)).count();
     let corrections: Vec<[f64; 2]> = matches.iter().map(|m| correction(m, scale)).collect();
-    let agreeing = median_consensus(&corrections, radius_px)
-        .map(|c| c.inliers)
-        .filter(|inliers| inliers.iter().filter(|&&i| i).count() >= min_agreeing.max(1));
+    let strong_corrections: Vec<[f64; 2]> = matches
+        .iter()
+        .zip(&corrections)
+        .filter_map(|(m, c)| strong(m).then_some(*c))
+        .collect();
+    let anchor_set = if strong_corrections.is_empty() {
+        &corrections
+    } else {
+        &strong_corrections
+    };
+    let agreeing: Option<Vec<bool>> = median_consensus(anchor_set, radius_px)
+        .map(|c| {
+            corrections
+                .iter()
+                .map(|v| (v[0] - c.median[0]).hypot(v[1] - c.median[1]) <= radius_px)
+                .collect::<Vec<bool>>()
+        })
+        .filter(|a| a.iter().filter(|&&i| i).count() >= min_agreeing.max(1));
     let mut out = Corroboration::default();
     for (k, m) in matches.into_iter().enumerate() {
-        let strong = m.observation.score >= min_peak;
+        let is_strong = strong(&m);
         let agrees = agreeing.as_ref().is_some_and(|a| a[k]);
-        if strong || agrees {
-            out.weak_kept += usize::from(!strong);
+        if is_strong || agrees {
+            out.weak_kept += usize::from(!is_strong);
             out.kept.push(m);
         }
     }
@@ -126,5 +143,23 @@ mod tests {
         ];
         assert_eq!(corroborated(m.clone(), 0.75, 1.0, 3, 2.0).kept.len(), 3);
         assert!(corroborated(m, 0.75, 1.0, 3, 1.0).kept.is_empty());
+    }
+
+    #[test]
+    fn weak_peaks_that_outnumber_the_strong_ones_are_held_to_the_strong_ones_correction() {
+        // Four weak peaks agree on (2, 0); the two strong ones on (0, 0). The median of all six is (2, 0), but
+        // the strong peaks set the correction: the weak ones 2 px away are dropped, the one at (0.3, 0.2) kept.
+        let m = vec![
+            located("strong_a", (0.1, -0.1), 0.85),
+            located("weak_a", (2.0, 0.1), 0.6),
+            located("weak_b", (2.1, -0.1), 0.62),
+            located("weak_c", (1.9, 0.0), 0.58),
+            located("weak_d", (2.0, 0.0), 0.55),
+            located("strong_b", (-0.1, 0.1), 0.8),
+            located("weak_e", (0.3, 0.2), 0.6),
+        ];
+        let c = corroborated(m, 0.75, 1.0, 3, 1.0);
+        assert_eq!(ids(&c), ["strong_a", "strong_b", "weak_e"]);
+        assert_eq!((c.weak_kept, c.weak_dropped), (1, 4));
     }
 }

@@ -8,6 +8,8 @@
 pub mod control;
 pub mod corroborate;
 pub mod dtm;
+pub mod level;
+pub mod precision;
 pub mod register;
 pub mod summary;
 
@@ -15,6 +17,7 @@ pub use crate::campaign::orthophoto::{DtmSource, OrthophotoSource, RasterFile};
 pub use crate::imaging::georef::{GeoTransform, RasterHeader};
 pub use control::{orthophoto_control, OrthophotoControl, OrthophotoInput};
 pub use dtm::{Dtm, DtmTile};
+pub use level::{ortho_params_for_orthophoto, orthophoto_level};
 pub use register::{nominal_transform, register_translation};
 pub use summary::OrthophotoSummary;
 
@@ -24,7 +27,7 @@ use crate::params::StageId;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("orthophoto", "4");
+pub const STAGE: StageId = StageId::new("orthophoto", "5");
 
 crate::params! {
     /// Parameters of the orthophoto route (registration, refinement and control points).
@@ -34,8 +37,9 @@ crate::params! {
         /// bounds the offset searched; `estimate_shape`, `seed` and `max_offset_disagreement_m` do not apply
         /// (one north-up orthophoto at a known scale: the translation alone).
         transform: TransformParams = TransformParams::default(), section;
-        /// Precision of a located tie point in the orthophoto at the working resolution, added to the stated
-        /// accuracy of the orthophoto for the control point's planimetric σ.
+        /// Precision of a tie point located with a strong peak (≥ `refine.min_peak`) in the orthophoto at the
+        /// working resolution, added to the stated accuracy of the orthophoto for the control point's
+        /// planimetric σ; a weak peak's is larger ([`precision`]).
         match_sigma_px: f64 = 0.3, unit "px", min 0.0, max 10.0;
         /// σ of a control point's height taken from the mobile-mapping ground estimate (no DTM, or outside it).
         mm_height_sigma_m: f64 = 0.5, unit "m", min 0.001, max 100.0;
@@ -49,5 +53,12 @@ crate::params! {
         corroboration_px: f64 = 1.0, unit "px", min 0.0, max 10.0;
         /// Fewest located tie points (weak or strong) that must agree on the correction for weak ones to be kept.
         min_corroborating: usize = 3, min 2, max 100;
+        /// A weak peak's matching σ is `match_sigma_px` · ((1 − peak) / (1 − `refine.min_peak`)) to this power
+        /// ([`precision`]); 0 = the strong peaks' σ. Graded on demo seed 2, 0 gave the best check points (1 and
+        /// 2 gave less weight to recordings whose correct weak peaks were their only control).
+        weak_sigma_exponent: f64 = 0.0, min 0.0, max 10.0;
+        /// The weak peaks of one recording taken as one observation (each σ × √count), for orthophotos whose
+        /// hidden templates are displaced alike ([`precision`]).
+        weak_peaks_correlated: bool = false;
     }
 }
