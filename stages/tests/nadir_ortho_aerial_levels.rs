@@ -4,14 +4,15 @@
 //! scaled by 4). The copy's pyramid has detail level 2; the ortho made for it must be the original's (same GSD,
 //! rotation, size, pixels and mask), not the 7.5 cm ortho its 12 cm working level alone would give.
 
+mod support;
+
 use skytie_stages::campaign::{AerialImage, Recording};
-use skytie_stages::estimators::SplitMix64;
 use skytie_stages::geometry::FrameCamera;
 use skytie_stages::imaging::pyramid::{MemoryPyramid, TileSource};
-use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::aerial_overlap::foot_point_world;
 use skytie_stages::nadir::aerial_patch::ortho_params_for_aerial_image;
 use skytie_stages::nadir::{ortho_project_whole, OrthoParams};
+use support::texture::repeated_texture;
 
 /// Linear enlargement of the copy.
 const FACTOR: u32 = 4;
@@ -48,27 +49,16 @@ fn aerial_row(rec: &Recording, scale: u32) -> AerialImage {
     }
 }
 
-/// A random texture of `width × height` grey values, each repeated `repeat × repeat` times.
-fn texture(width: usize, height: usize, repeat: usize, seed: u64) -> GrayImage {
-    let mut rng = SplitMix64::new(seed);
-    let base: Vec<f32> = (0..width * height).map(|_| rng.next_f64() as f32).collect();
-    let (w, h) = (width * repeat, height * repeat);
-    let data = (0..w * h)
-        .map(|i| base[(i / w / repeat) * width + (i % w) / repeat])
-        .collect();
-    GrayImage::from_vec(w, h, data).expect("w × h values")
-}
-
 #[test]
 fn a_pixel_repeated_frame_gives_the_same_aerial_ortho_as_the_original() {
     let rec = recording();
-    let panorama = texture(1024, 512, 1, 7);
+    let panorama = repeated_texture(1024, 512, 1, 7);
     let foot = foot_point_world(&rec);
     let base = OrthoParams::default();
     assert!(base.registration_gsd_m < 0.15);
 
-    let frame = MemoryPyramid::from_gray(&texture(400, 300, 1, 11));
-    let enlarged = MemoryPyramid::from_gray(&texture(400, 300, FACTOR as usize, 11));
+    let frame = MemoryPyramid::from_gray(&repeated_texture(400, 300, 1, 11));
+    let enlarged = MemoryPyramid::from_gray(&repeated_texture(400, 300, FACTOR as usize, 11));
     assert_eq!(frame.layout().detail_level, 0);
     assert_eq!(enlarged.layout().detail_level, 2);
 

@@ -4,26 +4,16 @@
 //! 4 × 4 times (5 cm pixels, detail level 2) and 8 × 8 times (2.5 cm, detail level 3). The ground ortho made
 //! for a copy must be the original's 20 cm one, not the 10 cm one its 12 cm working level alone would give.
 
-use skytie_stages::estimators::SplitMix64;
+mod support;
+
 use skytie_stages::imaging::pyramid::{MemoryPyramid, TileSource};
-use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::aerial_patch::working_level;
 use skytie_stages::nadir::OrthoParams;
 use skytie_stages::orthophoto::ortho_params_for_orthophoto;
+use support::texture::repeated_texture;
 
 /// Pixel size of the original orthophoto, m.
 const ORIGINAL_GSD_M: f64 = 0.20;
-
-/// A random texture of `width × height` grey values, each repeated `repeat × repeat` times.
-fn texture(width: usize, height: usize, repeat: usize, seed: u64) -> GrayImage {
-    let mut rng = SplitMix64::new(seed);
-    let base: Vec<f32> = (0..width * height).map(|_| rng.next_f64() as f32).collect();
-    let (w, h) = (width * repeat, height * repeat);
-    let data = (0..w * h)
-        .map(|i| base[(i / w / repeat) * width + (i % w) / repeat])
-        .collect();
-    GrayImage::from_vec(w, h, data).expect("w × h values")
-}
 
 #[test]
 fn a_pixel_repeated_orthophoto_gives_the_original_orthophotos_ortho() {
@@ -31,7 +21,7 @@ fn a_pixel_repeated_orthophoto_gives_the_original_orthophotos_ortho() {
     assert!(base.registration_gsd_m < ORIGINAL_GSD_M && base.registration_gsd_m >= 0.10);
     let (w, h) = (240usize, 180usize);
     let made_for = |factor: usize| {
-        let pyramid = MemoryPyramid::from_gray(&texture(w, h, factor, 5));
+        let pyramid = MemoryPyramid::from_gray(&repeated_texture(w, h, factor, 5));
         let size = ((w * factor) as u32, (h * factor) as u32);
         let gsd_m = ORIGINAL_GSD_M / factor as f64;
         let detail = pyramid.layout().detail_level;

@@ -13,6 +13,28 @@ use skytie_stages::nadir::{ortho_project, OrthoImage, OrthoParams};
 
 crate::serde_artifact!(OrthoImage);
 
+/// The panorama of `rec` ortho-projected with `params` derived from another image (`subject` names it in the
+/// error, e.g. "aerial image 'n_01'"): the derived parameters are checked first, since a bad source image
+/// (absurd GSD, size) yields parameters the projection cannot use.
+pub fn ortho_with_derived_params(
+    subject: &str,
+    params: &OrthoParams,
+    pano: &IngestedImage,
+    rec: &Recording,
+) -> Result<OrthoImage, StageError> {
+    if let Err(errs) = skytie_stages::params::Params::validate(params) {
+        return Err(StageError::new(format!(
+            "{subject}: the ortho parameters derived from it are invalid ({})",
+            errs.iter()
+                .map(|v| format!("{}: {}", v.field, v.message))
+                .collect::<Vec<_>>()
+                .join("; ")
+        )));
+    }
+    let panorama = panorama_for_ortho(pano, rec, params)?;
+    Ok(ortho_project(&panorama, rec, params))
+}
+
 /// The bands of `pano` that the ortho-projection of `rec` with `p` samples; an error when the panorama is not
 /// equirectangular (W = 2H).
 pub fn panorama_for_ortho(

@@ -4,14 +4,14 @@
 //! The aerial frame's ingested pyramid is an input for its detail level only: a frame enlarged by pixel
 //! repetition gets the ortho of the frame it was enlarged from.
 
-use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage};
 use crate::nodes::campaign::ingest::IngestedImage;
-use crate::nodes::nadir::ortho::panorama_for_ortho;
+use crate::nodes::nadir::ortho::ortho_with_derived_params;
 use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::geometry::FrameCamera;
 use skytie_stages::nadir::aerial_overlap::foot_point_world;
 use skytie_stages::nadir::aerial_patch::ortho_params_for_aerial_image;
-use skytie_stages::nadir::{ortho_project, OrthoImage, OrthoParams};
+use skytie_stages::nadir::{OrthoImage, OrthoParams};
 
 /// The aerial-oriented ortho-projection node. Its params are the workflow's `[ortho]` table (diagonal,
 /// vehicle mask, `registration_gsd_m`); `gsd_m` and `rotation_deg` are replaced by the aerial image's (at its
@@ -32,17 +32,7 @@ impl Stage for OrthoForAerial {
             base,
             aerial_file.detail_level as usize,
         );
-        if let Err(errs) = skytie_stages::params::Params::validate(&params) {
-            return Err(StageError::new(format!(
-                "aerial image '{}': the ortho parameters derived from it are invalid ({})",
-                aerial.image_id,
-                errs.iter()
-                    .map(|v| format!("{}: {}", v.field, v.message))
-                    .collect::<Vec<_>>()
-                    .join("; ")
-            )));
-        }
-        let panorama = panorama_for_ortho(&pano, &rec, &params)?;
-        Ok(ortho_project(&panorama, &rec, &params))
+        let subject = format!("aerial image '{}'", aerial.image_id);
+        ortho_with_derived_params(&subject, &params, &pano, &rec)
     }
 }

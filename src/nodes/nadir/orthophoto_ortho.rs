@@ -4,13 +4,13 @@
 //! enlarged by pixel repetition gets the ortho of the orthophoto it was enlarged from). The ingested orthophoto
 //! is an input for its size and detail level only.
 
-use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage, StageError};
+use crate::dag::{Handle, InputsOf, NodeCtx, RunResult, Stage};
 use crate::nodes::campaign::ingest::IngestedImage;
-use crate::nodes::nadir::ortho::panorama_for_ortho;
+use crate::nodes::nadir::ortho::ortho_with_derived_params;
 use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
 use skytie_stages::campaign::Recording;
-use skytie_stages::nadir::{ortho_project, OrthoImage, OrthoParams};
+use skytie_stages::nadir::{OrthoImage, OrthoParams};
 use skytie_stages::orthophoto::ortho_params_for_orthophoto;
 use skytie_stages::params::StageId;
 
@@ -53,17 +53,7 @@ impl Stage for OrthoForOrthophoto {
         );
         let params =
             ortho_params_for_orthophoto(&p.base, p.pixel_m, size_px, photo.detail_level as usize);
-        if let Err(errs) = skytie_stages::params::Params::validate(&params) {
-            return Err(StageError::new(format!(
-                "orthophoto '{}': the ortho parameters derived from it are invalid ({})",
-                photo.source,
-                errs.iter()
-                    .map(|v| format!("{}: {}", v.field, v.message))
-                    .collect::<Vec<_>>()
-                    .join("; ")
-            )));
-        }
-        let panorama = panorama_for_ortho(&pano, &rec, &params)?;
-        Ok(ortho_project(&panorama, &rec, &params))
+        let subject = format!("orthophoto '{}'", photo.source);
+        ortho_with_derived_params(&subject, &params, &pano, &rec)
     }
 }

@@ -292,7 +292,7 @@ mod tests {
             .map(|i| recording(i, 5.0 * i as f64, [0.8, 0.0, 0.0]))
             .collect();
         let mut r = run(config, recs, vec![point(PointKind::Control, &[2])]);
-        let report = widen_off_control_sigma(&mut r, &vec![(Some(1.0), None); 5]);
+        let report = widen_off_control_sigma(&mut r, &[(Some(1.0), None); 5]);
         assert!(report.variogram.is_empty());
         assert_eq!(report.raised_to_prior, 4);
         assert_eq!(r.recordings[0].sigma_m, [1.0, 1.0, 0.1]);

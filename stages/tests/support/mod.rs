@@ -9,6 +9,7 @@ use skytie_stages::geometry::{look_at_matrix, matrix_to_opk};
 
 pub mod adjusted;
 pub mod ortho_pair;
+pub mod texture;
 pub mod tiny;
 
 /// Easting of the street's first recording, metres.
