@@ -7,6 +7,7 @@
 
 pub mod adjustment;
 pub mod campaign;
+pub mod correction;
 pub mod correspondence;
 pub mod crs;
 pub mod estimators;

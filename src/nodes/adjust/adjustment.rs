@@ -14,8 +14,11 @@ use serde::{Deserialize, Serialize};
 use skytie_stages::adjustment::campaign_checkpoints::{compare_checkpoints, CheckPointComparison};
 use skytie_stages::adjustment::config::AdjustConfig;
 use skytie_stages::adjustment::evaluate::MULTI_VIEW_RADIUS_M;
-use skytie_stages::adjustment::from_correspondences::{run_in_frame, AdjustInputs, AdjustmentRun};
+use skytie_stages::adjustment::from_correspondences::{
+    prior_sigmas_m, run_in_frame, AdjustInputs, AdjustmentRun,
+};
 use skytie_stages::adjustment::{RmseSummary, ViewSelection};
+use skytie_stages::correction::{widen_off_control_sigma, OffControlSigma};
 use skytie_stages::correspondence::{AerialControlPoint, MmTiePoint};
 use skytie_stages::crs::MapFrame;
 use skytie_stages::export::{checkpoint_rows, recording_support, CheckPointRow, Support};
@@ -59,6 +62,8 @@ pub struct AdjustReport {
     pub multi_view: CheckPointSummary,
     /// The two nearest recordings (two-view evaluation).
     pub two_view: CheckPointSummary,
+    /// How the σ of recordings without control of their own was widened (`run`'s σ include it).
+    pub off_control_sigma: OffControlSigma,
 }
 crate::serde_artifact!(AdjustReport);
 
@@ -90,7 +95,7 @@ impl AdjustReport {
             "redundancy": r.redundancy,
             "build": r.build,
             "relative_sigma": r.relative_sigma,
-            "off_control_sigma": r.off_control_sigma,
+            "off_control_sigma": self.off_control_sigma,
             "trajectory": recording_metrics(r),
             "verdict": self.verdict().label(),
         }})
@@ -240,8 +245,18 @@ impl Stage for AdjustStage {
         // With aerial observations in the bundle, it runs in the campaign's Cartesian frame.
         let frame = MapFrame::from_spec(&campaign_frame_spec(c).0)
             .map_err(|e| StageError::new(format!("adjustment: {e}")))?;
-        let result = run_in_frame(&inputs, config, &frame)
+        let mut result = run_in_frame(&inputs, config, &frame)
             .map_err(|e| StageError::new(format!("adjustment failed: {e}")))?;
+        // σ of the recordings without control of their own, before any output reads it.
+        let priors: Vec<(Option<f64>, Option<f64>)> = c
+            .recordings
+            .iter()
+            .map(|r| {
+                let (xy, z) = prior_sigmas_m(r, config);
+                (Some(xy), Some(z))
+            })
+            .collect();
+        let off_control_sigma = widen_off_control_sigma(&mut result, &priors);
         let compare = |selection| {
             compare_checkpoints(
                 &c.recordings,
@@ -263,6 +278,7 @@ impl Stage for AdjustStage {
             run: result,
             multi_view,
             two_view,
+            off_control_sigma,
         })
     }
 }

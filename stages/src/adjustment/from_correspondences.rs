@@ -13,7 +13,6 @@ use super::adjust::{adjust, ObservationCounts};
 use super::config::{AdjustConfig, ControlWeighting};
 use super::error::AdjustError;
 use super::in_frame::{adjustment_to_map, block_to_local};
-use super::off_control_sigma::{widen_off_control_sigma, OffControlSigma};
 use super::problem::{
     AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, PanoObservation,
     RelativeConstraint,
@@ -164,10 +163,6 @@ pub struct AdjustmentRun {
     /// The σ of the relative constraints between consecutive recordings (used by them when they are on, and
     /// by the corrections' interpolation between recordings always).
     pub relative_sigma: RelativeSigma,
-    /// How the σ of recordings without aerial control of their own was widened
-    /// ([`super::off_control_sigma`]); their `sigma_m` already includes it.
-    #[serde(default)]
-    pub off_control_sigma: OffControlSigma,
 }
 
 /// Builds the block of one configuration.
@@ -387,23 +382,29 @@ fn block_recordings<'a>(
                 problem: "image_id occurs twice; image ids must be unique".to_string(),
             });
         }
+        let (prior_xy, prior_z) = prior_sigmas_m(rec, config);
         recordings.push(BlockRecording {
             camera: PanoramaCamera::from_recording(rec, w, h),
-            prior_sigma_xy_m: Some(
-                config
-                    .prior_sigma_xy_m
-                    .or(rec.sigma_xy_m)
-                    .unwrap_or(config.default_prior_sigma_xy_m),
-            ),
-            prior_sigma_z_m: Some(
-                config
-                    .prior_sigma_z_m
-                    .or(rec.sigma_z_m)
-                    .unwrap_or(config.default_prior_sigma_z_m),
-            ),
+            prior_sigma_xy_m: Some(prior_xy),
+            prior_sigma_z_m: Some(prior_z),
         });
     }
     Ok((recording_index, recordings))
+}
+
+/// The σ of a recording's position prior, m: horizontal, vertical (the workflow's override, else the
+/// recording's own `sigma_xy` / `sigma_z`, else the configuration's default).
+pub fn prior_sigmas_m(rec: &Recording, config: &AdjustConfig) -> (f64, f64) {
+    (
+        config
+            .prior_sigma_xy_m
+            .or(rec.sigma_xy_m)
+            .unwrap_or(config.default_prior_sigma_xy_m),
+        config
+            .prior_sigma_z_m
+            .or(rec.sigma_z_m)
+            .unwrap_or(config.default_prior_sigma_z_m),
+    )
 }
 
 /// The recording a correspondence of `owner` names, by image id.
@@ -650,13 +651,7 @@ pub fn run_in_frame(
         })
         .collect();
     let rejected_total = adj.rejected.pano + adj.rejected.control + adj.rejected.aerial;
-    let priors: Vec<(Option<f64>, Option<f64>)> = build
-        .block
-        .recordings
-        .iter()
-        .map(|r| (r.prior_sigma_xy_m, r.prior_sigma_z_m))
-        .collect();
-    let mut run = AdjustmentRun {
+    Ok(AdjustmentRun {
         config: config.clone(),
         recordings,
         points,
@@ -672,8 +667,5 @@ pub fn run_in_frame(
         rejection_rounds: adj.rounds.len(),
         build: build.counts,
         relative_sigma: build.relative_sigma,
-        off_control_sigma: OffControlSigma::default(),
-    };
-    run.off_control_sigma = widen_off_control_sigma(&mut run, &priors);
-    Ok(run)
+    })
 }

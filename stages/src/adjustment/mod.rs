@@ -14,9 +14,7 @@
 //! normalised residuals, re-solve), [`evaluate`] (check-point triangulation and RMSE), [`synthetic_block`]
 //! (known-answer test blocks). On top: [`config`] (the adjust node's params), [`in_frame`] (a block
 //! in the campaign's tangent frame and its results back in map coordinates), [`from_correspondences`]
-//! (correspondences → block → [`AdjustmentRun`]), [`support`] (what carries each recording's correction:
-//! its own control, control on both sides, on one side, none), [`off_control_sigma`] (the σ of recordings without
-//! control of their own, widened by the variogram of the controlled recordings' corrections), [`verify`] (thesis Table 5-13 verification per trajectory
+//! (correspondences → block → [`AdjustmentRun`]), [`verify`] (thesis Table 5-13 verification per trajectory
 //! segment) and [`synthetic_campaign`] (a synthetic block as campaign rows and correspondences, with aerial
 //! images, for known-answer tests).
 //!
@@ -34,7 +32,6 @@ pub mod from_correspondences;
 pub mod in_frame;
 pub mod layout;
 pub mod linearization;
-pub mod off_control_sigma;
 pub mod parallel;
 pub mod prepared;
 pub mod problem;
@@ -44,7 +41,6 @@ pub mod robust;
 pub mod schur;
 pub mod solver;
 pub mod sparse;
-pub mod support;
 pub mod synthetic_block;
 pub mod synthetic_campaign;
 pub mod synthetic_streets;

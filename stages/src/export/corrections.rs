@@ -16,9 +16,9 @@
 //! interpolated, but flagged [`SampleKind::Gap`]. Yaw uses the same model with `yaw_prior_sigma_deg` when
 //! yaw is estimated, and is exactly 0 otherwise.
 
-use crate::adjustment::support::{recording_support, Support};
 use crate::adjustment::AdjustmentRun;
 use crate::campaign::Recording;
+use crate::correction::support::{recording_support, Support};
 use serde::{Deserialize, Serialize};
 use std::io;
 
@@ -69,7 +69,7 @@ pub struct Correction {
 pub struct SeriesRecording {
     pub image_id: String,
     pub correction: Correction,
-    /// Linked-group index ([`crate::adjustment::support::linked_groups`]).
+    /// Linked-group index ([`crate::correction::support::linked_groups`]).
     pub group: usize,
     /// Linked to the next recording by the adjustment (same group).
     pub linked_to_next: bool,
@@ -258,7 +258,7 @@ pub(crate) mod tests {
     use super::*;
     use crate::adjustment::relative_noise::RelativeSigma;
     use crate::adjustment::{AdjustConfig, PointKind};
-    use crate::export::fixture::{point, recording, run};
+    use crate::correction::fixture::{point, recording, run};
 
     /// The campaign row of fixture recording `i` (same position and id).
     pub(crate) fn campaign_recording(a: &crate::adjustment::RunRecording, t: f64) -> Recording {

@@ -17,8 +17,6 @@ pub mod colmap;
 pub mod corrections;
 pub mod corrections_csv;
 pub mod correspondences;
-#[cfg(test)]
-pub(crate) mod fixture;
 pub mod gcp;
 pub mod geojson;
 pub mod gpkg;
@@ -28,7 +26,7 @@ pub mod second_crs_files;
 pub mod synthetic_outputs;
 pub mod trajectory;
 
-pub use crate::adjustment::support::{recording_support, RecordingSupport, Support};
+pub use crate::correction::{recording_support, RecordingSupport, Support};
 pub use checkpoints::{
     checkpoint_rows, write_checkpoint_errors_csv, CheckPointRow, CHECKPOINTS_CSV_HEADER,
 };

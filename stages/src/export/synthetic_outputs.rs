@@ -307,7 +307,6 @@ impl OutputsSpec {
             rejection_rounds: 0,
             build: Default::default(),
             relative_sigma: Default::default(),
-            off_control_sigma: Default::default(),
         };
         SyntheticOutputs {
             spec: *self,

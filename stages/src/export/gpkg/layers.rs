@@ -13,10 +13,10 @@
 //! reference), i.e. what was added.
 
 use super::writer::{FieldType, Geometry, GeometryType, Layer, Value};
-use crate::adjustment::support::recording_support;
 use crate::adjustment::verify::Verification;
 use crate::adjustment::AdjustmentRun;
 use crate::campaign::{CheckPoint, Recording};
+use crate::correction::support::recording_support;
 use crate::correspondence::AerialControlPoint;
 use crate::export::checkpoints::CheckPointRow;
 use crate::export::corrections::CorrectionSeries;

@@ -189,12 +189,12 @@ pub fn recording_support(run: &AdjustmentRun) -> Vec<RecordingSupport> {
 mod tests {
     use super::*;
     use crate::adjustment::AdjustConfig;
-    use crate::export::fixture::{point, recording};
+    use crate::correction::fixture::{point, recording};
 
     /// Recordings 5 m apart except a 100 m gap before recording 6; control at 1 and 3.
     fn run(relative: bool) -> AdjustmentRun {
         let xs = [0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 125.0, 130.0];
-        crate::export::fixture::run(
+        crate::correction::fixture::run(
             AdjustConfig {
                 relative_constraints: relative,
                 ..AdjustConfig::default()

@@ -18,8 +18,8 @@
 //! With too few controlled recordings for a variogram, such a recording's σ is at least its recorded prior σ:
 //! nothing better is known about it.
 
-use super::from_correspondences::AdjustmentRun;
 use super::support::{recording_support, Support};
+use crate::adjustment::AdjustmentRun;
 use crate::estimators::median_consensus::median_in_place;
 use serde::{Deserialize, Serialize};
 
@@ -197,7 +197,7 @@ pub fn widen_off_control_sigma(
 mod tests {
     use super::*;
     use crate::adjustment::{AdjustConfig, PointKind};
-    use crate::export::fixture::{point, recording, run};
+    use crate::correction::fixture::{point, recording, run};
 
     /// Corrections with white noise of known σ per axis (a deterministic ±σ pattern) have semivariance σ²
     /// at every lag.

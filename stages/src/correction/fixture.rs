@@ -54,6 +54,5 @@ pub fn run(
         rejection_rounds: 0,
         build: Default::default(),
         relative_sigma: Default::default(),
-        off_control_sigma: Default::default(),
     }
 }
