@@ -2,7 +2,7 @@
 //! one file each, all written atomically ([`crate::fsutil`]) and deterministically:
 //! [`trajectory`] `trajectory_adjusted.csv` (the input recordings file with adjusted values),
 //! [`corrections_csv`] `corrections.csv` (the correction time series of [`corrections`], each value with what
-//! supports it, [`support`]), [`geojson`] `trajectory.geojson` (QGIS), [`ply`] `tie_points.ply`
+//! supports it, [`crate::correction::support`]), [`geojson`] `trajectory.geojson` (QGIS), [`ply`] `tie_points.ply`
 //! (CloudCompare), [`checkpoints`] `checkpoints.csv` (per-point errors before/after), [`correspondences`]
 //! `correspondences.csv` (every control point's observations), [`gcp`] ground control for OpenSfM /
 //! OpenDroneMap, Metashape and as a plain list, [`gpkg`] `skytie.gpkg` (GeoPackage layers for GIS), [`colmap`] a COLMAP text
