@@ -86,6 +86,17 @@ fn coordinate_header(second: &SecondCrs) -> &'static str {
     }
 }
 
+/// The first line and the header row of a file: `lead`, the coordinate columns, the σ columns along the CRS's
+/// axes, then `tail` (starting with a comma, or empty).
+fn write_head(w: &mut dyn Write, second: &SecondCrs, lead: &str, tail: &str) -> io::Result<()> {
+    writeln!(w, "{}", first_line(second))?;
+    writeln!(
+        w,
+        "{lead},{},sigma_e_m,sigma_n_m,sigma_u_m{tail}",
+        coordinate_header(second)
+    )
+}
+
 fn write_trajectory(path: &Path, second: &SecondCrs, x: &SecondCrsRun<'_>) -> io::Result<()> {
     let mut rows = Vec::with_capacity(x.run.recordings.len());
     for (r, s) in x.run.recordings.iter().zip(&x.series.recordings) {
@@ -99,11 +110,11 @@ fn write_trajectory(path: &Path, second: &SecondCrs, x: &SecondCrsRun<'_>) -> io
         rows.push((r, c, p, [de, dn, c.delta_enu_m[2]], [se, sn, r.sigma_m[2]]));
     }
     atomic_write_with(path, |w| {
-        writeln!(w, "{}", first_line(second))?;
-        writeln!(
+        write_head(
             w,
-            "image_id,time,time_s,{},sigma_e_m,sigma_n_m,sigma_u_m,de_m,dn_m,du_m,correction",
-            coordinate_header(second)
+            second,
+            "image_id,time,time_s",
+            ",de_m,dn_m,du_m,correction",
         )?;
         for (r, c, [a, b, h], [de, dn, du], [se, sn, su]) in &rows {
             writeln!(
@@ -147,12 +158,7 @@ fn write_control_points(path: &Path, second: &SecondCrs, x: &SecondCrsRun<'_>) -
         rows.push((g, p, [se, sn, g.sigma[2]]));
     }
     atomic_write_with(path, |w| {
-        writeln!(w, "{}", first_line(second))?;
-        writeln!(
-            w,
-            "label,source,point_id,{},sigma_e_m,sigma_n_m,sigma_u_m",
-            coordinate_header(second)
-        )?;
+        write_head(w, second, "label,source,point_id", "")?;
         for (g, [a, b, h], [se, sn, su]) in &rows {
             writeln!(
                 w,
