@@ -149,7 +149,7 @@ impl Crs {
 
     /// This CRS with its datum shift (to ETRS89/WGS84) taken from the NTv2 grid `grid` instead of the EPSG
     /// definition's Helmert parameters ([`super::datum_grid`]): a national grid such as RDNAPTRANS's
-    /// `rdtrans2018.gsb` for RD New gives millimetres where the Helmert parameters give about a metre.
+    /// `rdtrans2018.gsb` for RD New gives millimetres where the Helmert parameters give decimetres.
     pub fn with_datum_grid(&self, grid: &std::path::Path) -> Result<Self, CrsError> {
         let key = super::datum_grid::load(grid)?;
         let mut definition: String = self

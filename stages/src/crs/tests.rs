@@ -103,7 +103,7 @@ fn etrs89_to_rd_and_back_within_a_millimetre() {
     let fwd = HorizontalTransform::new(&etrs, &rd);
     let back = HorizontalTransform::new(&rd, &etrs);
     let (e, n) = fwd.apply(52.0, 5.0).unwrap();
-    // Helmert-only ETRS89 → RD agrees with RDNAPTRANS to ≈ 1 m; here only plausibility and inversion.
+    // Helmert-only ETRS89 → RD agrees with RDNAPTRANS to decimetres (the self-validation test below); here only plausibility and inversion.
     assert!(
         (e - 128_410.0).abs() < 50.0 && (n - 445_806.0).abs() < 50.0,
         "{e} {n}"
@@ -111,6 +111,31 @@ fn etrs89_to_rd_and_back_within_a_millimetre() {
     let (lat, lon) = back.apply(e, n).unwrap();
     let err_m = ((lat - 52.0) * 111_200.0).hypot((lon - 5.0) * 68_500.0);
     assert!(err_m < 1e-3, "{err_m} m");
+}
+
+/// RDNAPTRANS™2018 self-validation file (`Z001_ETRS89andRDNAP.txt`, published by NSGI with the
+/// transformation), point 30010000: ETRS89 φ = 51.728601274°, λ = 4.712120126° ⇔ RD x = 108 360.8790 m,
+/// y = 415 757.2745 m. The EPSG definition without the RDNAPTRANS correction grid is what NSGI calls the
+/// simplified approximate transformation, off by at most a few decimetres horizontally: that is the bound
+/// here, both ways. Millimetres need the NTv2 grid (`datum_grid`).
+#[test]
+fn an_rdnaptrans_self_validation_point_within_the_documented_bound_without_the_grid() {
+    let etrs = Crs::parse("EPSG:4258").unwrap();
+    let rd = Crs::parse("EPSG:28992").unwrap();
+    let (lat, lon) = (51.728_601_274, 4.712_120_126);
+    let (x_ref, y_ref) = (108_360.879_0, 415_757.274_5);
+    let (x, y) = HorizontalTransform::new(&etrs, &rd)
+        .apply(lat, lon)
+        .unwrap();
+    let off_m = (x - x_ref).hypot(y - y_ref);
+    eprintln!("ETRS89 → RD without the grid: {off_m:.3} m from RDNAPTRANS ({x:.3}, {y:.3})");
+    assert!(off_m < 0.5, "{off_m} m off ({x}, {y})");
+    let (lat2, lon2) = HorizontalTransform::new(&rd, &etrs)
+        .apply(x_ref, y_ref)
+        .unwrap();
+    let back_m = ((lat2 - lat) * 111_200.0).hypot((lon2 - lon) * 69_100.0);
+    eprintln!("RD → ETRS89 without the grid: {back_m:.3} m from RDNAPTRANS");
+    assert!(back_m < 0.5, "{back_m} m off ({lat2}, {lon2})");
 }
 
 #[test]
