@@ -10,7 +10,9 @@
 //!   52.15517440° and longitude 5.38720621° (the reference point of Schreutelkamp and Strang van Hees,
 //!   "Benaderingsformules voor de transformatie tussen RD- en WGS84-kaartcoördinaten", Geodesia 2001/2, used
 //!   by every published RD ↔ WGS84 approximation). The EPSG definition's Helmert parameters reach it to
-//!   decimetres (the RD origin itself is given only to 0.1 m here, hence the metre bound); a national NTv2 grid (`datum_grid`) is what gives millimetres.
+//!   0.3 m. That reference is a WGS84 position of the approximation's time, not an RDNAPTRANS™ result, hence
+//!   the metre bound here; the decimetre check against RDNAPTRANS™2018's own self-validation point is a unit
+//!   test of the CRS layer. A national NTv2 grid (`datum_grid`) is what gives millimetres.
 
 use skytie_stages::crs::{OutputHeights, OutputsSection, SecondCrs, VerticalDatum};
 use skytie_stages::export::synthetic_outputs::OutputsSpec;
