@@ -6,7 +6,7 @@
 //!   Formulas"), worked example of the Oblique Stereographic method (EPSG 9809): Amersfoort / RD New,
 //!   φ = 53°00'00"N, λ = 6°00'00"E on the Amersfoort (Bessel 1841) datum ⇔ E = 196 105.283 m,
 //!   N = 557 057.739 m.
-//! - The RD origin, the Onze Lieve Vrouwetoren in Amersfoort, RD (155 000 m, 463 000 m), has ETRS89 latitude
+//! - The RD origin, the Onze Lieve Vrouwetoren in Amersfoort, RD (155 000 m, 463 000 m), has WGS84 latitude
 //!   52.15517440° and longitude 5.38720621° (the reference point of Schreutelkamp and Strang van Hees,
 //!   "Benaderingsformules voor de transformatie tussen RD- en WGS84-kaartcoördinaten", Geodesia 2001/2, used
 //!   by every published RD ↔ WGS84 approximation). The EPSG definition's Helmert parameters reach it to
