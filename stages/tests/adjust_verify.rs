@@ -1,6 +1,8 @@
 //! Known-answer tests of the verification (thesis Table 5-13): with exact observations
 //! and a purely systematic position error, every MM − aerial offset equals that error; a deteriorated campaign
-//! is flagged, an undeteriorated one passes; `verification.csv` parses back; segments by count and by length.
+//! is flagged, an undeteriorated one passes; a segment whose recordings drift with a mean near zero fails on its
+//! points, one wrong point does not fail a segment; `verification.csv` parses back; segments by count and by
+//! length.
 
 use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
 use skytie_stages::adjustment::verify::{
@@ -128,7 +130,8 @@ fn segments_by_length_and_csv_round_trip() {
             assert_eq!(row[8 + k].parse::<f64>().unwrap(), s.sd_m[k]);
             assert_eq!(row[13 + k].parse::<f64>().unwrap(), s.sigma_mean_m[k]);
         }
-        assert_eq!(&row[16], s.status.label());
+        assert_eq!(row[16].parse::<usize>().unwrap(), s.points_off);
+        assert_eq!(&row[17], s.status.label());
     }
     assert_eq!(&rows[rows.len() - 1][0], "all");
     std::fs::remove_dir_all(&dir).unwrap();
@@ -139,4 +142,38 @@ fn segments_by_length_and_csv_round_trip() {
     };
     let err = verify(&c.recordings, &c.pano_size_px, &c.control, &bad).unwrap_err();
     assert!(err.contains("tolerance_xy_m"), "{err}");
+}
+
+/// A GNSS outage: the middle segment's recordings drift 1 m east, then 1 m west, so the segment's mean offset is
+/// near zero and proves nothing; its points are each 1 m off, which fails it. One wrong aerial point in an
+/// otherwise exact segment is not enough to fail that segment.
+#[test]
+fn a_drifting_segment_fails_on_its_points_and_a_single_wrong_point_does_not() {
+    let mut c = campaign(0.0, 0.0, 0.5, 4);
+    for (i, r) in c.recordings.iter_mut().enumerate().take(40).skip(20) {
+        r.x += if i < 30 { 1.0 } else { -1.0 };
+    }
+    let config = VerifyConfig::default();
+    let v = verify(&c.recordings, &c.pano_size_px, &c.control, &config).unwrap();
+    let drift = &v.segments[1];
+    eprintln!("{}", render_verification_table(&v));
+    assert!(drift.offset_2d_m < 0.5, "mean {}", drift.offset_2d_m);
+    assert!(drift.points_off >= 2, "{} points off", drift.points_off);
+    assert_eq!(drift.status, VerifyStatus::Fail);
+    // The last segment is untouched; the first one's last point is also seen from drifted recordings.
+    assert_eq!(v.segments[2].points_off, 0);
+    assert!(v.segments[0].points_off <= 1);
+    for s in [&v.segments[0], &v.segments[2]] {
+        assert_eq!(s.status, VerifyStatus::Pass, "segment {}", s.index);
+    }
+    // One aerial point 2 m wrong in the last segment: counted, but the segment still passes.
+    let first = v.points.iter().find(|p| p.segment == 2).unwrap();
+    let id = first.tie_point_id.clone();
+    let mut wrong = c.control.clone();
+    let cp = wrong.iter_mut().find(|cp| cp.tie_point_id == id).unwrap();
+    let p = cp.point_world.as_mut().unwrap();
+    p[1] += 2.0;
+    let v = verify(&c.recordings, &c.pano_size_px, &wrong, &config).unwrap();
+    assert_eq!(v.segments[2].points_off, 1);
+    assert_eq!(v.segments[2].status, VerifyStatus::Pass);
 }

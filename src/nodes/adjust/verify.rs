@@ -25,6 +25,7 @@ pub fn verify_metrics(v: &Verification) -> serde_json::Value {
             "sd_m": s.sd_m,
             "sigma_mean_m": s.sigma_mean_m,
             "offset_2d_m": s.offset_2d_m,
+            "points_off": s.points_off,
             "status": s.status.label(),
         })
     };

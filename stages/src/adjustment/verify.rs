@@ -9,8 +9,13 @@
 //! `√(Σ σ²_k)/n` with `σ²_k` the diagonal of `C_MM + C_aerial` (a-priori triangulation covariances), so a
 //! segment with few points is not overconfident. Status: `fail` when the mean offset exceeds a tolerance
 //! *significantly* — the horizontal offset minus `confidence_k` σ of it above `tolerance_xy_m`, or (with
-//! `check_height`) |mean Z| minus `confidence_k` σ above `tolerance_z_m` — `insufficient` with fewer than
-//! `min_points` points, `pass` otherwise. The height is not tested by default: nadir images from ≈ 4500 m give
+//! `check_height`) |mean Z| minus `confidence_k` σ above `tolerance_z_m` — or when at least
+//! `min_points_off` points each show a horizontal offset beyond `tolerance_xy_m` by more than `confidence_k`
+//! of their own σ: a trajectory that drifts within a segment (a GNSS outage) has a mean that proves nothing,
+//! its spread is the evidence; otherwise `insufficient` with fewer than `min_points` points, `pass` otherwise.
+//! One point alone never fails a segment (a single wrong correspondence must not), but two independent
+//! points that both put the recordings significantly off are enough even where `min_points` are needed
+//! for a pass. The height is not tested by default: nadir images from ≈ 4500 m give
 //! aerial heights with metre-level errors (thesis 3.5.1.1), larger than their a-priori σ says once the aerial
 //! orientations are a few centimetres off, and an offset the data cannot resolve must not fail a good campaign.
 
@@ -27,7 +32,7 @@ use std::path::Path;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("verify", "5");
+pub const STAGE: StageId = StageId::new("verify", "6");
 
 crate::params! {
     /// Parameters of a verification (the verify node's params).
@@ -45,9 +50,14 @@ crate::params! {
         /// make them worse still, so a height test flags good trajectories (measured: the `aerial` error
         /// profile, demo seed 1, segment mean Z +3.9 m with the recorded positions exact).
         check_height: bool = false;
-        /// Fewer points in a segment give status `insufficient`.
+        /// Fewer points in a segment give status `insufficient` (unless it fails on `min_points_off`).
         min_points: usize = 3, min 1;
-        /// A segment fails only when an offset exceeds its tolerance by more than this many σ of the mean.
+        /// A segment fails when this many of its points each lie significantly beyond `tolerance_xy_m`
+        /// (horizontal offset minus `confidence_k` σ of that point): the recordings near them are off,
+        /// whatever the segment's mean says.
+        min_points_off: usize = 2, min 1;
+        /// A segment fails on its mean only when an offset exceeds its tolerance by more than this many σ of
+        /// the mean; a point counts as off (`min_points_off`) beyond this many σ of its own offset.
         confidence_k: f64 = 2.0, min 0.0;
         /// σ of a panorama observation (weights the MM triangulation), in pixels of the panorama's detail
         /// level (`PyramidLayout::detail_level`; full-resolution pixels unless the panorama was enlarged by
@@ -107,6 +117,8 @@ pub struct VerificationSegment {
     pub sigma_mean_m: [f64; 3],
     /// Length of the mean horizontal offset, metres.
     pub offset_2d_m: f64,
+    /// Points whose own horizontal offset exceeds `tolerance_xy_m` by more than `confidence_k` of their σ.
+    pub points_off: usize,
     pub status: VerifyStatus,
 }
 
@@ -351,7 +363,13 @@ fn statistics(
         }
     }
     let offset_2d = mean[0].hypot(mean[1]);
-    let status = if n < config.min_points {
+    let points_off = points
+        .iter()
+        .filter(|p| point_significantly_off(p, config))
+        .count();
+    let status = if points_off >= config.min_points_off {
+        VerifyStatus::Fail
+    } else if n < config.min_points {
         VerifyStatus::Insufficient
     } else if offset_2d - config.confidence_k * sigma_mean[0].max(sigma_mean[1])
         > config.tolerance_xy_m
@@ -374,12 +392,20 @@ fn statistics(
         sd_3d_m: sd_3d,
         sigma_mean_m: sigma_mean,
         offset_2d_m: offset_2d,
+        points_off,
         status,
     }
 }
 
+/// True when the point's horizontal offset exceeds `tolerance_xy_m` by more than `confidence_k` of its own
+/// horizontal σ (the root of the two variances, a bound on the σ in any horizontal direction).
+fn point_significantly_off(p: &VerifiedPoint, config: &VerifyConfig) -> bool {
+    let sigma_2d = (p.variance_m2[0] + p.variance_m2[1]).max(0.0).sqrt();
+    p.offset_m[0].hypot(p.offset_m[1]) - config.confidence_k * sigma_2d > config.tolerance_xy_m
+}
+
 /// Column names of `verification.csv`.
-pub const VERIFICATION_CSV_HEADER: [&str; 17] = [
+pub const VERIFICATION_CSV_HEADER: [&str; 18] = [
     "segment",
     "first_image_id",
     "last_image_id",
@@ -396,6 +422,7 @@ pub const VERIFICATION_CSV_HEADER: [&str; 17] = [
     "sigma_mean_x",
     "sigma_mean_y",
     "sigma_mean_z",
+    "points_off",
     "status",
 ];
 
@@ -426,12 +453,13 @@ pub fn write_verification_csv(path: &Path, v: &Verification) -> io::Result<()> {
             .map(|x| format!("{x}"));
             writeln!(
                 w,
-                "{label},{},{},{},{},{},{}",
+                "{label},{},{},{},{},{},{},{}",
                 csv_text(&s.first_image_id),
                 csv_text(&s.last_image_id),
                 s.recordings,
                 s.points,
                 nums.join(","),
+                s.points_off,
                 s.status.label()
             )?;
         }
@@ -457,11 +485,12 @@ pub fn render_verification_table(v: &Verification) -> String {
         v.config.tolerance_z_m * 100.0
     ));
     out.push_str(&format!(
-        "{:>4} {:<14} {:<14} {:>4} {:>7} {:>7} {:>7} {:>6} {:>6} {:>6} {:>7} {:>6} {:>7}  {}\n",
+        "{:>4} {:<14} {:<14} {:>4} {:>4} {:>7} {:>7} {:>7} {:>6} {:>6} {:>6} {:>7} {:>6} {:>7}  {}\n",
         "seg",
         "first",
         "last",
         "pts",
+        "off",
         "mean X",
         "mean Y",
         "mean Z",
@@ -481,11 +510,12 @@ pub fn render_verification_table(v: &Verification) -> String {
         };
         let cm = |x: f64| x * 100.0;
         out.push_str(&format!(
-            "{:>4} {:<14} {:<14} {:>4} {:>7.1} {:>7.1} {:>7.1} {:>6.1} {:>6.1} {:>6.1} {:>7.1} {:>6.1} {:>7.1}  {}\n",
+            "{:>4} {:<14} {:<14} {:>4} {:>4} {:>7.1} {:>7.1} {:>7.1} {:>6.1} {:>6.1} {:>6.1} {:>7.1} {:>6.1} {:>7.1}  {}\n",
             label,
             truncate(&s.first_image_id, 14),
             truncate(&s.last_image_id, 14),
             s.points,
+            s.points_off,
             cm(s.mean_m[0]),
             cm(s.mean_m[1]),
             cm(s.mean_m[2]),
