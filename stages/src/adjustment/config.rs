@@ -119,11 +119,14 @@ crate::params! {
         /// consecutive recordings); absent = estimated from the recorded trajectory itself (cross-track second
         /// differences, `adjustment::relative_noise`).
         relative_sigma_m: Option<f64> = None, unit "m", above 0.0;
-        /// Huber threshold of the relative constraints, in σ units: a step between consecutive recordings that
-        /// differs from the recorded one by more than this many σ (a jump when GNSS is re-acquired, drift
-        /// during an outage, an error turning with the vehicle) is released linearly instead of
-        /// quadratically, so the aerial evidence can correct it; absent = plain least squares.
-        relative_huber_threshold: Option<f64> = Some(3.0), above 0.0;
+        /// Robust loss on the relative constraints: `none`, `huber` or `cauchy`. A step between consecutive
+        /// recordings that differs from the recorded one by more than `relative_loss_scale` σ (a jump when
+        /// GNSS is re-acquired, drift during an outage, an error turning with the vehicle) is released so that
+        /// the aerial evidence can correct it: linearly (`huber`) or almost entirely (`cauchy`, whose weight
+        /// falls as 1 / (1 + (r/scale)²)); `none` is plain least squares.
+        relative_loss: LossKind = LossKind::Huber;
+        /// Huber threshold / Cauchy scale of `relative_loss`, in σ units.
+        relative_loss_scale: f64 = 3.0, above 0.0;
         /// Consecutive recordings farther apart than this are not linked (a gap in the trajectory).
         relative_max_gap_m: f64 = 15.0, unit "m", above 0.0;
         /// Estimate a yaw correction per recording.
@@ -132,6 +135,15 @@ crate::params! {
         yaw_prior_sigma_deg: f64 = 1.0, unit "deg", above 0.0;
         /// Largest number of Levenberg–Marquardt iterations per solve.
         max_iterations: usize = 100, min 1;
+    }
+}
+
+/// The robust loss of `kind` with its Huber threshold / Cauchy scale `scale` (σ units).
+fn robust_loss(kind: LossKind, scale: f64) -> RobustLoss {
+    match kind {
+        LossKind::None => RobustLoss::Squared,
+        LossKind::Huber => RobustLoss::Huber { threshold: scale },
+        LossKind::Cauchy => RobustLoss::Cauchy { scale },
     }
 }
 
@@ -157,19 +169,8 @@ impl AdjustConfig {
             estimate_yaw: self.estimate_yaw,
             yaw_prior_sigma_deg: self.estimate_yaw.then_some(self.yaw_prior_sigma_deg),
             weighting: self.weighting(),
-            loss: match self.loss {
-                LossKind::None => RobustLoss::Squared,
-                LossKind::Huber => RobustLoss::Huber {
-                    threshold: self.loss_scale,
-                },
-                LossKind::Cauchy => RobustLoss::Cauchy {
-                    scale: self.loss_scale,
-                },
-            },
-            relative_loss: match self.relative_huber_threshold {
-                Some(threshold) => RobustLoss::Huber { threshold },
-                None => RobustLoss::Squared,
-            },
+            loss: robust_loss(self.loss, self.loss_scale),
+            relative_loss: robust_loss(self.relative_loss, self.relative_loss_scale),
             rejection_threshold: self.rejection_threshold,
             max_rejection_rounds: self.max_rejection_rounds,
             lm: LmOptions {
