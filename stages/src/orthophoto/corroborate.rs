@@ -231,6 +231,53 @@ mod tests {
     }
 
     #[test]
+    fn references_are_the_triangulated_positions_through_the_registration() {
+        use crate::correspondence::{MmTiePoint, PanoObservation};
+        // A 200 × 200 px north-up ortho of 0.1 m pixels centred at (1000, 2000); the orthophoto pixel of an
+        // ortho pixel is (u + 50, v − 30) (a pure translation, as the registration finds it).
+        let georef = OrthoGeoref {
+            foot_world: [1000.0, 2000.0, 10.0],
+            gsd_m: 0.1,
+            rotation_deg: 0.0,
+            width_px: 200,
+            height_px: 200,
+        };
+        let tf = Similarity2::new(1.0, 0.0, 50.0, -30.0);
+        let obs = PanoObservation {
+            image_id: "r1".into(),
+            u_px: 1.0,
+            v_px: 2.0,
+        };
+        let tie_point = MmTiePoint {
+            id: "r1#4".into(),
+            observations: vec![obs.clone(), obs],
+            // 3 m east and 2 m north of the foot, 0.2 m below the plane: its height plays no part.
+            point_world: [1003.0, 2002.0, 9.8],
+            covariance_m2: [[0.0; 3]; 3],
+            max_angle_deg: 10.0,
+        };
+        let window = MmWindowMatch {
+            recording_id: "r1".into(),
+            pairs: Vec::new(),
+            corners_detected: 1,
+            tie_points: vec![tie_point],
+            ground_world: vec![[1002.9, 2001.9, 10.0]],
+            neighbour_ground_world: vec![Vec::new()],
+        };
+        let m = vec![
+            located("r1#4", (0.0, 0.0), 0.6),
+            located("elsewhere", (0.0, 0.0), 0.6),
+        ];
+        let refs = triangulated_references(&m, &window, &georef, &tf);
+        // Ortho pixel (100 + 30, 100 − 20) → orthophoto (180, 50); the unknown tie point keeps its prediction.
+        assert!(
+            (refs[0][0] - 180.0).abs() < 1e-9 && (refs[0][1] - 50.0).abs() < 1e-9,
+            "{refs:?}"
+        );
+        assert_eq!(refs[1], [500.0, 700.0]);
+    }
+
+    #[test]
     fn corrections_from_the_triangulated_positions_agree_where_the_ground_plane_spreads_them() {
         let (m, refs) = radial_scene();
         // From the ground plane the six corrections spread radially by 0.7–3.5 px around (3, −2): one lies
