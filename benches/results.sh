@@ -7,7 +7,7 @@
 #   WORK_DIR   where caches, outputs and logs go (default: a new temporary folder; it is emptied first)
 #   SEEDS      demo seeds for the default workflow (default "1 4 5"; seed 1 is the README's main job; "" = none)
 #   ORTHO_SEEDS  demo seeds for the orthophoto route and, on the same scene, the frame route with the same
-#              workflow (default "3 4 5"; seed 2 was used to choose the route's parameters; "" = none)
+#              workflow (default "4 5 6"; seeds 2 and 3 were used to choose the route's parameters; "" = none)
 #   ORTHO_ROUTES  which of the two runs per orthophoto seed (default "ortho frames"; "ortho" = the orthophoto
 #              route only)
 #
@@ -17,7 +17,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 REPO="$(pwd)"
 SEEDS="${SEEDS-1 4 5}"
-ORTHO_SEEDS="${ORTHO_SEEDS-3 4 5}"
+ORTHO_SEEDS="${ORTHO_SEEDS-4 5 6}"
 ORTHO_ROUTES="${ORTHO_ROUTES-ortho frames}"
 WORK="${1:-$(mktemp -d -t skytie-results-XXXXXX)}"
 rm -rf "$WORK" && mkdir -p "$WORK"
@@ -262,7 +262,7 @@ if route_runs:
     else:
         w("0.03 m RMS 2-D (stated σ 0.021 m per axis), a 1 m DTM and no nadir frames ([orthophoto.md](orthophoto.md);")
         w("this run left out the frame route on the same scenes, `ORTHO_ROUTES=ortho`). The route's parameters")
-    w("were chosen on demo seed 2" + (f"; seed{'s' if len(ortho_seeds) > 1 else ''} {', '.join(ortho_seeds)} "
+    w("were chosen on demo seeds 2 and 3" + (f"; seed{'s' if len(ortho_seeds) > 1 else ''} {', '.join(ortho_seeds)} "
       "played no part in choosing them." if ortho_seeds else "."))
     w("")
     table(rows[:8] + [

@@ -10,7 +10,7 @@
 //! where the corrections agree ([`super::corroborate`]), control points — is
 //! [`orthophoto_control`].
 
-use super::corroborate::corroborated;
+use super::corroborate::{corroborated, triangulated_references};
 use super::dtm::Dtm;
 use super::precision::{match_sigma_px, WeakPeakSigma};
 use super::register::register_translation;
@@ -69,8 +69,14 @@ fn refine_corroborated(
     let image = (photo.tile.file.as_str(), AerialKind::Nadir);
     let mut r = refine_in_image(ortho, photo.pixels, image, t, window, neighbours, &relaxed)?;
     let scale = r.matches.first().map_or(1.0, |m| (1u64 << m.level) as f64);
+    let references = if p.corroborate_triangulated {
+        triangulated_references(&r.matches, window, &ortho.georef, &t.ortho_to_aerial)
+    } else {
+        Vec::new()
+    };
     let c = corroborated(
         std::mem::take(&mut r.matches),
+        &references,
         p.refine.min_peak,
         p.corroboration_px,
         p.min_corroborating,

@@ -8,19 +8,56 @@
 //! (weak or strong) agree there. A chance peak meets one given pixel disc of radius r in a (2m + 1)² window
 //! with probability ≈ πr²/(2m + 1)² (0.5 % for r = 1, m = 12), so agreeing weak peaks are not chance.
 //!
+//! A tie point's correction is measured from where its triangulated position (the panoramas' ray intersection,
+//! `MmTiePoint::point_world`) falls in the orthophoto through the recording's registration, not from its corner
+//! on the ortho's ground plane: the plane lies `camera_height` below the camera, and a ground point Δh below
+//! the plane at horizontal distance r shows in the ortho r·Δh/(h + Δh) nearer the camera (a road's camber and
+//! the terrain's slope put Δh at several centimetres: on the demo scenes the tie points lie a median 4 cm and
+//! up to 13 cm below the plane, 6.5 m out, which is 1–4 working pixels of 0.1 m). Corrections from the plane
+//! therefore spread radially around the car by more than the corroboration radius even where every peak is
+//! right; the triangulated positions carry no such parallax, so correct peaks agree to the triangulation's
+//! own error.
+//!
 //! The agreed correction is the median of the strong peaks' corrections (≥ `min_peak`) when the recording has
 //! any, else the median of all: weak peaks under the same crowns are displaced alike (the visible part of each
 //! template pulls its peak the same way), so several of them can agree with each other a few pixels away from
 //! the strong ones, and outnumber them. Strong peaks keep the refinement's own shift-consistency check.
 
 use crate::estimators::median_consensus::median_consensus;
-use crate::nadir::AerialMatch;
+use crate::geometry::Similarity2;
+use crate::nadir::{AerialMatch, MmWindowMatch, OrthoGeoref};
+use nalgebra::{Vector2, Vector3};
 
-/// The correction (observed − predicted) of `m` in working pixels (`scale` full pixels per working pixel).
-fn correction(m: &AerialMatch, scale: f64) -> [f64; 2] {
+/// Where each of `matches`' tie points (looked up by id in `window`) lies in the orthophoto, full pixels: its
+/// triangulated position's vertical projection onto the ortho (`georef`), through the registration
+/// `ortho_to_photo` (ortho px → full orthophoto px). A match whose tie point is not in the window keeps its
+/// prediction.
+pub fn triangulated_references(
+    matches: &[AerialMatch],
+    window: &MmWindowMatch,
+    georef: &OrthoGeoref,
+    ortho_to_photo: &Similarity2,
+) -> Vec<[f64; 2]> {
+    matches
+        .iter()
+        .map(|m| {
+            let Some(tp) = window.tie_points.iter().find(|tp| tp.id == m.tie_point_id) else {
+                return [m.predicted_u_px, m.predicted_v_px];
+            };
+            let [x, y, z] = tp.point_world;
+            let (u, v) = georef.world_to_pixel(&Vector3::new(x, y, z));
+            let r = ortho_to_photo.apply(&Vector2::new(u, v));
+            [r.x, r.y]
+        })
+        .collect()
+}
+
+/// The correction (observed − `reference`, full pixels) of `m` in working pixels (`scale` full pixels per
+/// working pixel).
+fn correction(m: &AerialMatch, reference: [f64; 2], scale: f64) -> [f64; 2] {
     [
-        (m.observation.u_px - m.predicted_u_px) / scale,
-        (m.observation.v_px - m.predicted_v_px) / scale,
+        (m.observation.u_px - reference[0]) / scale,
+        (m.observation.v_px - reference[1]) / scale,
     ]
 }
 
@@ -37,9 +74,13 @@ pub struct Corroboration {
 /// The matches to keep among `matches` (one recording, one orthophoto): every one with a peak ≥ `min_peak`,
 /// and those with a weaker peak whose correction lies within `radius_px` (working pixels; `scale` full pixels
 /// each) of the agreed correction — the median correction of the strong matches, or of all matches when none
-/// is strong — when at least `min_agreeing` matches lie there. The order of `matches` is kept.
+/// is strong — when at least `min_agreeing` matches lie there. A match's correction is its observation minus
+/// its entry of `references` (full orthophoto pixels: where its tie point's triangulated position falls, see
+/// the module documentation); a match without one (`references` shorter) is measured from its prediction.
+/// The order of `matches` is kept.
 pub fn corroborated(
     matches: Vec<AerialMatch>,
+    references: &[[f64; 2]],
     min_peak: f64,
     radius_px: f64,
     min_agreeing: usize,
@@ -47,7 +88,17 @@ pub fn corroborated(
 ) -> Corroboration {
     let strong = |m: &AerialMatch| m.observation.score >= min_peak;
     let n_weak = matches.iter().filter(|m| !strong(m)).count();
-    let corrections: Vec<[f64; 2]> = matches.iter().map(|m| correction(m, scale)).collect();
+    let corrections: Vec<[f64; 2]> = matches
+        .iter()
+        .enumerate()
+        .map(|(k, m)| {
+            let r = references
+                .get(k)
+                .copied()
+                .unwrap_or([m.predicted_u_px, m.predicted_v_px]);
+            correction(m, r, scale)
+        })
+        .collect();
     let strong_corrections: Vec<[f64; 2]> = matches
         .iter()
         .zip(&corrections)
@@ -115,7 +166,7 @@ mod tests {
             located("stray", (-7.0, 5.0), 0.58),
             located("weak_c", (2.4, -0.6), 0.51),
         ];
-        let c = corroborated(m, 0.75, 1.0, 3, 1.0);
+        let c = corroborated(m, &[], 0.75, 1.0, 3, 1.0);
         assert_eq!(ids(&c), ["weak_a", "strong", "weak_b", "weak_c"]);
         assert_eq!((c.weak_kept, c.weak_dropped), (3, 1));
     }
@@ -127,7 +178,7 @@ mod tests {
             located("strong", (9.0, 3.0), 0.8),
             located("weak_b", (-4.0, 6.0), 0.6),
         ];
-        let c = corroborated(m, 0.75, 1.0, 3, 1.0);
+        let c = corroborated(m, &[], 0.75, 1.0, 3, 1.0);
         assert_eq!(ids(&c), ["strong"]);
         assert_eq!((c.weak_kept, c.weak_dropped), (0, 2));
     }
@@ -141,8 +192,102 @@ mod tests {
             located("b", (2.4, 0.0), 0.6),
             located("c", (1.2, 0.0), 0.6),
         ];
-        assert_eq!(corroborated(m.clone(), 0.75, 1.0, 3, 2.0).kept.len(), 3);
-        assert!(corroborated(m, 0.75, 1.0, 3, 1.0).kept.is_empty());
+        assert_eq!(
+            corroborated(m.clone(), &[], 0.75, 1.0, 3, 2.0).kept.len(),
+            3
+        );
+        assert!(corroborated(m, &[], 0.75, 1.0, 3, 1.0).kept.is_empty());
+    }
+
+    /// A camera h = 2.2 m above the ortho's plane, at the origin (north-up, 0.1 m pixels: pixel = 10 × metre,
+    /// v southwards); the road falls away from the car, so a ground point r metres out (r = 4 … 9 m, six
+    /// directions) lies Δh = 0.01·r m below the plane and the ortho shows it r·h/(h + Δh) from the camera —
+    /// its corner on the plane, 0.7–3.5 px nearer the car. The orthophoto shows it at its true place shifted
+    /// by the recording's offset (3, −2) px; the triangulated position is the true one.
+    fn radial_scene() -> (Vec<AerialMatch>, Vec<[f64; 2]>) {
+        let h = 2.2;
+        let mut matches = Vec::new();
+        let mut references = Vec::new();
+        for (k, deg) in [0.0f64, 60.0, 120.0, 180.0, 240.0, 300.0]
+            .iter()
+            .enumerate()
+        {
+            let r = 4.0 + k as f64;
+            let (s, c) = deg.to_radians().sin_cos();
+            let true_xy = [r * s, r * c];
+            let dh = 0.01 * r;
+            let plane = [true_xy[0] * h / (h + dh), true_xy[1] * h / (h + dh)];
+            let px = |p: [f64; 2]| [500.0 + 10.0 * p[0], 700.0 - 10.0 * p[1]];
+            let (t, pl) = (px(true_xy), px(plane));
+            let mut m = located(&format!("tp{k}"), (0.0, 0.0), 0.6);
+            m.observation.u_px = t[0] + 3.0;
+            m.observation.v_px = t[1] - 2.0;
+            m.predicted_u_px = pl[0];
+            m.predicted_v_px = pl[1];
+            matches.push(m);
+            references.push(t);
+        }
+        (matches, references)
+    }
+
+    #[test]
+    fn references_are_the_triangulated_positions_through_the_registration() {
+        use crate::correspondence::{MmTiePoint, PanoObservation};
+        // A 200 × 200 px north-up ortho of 0.1 m pixels centred at (1000, 2000); the orthophoto pixel of an
+        // ortho pixel is (u + 50, v − 30) (a pure translation, as the registration finds it).
+        let georef = OrthoGeoref {
+            foot_world: [1000.0, 2000.0, 10.0],
+            gsd_m: 0.1,
+            rotation_deg: 0.0,
+            width_px: 200,
+            height_px: 200,
+        };
+        let tf = Similarity2::new(1.0, 0.0, 50.0, -30.0);
+        let obs = PanoObservation {
+            image_id: "r1".into(),
+            u_px: 1.0,
+            v_px: 2.0,
+        };
+        let tie_point = MmTiePoint {
+            id: "r1#4".into(),
+            observations: vec![obs.clone(), obs],
+            // 3 m east and 2 m north of the foot, 0.2 m below the plane: its height plays no part.
+            point_world: [1003.0, 2002.0, 9.8],
+            covariance_m2: [[0.0; 3]; 3],
+            max_angle_deg: 10.0,
+        };
+        let window = MmWindowMatch {
+            recording_id: "r1".into(),
+            pairs: Vec::new(),
+            corners_detected: 1,
+            tie_points: vec![tie_point],
+            ground_world: vec![[1002.9, 2001.9, 10.0]],
+            neighbour_ground_world: vec![Vec::new()],
+        };
+        let m = vec![
+            located("r1#4", (0.0, 0.0), 0.6),
+            located("elsewhere", (0.0, 0.0), 0.6),
+        ];
+        let refs = triangulated_references(&m, &window, &georef, &tf);
+        // Ortho pixel (100 + 30, 100 − 20) → orthophoto (180, 50); the unknown tie point keeps its prediction.
+        assert!(
+            (refs[0][0] - 180.0).abs() < 1e-9 && (refs[0][1] - 50.0).abs() < 1e-9,
+            "{refs:?}"
+        );
+        assert_eq!(refs[1], [500.0, 700.0]);
+    }
+
+    #[test]
+    fn corrections_from_the_triangulated_positions_agree_where_the_ground_plane_spreads_them() {
+        let (m, refs) = radial_scene();
+        // From the ground plane the six corrections spread radially by 0.7–3.5 px around (3, −2): one lies
+        // within 1 px of their median, too few, so every weak peak is dropped.
+        let from_plane = corroborated(m.clone(), &[], 0.75, 1.0, 3, 1.0);
+        assert!(from_plane.kept.is_empty(), "{:?}", ids(&from_plane));
+        // From the triangulated positions all six agree on (3, −2) exactly.
+        let c = corroborated(m, &refs, 0.75, 1.0, 3, 1.0);
+        assert_eq!(ids(&c), ["tp0", "tp1", "tp2", "tp3", "tp4", "tp5"]);
+        assert_eq!((c.weak_kept, c.weak_dropped), (6, 0));
     }
 
     #[test]
@@ -158,7 +303,7 @@ mod tests {
             located("strong_b", (-0.1, 0.1), 0.8),
             located("weak_e", (0.3, 0.2), 0.6),
         ];
-        let c = corroborated(m, 0.75, 1.0, 3, 1.0);
+        let c = corroborated(m, &[], 0.75, 1.0, 3, 1.0);
         assert_eq!(ids(&c), ["strong_a", "strong_b", "weak_e"]);
         assert_eq!((c.weak_kept, c.weak_dropped), (1, 4));
     }

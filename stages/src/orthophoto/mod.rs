@@ -27,7 +27,7 @@ use crate::params::StageId;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("orthophoto", "5");
+pub const STAGE: StageId = StageId::new("orthophoto", "6");
 
 crate::params! {
     /// Parameters of the orthophoto route (registration, refinement and control points).
@@ -51,6 +51,10 @@ crate::params! {
         corroborated_min_peak: f64 = 0.5, min 0.0, below 1.0;
         /// Radius around the agreed correction within which a weak peak is corroborated, working pixels.
         corroboration_px: f64 = 1.0, unit "px", min 0.0, max 10.0;
+        /// Measure a located tie point's correction from its triangulated position rather than from its corner
+        /// on the ortho's ground plane ([`corroborate`]): the plane's parallax spreads correct corrections
+        /// radially by 1–4 px where the road lies a few centimetres below it.
+        corroborate_triangulated: bool = true;
         /// Fewest located tie points (weak or strong) that must agree on the correction for weak ones to be kept.
         min_corroborating: usize = 3, min 2, max 100;
         /// A weak peak's matching σ is `match_sigma_px` · ((1 − peak) / (1 − `refine.min_peak`)) to this power
