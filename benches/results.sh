@@ -149,7 +149,7 @@ w(f"Measured with {os.environ['VERSION']} (commit `{os.environ['COMMIT']}`) on {
   "horizontal axis, thesis 3.5.1.2), and the grading compares with their `truth/`.")
 w("")
 w("The default workflow's adjustment settings (`relative_sigma_m`, `loss`, `rejection_threshold`, `aerial_observations`, "
-  "`estimate_yaw` and `yaw_prior_sigma_deg`, `relative_huber_threshold`; see "
+  "`estimate_yaw` and `yaw_prior_sigma_deg`, `relative_loss` and `relative_loss_scale`; see "
   "`skytie workflows show default`) were chosen by looking at demo seeds 1–3. "
   + (f"Seed{'s' if len(held_out) > 1 else ''} {', '.join(held_out)} "
      "played no part in choosing any parameter." if held_out else ""))
