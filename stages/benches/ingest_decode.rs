@@ -103,7 +103,8 @@ fn decode_tiff_zune_luma(path: &Path) -> Option<Result<u64, String>> {
         let mut chunk = Vec::new();
         for (&offset, &count) in offsets.iter().zip(&counts) {
             chunk.resize(count as usize, 0);
-            raw.read_exact_at(&mut chunk, offset).map_err(|e| e.to_string())?;
+            raw.read_exact_at(&mut chunk, offset)
+                .map_err(|e| e.to_string())?;
             let stream = match &tables {
                 Some(t) if t.len() >= 4 => [&t[..t.len() - 2], &chunk[2..]].concat(),
                 _ => chunk.clone(),

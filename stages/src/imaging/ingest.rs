@@ -168,9 +168,11 @@ impl Worker {
 
     /// Sends the last rows and [`Message::Finish`], and waits for the finished pyramid.
     fn finish(mut self) -> io::Result<PyramidSummary> {
-        let sent = self
-            .send_band(true)
-            .and_then(|()| self.to_builder.send(Message::Finish).map_err(|_| self.builder_stopped()));
+        let sent = self.send_band(true).and_then(|()| {
+            self.to_builder
+                .send(Message::Finish)
+                .map_err(|_| self.builder_stopped())
+        });
         drop(self.to_builder);
         let built = join(self.handle);
         sent.and(built)
@@ -244,7 +246,12 @@ pub fn ingest_with_tiles(
             let pyramid = worker.finish().map_err(incomplete)?;
             return Ok(Ingested { info, pyramid });
         }
-        (Ok(_), None) => return Err(ImageIoError::new(source, "internal: the decoder produced no image")),
+        (Ok(_), None) => {
+            return Err(ImageIoError::new(
+                source,
+                "internal: the decoder produced no image",
+            ))
+        }
         (Err(e), worker) => (e, worker),
     };
     // The decoder failed: stop the builder (its temporary file goes) and report why. A decoder error caused
@@ -259,4 +266,107 @@ pub fn ingest_with_tiles(
         }
     }
     Err(e)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::imaging::tiff_write::{TiffCompression, TiledTiffSpec, TiledTiffWriter};
+
+    /// Feeds decoded rows straight into a builder on this thread: the single-threaded reference.
+    struct Direct {
+        dest: PathBuf,
+        builder: Option<PyramidBuilder>,
+    }
+
+    impl GreyRowSink for Direct {
+        fn begin(&mut self, info: &GreyInfo) -> io::Result<()> {
+            let b = PyramidBuilder::create(&self.dest, info.width, info.height, info.depth, 64)?;
+            self.builder = Some(b);
+            Ok(())
+        }
+        fn row_u8(&mut self, row: &[u8]) -> io::Result<()> {
+            self.builder.as_mut().unwrap().push_row_u8(row)
+        }
+        fn row_u16(&mut self, row: &[u16]) -> io::Result<()> {
+            self.builder.as_mut().unwrap().push_row_u16(row)
+        }
+    }
+
+    /// A `w × h` tiled TIFF (64-px tiles) of `bytes` bytes per grey sample, compressed as `compression`.
+    fn write(path: &Path, (w, h): (usize, usize), bytes: usize, compression: TiffCompression) {
+        let spec = TiledTiffSpec {
+            width: w,
+            height: h,
+            channels: 1,
+            bytes_per_sample: bytes,
+            tile_side: 64,
+            compression,
+            big: false,
+        };
+        let mut out = TiledTiffWriter::create(path, spec).unwrap();
+        for r in 0..h {
+            let value = |c: usize| (c * 31 + r * 17 + (c * r) % 101) % 4096;
+            if bytes == 1 {
+                let row: Vec<u8> = (0..w).map(|c| value(c) as u8).collect();
+                out.push_row_u8(&row).unwrap();
+            } else {
+                let row: Vec<u16> = (0..w).map(|c| value(c) as u16).collect();
+                out.push_row_u16(&row).unwrap();
+            }
+        }
+        out.finish().unwrap();
+    }
+
+    #[test]
+    fn the_pyramid_built_beside_the_decoder_is_the_single_threaded_one_byte_for_byte() {
+        let dir = tempfile::tempdir().unwrap();
+        // Taller than all band buffers together, so every buffer goes round several times.
+        let size = (333, BANDS * BAND_ROWS * 3 + 37);
+        for (i, (bytes, compression)) in [
+            (1, TiffCompression::Jpeg(90)),
+            (2, TiffCompression::Deflate),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let src = dir.path().join(format!("s{i}.tif"));
+            write(&src, size, bytes, compression);
+            let threaded = dir.path().join(format!("t{i}.pyr"));
+            let done = ingest_with_tiles(&src, &threaded, 64).unwrap();
+            let mut direct = Direct {
+                dest: dir.path().join(format!("d{i}.pyr")),
+                builder: None,
+            };
+            decode_grey(&src, &mut direct).unwrap();
+            let reference = direct.builder.take().unwrap().finish().unwrap();
+            assert_eq!(done.pyramid, reference);
+            assert!(
+                std::fs::read(&threaded).unwrap() == std::fs::read(&direct.dest).unwrap(),
+                "case {i}: the files differ"
+            );
+        }
+    }
+
+    #[test]
+    fn a_decoder_failing_midway_leaves_no_pyramid_and_names_the_file() {
+        use std::os::unix::fs::FileExt;
+        let dir = tempfile::tempdir().unwrap();
+        let src = dir.path().join("bad.tif");
+        write(&src, (200, 900), 1, TiffCompression::Deflate);
+        // Spoil the compressed data of the last tile: rows before it decode, then the decoder fails.
+        let mut dec = tiff::decoder::Decoder::new(std::io::BufReader::new(
+            std::fs::File::open(&src).unwrap(),
+        ))
+        .unwrap();
+        let offsets = dec.get_tag_u64_vec(tiff::tags::Tag::TileOffsets).unwrap();
+        let file = std::fs::OpenOptions::new().write(true).open(&src).unwrap();
+        file.write_all_at(&[0xFF; 8], *offsets.last().unwrap())
+            .unwrap();
+        let out = dir.path().join("out");
+        let e = ingest_with_tiles(&src, &out.join("p.pyr"), 64).unwrap_err();
+        assert!(e.to_string().contains("bad.tif"), "{e}");
+        let left: Vec<_> = std::fs::read_dir(&out).unwrap().collect();
+        assert!(left.is_empty(), "left behind: {left:?}");
+    }
 }

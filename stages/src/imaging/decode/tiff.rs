@@ -268,7 +268,11 @@ fn read_chunk(
                     ),
                 ));
             }
-            return Ok((Samples::U8(chunk.samples), chunk.width, Channels::Grey { extra: 0 }));
+            return Ok((
+                Samples::U8(chunk.samples),
+                chunk.width,
+                Channels::Grey { extra: 0 },
+            ));
         }
     };
     let expected = c.row_px * rows * c.samples * c.bytes_per_sample;
@@ -310,7 +314,13 @@ impl Band {
                 decoded.push(samples);
                 (row_px, channels) = (px, ch);
             }
-            let layout = ChunkLayout { x0: c * s.chunk_w, dw, dh, row_px, channels };
+            let layout = ChunkLayout {
+                x0: c * s.chunk_w,
+                dw,
+                dh,
+                row_px,
+                channels,
+            };
             self.place(path, s, &decoded, layout)?;
         }
         Ok(band_h)

@@ -64,7 +64,9 @@ pub fn read_jpeg_chunk(
         .set_max_height(MAX_SIDE_PX);
     let mut decoder = JpegDecoder::new_with_options(ZCursor::new(&data[..]), options);
     let bad = |e: zune_jpeg::errors::DecodeErrors| {
-        corrupt(format!("a JPEG chunk at byte {offset} does not decode ({e:?})"))
+        corrupt(format!(
+            "a JPEG chunk at byte {offset} does not decode ({e:?})"
+        ))
     };
     decoder.decode_headers().map_err(bad)?;
     let input = decoder.input_colorspace().unwrap_or(ColorSpace::Unknown);
@@ -93,4 +95,103 @@ pub fn read_jpeg_chunk(
         width,
         height,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::imaging::decode::{decode_grey, GreyInfo, GreyRowSink};
+    use crate::imaging::tiff_write::{TiffCompression, TiledTiffSpec, TiledTiffWriter};
+    use std::path::Path;
+
+    /// Keeps every 8-bit row.
+    #[derive(Default)]
+    struct Rows(Vec<u8>);
+
+    impl GreyRowSink for Rows {
+        fn begin(&mut self, _: &GreyInfo) -> std::io::Result<()> {
+            Ok(())
+        }
+        fn row_u8(&mut self, row: &[u8]) -> std::io::Result<()> {
+            self.0.extend_from_slice(row);
+            Ok(())
+        }
+        fn row_u16(&mut self, _: &[u16]) -> std::io::Result<()> {
+            Err(std::io::Error::other("16-bit rows from an 8-bit image"))
+        }
+    }
+
+    /// A `w × h` JPEG-compressed tiled TIFF of `channels` (1 or 3) channels with 64-px tiles.
+    fn write(path: &Path, w: usize, h: usize, channels: usize) {
+        let spec = TiledTiffSpec {
+            width: w,
+            height: h,
+            channels,
+            bytes_per_sample: 1,
+            tile_side: 64,
+            compression: TiffCompression::Jpeg(90),
+            big: false,
+        };
+        let mut out = TiledTiffWriter::create(path, spec).unwrap();
+        for r in 0..h {
+            let row: Vec<u8> = (0..w * channels)
+                .map(|i| ((i * 7 + r * 13 + (i * r) % 29) % 256) as u8)
+                .collect();
+            out.push_row_u8(&row).unwrap();
+        }
+        out.finish().unwrap();
+    }
+
+    /// The grey the `tiff` crate's own decode of every tile gives (all components, the first one taken).
+    fn tiff_crate_grey(path: &Path) -> Vec<u8> {
+        let file = std::io::BufReader::new(std::fs::File::open(path).unwrap());
+        let mut dec = tiff::decoder::Decoder::new(file).unwrap();
+        let (w, h) = dec.dimensions().unwrap();
+        let (w, h) = (w as usize, h as usize);
+        let n = match dec.colortype().unwrap() {
+            tiff::ColorType::Gray(8) => 1,
+            _ => 3,
+        };
+        let mut grey = vec![0u8; w * h];
+        let across = w.div_ceil(64);
+        for t in 0..across * h.div_ceil(64) {
+            let (dw, dh) = dec.chunk_data_dimensions(t as u32);
+            let tiff::decoder::DecodingResult::U8(v) = dec.read_chunk(t as u32).unwrap() else {
+                panic!("8-bit samples expected");
+            };
+            let (x0, y0) = ((t % across) * 64, (t / across) * 64);
+            for r in 0..dh as usize {
+                for c in 0..dw as usize {
+                    grey[(y0 + r) * w + x0 + c] = v[(r * dw as usize + c) * n];
+                }
+            }
+        }
+        grey
+    }
+
+    #[test]
+    fn jpeg_tiles_decode_to_the_luma_the_tiff_crate_decodes() {
+        let dir = tempfile::tempdir().unwrap();
+        for channels in [3, 1] {
+            let path = dir.path().join(format!("j{channels}.tif"));
+            write(&path, 300, 170, channels);
+            let mut rows = Rows::default();
+            decode_grey(&path, &mut rows).unwrap();
+            assert_eq!(rows.0.len(), 300 * 170);
+            assert!(
+                rows.0 == tiff_crate_grey(&path),
+                "{channels} channels: the luma-only decode differs from the tiff crate's"
+            );
+        }
+    }
+
+    #[test]
+    fn shared_tables_are_prepended_without_the_duplicate_markers() {
+        let tables = [0xFF, 0xD8, 0xFF, 0xDB, 1, 2, 0xFF, 0xD9];
+        let chunk = vec![0xFF, 0xD8, 0xFF, 0xC0, 9, 0xFF, 0xD9];
+        assert_eq!(
+            super::stream(Some(&tables), chunk.clone()),
+            vec![0xFF, 0xD8, 0xFF, 0xDB, 1, 2, 0xFF, 0xC0, 9, 0xFF, 0xD9]
+        );
+        assert_eq!(super::stream(None, chunk.clone()), chunk);
+    }
 }
