@@ -65,7 +65,7 @@ struct PyramidSink {
 
 /// The builder thread: builds the pyramid from the bands received until [`Message::Finish`], returning each
 /// band's buffer for refilling. A closed channel without `Finish` (the decoder failed) drops the builder,
-/// which removes its temporary file.
+/// which removes its temporary file, and is an [`io::ErrorKind::Interrupted`] error.
 fn build(
     mut builder: PyramidBuilder,
     width: usize,
@@ -92,7 +92,10 @@ fn build(
         // The decoder may have stopped already; the buffer is then simply dropped.
         let _ = free.send(band);
     }
-    Err(io::Error::other("the decoder stopped before the last row"))
+    Err(io::Error::new(
+        io::ErrorKind::Interrupted,
+        "the decoder stopped before the last row",
+    ))
 }
 
 impl PyramidSink {
@@ -241,7 +244,7 @@ pub fn ingest_with_tiles(
             format!("cannot complete its pyramid in {} ({e})", dest.display()),
         )
     };
-    let info = match (decoded, worker) {
+    let (e, worker) = match (decoded, worker) {
         (Ok(info), Some(worker)) => {
             let pyramid = worker.finish().map_err(incomplete)?;
             return Ok(Ingested { info, pyramid });
@@ -254,15 +257,15 @@ pub fn ingest_with_tiles(
         }
         (Err(e), worker) => (e, worker),
     };
-    // The decoder failed: stop the builder (its temporary file goes) and report why. A decoder error caused
-    // by the builder failing first (e.g. a full disk) is reported with the builder's reason.
-    let (e, worker) = info;
+    // The decoder failed: stop the builder (its temporary file goes) and report why. When the builder had
+    // failed on its own first (e.g. a full disk), its reason is the one to report.
     if let Some(w) = worker {
         drop(w.to_builder);
-        if let Err(built) = join(w.handle) {
-            if e.to_string().contains("the pyramid builder stopped") {
-                return Err(incomplete(built));
+        match join(w.handle) {
+            Err(built) if built.kind() != io::ErrorKind::Interrupted => {
+                return Err(incomplete(built))
             }
+            _ => {}
         }
     }
     Err(e)
