@@ -11,7 +11,8 @@
 # Environment: SEED (default 1), THREADS (default: all cores), SKIP_SYNTH=1 reuses the campaigns in WORK_DIR,
 # CHAIN=nadir runs the default workflow without the oblique chain (adjustment on the nadir correspondences
 # only: the obliques are then not ingested, which saves their ≈ 3.2 GB of pyramids in the cache).
-# Disk: the real-size campaign takes ≈ 1 GB and its cache ≈ 8 GB (uncompressed pyramids of 7 nadir frames of
+# INGEST_REPS (default 2): runs of each ingestion and plain decode timed (the minimum is kept).
+# Disk: the real-size campaign takes ≈ 0.6 GB and its cache ≈ 7.7 GB (uncompressed pyramids of 7 nadir frames of
 # 450 MP, 16 obliques of 151 MP and 12 panoramas of 34 MP), ≈ 4.8 GB with CHAIN=nadir.
 # Needs /usr/bin/time (Debian package `time`) and python3 for the summary.
 set -euo pipefail

@@ -109,7 +109,8 @@ rows = [
     ("check points 2D after m", ("adjust", label, "checkpoints", "after", "2d")),
     ("recordings RMSE 2D before m", ("adjust", label, "recordings", "before", "rmse_2d")),
     ("recordings RMSE 2D after m", ("adjust", label, "recordings", "after", "rmse_2d")),
-    ("verification passed", ("verify", "passed")),
+    ("verification of the recorded trajectory passed", ("verify", "passed")),
+    ("verification of the adjusted trajectory passed", ("verify_adjusted", "passed")),
 ]
 print("| quantity | twin | real-size |")
 print("|---|---|---|")

@@ -3,7 +3,7 @@
 //! `image` crate's reader) and must decode to the expected grey; bad files fail with their name.
 
 use skytie_stages::imaging::decode::grey::{luma16, luma8};
-use skytie_stages::imaging::decode::{decode_grey, probe_file, ImageFormat};
+use skytie_stages::imaging::decode::{decode_grey, probe_file, GreyInfo, GreyRowSink, ImageFormat};
 use skytie_stages::imaging::ingest::ingest_with_tiles;
 use skytie_stages::imaging::io::load_gray;
 use skytie_stages::imaging::pyramid::{read_window, PixelRect, SampleDepth, TiledPyramid};
@@ -144,6 +144,67 @@ fn jpeg_compressed_tiled_tiff_keeps_its_luma() {
     }
     // JPEG is lossy: the pattern has sharp steps, quality 95 keeps them within a few grey levels.
     assert!(worst < 24.0 / 255.0, "worst error {worst}");
+}
+
+/// Keeps every 8-bit row a decoder delivers.
+#[derive(Default)]
+struct Rows8(Vec<u8>);
+
+impl GreyRowSink for Rows8 {
+    fn begin(&mut self, _: &GreyInfo) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn row_u8(&mut self, row: &[u8]) -> std::io::Result<()> {
+        self.0.extend_from_slice(row);
+        Ok(())
+    }
+    fn row_u16(&mut self, _: &[u16]) -> std::io::Result<()> {
+        Err(std::io::Error::other("16-bit rows from an 8-bit image"))
+    }
+}
+
+/// The grey of the `tiff` crate's own decode of every tile (all components, the first one taken), as skytie
+/// read JPEG-compressed TIFFs before it decoded their luma plane alone.
+fn tiff_crate_grey(path: &Path) -> Vec<u8> {
+    let file = std::io::BufReader::new(std::fs::File::open(path).unwrap());
+    let mut dec = tiff::decoder::Decoder::new(file).unwrap();
+    let (w, h) = dec.dimensions().unwrap();
+    let (w, h) = (w as usize, h as usize);
+    let n = match dec.colortype().unwrap() {
+        tiff::ColorType::Gray(8) => 1,
+        _ => 3,
+    };
+    let mut grey = vec![0u8; w * h];
+    let across = w.div_ceil(64);
+    for t in 0..across * h.div_ceil(64) {
+        let (dw, dh) = dec.chunk_data_dimensions(t as u32);
+        let tiff::decoder::DecodingResult::U8(v) = dec.read_chunk(t as u32).unwrap() else {
+            panic!("8-bit samples expected");
+        };
+        let (x0, y0) = ((t % across) * 64, (t / across) * 64);
+        for r in 0..dh as usize {
+            for c in 0..dw as usize {
+                grey[(y0 + r) * w + x0 + c] = v[(r * dw as usize + c) * n];
+            }
+        }
+    }
+    grey
+}
+
+#[test]
+fn jpeg_tiff_tiles_decode_to_the_luma_the_tiff_crate_decodes() {
+    let dir = tempfile::tempdir().unwrap();
+    for channels in [3, 1] {
+        let path = dir.path().join(format!("j{channels}.tif"));
+        write_tiled(&path, channels, 1, TiffCompression::Jpeg(90), false);
+        let mut rows = Rows8::default();
+        decode_grey(&path, &mut rows).unwrap();
+        assert_eq!(rows.0.len(), W * H);
+        assert!(
+            rows.0 == tiff_crate_grey(&path),
+            "{channels} channels: the luma-only decode differs from the tiff crate's"
+        );
+    }
 }
 
 #[test]

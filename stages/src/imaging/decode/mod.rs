@@ -24,6 +24,7 @@ pub mod jpeg;
 pub mod limits;
 pub mod png;
 pub mod tiff;
+mod tiff_jpeg;
 mod tiff_lzw;
 
 pub use geotiff::GeoTiffTags;

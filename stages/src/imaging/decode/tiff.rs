@@ -6,6 +6,7 @@
 use super::geotiff::GeoTiffTags;
 use super::grey::{grey_row16, grey_row8, Channels};
 use super::limits::reserve;
+use super::tiff_jpeg::read_jpeg_chunk;
 use super::tiff_lzw::{read_lzw_chunk, ChunkCoding};
 use super::{sink_error, GreyInfo, GreyRowSink, ImageHeader};
 use crate::imaging::io_error::ImageIoError;
@@ -35,16 +36,24 @@ struct Structure {
     /// Chunk (strip or tile) size, pixels.
     chunk_w: usize,
     chunk_h: usize,
-    /// LZW chunks are decompressed by [`read_lzw_chunk`]: their offsets, byte counts and coding.
-    lzw: Option<LzwChunks>,
+    /// LZW chunks are decompressed by [`read_lzw_chunk`], JPEG chunks of grey or YCbCr images decoded by
+    /// [`read_jpeg_chunk`]: their offsets, byte counts and coding. `None`: the `tiff` crate reads them.
+    raw: Option<RawChunks>,
 }
 
-struct LzwChunks {
+/// How chunks read without the `tiff` crate are coded.
+enum RawCoding {
+    Lzw(ChunkCoding),
+    /// JPEG (TIFF compression 7), with the file's shared `JPEGTables`, if any.
+    Jpeg(Option<Vec<u8>>),
+}
+
+struct RawChunks {
     /// Tiles hold `chunk_h` rows even at the bottom edge; the last strip holds only the rows left.
     tiled: bool,
     offsets: Vec<u64>,
     counts: Vec<u64>,
-    coding: ChunkCoding,
+    coding: RawCoding,
 }
 
 impl Structure {
@@ -113,19 +122,7 @@ fn structure(path: &Path, dec: &mut TiffDecoder) -> Result<Structure, ImageIoErr
         .find_tag_unsigned::<u16>(Tag::Compression)
         .ok()
         .flatten();
-    let lzw = if compression == Some(CompressionMethod::LZW.to_u16()) {
-        let tiled = matches!(dec.get_chunk_type(), ChunkType::Tile);
-        let (offsets_tag, counts_tag) = if tiled {
-            (Tag::TileOffsets, Tag::TileByteCounts)
-        } else {
-            (Tag::StripOffsets, Tag::StripByteCounts)
-        };
-        let offsets = dec
-            .get_tag_u64_vec(offsets_tag)
-            .map_err(|e| tiff_error(path, e))?;
-        let counts = dec
-            .get_tag_u64_vec(counts_tag)
-            .map_err(|e| tiff_error(path, e))?;
+    let coding = if compression == Some(CompressionMethod::LZW.to_u16()) {
         let predictor = dec
             .find_tag_unsigned::<u16>(Tag::Predictor)
             .ok()
@@ -136,20 +133,26 @@ fn structure(path: &Path, dec: &mut TiffDecoder) -> Result<Structure, ImageIoErr
                 "its LZW predictor {predictor} is not supported"
             )));
         }
-        Some(LzwChunks {
-            tiled,
-            offsets,
-            counts,
-            coding: ChunkCoding {
-                row_px: chunk_w,
-                samples: if planar { 1 } else { channels.samples() },
-                bytes_per_sample: depth.bytes(),
-                horizontal_predictor: predictor == Predictor::Horizontal.to_u16(),
-                big_endian: dec.byte_order() == ByteOrder::BigEndian,
-            },
-        })
+        Some(RawCoding::Lzw(ChunkCoding {
+            row_px: chunk_w,
+            samples: if planar { 1 } else { channels.samples() },
+            bytes_per_sample: depth.bytes(),
+            horizontal_predictor: predictor == Predictor::Horizontal.to_u16(),
+            big_endian: dec.byte_order() == ByteOrder::BigEndian,
+        }))
+    } else if compression == Some(CompressionMethod::ModernJPEG.to_u16())
+        && depth == SampleDepth::U8
+        && !planar
+        && matches!(channels, Channels::YCbCr | Channels::Grey { extra: 0 })
+    {
+        let tables = dec.get_tag_u8_vec(Tag::JPEGTables).ok();
+        Some(RawCoding::Jpeg(tables))
     } else {
         None
+    };
+    let raw = match coding {
+        Some(coding) => Some(raw_chunks(path, dec, coding)?),
+        None => None,
     };
     Ok(Structure {
         width: w as usize,
@@ -159,7 +162,33 @@ fn structure(path: &Path, dec: &mut TiffDecoder) -> Result<Structure, ImageIoErr
         planar,
         chunk_w,
         chunk_h,
-        lzw,
+        raw,
+    })
+}
+
+/// The offsets and byte counts of the chunks of `dec`'s image, read without the `tiff` crate as `coding`.
+fn raw_chunks(
+    path: &Path,
+    dec: &mut TiffDecoder,
+    coding: RawCoding,
+) -> Result<RawChunks, ImageIoError> {
+    let tiled = matches!(dec.get_chunk_type(), ChunkType::Tile);
+    let (offsets_tag, counts_tag) = if tiled {
+        (Tag::TileOffsets, Tag::TileByteCounts)
+    } else {
+        (Tag::StripOffsets, Tag::StripByteCounts)
+    };
+    let offsets = dec
+        .get_tag_u64_vec(offsets_tag)
+        .map_err(|e| tiff_error(path, e))?;
+    let counts = dec
+        .get_tag_u64_vec(counts_tag)
+        .map_err(|e| tiff_error(path, e))?;
+    Ok(RawChunks {
+        tiled,
+        offsets,
+        counts,
+        coding,
     })
 }
 
@@ -180,6 +209,16 @@ fn samples(path: &Path, r: DecodingResult) -> Result<Samples, ImageIoError> {
     }
 }
 
+/// Where a decoded chunk goes in the band and how its samples are laid out: `dw × dh` pixels in rows of
+/// `row_px` pixels, each pixel's samples as `channels` says (for planar images, per plane).
+struct ChunkLayout {
+    x0: usize,
+    dw: usize,
+    dh: usize,
+    row_px: usize,
+    channels: Channels,
+}
+
 /// One row of chunks decoded into full-width grey rows (`band8` or `band16`, `width × band_h`).
 struct Band {
     band8: Vec<u8>,
@@ -190,32 +229,54 @@ struct Band {
     grey16: Vec<u16>,
 }
 
-/// The decoded samples of chunk `index` (as the `tiff` crate returns them: `dw` pixels per row) or, for LZW,
-/// as [`read_lzw_chunk`] does (the chunk's full stored width per row); returns them and that row width.
+/// The decoded samples of chunk `index` (as the `tiff` crate returns them: `dw` pixels per row), or as
+/// [`read_lzw_chunk`] returns them (the chunk's full stored width per row), or the grey plane of a JPEG chunk
+/// from [`read_jpeg_chunk`]; returns them, that row width and how a pixel's samples are laid out.
 fn read_chunk(
     path: &Path,
     dec: &mut TiffDecoder,
-    raw: &std::fs::File,
+    file: &std::fs::File,
     s: &Structure,
     index: usize,
     (dw, dh): (usize, usize),
-) -> Result<(Samples, usize), ImageIoError> {
-    let Some(lzw) = &s.lzw else {
+) -> Result<(Samples, usize, Channels), ImageIoError> {
+    let Some(raw) = &s.raw else {
         let r = dec
             .read_chunk(index as u32)
             .map_err(|e| tiff_error(path, e))?;
-        return Ok((samples(path, r)?, dw));
+        return Ok((samples(path, r)?, dw, s.channels));
     };
-    let (Some(&offset), Some(&count)) = (lzw.offsets.get(index), lzw.counts.get(index)) else {
+    let (Some(&offset), Some(&count)) = (raw.offsets.get(index), raw.counts.get(index)) else {
         return Err(ImageIoError::new(
             path,
             format!("has no offset for strip or tile {index}: the file is corrupt"),
         ));
     };
-    let rows = if lzw.tiled { s.chunk_h } else { dh };
-    let c = &lzw.coding;
+    let rows = if raw.tiled { s.chunk_h } else { dh };
+    let c = match &raw.coding {
+        RawCoding::Lzw(c) => c,
+        RawCoding::Jpeg(tables) => {
+            // A JPEG stream is never larger than a few times its raw samples plus its tables.
+            let max_bytes = 4 * s.chunk_w * rows * s.channels.samples() + (1 << 20);
+            let chunk = read_jpeg_chunk(path, file, (offset, count), max_bytes, tables.as_deref())?;
+            if chunk.width < dw || chunk.height < dh {
+                return Err(ImageIoError::new(
+                    path,
+                    format!(
+                        "strip or tile {index} holds {} × {} px where {dw} × {dh} are needed: the file is corrupt",
+                        chunk.width, chunk.height
+                    ),
+                ));
+            }
+            return Ok((
+                Samples::U8(chunk.samples),
+                chunk.width,
+                Channels::Grey { extra: 0 },
+            ));
+        }
+    };
     let expected = c.row_px * rows * c.samples * c.bytes_per_sample;
-    let bytes = read_lzw_chunk(path, raw, offset, count, expected, c)?;
+    let bytes = read_lzw_chunk(path, file, offset, count, expected, c)?;
     let samples = match s.depth {
         SampleDepth::U8 => Samples::U8(bytes),
         SampleDepth::U16 => Samples::U16(
@@ -225,7 +286,7 @@ fn read_chunk(
                 .collect(),
         ),
     };
-    Ok((samples, c.row_px))
+    Ok((samples, c.row_px, s.channels))
 }
 
 impl Band {
@@ -246,29 +307,42 @@ impl Band {
             let (dw, dh) = (dw as usize, (dh as usize).min(band_h));
             let planes = if s.planar { s.channels.samples() } else { 1 };
             let mut decoded = Vec::with_capacity(planes);
-            let mut row_px = dw;
+            let (mut row_px, mut channels) = (dw, s.channels);
             for p in 0..planes {
-                let (samples, px) = read_chunk(path, dec, raw, s, p * per_plane + index, (dw, dh))?;
+                let (samples, px, ch) =
+                    read_chunk(path, dec, raw, s, p * per_plane + index, (dw, dh))?;
                 decoded.push(samples);
-                row_px = px;
+                (row_px, channels) = (px, ch);
             }
-            self.place(path, s, &decoded, c * s.chunk_w, (dw, dh), row_px)?;
+            let layout = ChunkLayout {
+                x0: c * s.chunk_w,
+                dw,
+                dh,
+                row_px,
+                channels,
+            };
+            self.place(path, s, &decoded, layout)?;
         }
         Ok(band_h)
     }
 
-    /// Converts the decoded chunk (`dw × dh` pixels in rows of `row_px` pixels; one sample vector, or one per
-    /// plane) to grey and copies it into the band at column `x0`.
+    /// Converts the decoded chunk (one sample vector, or one per plane, laid out as `layout` says) to grey and
+    /// copies it into the band at column `layout.x0`.
     fn place(
         &mut self,
         path: &Path,
         s: &Structure,
         decoded: &[Samples],
-        x0: usize,
-        (dw, dh): (usize, usize),
-        row_px: usize,
+        layout: ChunkLayout,
     ) -> Result<(), ImageIoError> {
-        let n = s.channels.samples();
+        let ChunkLayout {
+            x0,
+            dw,
+            dh,
+            row_px,
+            channels,
+        } = layout;
+        let n = channels.samples();
         let stride = if s.planar { row_px } else { row_px * n };
         let short = || {
             ImageIoError::new(
@@ -277,12 +351,20 @@ impl Band {
             )
         };
         for r in 0..dh {
-            match (s.depth, decoded) {
-                (SampleDepth::U8, [Samples::U8(v)]) => {
-                    let src = v.get(r * stride..r * stride + dw * n).ok_or_else(short)?;
-                    grey_row8(src, s.channels, &mut self.grey8);
+            let dst = r * s.width + x0;
+            let w = dw.min(s.width - x0);
+            match (s.depth, decoded, channels) {
+                // Grey samples go straight into the band.
+                (SampleDepth::U8, [Samples::U8(v)], Channels::Grey { extra: 0 }) => {
+                    let src = v.get(r * stride..r * stride + w).ok_or_else(short)?;
+                    self.band8[dst..dst + w].copy_from_slice(src);
+                    continue;
                 }
-                (SampleDepth::U8, planes) => {
+                (SampleDepth::U8, [Samples::U8(v)], _) => {
+                    let src = v.get(r * stride..r * stride + dw * n).ok_or_else(short)?;
+                    grey_row8(src, channels, &mut self.grey8);
+                }
+                (SampleDepth::U8, planes, _) => {
                     self.pixel8.clear();
                     for i in 0..dw {
                         for p in planes {
@@ -292,13 +374,13 @@ impl Band {
                             self.pixel8.push(*v.get(r * stride + i).ok_or_else(short)?);
                         }
                     }
-                    grey_row8(&self.pixel8, s.channels, &mut self.grey8);
+                    grey_row8(&self.pixel8, channels, &mut self.grey8);
                 }
-                (SampleDepth::U16, [Samples::U16(v)]) => {
+                (SampleDepth::U16, [Samples::U16(v)], _) => {
                     let src = v.get(r * stride..r * stride + dw * n).ok_or_else(short)?;
-                    grey_row16(src, s.channels, &mut self.grey16);
+                    grey_row16(src, channels, &mut self.grey16);
                 }
-                (SampleDepth::U16, planes) => {
+                (SampleDepth::U16, planes, _) => {
                     self.pixel16.clear();
                     for i in 0..dw {
                         for p in planes {
@@ -308,11 +390,9 @@ impl Band {
                             self.pixel16.push(*v.get(r * stride + i).ok_or_else(short)?);
                         }
                     }
-                    grey_row16(&self.pixel16, s.channels, &mut self.grey16);
+                    grey_row16(&self.pixel16, channels, &mut self.grey16);
                 }
             }
-            let dst = r * s.width + x0;
-            let w = dw.min(s.width - x0);
             match s.depth {
                 SampleDepth::U8 => self.band8[dst..dst + w].copy_from_slice(&self.grey8[..w]),
                 SampleDepth::U16 => self.band16[dst..dst + w].copy_from_slice(&self.grey16[..w]),

@@ -3,7 +3,8 @@
 //! band per level (≈ 2 × `tile_side` rows of the full width), whatever the image's height.
 //!
 //! The file is written under a temporary name next to the destination and renamed into place by
-//! [`PyramidBuilder::finish`]; a builder dropped before that removes its temporary file.
+//! [`PyramidBuilder::finish`] (atomic, not fsynced: see there); a builder dropped before that removes its
+//! temporary file.
 
 use super::layout::{PyramidLayout, SampleDepth, HEADER_LEN, TILE_HASH_LEN};
 use super::sample::{reduce_rows, Sample};
@@ -125,8 +126,11 @@ impl<S: Sample, K: TileSink> Chain<S, K> {
                 self.layout.height
             )));
         }
-        let row_max = row.iter().map(|s| s.as_u16()).max().unwrap_or(0);
-        self.max_sample = self.max_sample.max(row_max);
+        // The white level of 8-bit samples is 255 whatever they hold: only 16-bit rows need their maximum.
+        if S::BYTES > 1 {
+            let row_max = row.iter().map(|s| s.as_u16()).max().unwrap_or(0);
+            self.max_sample = self.max_sample.max(row_max);
+        }
         self.push_at(0, row)
     }
 
@@ -369,7 +373,14 @@ impl PyramidBuilder {
         }
     }
 
-    /// Completes the file (all rows must have been pushed), syncs it and renames it into place.
+    /// Completes the file (all rows must have been pushed) and renames it into place.
+    ///
+    /// The file is not fsynced: the rename is atomic, so readers and an interrupted process see either no
+    /// pyramid or the whole one, and what reaches the disk is left to the caller (a run flushes its cache's
+    /// file system once at its end, with `syncfs`). After a crash of the machine before that
+    /// flush, a pyramid may be in place with some of its pages never written; its index and every tile are
+    /// checked against their hashes when read ([`super::TiledPyramid::open`]), so such a file is refused,
+    /// never read as an image.
     pub fn finish(mut self) -> io::Result<PyramidSummary> {
         let done = match self.chain.take().expect("not finished") {
             AnyChain::U8(c) => c.finish()?,
@@ -378,7 +389,6 @@ impl PyramidBuilder {
         let file = done.sink;
         file.write_all_at(&done.table, done.layout.hash_table_offset())?;
         file.write_all_at(&done.header, 0)?;
-        file.sync_all()?;
         drop(file);
         fs::rename(&self.tmp, &self.dest)?;
         let file_len = done.layout.file_len();
