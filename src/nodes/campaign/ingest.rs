@@ -12,7 +12,7 @@ use crate::workflow::{ParamError, StageParams};
 use serde::{Deserialize, Serialize};
 use skytie_stages::imaging::decode::{GeoTiffTags, ImageFormat};
 use skytie_stages::imaging::ingest::ingest_with_tiles;
-use skytie_stages::imaging::pyramid::{SampleDepth, DEFAULT_TILE_SIDE};
+use skytie_stages::imaging::pyramid::{SampleDepth, TiledPyramid, DEFAULT_TILE_SIDE};
 
 /// File name of the pyramid in the node's folder.
 const PYRAMID_FILE: &str = "image.pyr";
@@ -104,8 +104,12 @@ impl Stage for Ingest {
         })
     }
 
+    /// A cached pyramid is used only when its length and its index (header and tile hash table, a few kB)
+    /// match what was recorded: a file cut short or left with unwritten pages by a crash is built again.
+    /// Each tile is checked against the index when it is read.
     fn cached_output_ok(&self, out: &IngestedImage, _ctx: &NodeCtx) -> bool {
         std::fs::metadata(&out.pyramid_path).is_ok_and(|m| m.len() == out.file_len)
+            && TiledPyramid::open(std::path::Path::new(&out.pyramid_path), &out.index_hash).is_ok()
     }
 }
 
