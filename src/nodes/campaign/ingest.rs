@@ -1,8 +1,8 @@
 //! `ingest`: one image file (panorama, nadir or oblique frame) decoded once into a tiled, multi-resolution grey
 //! pyramid in the node's cache folder (`skytie_stages::imaging::ingest`), which every later stage reads window
 //! by window at the resolution it works at. The output records where the pyramid lies and the hash that
-//! authenticates its index (and through it every tile); a pyramid file that went missing or changed size is
-//! rebuilt. A file that does not decode fails this node only, with the file and the decoder's reason; its
+//! authenticates its index (and through it every tile); a pyramid file that went missing, changed size or whose
+//! index no longer matches that hash is rebuilt. A file that does not decode fails this node only, with the file and the decoder's reason; its
 //! dependents are skipped and counted.
 
 use crate::dag::{
@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 use skytie_stages::imaging::decode::{GeoTiffTags, ImageFormat};
 use skytie_stages::imaging::ingest::ingest_with_tiles;
 use skytie_stages::imaging::pyramid::{SampleDepth, TiledPyramid, DEFAULT_TILE_SIDE};
+use std::path::Path;
 
 /// File name of the pyramid in the node's folder.
 const PYRAMID_FILE: &str = "image.pyr";
@@ -108,9 +109,14 @@ impl Stage for Ingest {
     /// match what was recorded: a file cut short or left with unwritten pages by a crash is built again.
     /// Each tile is checked against the index when it is read.
     fn cached_output_ok(&self, out: &IngestedImage, _ctx: &NodeCtx) -> bool {
-        std::fs::metadata(&out.pyramid_path).is_ok_and(|m| m.len() == out.file_len)
-            && TiledPyramid::open(std::path::Path::new(&out.pyramid_path), &out.index_hash).is_ok()
+        pyramid_intact(Path::new(&out.pyramid_path), out.file_len, &out.index_hash)
     }
+}
+
+/// True when the pyramid file at `path` has `file_len` bytes and its index hashes to `index_hash`.
+fn pyramid_intact(path: &Path, file_len: u64, index_hash: &[u8; 32]) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| m.len() == file_len)
+        && TiledPyramid::open(path, index_hash).is_ok()
 }
 
 /// Adds the ingestion of `path` (item label `label`); equal files share one node.
@@ -120,4 +126,39 @@ pub fn ingest_file(
     path: std::path::PathBuf,
 ) -> Result<Handle<IngestedImage>, BuildError> {
     b.add(Ingest, label, IngestParams::default(), RawFile(path))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::os::unix::fs::FileExt;
+
+    /// A pyramid whose index was changed on disk, or which was cut short, is not reused from the cache.
+    #[test]
+    fn a_pyramid_with_a_changed_index_or_length_is_not_reused() {
+        let dir = tempfile::tempdir().unwrap();
+        let src = dir.path().join("frame.png");
+        image::GrayImage::from_fn(300, 200, |x, y| {
+            image::Luma([((x * 7 + y * 3) % 251) as u8])
+        })
+        .save(&src)
+        .unwrap();
+        let pyr = dir.path().join(PYRAMID_FILE);
+        let done = ingest_with_tiles(&src, &pyr, 64).unwrap();
+        let (len, hash) = (done.pyramid.file_len, done.pyramid.index_hash);
+        assert!(pyramid_intact(&pyr, len, &hash));
+        let at = done.pyramid.layout.hash_table_offset();
+        let file = std::fs::OpenOptions::new().write(true).open(&pyr).unwrap();
+        let mut byte = [0u8; 1];
+        std::fs::File::open(&pyr)
+            .unwrap()
+            .read_exact_at(&mut byte, at)
+            .unwrap();
+        file.write_all_at(&[byte[0] ^ 0xFF], at).unwrap();
+        assert!(!pyramid_intact(&pyr, len, &hash), "a changed tile hash");
+        file.write_all_at(&byte, at).unwrap();
+        assert!(pyramid_intact(&pyr, len, &hash));
+        file.set_len(len - 1).unwrap();
+        assert!(!pyramid_intact(&pyr, len, &hash), "a file cut short");
+    }
 }

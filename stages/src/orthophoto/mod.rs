@@ -52,7 +52,7 @@ crate::params! {
         /// Radius around the agreed correction within which a weak peak is corroborated, working pixels.
         corroboration_px: f64 = 1.0, unit "px", min 0.0, max 10.0;
         /// Measure a located tie point's correction from its triangulated position rather than from its corner
-        /// on the ortho's ground plane ([`corroborate`]): the plane's parallax spreads correct corrections
+        /// on the ortho's ground plane (module `corroborate`): the plane's parallax spreads correct corrections
         /// radially by 1–4 px where the road lies a few centimetres below it.
         corroborate_triangulated: bool = true;
         /// Fewest located tie points (weak or strong) that must agree on the correction for weak ones to be kept.
