@@ -149,6 +149,25 @@ impl Worker {
         Ok(self.filling.as_mut().expect("just filled"))
     }
 
+    /// Copies one decoded row into the band being filled and sends the band when it is full; `samples` picks
+    /// the band's buffer of the row's sample depth (`None`: the image was announced with the other depth).
+    fn push_row<T: Copy>(
+        &mut self,
+        row: &[T],
+        samples: fn(&mut Rows) -> Option<&mut Vec<T>>,
+    ) -> io::Result<()> {
+        let width = self.width;
+        let band = self.band()?;
+        let Some(v) = samples(&mut band.rows) else {
+            return Err(io::Error::other(
+                "internal: rows of a sample depth the image was not announced with",
+            ));
+        };
+        v[band.count * width..(band.count + 1) * width].copy_from_slice(row);
+        band.count += 1;
+        self.send_band(false)
+    }
+
     /// Sends the band being filled when it is full (or, with `force`, when it holds any row).
     fn send_band(&mut self, force: bool) -> io::Result<()> {
         let full = self
@@ -196,27 +215,17 @@ impl GreyRowSink for PyramidSink {
     }
 
     fn row_u8(&mut self, row: &[u8]) -> io::Result<()> {
-        let w = self.worker()?;
-        let width = w.width;
-        let band = w.band()?;
-        let Rows::U8(v) = &mut band.rows else {
-            return Err(io::Error::other("internal: 8-bit rows for a 16-bit image"));
-        };
-        v[band.count * width..(band.count + 1) * width].copy_from_slice(row);
-        band.count += 1;
-        w.send_band(false)
+        self.worker()?.push_row(row, |rows| match rows {
+            Rows::U8(v) => Some(v),
+            Rows::U16(_) => None,
+        })
     }
 
     fn row_u16(&mut self, row: &[u16]) -> io::Result<()> {
-        let w = self.worker()?;
-        let width = w.width;
-        let band = w.band()?;
-        let Rows::U16(v) = &mut band.rows else {
-            return Err(io::Error::other("internal: 16-bit rows for an 8-bit image"));
-        };
-        v[band.count * width..(band.count + 1) * width].copy_from_slice(row);
-        band.count += 1;
-        w.send_band(false)
+        self.worker()?.push_row(row, |rows| match rows {
+            Rows::U16(v) => Some(v),
+            Rows::U8(_) => None,
+        })
     }
 }
 
