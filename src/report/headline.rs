@@ -352,8 +352,8 @@ impl Headline {
         }
         if let Some(v) = &self.verification_after {
             out.push(format!(
-                "Verification of the adjusted trajectory: {} of {} segment(s) pass, {} fail, {} with too few \
-                 points.",
+                "Verification of the adjusted trajectory: {} of {} segment(s) pass, {} fail, {} insufficient (too \
+                 few points, or a stretch without any).",
                 v.count("pass"),
                 v.segments.len(),
                 v.count("fail"),

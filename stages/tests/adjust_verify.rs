@@ -1,8 +1,8 @@
 //! Known-answer tests of the verification (thesis Table 5-13): with exact observations
 //! and a purely systematic position error, every MM − aerial offset equals that error; a deteriorated campaign
 //! is flagged, an undeteriorated one passes; a segment whose recordings drift with a mean near zero fails on its
-//! points, one wrong point does not fail a segment; `verification.csv` parses back; segments by count and by
-//! length.
+//! points, one wrong point does not fail a segment; a segment whose points leave half of it unobserved does not
+//! pass; `verification.csv` parses back; segments by count and by length.
 
 use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
 use skytie_stages::adjustment::verify::{
@@ -132,6 +132,7 @@ fn segments_by_length_and_csv_round_trip() {
         }
         assert_eq!(row[16].parse::<usize>().unwrap(), s.points_off);
         assert_eq!(&row[17], s.status.label());
+        assert_eq!(row[18].parse::<usize>().unwrap(), s.unobserved_run);
     }
     assert_eq!(&rows[rows.len() - 1][0], "all");
     std::fs::remove_dir_all(&dir).unwrap();
@@ -176,4 +177,54 @@ fn a_drifting_segment_fails_on_its_points_and_a_single_wrong_point_does_not() {
     let v = verify(&c.recordings, &c.pano_size_px, &wrong, &config).unwrap();
     assert_eq!(v.segments[2].points_off, 1);
     assert_eq!(v.segments[2].status, VerifyStatus::Pass);
+}
+
+/// The middle segment's second half drifts 1 m and has no point of its own: its points, all in the good first
+/// half, agree with the aerial control, yet they vouch for nothing in the drifted half — the segment is
+/// `insufficient`, not `pass`. With every point present it fails on the drifted points, and an exact campaign
+/// passes everywhere (its points cover every segment).
+#[test]
+fn a_segment_whose_points_leave_half_of_it_unobserved_does_not_pass() {
+    let mut c = campaign(0.0, 0.0, 0.0, 4);
+    let config = VerifyConfig::default();
+    let exact = verify(&c.recordings, &c.pano_size_px, &c.control, &config).unwrap();
+    eprintln!("{}", render_verification_table(&exact));
+    for s in &exact.segments {
+        assert_eq!(s.status, VerifyStatus::Pass, "segment {}", s.index);
+        assert!(s.unobserved_run * 2 <= s.recordings, "segment {}", s.index);
+    }
+    for r in c.recordings.iter_mut().take(40).skip(30) {
+        r.x += 1.0;
+    }
+    let all_points = verify(&c.recordings, &c.pano_size_px, &c.control, &config).unwrap();
+    assert_eq!(all_points.segments[1].status, VerifyStatus::Fail);
+    // Drop every control point seen from a drifted recording (indices 30–39): the points left are exact.
+    let drifted: std::collections::HashSet<String> = c.recordings[30..40]
+        .iter()
+        .map(|r| r.image_id.clone())
+        .collect();
+    let before = c.control.len();
+    c.control
+        .retain(|cp| cp.mm.iter().all(|o| !drifted.contains(&o.image_id)));
+    assert!(
+        before - c.control.len() >= 2,
+        "{} points dropped",
+        before - c.control.len()
+    );
+    let v = verify(&c.recordings, &c.pano_size_px, &c.control, &config).unwrap();
+    eprintln!("{}", render_verification_table(&v));
+    let middle = &v.segments[1];
+    assert!(
+        middle.points >= config.min_points,
+        "{} points",
+        middle.points
+    );
+    assert_eq!(middle.points_off, 0);
+    assert!(
+        middle.offset_2d_m < config.tolerance_xy_m,
+        "mean {}",
+        middle.offset_2d_m
+    );
+    assert!(middle.unobserved_run >= 10, "run {}", middle.unobserved_run);
+    assert_eq!(middle.status, VerifyStatus::Insufficient);
 }

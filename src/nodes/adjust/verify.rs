@@ -26,6 +26,7 @@ pub fn verify_metrics(v: &Verification) -> serde_json::Value {
             "sigma_mean_m": s.sigma_mean_m,
             "offset_2d_m": s.offset_2d_m,
             "points_off": s.points_off,
+            "unobserved_run": s.unobserved_run,
             "status": s.status.label(),
         })
     };

@@ -12,7 +12,9 @@
 //! `check_height`) |mean Z| minus `confidence_k` σ above `tolerance_z_m` — or when at least
 //! `min_points_off` points each show a horizontal offset beyond `tolerance_xy_m` by more than `confidence_k`
 //! of their own σ: a trajectory that drifts within a segment (a GNSS outage) has a mean that proves nothing,
-//! its spread is the evidence; otherwise `insufficient` with fewer than `min_points` points, `pass` otherwise.
+//! its spread is the evidence; otherwise `insufficient` with fewer than `min_points` points or when the points
+//! leave a run of at least `max_unobserved_share` of the segment's recordings without any (they vouch only for
+//! the part they lie in), `pass` otherwise.
 //! One point alone never fails a segment (a single wrong correspondence must not), but two independent
 //! points that both put the recordings significantly off are enough even where `min_points` are needed
 //! for a pass. The height is not tested by default: nadir images from ≈ 4500 m give
@@ -28,11 +30,12 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::io::{self, Write};
+use std::ops::RangeInclusive;
 use std::path::Path;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("verify", "6");
+pub const STAGE: StageId = StageId::new("verify", "7");
 
 crate::params! {
     /// Parameters of a verification (the verify node's params).
@@ -56,6 +59,11 @@ crate::params! {
         /// (horizontal offset minus `confidence_k` σ of that point): the recordings near them are off,
         /// whatever the segment's mean says.
         min_points_off: usize = 2, min 1;
+        /// A segment passes only when its points cover it: a run of consecutive recordings none of which is the
+        /// nearest recording of a compared point, as long as this share of the segment's recordings or longer,
+        /// gives `insufficient` instead of `pass` (the points vouch for the part of the segment they lie in, not for
+        /// a stretch without any). Evidence of a failure still fails the segment.
+        max_unobserved_share: f64 = 0.5, above 0.0, max 1.0;
         /// A segment fails on its mean only when an offset exceeds its tolerance by more than this many σ of
         /// the mean; a point counts as off (`min_points_off`) beyond this many σ of its own offset.
         confidence_k: f64 = 2.0, min 0.0;
@@ -91,6 +99,8 @@ pub struct VerifiedPoint {
     pub tie_point_id: String,
     /// Segment index.
     pub segment: usize,
+    /// Index (in the verified recordings) of the recording nearest to the point: the one it vouches for.
+    pub recording: usize,
     /// MM triangulation (recorded poses) − aerial triangulation, world axes, metres.
     pub offset_m: [f64; 3],
     /// Diagonal of `C_MM + C_aerial` (a priori), m².
@@ -119,6 +129,9 @@ pub struct VerificationSegment {
     pub offset_2d_m: f64,
     /// Points whose own horizontal offset exceeds `tolerance_xy_m` by more than `confidence_k` of their σ.
     pub points_off: usize,
+    /// Longest run of consecutive recordings of the segment none of which is a compared point's nearest
+    /// recording (`max_unobserved_share`).
+    pub unobserved_run: usize,
     pub status: VerifyStatus,
 }
 
@@ -264,6 +277,7 @@ pub fn verify_with_detail_levels(
         points.push(VerifiedPoint {
             tie_point_id: cp.tie_point_id.clone(),
             segment: segment_of[r],
+            recording: r,
             offset_m: offset.into(),
             variance_m2: [cov[(0, 0)], cov[(1, 1)], cov[(2, 2)]],
             mm_views: rays.len(),
@@ -296,7 +310,7 @@ pub fn verify_with_detail_levels(
                 recordings[a].image_id.clone(),
                 recordings[b].image_id.clone(),
             );
-            Some(statistics(s, n_rec, first, last, members, config))
+            Some(statistics(s, n_rec, first, last, a..=b, members, config))
         })
         .collect();
     let all: Vec<&VerifiedPoint> = points.iter().collect();
@@ -311,6 +325,7 @@ pub fn verify_with_detail_levels(
             .last()
             .map(|r| r.image_id.clone())
             .unwrap_or_default(),
+        0..=recordings.len().saturating_sub(1),
         &all,
         config,
     );
@@ -330,6 +345,7 @@ fn statistics(
     recordings: usize,
     first_image_id: String,
     last_image_id: String,
+    span: RangeInclusive<usize>,
     points: &[&VerifiedPoint],
     config: &VerifyConfig,
 ) -> VerificationSegment {
@@ -367,9 +383,16 @@ fn statistics(
         .iter()
         .filter(|p| point_significantly_off(p, config))
         .count();
+    let unobserved_run = if recordings == 0 {
+        0
+    } else {
+        longest_unobserved_run(span, points)
+    };
     let status = if points_off >= config.min_points_off {
         VerifyStatus::Fail
-    } else if n < config.min_points {
+    } else if n < config.min_points
+        || unobserved_run as f64 >= config.max_unobserved_share * recordings as f64
+    {
         VerifyStatus::Insufficient
     } else if offset_2d - config.confidence_k * sigma_mean[0].max(sigma_mean[1])
         > config.tolerance_xy_m
@@ -393,8 +416,29 @@ fn statistics(
         sigma_mean_m: sigma_mean,
         offset_2d_m: offset_2d,
         points_off,
+        unobserved_run,
         status,
     }
+}
+
+/// Longest run of consecutive recordings in `span` (indices into the verified recordings) that are no point's
+/// nearest recording; the whole span when there are no points.
+fn longest_unobserved_run(span: RangeInclusive<usize>, points: &[&VerifiedPoint]) -> usize {
+    let (first, last) = (*span.start(), *span.end());
+    let mut observed: Vec<usize> = points
+        .iter()
+        .map(|p| p.recording)
+        .filter(|r| span.contains(r))
+        .collect();
+    observed.sort_unstable();
+    observed.dedup();
+    let mut longest = 0;
+    let mut next_unobserved = first;
+    for &r in &observed {
+        longest = longest.max(r - next_unobserved);
+        next_unobserved = r + 1;
+    }
+    longest.max((last + 1).saturating_sub(next_unobserved))
 }
 
 /// True when the point's horizontal offset exceeds `tolerance_xy_m` by more than `confidence_k` of its own
@@ -405,7 +449,7 @@ fn point_significantly_off(p: &VerifiedPoint, config: &VerifyConfig) -> bool {
 }
 
 /// Column names of `verification.csv`.
-pub const VERIFICATION_CSV_HEADER: [&str; 18] = [
+pub const VERIFICATION_CSV_HEADER: [&str; 19] = [
     "segment",
     "first_image_id",
     "last_image_id",
@@ -424,6 +468,7 @@ pub const VERIFICATION_CSV_HEADER: [&str; 18] = [
     "sigma_mean_z",
     "points_off",
     "status",
+    "unobserved_run",
 ];
 
 /// `verification.csv`: one row per segment (metres; floats in shortest round-trip form), then a row
@@ -453,14 +498,15 @@ pub fn write_verification_csv(path: &Path, v: &Verification) -> io::Result<()> {
             .map(|x| format!("{x}"));
             writeln!(
                 w,
-                "{label},{},{},{},{},{},{},{}",
+                "{label},{},{},{},{},{},{},{},{}",
                 csv_text(&s.first_image_id),
                 csv_text(&s.last_image_id),
                 s.recordings,
                 s.points,
                 nums.join(","),
                 s.points_off,
-                s.status.label()
+                s.status.label(),
+                s.unobserved_run
             )?;
         }
         Ok(())
