@@ -13,8 +13,8 @@
 //! `min_points_off` points each show a horizontal offset beyond `tolerance_xy_m` by more than `confidence_k`
 //! of their own σ: a trajectory that drifts within a segment (a GNSS outage) has a mean that proves nothing,
 //! its spread is the evidence; otherwise `insufficient` with fewer than `min_points` points or when the points
-//! leave a run of at least `max_unobserved_share` of the segment's recordings without any (they vouch only for
-//! the part they lie in), `pass` otherwise.
+//! leave a run of at least `max_unobserved_share` of the segment's recordings unobserved (they vouch only for
+//! the recordings they were observed from), `pass` otherwise.
 //! One point alone never fails a segment (a single wrong correspondence must not), but two independent
 //! points that both put the recordings significantly off are enough even where `min_points` are needed
 //! for a pass. The height is not tested by default: nadir images from ≈ 4500 m give
@@ -59,9 +59,9 @@ crate::params! {
         /// (horizontal offset minus `confidence_k` σ of that point): the recordings near them are off,
         /// whatever the segment's mean says.
         min_points_off: usize = 2, min 1;
-        /// A segment passes only when its points cover it: a run of consecutive recordings none of which is the
-        /// nearest recording of a compared point, as long as this share of the segment's recordings or longer,
-        /// gives `insufficient` instead of `pass` (the points vouch for the part of the segment they lie in, not for
+        /// A segment passes only when its points cover it: a run of consecutive recordings from which none of
+        /// its compared points was observed, as long as this share of the segment's recordings or longer, gives
+        /// `insufficient` instead of `pass` (the points vouch for the part of the segment they lie in, not for
         /// a stretch without any). Evidence of a failure still fails the segment.
         max_unobserved_share: f64 = 0.5, above 0.0, max 1.0;
         /// A segment fails on its mean only when an offset exceeds its tolerance by more than this many σ of
@@ -99,8 +99,9 @@ pub struct VerifiedPoint {
     pub tie_point_id: String,
     /// Segment index.
     pub segment: usize,
-    /// Index (in the verified recordings) of the recording nearest to the point: the one it vouches for.
-    pub recording: usize,
+    /// Indices (in the verified recordings) of the recordings the point was observed from: the ones whose
+    /// poses its MM triangulation, and so its offset, depends on.
+    pub observed_from: Vec<usize>,
     /// MM triangulation (recorded poses) − aerial triangulation, world axes, metres.
     pub offset_m: [f64; 3],
     /// Diagonal of `C_MM + C_aerial` (a priori), m².
@@ -129,8 +130,8 @@ pub struct VerificationSegment {
     pub offset_2d_m: f64,
     /// Points whose own horizontal offset exceeds `tolerance_xy_m` by more than `confidence_k` of their σ.
     pub points_off: usize,
-    /// Longest run of consecutive recordings of the segment none of which is a compared point's nearest
-    /// recording (`max_unobserved_share`).
+    /// Longest run of consecutive recordings of the segment from which none of its compared points was
+    /// observed (`max_unobserved_share`).
     pub unobserved_run: usize,
     pub status: VerifyStatus,
 }
@@ -253,11 +254,13 @@ pub fn verify_with_detail_levels(
         let aerial = Vector3::from(aerial_xyz);
         rays.clear();
         sigmas.clear();
+        let mut observed_from = Vec::with_capacity(cp.mm.len());
         let mut nearest: Option<(f64, usize)> = None;
         for o in &cp.mm {
             if let Some(&r) = index.get(o.image_id.as_str()) {
                 rays.push(cameras[r].pixel_ray(o.u_px, o.v_px));
                 sigmas.push(angular_sigma_rad[r]);
+                observed_from.push(r);
                 let d = (cameras[r].center_world - aerial).norm();
                 if nearest.is_none_or(|(best, _)| d < best) {
                     nearest = Some((d, r));
@@ -277,7 +280,7 @@ pub fn verify_with_detail_levels(
         points.push(VerifiedPoint {
             tie_point_id: cp.tie_point_id.clone(),
             segment: segment_of[r],
-            recording: r,
+            observed_from,
             offset_m: offset.into(),
             variance_m2: [cov[(0, 0)], cov[(1, 1)], cov[(2, 2)]],
             mm_views: rays.len(),
@@ -421,13 +424,13 @@ fn statistics(
     }
 }
 
-/// Longest run of consecutive recordings in `span` (indices into the verified recordings) that are no point's
-/// nearest recording; the whole span when there are no points.
+/// Longest run of consecutive recordings in `span` (indices into the verified recordings) from which none of
+/// `points` was observed; the whole span when there are no points.
 fn longest_unobserved_run(span: RangeInclusive<usize>, points: &[&VerifiedPoint]) -> usize {
     let (first, last) = (*span.start(), *span.end());
     let mut observed: Vec<usize> = points
         .iter()
-        .map(|p| p.recording)
+        .flat_map(|p| p.observed_from.iter().copied())
         .filter(|r| span.contains(r))
         .collect();
     observed.sort_unstable();
