@@ -10,6 +10,17 @@ pub fn skytie() -> Command {
     Command::new(env!("CARGO_BIN_EXE_skytie"))
 }
 
+/// `skytie synth --preset tiny --seed SEED OPTIONS… --out OUT`, which must succeed.
+pub fn synth_tiny(out: &Path, seed: u64, options: &[&str]) {
+    run_ok(
+        skytie()
+            .args(["synth", "--preset", "tiny", "--seed", &seed.to_string()])
+            .args(options)
+            .arg("--out")
+            .arg(out),
+    );
+}
+
 /// Runs `cmd` to its end: its exit code (-1 when a signal ended it), stdout and stderr.
 pub fn finish(cmd: &mut Command) -> (i32, String, String) {
     let out = cmd.output().expect("start skytie");
