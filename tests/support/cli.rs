@@ -102,3 +102,12 @@ pub fn output_files(root: &Path) -> std::collections::BTreeMap<String, Vec<u8>> 
 pub fn json(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
 }
+
+/// A run's metrics.json without the engine's bookkeeping (node counts, seconds).
+pub fn results_of(metrics: &serde_json::Value) -> serde_json::Value {
+    let mut m = metrics.clone();
+    let obj = m.as_object_mut().unwrap();
+    obj.remove("engine");
+    obj.remove("stages");
+    m
+}
