@@ -60,6 +60,13 @@ pub fn run(cache: &Path, dag: &Dag, mode: Mode) -> Outcome {
     SilentEngine::open(cache).unwrap().execute(dag, mode)
 }
 
+/// Builds the toy DAG of one configuration and runs it against the cache at `cache`: the outcome and the sum's
+/// handle.
+pub fn run_toy(cache: &Path, items: &[PathBuf], cfg: &ToyConfig) -> (Outcome, Handle<ToySummary>) {
+    let (dag, h) = toy_dag(items, cfg);
+    (run(cache, &dag, Mode::Run), h)
+}
+
 /// Executed count per stage name of an outcome, as (parse, scale, sum).
 pub fn executed(o: &Outcome) -> (usize, usize, usize) {
     (
