@@ -45,7 +45,7 @@ fn first_run_executes_all_and_second_identical_run_executes_nothing() {
 fn changing_one_param_reruns_that_stage_and_its_dependents_only() {
     let (_d, cache, items) = setup();
     let mut cfg = ToyConfig::default();
-    run_toy(&cache, &items, &cfg).0;
+    run_toy(&cache, &items, &cfg);
     cfg.scale.factor = 3.0;
     let (o, h) = run_toy(&cache, &items, &cfg);
     assert_eq!(executed(&o), (0, 4, 1));
@@ -69,7 +69,7 @@ fn early_cutoff_keeps_dependents_cached_when_output_is_identical() {
         },
         ..Default::default()
     };
-    run_toy(&cache, &items, &cfg).0;
+    run_toy(&cache, &items, &cfg);
     // 2.001 * v rounds to the same integers: toy_scale re-runs, its outputs are identical, toy_sum is cached.
     cfg.scale.factor = 2.001;
     let (o, h) = run_toy(&cache, &items, &cfg);
@@ -82,7 +82,7 @@ fn early_cutoff_keeps_dependents_cached_when_output_is_identical() {
 fn stage_version_bump_reruns_that_stage() {
     let (_d, cache, items) = setup();
     let mut cfg = ToyConfig::default();
-    run_toy(&cache, &items, &cfg).0;
+    run_toy(&cache, &items, &cfg);
     cfg.scale_v2 = true;
     let (o, h) = run_toy(&cache, &items, &cfg);
     // The twin computes the same values, so the sum is cut off early.
@@ -100,7 +100,7 @@ fn stage_version_bump_reruns_that_stage() {
 fn adding_one_item_reruns_only_the_nodes_that_involve_it() {
     let (d, cache, items) = setup();
     let cfg = ToyConfig::default();
-    run_toy(&cache, &items, &cfg).0;
+    run_toy(&cache, &items, &cfg);
     let items5 = make_items(d.path(), &[1.0, 2.0, 3.0, 4.0, 10.0]);
     let (o, h) = run_toy(&cache, &items5, &cfg);
     assert_eq!(executed(&o), (1, 1, 1));

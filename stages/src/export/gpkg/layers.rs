@@ -297,7 +297,7 @@ fn verification_layer(x: &RunLayers<'_>) -> Layer {
         ]),
         features: Vec::new(),
     };
-    let index = positions_by(&x.recordings, |r| r.image_id.as_str());
+    let index = positions_by(x.recordings, |r| r.image_id.as_str());
     for (name, v) in [
         ("recorded", x.verification),
         ("adjusted", x.verification_adjusted),

@@ -82,6 +82,18 @@ pub fn reduce_rows<S: Sample>(a: &[S], b: &[S], out: &mut Vec<S>) {
     }
 }
 
+/// An 8-bit row as 16-bit samples (`v · 257`, so 255 becomes 65535), into `out`.
+pub fn widen_row(row: &[u8], out: &mut Vec<u16>) {
+    out.clear();
+    out.extend(row.iter().map(|&v| u16::from(v) * 257));
+}
+
+/// A 16-bit row as 8-bit samples (`v / 257`, rounded), into `out`.
+pub fn narrow_row(row: &[u16], out: &mut Vec<u8>) {
+    out.clear();
+    out.extend(row.iter().map(|&v| ((u32::from(v) + 128) / 257) as u8));
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -105,16 +117,4 @@ mod tests {
         assert_eq!(bytes, vec![1, 0, 2, 1]);
         assert_eq!(u16::read_le(&bytes, 1), 258);
     }
-}
-
-/// An 8-bit row as 16-bit samples (`v · 257`, so 255 becomes 65535), into `out`.
-pub fn widen_row(row: &[u8], out: &mut Vec<u16>) {
-    out.clear();
-    out.extend(row.iter().map(|&v| u16::from(v) * 257));
-}
-
-/// A 16-bit row as 8-bit samples (`v / 257`, rounded), into `out`.
-pub fn narrow_row(row: &[u16], out: &mut Vec<u8>) {
-    out.clear();
-    out.extend(row.iter().map(|&v| ((u32::from(v) + 128) / 257) as u8));
 }
