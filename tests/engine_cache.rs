@@ -9,17 +9,6 @@ use support::*;
 
 const VALUES: [f64; 4] = [1.0, 2.0, 3.0, 4.0];
 
-fn setup() -> (
-    tempfile::TempDir,
-    std::path::PathBuf,
-    Vec<std::path::PathBuf>,
-) {
-    let dir = tempfile::tempdir().unwrap();
-    let items = make_items(dir.path(), &VALUES);
-    let cache = dir.path().join("cache");
-    (dir, cache, items)
-}
-
 /// The toy summary of `count` numbers adding up to `sum`.
 fn summary(sum: f64, count: u64) -> ToySummary {
     ToySummary { sum, count }
@@ -27,7 +16,7 @@ fn summary(sum: f64, count: u64) -> ToySummary {
 
 #[test]
 fn first_run_executes_all_and_second_identical_run_executes_nothing() {
-    let (_d, cache, items) = setup();
+    let (_d, cache, items) = toy_workspace(&VALUES);
     let cfg = ToyConfig::default();
     let (o1, h) = run_toy(&cache, &items, &cfg);
     assert_eq!(executed(&o1), (4, 4, 1));
@@ -43,7 +32,7 @@ fn first_run_executes_all_and_second_identical_run_executes_nothing() {
 
 #[test]
 fn changing_one_param_reruns_that_stage_and_its_dependents_only() {
-    let (_d, cache, items) = setup();
+    let (_d, cache, items) = toy_workspace(&VALUES);
     let mut cfg = ToyConfig::default();
     run_toy(&cache, &items, &cfg);
     cfg.scale.factor = 3.0;
@@ -60,7 +49,7 @@ fn changing_one_param_reruns_that_stage_and_its_dependents_only() {
 
 #[test]
 fn early_cutoff_keeps_dependents_cached_when_output_is_identical() {
-    let (_d, cache, items) = setup();
+    let (_d, cache, items) = toy_workspace(&VALUES);
     let mut cfg = ToyConfig {
         scale: ToyScaleParams {
             factor: 2.0,
@@ -80,7 +69,7 @@ fn early_cutoff_keeps_dependents_cached_when_output_is_identical() {
 
 #[test]
 fn stage_version_bump_reruns_that_stage() {
-    let (_d, cache, items) = setup();
+    let (_d, cache, items) = toy_workspace(&VALUES);
     let mut cfg = ToyConfig::default();
     run_toy(&cache, &items, &cfg);
     cfg.scale_v2 = true;
@@ -98,7 +87,7 @@ fn stage_version_bump_reruns_that_stage() {
 
 #[test]
 fn adding_one_item_reruns_only_the_nodes_that_involve_it() {
-    let (d, cache, items) = setup();
+    let (d, cache, items) = toy_workspace(&VALUES);
     let cfg = ToyConfig::default();
     run_toy(&cache, &items, &cfg);
     let items5 = make_items(d.path(), &[1.0, 2.0, 3.0, 4.0, 10.0]);
@@ -120,7 +109,7 @@ fn adding_one_item_reruns_only_the_nodes_that_involve_it() {
 
 #[test]
 fn sweep_variants_sharing_a_prefix_execute_shared_nodes_once() {
-    let (_d, cache, items) = setup();
+    let (_d, cache, items) = toy_workspace(&VALUES);
     let mut b = DagBuilder::new();
     let mut handles = Vec::new();
     for (name, offset) in [("a", 0.0), ("b", 100.0), ("c", 200.0)] {
@@ -154,7 +143,7 @@ fn sweep_variants_sharing_a_prefix_execute_shared_nodes_once() {
 
 #[test]
 fn corrupt_or_truncated_artifacts_warn_once_and_are_recomputed() {
-    let (_d, cache, items) = setup();
+    let (_d, cache, items) = toy_workspace(&VALUES);
     let mut cfg = ToyConfig::default();
     let (o1, _) = run_toy(&cache, &items, &cfg);
     let store = skytie::store::Store::open(&cache).unwrap();
@@ -204,7 +193,7 @@ fn corrupt_or_truncated_artifacts_warn_once_and_are_recomputed() {
 #[test]
 fn failing_and_panicking_nodes_are_not_recorded_and_dependents_are_skipped() {
     for panic in [false, true] {
-        let (_d, cache, items) = setup();
+        let (_d, cache, items) = toy_workspace(&VALUES);
         let mut cfg = ToyConfig::default();
         if panic {
             cfg.scale.faults.panic_item = "item_001".into();
@@ -259,7 +248,7 @@ fn failing_and_panicking_nodes_are_not_recorded_and_dependents_are_skipped() {
 
 #[test]
 fn results_are_identical_for_one_or_many_threads() {
-    let (d, _, items) = setup();
+    let (d, _, items) = toy_workspace(&VALUES);
     let cfg = ToyConfig {
         scale: ToyScaleParams {
             factor: 0.1,

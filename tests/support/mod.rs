@@ -48,6 +48,15 @@ pub fn add_toy(b: &mut DagBuilder, items: &[PathBuf], cfg: &ToyConfig) -> Handle
     h
 }
 
+/// A temporary folder holding the toy item files with `values` (see [`make_items`]), and the path of a cache
+/// folder inside it.
+pub fn toy_workspace(values: &[f64]) -> (tempfile::TempDir, PathBuf, Vec<PathBuf>) {
+    let dir = tempfile::tempdir().unwrap();
+    let items = make_items(dir.path(), values);
+    let cache = dir.path().join("cache");
+    (dir, cache, items)
+}
+
 /// The toy DAG of one configuration.
 pub fn toy_dag(items: &[PathBuf], cfg: &ToyConfig) -> (Dag, Handle<ToySummary>) {
     let mut b = DagBuilder::new();
