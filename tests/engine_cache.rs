@@ -9,17 +9,6 @@ use support::*;
 
 const VALUES: [f64; 4] = [1.0, 2.0, 3.0, 4.0];
 
-fn setup() -> (
-    tempfile::TempDir,
-    std::path::PathBuf,
-    Vec<std::path::PathBuf>,
-) {
-    let dir = tempfile::tempdir().unwrap();
-    let items = make_items(dir.path(), &VALUES);
-    let cache = dir.path().join("cache");
-    (dir, cache, items)
-}
-
 /// The toy summary of `count` numbers adding up to `sum`.
 fn summary(sum: f64, count: u64) -> ToySummary {
     ToySummary { sum, count }
@@ -27,15 +16,13 @@ fn summary(sum: f64, count: u64) -> ToySummary {
 
 #[test]
 fn first_run_executes_all_and_second_identical_run_executes_nothing() {
-    let (_d, cache, items) = setup();
+    let (_d, cache, items) = toy_workspace(&VALUES);
     let cfg = ToyConfig::default();
-    let (dag, h) = toy_dag(&items, &cfg);
-    let o1 = run(&cache, &dag, Mode::Run);
+    let (o1, h) = run_toy(&cache, &items, &cfg);
     assert_eq!(executed(&o1), (4, 4, 1));
     assert_eq!(o1.cached(), 0);
     assert_eq!(*o1.get(h).unwrap(), summary(20.0, 4));
-    let (dag, h) = toy_dag(&items, &cfg);
-    let o2 = run(&cache, &dag, Mode::Run);
+    let (o2, h) = run_toy(&cache, &items, &cfg);
     assert_eq!(o2.executed(), 0);
     assert_eq!(o2.cached(), 9);
     assert!(o2.warnings.is_empty(), "{:?}", o2.warnings);
@@ -45,26 +32,24 @@ fn first_run_executes_all_and_second_identical_run_executes_nothing() {
 
 #[test]
 fn changing_one_param_reruns_that_stage_and_its_dependents_only() {
-    let (_d, cache, items) = setup();
+    let (_d, cache, items) = toy_workspace(&VALUES);
     let mut cfg = ToyConfig::default();
-    run(&cache, &toy_dag(&items, &cfg).0, Mode::Run);
+    run_toy(&cache, &items, &cfg);
     cfg.scale.factor = 3.0;
-    let (dag, h) = toy_dag(&items, &cfg);
-    let o = run(&cache, &dag, Mode::Run);
+    let (o, h) = run_toy(&cache, &items, &cfg);
     assert_eq!(executed(&o), (0, 4, 1));
     assert_eq!(o.cached(), 4);
     assert_eq!(o.get(h).unwrap().sum, 30.0);
     // Only the sum's param: only the sum.
     cfg.sum.offset = 1.5;
-    let (dag, h) = toy_dag(&items, &cfg);
-    let o = run(&cache, &dag, Mode::Run);
+    let (o, h) = run_toy(&cache, &items, &cfg);
     assert_eq!(executed(&o), (0, 0, 1));
     assert_eq!(o.get(h).unwrap().sum, 31.5);
 }
 
 #[test]
 fn early_cutoff_keeps_dependents_cached_when_output_is_identical() {
-    let (_d, cache, items) = setup();
+    let (_d, cache, items) = toy_workspace(&VALUES);
     let mut cfg = ToyConfig {
         scale: ToyScaleParams {
             factor: 2.0,
@@ -73,11 +58,10 @@ fn early_cutoff_keeps_dependents_cached_when_output_is_identical() {
         },
         ..Default::default()
     };
-    run(&cache, &toy_dag(&items, &cfg).0, Mode::Run);
+    run_toy(&cache, &items, &cfg);
     // 2.001 * v rounds to the same integers: toy_scale re-runs, its outputs are identical, toy_sum is cached.
     cfg.scale.factor = 2.001;
-    let (dag, h) = toy_dag(&items, &cfg);
-    let o = run(&cache, &dag, Mode::Run);
+    let (o, h) = run_toy(&cache, &items, &cfg);
     assert_eq!(executed(&o), (0, 4, 0));
     assert_eq!(o.cached(), 5);
     assert_eq!(o.get(h).unwrap().sum, 20.0);
@@ -85,12 +69,11 @@ fn early_cutoff_keeps_dependents_cached_when_output_is_identical() {
 
 #[test]
 fn stage_version_bump_reruns_that_stage() {
-    let (_d, cache, items) = setup();
+    let (_d, cache, items) = toy_workspace(&VALUES);
     let mut cfg = ToyConfig::default();
-    run(&cache, &toy_dag(&items, &cfg).0, Mode::Run);
+    run_toy(&cache, &items, &cfg);
     cfg.scale_v2 = true;
-    let (dag, h) = toy_dag(&items, &cfg);
-    let o = run(&cache, &dag, Mode::Run);
+    let (o, h) = run_toy(&cache, &items, &cfg);
     // The twin computes the same values, so the sum is cut off early.
     assert_eq!(executed(&o), (0, 4, 0));
     assert_eq!(o.get(h).unwrap().sum, 20.0);
@@ -104,12 +87,11 @@ fn stage_version_bump_reruns_that_stage() {
 
 #[test]
 fn adding_one_item_reruns_only_the_nodes_that_involve_it() {
-    let (d, cache, items) = setup();
+    let (d, cache, items) = toy_workspace(&VALUES);
     let cfg = ToyConfig::default();
-    run(&cache, &toy_dag(&items, &cfg).0, Mode::Run);
+    run_toy(&cache, &items, &cfg);
     let items5 = make_items(d.path(), &[1.0, 2.0, 3.0, 4.0, 10.0]);
-    let (dag, h) = toy_dag(&items5, &cfg);
-    let o = run(&cache, &dag, Mode::Run);
+    let (o, h) = run_toy(&cache, &items5, &cfg);
     assert_eq!(executed(&o), (1, 1, 1));
     assert_eq!(o.cached(), 8);
     assert_eq!(*o.get(h).unwrap(), summary(40.0, 5));
@@ -127,7 +109,7 @@ fn adding_one_item_reruns_only_the_nodes_that_involve_it() {
 
 #[test]
 fn sweep_variants_sharing_a_prefix_execute_shared_nodes_once() {
-    let (_d, cache, items) = setup();
+    let (_d, cache, items) = toy_workspace(&VALUES);
     let mut b = DagBuilder::new();
     let mut handles = Vec::new();
     for (name, offset) in [("a", 0.0), ("b", 100.0), ("c", 200.0)] {
@@ -161,10 +143,9 @@ fn sweep_variants_sharing_a_prefix_execute_shared_nodes_once() {
 
 #[test]
 fn corrupt_or_truncated_artifacts_warn_once_and_are_recomputed() {
-    let (_d, cache, items) = setup();
+    let (_d, cache, items) = toy_workspace(&VALUES);
     let mut cfg = ToyConfig::default();
-    let (dag, _) = toy_dag(&items, &cfg);
-    let o1 = run(&cache, &dag, Mode::Run);
+    let (o1, _) = run_toy(&cache, &items, &cfg);
     let store = skytie::store::Store::open(&cache).unwrap();
     let key_of = |identity: &str| {
         o1.reports
@@ -179,8 +160,7 @@ fn corrupt_or_truncated_artifacts_warn_once_and_are_recomputed() {
     let mut bytes = std::fs::read(&sum_path).unwrap();
     *bytes.last_mut().unwrap() ^= 0x55;
     std::fs::write(&sum_path, &bytes).unwrap();
-    let (dag, h) = toy_dag(&items, &cfg);
-    let o2 = run(&cache, &dag, Mode::Run);
+    let (o2, h) = run_toy(&cache, &items, &cfg);
     assert_eq!(o2.warnings.len(), 1, "{:?}", o2.warnings);
     assert!(o2.warnings[0].contains("toy_sum"), "{}", o2.warnings[0]);
     assert_eq!(executed(&o2), (0, 0, 1));
@@ -196,8 +176,7 @@ fn corrupt_or_truncated_artifacts_warn_once_and_are_recomputed() {
         .set_len(len / 2)
         .unwrap();
     cfg.sum.offset = 1.0;
-    let (dag, h) = toy_dag(&items, &cfg);
-    let o3 = run(&cache, &dag, Mode::Run);
+    let (o3, h) = run_toy(&cache, &items, &cfg);
     assert_eq!(o3.warnings.len(), 1, "{:?}", o3.warnings);
     assert!(
         o3.warnings[0].contains("toy_scale[item_002]"),
@@ -207,22 +186,21 @@ fn corrupt_or_truncated_artifacts_warn_once_and_are_recomputed() {
     assert_eq!(executed(&o3), (0, 1, 1));
     assert_eq!(o3.get(h).unwrap().sum, 21.0);
     // And everything is healthy again.
-    let o4 = run(&cache, &toy_dag(&items, &cfg).0, Mode::Run);
+    let o4 = run_toy(&cache, &items, &cfg).0;
     assert_eq!((o4.executed(), o4.warnings.len()), (0, 0));
 }
 
 #[test]
 fn failing_and_panicking_nodes_are_not_recorded_and_dependents_are_skipped() {
     for panic in [false, true] {
-        let (_d, cache, items) = setup();
+        let (_d, cache, items) = toy_workspace(&VALUES);
         let mut cfg = ToyConfig::default();
         if panic {
             cfg.scale.faults.panic_item = "item_001".into();
         } else {
             cfg.scale.faults.fail_item = "item_001".into();
         }
-        let (dag, h) = toy_dag(&items, &cfg);
-        let o = run(&cache, &dag, Mode::Run);
+        let (o, h) = run_toy(&cache, &items, &cfg);
         let bad = o
             .reports
             .iter()
@@ -254,15 +232,14 @@ fn failing_and_panicking_nodes_are_not_recorded_and_dependents_are_skipped() {
         assert_eq!((o.executed(), o.failed(), o.skipped()), (7, 1, 1));
         assert!(o.get(h).is_none());
         // Same failure again: the failure was not cached as a success.
-        let o = run(&cache, &toy_dag(&items, &cfg).0, Mode::Run);
+        let o = run_toy(&cache, &items, &cfg).0;
         assert_eq!(
             (o.executed(), o.cached(), o.failed(), o.skipped()),
             (0, 7, 1, 1)
         );
         // Fix it: only the failed node and its dependent run.
         cfg.scale.faults = Faults::default();
-        let (dag, h) = toy_dag(&items, &cfg);
-        let o = run(&cache, &dag, Mode::Run);
+        let (o, h) = run_toy(&cache, &items, &cfg);
         // The fault params are part of the key, so all scale nodes re-run; their outputs are unchanged.
         assert_eq!(executed(&o), (0, 4, 1));
         assert_eq!(o.get(h).unwrap().sum, 20.0);
@@ -271,7 +248,7 @@ fn failing_and_panicking_nodes_are_not_recorded_and_dependents_are_skipped() {
 
 #[test]
 fn results_are_identical_for_one_or_many_threads() {
-    let (d, _, items) = setup();
+    let (d, _, items) = toy_workspace(&VALUES);
     let cfg = ToyConfig {
         scale: ToyScaleParams {
             factor: 0.1,
@@ -287,7 +264,7 @@ fn results_are_identical_for_one_or_many_threads() {
             .num_threads(threads)
             .build()
             .unwrap();
-        let o = pool.install(|| run(&cache, &toy_dag(&items, &cfg).0, Mode::Run));
+        let o = pool.install(|| run_toy(&cache, &items, &cfg).0);
         let h: Vec<_> = o
             .reports
             .iter()

@@ -44,9 +44,7 @@ fn line_of<'a>(plan: &'a str, identity: &str) -> &'a str {
 
 #[test]
 fn plan_says_a_node_failed_last_time_until_it_succeeds() {
-    let dir = tempfile::tempdir().unwrap();
-    let cache = dir.path().join("cache");
-    let items = make_items(dir.path(), &[1.0, 2.0, 3.0]);
+    let (_dir, cache, items) = toy_workspace(&[1.0, 2.0, 3.0]);
     let mut cfg = ToyConfig::default();
     cfg.scale.faults.fail_item = "item_001".into();
     let (_, failed) = session(&cache, &items, &cfg, Mode::Run);

@@ -12,11 +12,7 @@ mod support;
 struct Mix;
 
 impl Stage for Mix {
-    const NAME: &'static str = "mix";
-    const VERSION: &'static str = "1";
-    type Params = ();
-    type Output = f64;
-    type Inputs = (Handle<f64>, RawFile, Vec<Handle<f64>>);
+    skytie::stage_items!("mix", "1", () => f64, inputs: (Handle<f64>, RawFile, Vec<Handle<f64>>));
     fn run(
         &self,
         _: &(),

@@ -29,11 +29,7 @@ impl Drop for Tracked {
 
 struct Make;
 impl Stage for Make {
-    const NAME: &'static str = "make";
-    const VERSION: &'static str = "1";
-    type Params = u64;
-    type Output = Tracked;
-    type Inputs = ();
+    skytie::stage_items!("make", "1", u64 => Tracked, inputs: ());
     fn run(&self, v: &u64, _: (), _: &NodeCtx) -> Result<Tracked, StageError> {
         Ok(Tracked::new(*v))
     }
@@ -42,11 +38,7 @@ impl Stage for Make {
 /// Reads one Tracked and reports how many Tracked values are alive while it runs.
 struct Observe;
 impl Stage for Observe {
-    const NAME: &'static str = "observe";
-    const VERSION: &'static str = "1";
-    type Params = ();
-    type Output = u64;
-    type Inputs = Handle<Tracked>;
+    skytie::stage_items!("observe", "1", () => u64, inputs: Handle<Tracked>);
     fn run(&self, _: &(), t: Arc<Tracked>, _: &NodeCtx) -> Result<u64, StageError> {
         Ok(t.0 * 1000 + LIVE.load(Ordering::SeqCst) as u64)
     }

@@ -24,14 +24,12 @@ fn reasons_of(o: &skytie::dag::Outcome, identity: &str) -> Vec<String> {
 
 #[test]
 fn plan_names_the_reason_each_node_will_run() {
-    let dir = tempfile::tempdir().unwrap();
-    let cache = dir.path().join("cache");
-    let items = make_items(dir.path(), &[1.0, 2.0, 3.0]);
+    let (_dir, cache, items) = toy_workspace(&[1.0, 2.0, 3.0]);
     let mut cfg = ToyConfig::default();
     let p = run(&cache, &toy_dag(&items, &cfg).0, Mode::Plan);
     assert_eq!((p.will_run(), p.executed()), (7, 0), "plan never executes");
     assert!(reasons_of(&p, "toy_parse[item_000]")[0].starts_with("new node"));
-    run(&cache, &toy_dag(&items, &cfg).0, Mode::Run);
+    run_toy(&cache, &items, &cfg);
     let p = run(&cache, &toy_dag(&items, &cfg).0, Mode::Plan);
     assert_eq!((p.will_run(), p.cached()), (0, 7));
 

@@ -15,7 +15,7 @@
 #[path = "support/cli.rs"]
 mod cli;
 
-use cli::{json, run_ok, skytie};
+use cli::{json, run_ok, skytie, synth_tiny};
 
 /// A number in metrics.json, by path.
 fn num(m: &serde_json::Value, path: &[&str]) -> f64 {
@@ -32,12 +32,7 @@ fn a_tiny_street_with_road_markings_is_corrected() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     let camp = dir.join("tiny2048");
-    run_ok(
-        skytie()
-            .args(["synth", "--preset", "tiny", "--seed", "1"])
-            .args(["--panorama-width", "2048", "--out"])
-            .arg(&camp),
-    );
+    synth_tiny(&camp, 1, &["--panorama-width", "2048"]);
     // The campaign also asks for its outputs in ETRS89 / UTM zone 31N ([outputs], docs/outputs.md).
     let toml_path = camp.join("campaign.toml");
     let mut toml = std::fs::read_to_string(&toml_path).unwrap();

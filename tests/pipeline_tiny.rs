@@ -8,7 +8,7 @@
 #[path = "support/cli.rs"]
 mod cli;
 
-use cli::{files_under, run_ok, skytie};
+use cli::{files_under, run_ok, skytie, synth_tiny};
 use std::path::{Path, PathBuf};
 
 fn metrics(out: &Path) -> serde_json::Value {
@@ -79,11 +79,7 @@ fn tiny_campaign_end_to_end() {
 
     // 1. The CLI generator and the checker.
     let camp = dir.join("tiny");
-    run_ok(
-        skytie()
-            .args(["synth", "--preset", "tiny", "--seed", "1", "--out"])
-            .arg(&camp),
-    );
+    synth_tiny(&camp, 1, &[]);
     let report = run_ok(skytie().arg("check").arg("--json").arg(&camp));
     let report: serde_json::Value =
         serde_json::from_str(&report).expect("check --json prints JSON");

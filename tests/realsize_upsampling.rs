@@ -306,11 +306,7 @@ struct Differences {
 fn compare_with_upsampled(what: Upsample) -> Differences {
     let work = tempfile::tempdir().unwrap();
     let base = work.path().join("base");
-    cli::run_ok(
-        cli::skytie()
-            .args(["synth", "--preset", "tiny", "--seed", "1", "--out"])
-            .arg(&base),
-    );
+    cli::synth_tiny(&base, 1, &[]);
     let big = work.path().join("big");
     scaled_copy(&base, &big, Path::new(""), what);
     let (m1, out1) = run_chain(&base, work.path(), "base");

@@ -7,7 +7,7 @@
 #[path = "support/cli.rs"]
 mod cli;
 
-use cli::{finish, run_ok, skytie};
+use cli::{finish, skytie, synth_tiny};
 use std::path::Path;
 
 fn png(path: &Path, w: u32, h: u32, claim: Option<(u32, u32)>) {
@@ -98,11 +98,7 @@ fn bad_items_are_dropped_counted_and_the_run_finishes_partially() {
     let dir = tmp.path();
     let wf = Path::new(env!("CARGO_MANIFEST_DIR")).join("workflows/tiny.toml");
     let tiny = dir.join("tiny");
-    run_ok(
-        skytie()
-            .args(["synth", "--preset", "tiny", "--seed", "1", "--out"])
-            .arg(&tiny),
-    );
+    synth_tiny(&tiny, 1, &[]);
     let cache = dir.join("cache");
     let (code, text) = run(&wf, &tiny, &cache, &dir.join("clean"));
     assert_complete_input(code, &text);
@@ -185,11 +181,7 @@ fn a_corrupted_cache_object_is_detected_and_recomputed() {
     .unwrap();
     let cache = dir.join("cache");
     let tiny = dir.join("tiny");
-    run_ok(
-        skytie()
-            .args(["synth", "--preset", "tiny", "--seed", "1", "--out"])
-            .arg(&tiny),
-    );
+    synth_tiny(&tiny, 1, &[]);
     let (code, text) = run(&wf, &tiny, &cache, &dir.join("a"));
     assert_eq!(code, 0, "{text}");
     // Flip one byte in the middle of every stored object.

@@ -8,19 +8,10 @@
 #[path = "support/cli.rs"]
 mod cli;
 
-use cli::{exit_and_output, json, output_files, skytie};
+use cli::{exit_and_output, json, output_files, results_of, skytie};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::Path;
-
-/// metrics.json without the engine's bookkeeping (node counts, seconds).
-fn results_of(metrics: &Value) -> Value {
-    let mut m = metrics.clone();
-    let obj = m.as_object_mut().unwrap();
-    obj.remove("engine");
-    obj.remove("stages");
-    m
-}
 
 /// Executed nodes per stage.
 fn executed(metrics: &Value) -> BTreeMap<String, u64> {

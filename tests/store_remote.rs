@@ -11,7 +11,7 @@
 mod cli;
 mod support;
 
-use cli::{exit_and_output, json, output_files, skytie};
+use cli::{exit_and_output, json, output_files, results_of, skytie};
 use serde_json::Value;
 use skytie::dag::progress::{Progress, ProgressMode};
 use skytie::dag::{execute, DagBuilder, Env, Mode, Outcome};
@@ -427,15 +427,6 @@ fn cli_run(
             .arg(out)
             .args(extra),
     )
-}
-
-/// metrics.json without the engine's bookkeeping (node counts, seconds).
-fn results_of(metrics: &Value) -> Value {
-    let mut m = metrics.clone();
-    let obj = m.as_object_mut().unwrap();
-    obj.remove("engine");
-    obj.remove("stages");
-    m
 }
 
 /// Outputs equal apart from run bookkeeping (metrics' engine and stage counters, provenance).

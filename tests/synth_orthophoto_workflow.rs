@@ -6,7 +6,7 @@
 #[path = "support/cli.rs"]
 mod cli;
 
-use cli::{exit_and_output, files_under, run_ok, skytie};
+use cli::{exit_and_output, files_under, skytie, synth_tiny};
 use std::path::{Path, PathBuf};
 
 /// A tiny `synth:` workflow that stops after loading the campaign, with `synth_keys` in its `[synth]` table.
@@ -37,13 +37,16 @@ fn synth_table_orthophoto_keys_generate_the_cli_campaign() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     let camp = dir.join("cli");
-    run_ok(
-        skytie()
-            .args(["synth", "--preset", "tiny", "--seed", "3"])
-            .args(["--orthophoto-gsd", "0.2", "--orthophoto-error", "0.03"])
-            .arg("--without-nadir")
-            .arg("--out")
-            .arg(&camp),
+    synth_tiny(
+        &camp,
+        3,
+        &[
+            "--orthophoto-gsd",
+            "0.2",
+            "--orthophoto-error",
+            "0.03",
+            "--without-nadir",
+        ],
     );
     let wf = write_workflow(
         dir,

@@ -253,34 +253,28 @@ fn bad_input_exits_2_naming_the_file() {
 
     let camp = dir.path().join("camp");
     stripe_campaign(&camp, 0.0);
-    let (code, _, err) = tool(&[
-        "perspective",
-        "--campaign",
-        s(&camp),
-        "--recording",
-        "r9",
-        "--yaw-deg",
-        "0",
-        "--out",
-        s(&dir.path().join("v.png")),
-    ]);
-    assert_eq!(code, 2);
+    let view = dir.path().join("v.png");
+    let perspective_of = |recording: &str| {
+        let (code, _, err) = tool(&[
+            "perspective",
+            "--campaign",
+            s(&camp),
+            "--recording",
+            recording,
+            "--yaw-deg",
+            "0",
+            "--out",
+            s(&view),
+        ]);
+        assert_eq!(code, 2);
+        err
+    };
+    let err = perspective_of("r9");
     assert!(
         err.contains("mm/recordings.csv") && err.contains("'r9'"),
         "{err}"
     );
     std::fs::remove_file(camp.join("mm/panoramas/r1.png")).unwrap();
-    let (code, _, err) = tool(&[
-        "perspective",
-        "--campaign",
-        s(&camp),
-        "--recording",
-        "r1",
-        "--yaw-deg",
-        "0",
-        "--out",
-        s(&dir.path().join("v.png")),
-    ]);
-    assert_eq!(code, 2);
+    let err = perspective_of("r1");
     assert!(err.contains("r1.png"), "{err}");
 }

@@ -13,6 +13,20 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
+/// Declares a [`Stage`]'s name, version and its parameter, output and input types in one line:
+/// `skytie::stage_items!("toy_sum", "1", ToySumParams => ToySummary, inputs: Vec<Handle<f64>>);`
+/// inside `impl Stage for …`.
+#[macro_export]
+macro_rules! stage_items {
+    ($name:expr, $version:expr, $params:ty => $output:ty, inputs: $inputs:ty) => {
+        const NAME: &'static str = $name;
+        const VERSION: &'static str = $version;
+        type Params = $params;
+        type Output = $output;
+        type Inputs = $inputs;
+    };
+}
+
 /// A typed DAG computation. See the module documentation.
 pub trait Stage: Send + Sync + 'static {
     /// Stable stage name (used in keys, workflows, metrics: keep it snake_case).

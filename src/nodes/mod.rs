@@ -16,11 +16,7 @@ macro_rules! stage_types {
         );
     };
     ($id:expr, $params:ty => $output:ty, inputs: $inputs:ty) => {
-        const NAME: &'static str = $id.name;
-        const VERSION: &'static str = $id.version;
-        type Params = $params;
-        type Output = $output;
-        type Inputs = $inputs;
+        $crate::stage_items!($id.name, $id.version, $params => $output, inputs: $inputs);
     };
 }
 pub(crate) use stage_types;

@@ -16,6 +16,27 @@ pub struct ResultSet {
     pub metrics: Value,
 }
 
+impl ResultSet {
+    /// What the HTML anchors and figure files of this set start with: nothing for a plain run, `variant-` for
+    /// a sweep variant.
+    pub fn anchor_prefix(&self) -> String {
+        if self.name.is_empty() {
+            String::new()
+        } else {
+            format!("{}-", super::slug(&self.name))
+        }
+    }
+
+    /// What figure titles of this set end with: nothing for a plain run, ` (variant)` for a sweep variant.
+    pub fn title_suffix(&self) -> String {
+        if self.name.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", self.name)
+        }
+    }
+}
+
 /// Everything the report reads from OUT.
 #[derive(Debug)]
 pub struct RunOutputs {

@@ -11,7 +11,7 @@ use super::plots::histogram::{histogram, HistSeries};
 use super::plots::trajectory::{trajectory_map, trim, MapRecording};
 use super::plots::{GREY, VERMILLION};
 use super::tables::{fmt_count, fmt_num, fmt_percent, Origin, Table};
-use super::{interactive_map, registration, slug, thesis_values, Builder};
+use super::{interactive_map, registration, thesis_values, Builder};
 use serde_json::Value;
 
 /// Appends the sections of `set` to `page`.
@@ -21,26 +21,17 @@ pub fn results_sections(
     set: &ResultSet,
     _run: &RunOutputs,
 ) -> Result<(), String> {
-    let prefix = if set.name.is_empty() {
-        String::new()
-    } else {
-        format!("{}-", slug(&set.name))
-    };
-    let title_suffix = if set.name.is_empty() {
-        String::new()
-    } else {
-        format!(" ({})", set.name)
-    };
+    let prefix = set.anchor_prefix();
     // Answer first, then the map, accuracy, registration; the map is built last (it links the registration
     // views) but shown second.
     headline_section(b, page, set, &prefix)?;
     let mut rest = Page::new("");
-    accuracy_section(b, &mut rest, set, &prefix, &title_suffix)?;
+    accuracy_section(b, &mut rest, set)?;
     super::headline_section::adjusted_verification_table(b, &mut rest, set, &prefix)?;
     verification_section(b, &mut rest, set, &prefix)?;
     nadir_section(b, &mut rest, &set.metrics, &prefix);
     registration::registration_section(b, &mut rest, set, &prefix)?;
-    map_section(b, &mut rest, set, &prefix, &title_suffix)?;
+    map_section(b, &mut rest, set)?;
     let views = std::mem::take(&mut b.recording_views);
     interactive_map::map_section(b, page, set, &prefix, &views)?;
     page.append(rest);
@@ -50,13 +41,8 @@ pub fn results_sections(
 /// Most recordings drawn in one static trajectory figure.
 pub const STATIC_MAP_LIMIT: usize = 3000;
 
-fn map_section(
-    b: &mut Builder,
-    page: &mut Page,
-    set: &ResultSet,
-    prefix: &str,
-    title_suffix: &str,
-) -> Result<(), String> {
+fn map_section(b: &mut Builder, page: &mut Page, set: &ResultSet) -> Result<(), String> {
+    let (prefix, title_suffix) = (set.anchor_prefix(), set.title_suffix());
     page.heading(
         &format!("{prefix}static-map"),
         "Trajectory map (static figure)",
@@ -204,13 +190,8 @@ const AXES: [(&str, &str); 5] = [
     ("3d", "3D"),
 ];
 
-fn accuracy_section(
-    b: &mut Builder,
-    page: &mut Page,
-    set: &ResultSet,
-    prefix: &str,
-    title_suffix: &str,
-) -> Result<(), String> {
+fn accuracy_section(b: &mut Builder, page: &mut Page, set: &ResultSet) -> Result<(), String> {
+    let (prefix, title_suffix) = (set.anchor_prefix(), set.title_suffix());
     let m = &set.metrics;
     let Some(adjust) = obj_at(m, "adjust") else {
         return Ok(());

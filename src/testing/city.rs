@@ -92,11 +92,7 @@ macro_rules! city_stage {
         $(#[$doc])*
         pub struct $ty;
         impl Stage for $ty {
-            const NAME: &'static str = $name;
-            const VERSION: &'static str = "1";
-            type Params = CityParams;
-            type Output = u64;
-            type Inputs = $inputs;
+            crate::stage_items!($name, "1", CityParams => u64, inputs: $inputs);
             fn run(&self, p: &CityParams, v: InputsOf<Self>, _ctx: &NodeCtx) -> RunResult<Self> {
                 let seed = mix(p.salt ^ mix(p.index ^ $name.len() as u64));
                 Ok(v.fold(seed))

@@ -49,11 +49,7 @@ pub struct ToyParseParams {
 }
 
 impl Stage for ToyParse {
-    const NAME: &'static str = "toy_parse";
-    const VERSION: &'static str = "1";
-    type Params = ToyParseParams;
-    type Output = f64;
-    type Inputs = RawFile;
+    crate::stage_items!("toy_parse", "1", ToyParseParams => f64, inputs: RawFile);
     fn run(&self, p: &ToyParseParams, file: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         p.faults.apply(ctx)?;
         let text = std::fs::read_to_string(&file.path)
@@ -91,11 +87,7 @@ impl Default for ToyScaleParams {
 }
 
 impl Stage for ToyScale {
-    const NAME: &'static str = "toy_scale";
-    const VERSION: &'static str = "1";
-    type Params = ToyScaleParams;
-    type Output = f64;
-    type Inputs = Handle<f64>;
+    crate::stage_items!("toy_scale", "1", ToyScaleParams => f64, inputs: Handle<f64>);
     fn run(&self, p: &ToyScaleParams, v: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         p.faults.apply(ctx)?;
         let x = *v * p.factor;
@@ -111,11 +103,7 @@ impl Stage for ToyScale {
 pub struct ToyScaleV2;
 
 impl Stage for ToyScaleV2 {
-    const NAME: &'static str = "toy_scale";
-    const VERSION: &'static str = "2";
-    type Params = ToyScaleParams;
-    type Output = f64;
-    type Inputs = Handle<f64>;
+    crate::stage_items!("toy_scale", "2", ToyScaleParams => f64, inputs: Handle<f64>);
     fn run(&self, p: &ToyScaleParams, v: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         ToyScale.run(p, v, ctx)
     }
@@ -141,11 +129,7 @@ pub struct ToySumParams {
 }
 
 impl Stage for ToySum {
-    const NAME: &'static str = "toy_sum";
-    const VERSION: &'static str = "1";
-    type Params = ToySumParams;
-    type Output = ToySummary;
-    type Inputs = Vec<Handle<f64>>;
+    crate::stage_items!("toy_sum", "1", ToySumParams => ToySummary, inputs: Vec<Handle<f64>>);
     fn run(&self, p: &ToySumParams, values: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         p.faults.apply(ctx)?;
         // Sequential sum in input order: deterministic whatever the thread count.
@@ -189,11 +173,7 @@ impl Default for ToyGenParams {
 }
 
 impl Stage for ToyGen {
-    const NAME: &'static str = "toy_gen";
-    const VERSION: &'static str = "1";
-    type Params = ToyGenParams;
-    type Output = ToyDir;
-    type Inputs = ();
+    crate::stage_items!("toy_gen", "1", ToyGenParams => ToyDir, inputs: ());
     fn run(&self, p: &ToyGenParams, _: InputsOf<Self>, ctx: &NodeCtx) -> RunResult<Self> {
         p.faults.apply(ctx)?;
         let tmp = ctx.output_dir_tmp()?;

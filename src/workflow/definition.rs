@@ -9,7 +9,7 @@ use super::error::WorkflowError;
 use super::file::{load_document, WorkflowFiles, BUILT_IN_DIR};
 use super::source::{describe_position, error_at, SourceFile};
 use super::suggest::did_you_mean;
-use super::sweep::{parse_sweep, Sweep};
+use super::sweep::{parse_sweep, valid_folder_name, Sweep};
 use super::tree::{Entry, Loc, Table, Value};
 
 /// Keys of a workflow file that are not stage tables.
@@ -250,15 +250,6 @@ fn hash_sources(files: &[SourceFile]) -> [u8; 32] {
     *hasher.finalize().as_bytes()
 }
 
-/// A name usable as a folder name (`out/<name>/`).
-fn valid_name(name: &str) -> bool {
-    !name.is_empty()
-        && !name.starts_with('.')
-        && name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
-}
-
 /// Stage names: identifiers (letters, digits, `_`, `-`), not a top-level key.
 fn valid_stage_name(name: &str) -> bool {
     !name.is_empty()
@@ -296,7 +287,7 @@ fn interpret(
     let mut name = stem;
     if let Some(e) = document.get("name") {
         if let Some(s) = string_of(e, &mut errors) {
-            if valid_name(&s) {
+            if valid_folder_name(&s) {
                 name = s;
             } else {
                 errors.push(at(

@@ -144,8 +144,9 @@ pub(crate) fn parse_sweep(
     Some(sweep)
 }
 
-/// Variant names become folder names (`OUT/variants/<name>/`): letters, digits, `_`, `-`, `.`; not starting with `.`.
-fn valid_variant_name(name: &str) -> bool {
+/// A name usable as a folder name (a workflow's `OUT/<name>/`, a variant's `OUT/variants/<name>/`): letters,
+/// digits, `_`, `-`, `.`; not starting with `.`.
+pub(super) fn valid_folder_name(name: &str) -> bool {
     !name.is_empty()
         && !name.starts_with('.')
         && name
@@ -174,7 +175,7 @@ fn parse_variant(
     };
     let name_entry = table.get("name");
     let (name, name_at) = match name_entry.map(|e| (&e.node.value, e.node.at)) {
-        Some((Value::String(s), at)) if valid_variant_name(s) => (s.clone(), at),
+        Some((Value::String(s), at)) if valid_folder_name(s) => (s.clone(), at),
         Some((Value::String(s), at)) => {
             errors.push(error_at(
                 sources,

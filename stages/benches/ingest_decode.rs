@@ -41,20 +41,24 @@ fn decode_zune_luma(path: &Path) -> Option<Result<u64, String>> {
     if !bytes.starts_with(&[0xFF, 0xD8]) {
         return None;
     }
+    Some(
+        zune_luma(&bytes)
+            .map(|plane| plane.len() as u64)
+            .map_err(|e| e.to_string()),
+    )
+}
+
+/// zune-jpeg's decode of the JPEG stream `bytes` to its luma plane.
+fn zune_luma(bytes: &[u8]) -> Result<Vec<u8>, zune_jpeg::errors::DecodeErrors> {
     let options = zune_jpeg::zune_core::options::DecoderOptions::default()
         .jpeg_set_out_colorspace(zune_jpeg::zune_core::colorspace::ColorSpace::Luma)
         .set_max_width(1 << 20)
         .set_max_height(1 << 20);
-    let mut decoder = zune_jpeg::JpegDecoder::new_with_options(
-        zune_jpeg::zune_core::bytestream::ZCursor::new(&bytes),
+    zune_jpeg::JpegDecoder::new_with_options(
+        zune_jpeg::zune_core::bytestream::ZCursor::new(bytes),
         options,
-    );
-    Some(
-        decoder
-            .decode()
-            .map(|plane| plane.len() as u64)
-            .map_err(|e| e.to_string()),
     )
+    .decode()
 }
 
 /// The `tiff` crate's decode of every strip or tile of the first image of `path`, one at a time; returns the
@@ -109,15 +113,7 @@ fn decode_tiff_zune_luma(path: &Path) -> Option<Result<u64, String>> {
                 Some(t) if t.len() >= 4 => [&t[..t.len() - 2], &chunk[2..]].concat(),
                 _ => chunk.clone(),
             };
-            let options = zune_jpeg::zune_core::options::DecoderOptions::default()
-                .jpeg_set_out_colorspace(zune_jpeg::zune_core::colorspace::ColorSpace::Luma)
-                .set_max_width(1 << 20)
-                .set_max_height(1 << 20);
-            let mut decoder = zune_jpeg::JpegDecoder::new_with_options(
-                zune_jpeg::zune_core::bytestream::ZCursor::new(&stream),
-                options,
-            );
-            decoder.decode().map_err(|e| format!("{e:?}"))?;
+            zune_luma(&stream).map_err(|e| format!("{e:?}"))?;
         }
         let (w, h) = dec.dimensions().map_err(|e| e.to_string())?;
         Ok(u64::from(w) * u64::from(h))

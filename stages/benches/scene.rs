@@ -87,6 +87,22 @@ fn render_nadir(
     (img, t.secs())
 }
 
+/// Prints the speed of the rendering `img` that took `secs` of CPU time (one radiance call per pixel); with a
+/// preview folder, also writes it there as the display-encoded PNG `file`, for looking at the scene.
+fn report(label: &str, img: &RgbImage, secs: f64, preview: Option<&std::path::Path>, file: &str) {
+    println!(
+        "{label}: {secs:.3} s, {:.2} M radiance calls/s (1 thread, CPU time)",
+        (img.width * img.height) as f64 / secs / 1e6
+    );
+    if let Some(dir) = preview {
+        let mut disp = img.clone();
+        disp.data
+            .chunks_exact_mut(3)
+            .for_each(|c| c.copy_from_slice(&to_display([c[0], c[1], c[2]])));
+        skytie_stages::imaging::io::save_rgb(&dir.join(file), &disp, 95).expect("write preview");
+    }
+}
+
 fn main() {
     let t = Instant::now();
     let scene = Scene::generate(&SceneSpec::demo(), 1);
@@ -108,37 +124,27 @@ fn main() {
     let preview = std::env::var_os("SKYTIE_SCENE_PREVIEW").map(std::path::PathBuf::from);
     for epoch in [Epoch::MobileMapping, Epoch::Aerial] {
         let (img, secs) = render_pano(&scene, &o, w, h, epoch);
-        println!(
-            "panorama {w}x{h} {epoch:?}: {:.3} s, {:.2} M radiance calls/s (1 thread, CPU time)",
+        let label = format!("panorama {w}x{h} {epoch:?}");
+        report(
+            &label,
+            &img,
             secs,
-            (w * h) as f64 / secs / 1e6
+            preview.as_deref(),
+            &format!("pano_{epoch:?}.png"),
         );
-        if let Some(dir) = &preview {
-            let mut disp = img.clone();
-            disp.data
-                .chunks_exact_mut(3)
-                .for_each(|c| c.copy_from_slice(&to_display([c[0], c[1], c[2]])));
-            let path = dir.join(format!("pano_{epoch:?}.png"));
-            skytie_stages::imaging::io::save_rgb(&path, &disp, 95).expect("write preview");
-        }
     }
     let centre = scene.local_to_world_xy([100.0, 0.0]);
     let _ = mid;
     for epoch in [Epoch::MobileMapping, Epoch::Aerial] {
         let n = 768;
         let (img, secs) = render_nadir(&scene, centre, 0.1, n, epoch);
-        println!(
-            "nadir {n}x{n} from 450 m, 10 cm GSD {epoch:?}: {:.3} s, {:.2} M radiance calls/s (1 thread, CPU time)",
+        let label = format!("nadir {n}x{n} from 450 m, 10 cm GSD {epoch:?}");
+        report(
+            &label,
+            &img,
             secs,
-            (n * n) as f64 / secs / 1e6
+            preview.as_deref(),
+            &format!("nadir_{epoch:?}.png"),
         );
-        if let Some(dir) = &preview {
-            let mut disp = img.clone();
-            disp.data
-                .chunks_exact_mut(3)
-                .for_each(|c| c.copy_from_slice(&to_display([c[0], c[1], c[2]])));
-            let path = dir.join(format!("nadir_{epoch:?}.png"));
-            skytie_stages::imaging::io::save_rgb(&path, &disp, 95).expect("write preview");
-        }
     }
 }

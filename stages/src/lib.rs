@@ -22,6 +22,7 @@ pub mod nadir;
 pub mod oblique;
 pub mod orthophoto;
 pub mod params;
+pub mod positions;
 pub mod ratio;
 pub mod rng;
 pub mod synth;

@@ -10,23 +10,16 @@ use skytie_stages::campaign::{
     write_observations_csv, write_recordings_csv, AerialImage, CheckPoint, Observation,
     ProblemKind, Recording, Severity,
 };
-use skytie_stages::imaging::io::save_rgb;
-use skytie_stages::imaging::RgbImage;
 use std::path::Path;
+use support::campaign_files::image;
+
+mod support;
 
 const REC: &str = "mm/recordings.csv";
 const NADIR: &str = "aerial/nadir/cameras.csv";
 const OBL: &str = "aerial/oblique/cameras.csv";
 const CP: &str = "control/checkpoints.csv";
 const OBS: &str = "control/observations.csv";
-
-fn image(path: &Path, width: usize, height: usize) {
-    let mut img = RgbImage::filled(width, height, [0.2, 0.5, 0.7]);
-    for x in 0..width {
-        img.set(x, height / 2, [1.0, 1.0, 1.0]);
-    }
-    save_rgb(path, &img, 90).unwrap();
-}
 
 fn aerial(id: &str, file: &str, y: f64, omega_deg: f64) -> AerialImage {
     AerialImage {

@@ -11,14 +11,9 @@ use skytie_stages::campaign::{
 use skytie_stages::imaging::io::save_rgb;
 use skytie_stages::imaging::RgbImage;
 use std::path::Path;
+use support::campaign_files::image;
 
-fn image(path: &Path, width: usize, height: usize) {
-    let mut img = RgbImage::filled(width, height, [0.2, 0.5, 0.7]);
-    for x in 0..width {
-        img.set(x, height / 2, [1.0, 1.0, 1.0]);
-    }
-    save_rgb(path, &img, 90).unwrap();
-}
+mod support;
 
 fn recording(i: usize, file: &str) -> Recording {
     Recording {

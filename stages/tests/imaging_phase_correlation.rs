@@ -7,8 +7,9 @@ mod imaging_support;
 
 use imaging_support::{radiometric, SplitMix64, Texture};
 use skytie_stages::imaging::window::WindowKind;
+use skytie_stages::imaging::GrayImage;
 use skytie_stages::matching::phase_correlation::{
-    locate_template, phase_correlate, PhaseCorrelationParams,
+    locate_template, phase_correlate, PhaseCorrelationParams, PhaseShift,
 };
 use skytie_stages::matching::subpixel::PeakFit;
 
@@ -20,39 +21,49 @@ fn unwindowed() -> PhaseCorrelationParams {
     }
 }
 
+/// A `size × size` crop of `tex` at `origin` and the same crop with its content moved by `shift` px.
+fn shifted_pair(
+    tex: &Texture,
+    size: usize,
+    (x0, y0): (f64, f64),
+    (tx, ty): (f64, f64),
+) -> (GrayImage, GrayImage) {
+    (
+        tex.render(size, size, x0, y0, 0.0, 0.0),
+        tex.render(size, size, x0, y0, tx, ty),
+    )
+}
+
+/// Asserts that `s` is the shift `want` (dx, dy) within `tol_px` on each axis.
+fn assert_shift(s: &PhaseShift, want: (f64, f64), tol_px: f64) {
+    assert!(
+        (s.dx_px - want.0).abs() < tol_px && (s.dy_px - want.1).abs() < tol_px,
+        "{s:?} vs {want:?}"
+    );
+}
+
 #[test]
 fn integer_circular_shift_gives_exact_peak() {
     let tex = Texture::new(128, 32, 1);
-    let f1 = tex.render(128, 128, 0.0, 0.0, 0.0, 0.0);
-    let f2 = tex.render(128, 128, 0.0, 0.0, 5.0, -3.0);
+    let (f1, f2) = shifted_pair(&tex, 128, (0.0, 0.0), (5.0, -3.0));
     let p = unwindowed();
     let s = phase_correlate(&f1, &f2, &p).unwrap();
-    assert!(
-        (s.dx_px - 5.0).abs() < 1e-6 && (s.dy_px + 3.0).abs() < 1e-6,
-        "{s:?}"
-    );
+    assert_shift(&s, (5.0, -3.0), 1e-6);
     assert!(s.peak > 0.2, "{s:?}");
     // Windowed: the taper cuts the circularly wrapped seam differently in both images, so only the integer
     // peak is exact; the sub-pixel part stays small.
     let s = phase_correlate(&f1, &f2, &PhaseCorrelationParams::default()).unwrap();
     assert_eq!((s.dx_px.round(), s.dy_px.round()), (5.0, -3.0), "{s:?}");
-    assert!(
-        (s.dx_px - 5.0).abs() < 0.05 && (s.dy_px + 3.0).abs() < 0.05,
-        "{s:?}"
-    );
+    assert_shift(&s, (5.0, -3.0), 0.05);
 }
 
 #[test]
 fn circular_fourier_shift_is_recovered() {
     let tex = Texture::new(128, 32, 2);
-    let f1 = tex.render(128, 128, 0.0, 0.0, 0.0, 0.0);
-    let f2 = tex.render(128, 128, 0.0, 0.0, 2.3, -1.7);
+    let (f1, f2) = shifted_pair(&tex, 128, (0.0, 0.0), (2.3, -1.7));
     let p = unwindowed();
     let s = phase_correlate(&f1, &f2, &p).unwrap();
-    assert!(
-        (s.dx_px - 2.3).abs() < 0.02 && (s.dy_px + 1.7).abs() < 0.02,
-        "{s:?}"
-    );
+    assert_shift(&s, (2.3, -1.7), 0.02);
     // Plain quadratic on the unweighted spectrum (thesis' fit): the bound of 0.15 px.
     let p = PhaseCorrelationParams {
         window: WindowKind::Rectangular,
@@ -61,10 +72,7 @@ fn circular_fourier_shift_is_recovered() {
         refinements: 0,
     };
     let s = phase_correlate(&f1, &f2, &p).unwrap();
-    assert!(
-        (s.dx_px - 2.3).abs() < 0.15 && (s.dy_px + 1.7).abs() < 0.15,
-        "{s:?}"
-    );
+    assert_shift(&s, (2.3, -1.7), 0.15);
 }
 
 /// RMS error over random sub-pixel shifts of crops (non-circular content) with gain/offset/gamma and noise.
@@ -102,29 +110,21 @@ fn subpixel_shifts_under_radiometric_change_and_noise_128() {
 #[test]
 fn illumination_change_gives_the_same_shift() {
     let tex = Texture::new(256, 64, 3);
-    let f1 = tex.render(96, 96, 20.0, 30.0, 0.0, 0.0);
-    let f2 = tex.render(96, 96, 20.0, 30.0, 1.4, 2.6);
+    let (f1, f2) = shifted_pair(&tex, 96, (20.0, 30.0), (1.4, 2.6));
     let p = PhaseCorrelationParams::default();
     let a = phase_correlate(&f1, &f2, &p).unwrap();
     let f2b = radiometric(&f2, 0.5, 0.3, 1.0, 0.0, 0);
     let b = phase_correlate(&f1, &f2b, &p).unwrap();
     // Identical up to the f32 rounding of the transformed image.
-    assert!(
-        (a.dx_px - b.dx_px).abs() < 1e-5 && (a.dy_px - b.dy_px).abs() < 1e-5,
-        "{a:?} {b:?}"
-    );
-    assert!(
-        (a.dx_px - 1.4).abs() < 0.05 && (a.dy_px - 2.6).abs() < 0.05,
-        "{a:?}"
-    );
+    assert_shift(&a, (b.dx_px, b.dy_px), 1e-5);
+    assert_shift(&a, (1.4, 2.6), 0.05);
 }
 
 #[test]
 fn sign_convention_matches_opencv() {
     // Content moves right/down in `moving` ⇒ positive (dx, dy), x first.
     let tex = Texture::new(256, 64, 4);
-    let f1 = tex.render(64, 64, 50.0, 50.0, 0.0, 0.0);
-    let f2 = tex.render(64, 64, 50.0, 50.0, 3.0, 1.0);
+    let (f1, f2) = shifted_pair(&tex, 64, (50.0, 50.0), (3.0, 1.0));
     let s = phase_correlate(&f1, &f2, &PhaseCorrelationParams::default()).unwrap();
     assert!(s.dx_px > 2.5 && s.dy_px > 0.5 && s.dy_px < 1.5, "{s:?}");
 }
@@ -162,14 +162,10 @@ fn reused_correlator_gives_the_free_functions_results() {
         .enumerate()
     {
         let x0 = 30.0 * k as f64;
-        let a = tex.render(64, 64, x0, 40.0, 0.0, 0.0);
-        let b = tex.render(64, 64, x0, 40.0, tx, ty);
+        let (a, b) = shifted_pair(&tex, 64, (x0, 40.0), (tx, ty));
         let reused = c.correlate(&a, &b).unwrap();
         assert_eq!(reused, phase_correlate(&a, &b, &p).unwrap());
-        assert!(
-            (reused.dx_px - tx).abs() < 0.05 && (reused.dy_px - ty).abs() < 0.05,
-            "{reused:?} vs ({tx}, {ty})"
-        );
+        assert_shift(&reused, (tx, ty), 0.05);
     }
     // Template location through a correlator sized for the search window.
     let search = tex.render(48, 48, 100.0, 80.0, 0.0, 0.0);

@@ -10,6 +10,17 @@ pub fn skytie() -> Command {
     Command::new(env!("CARGO_BIN_EXE_skytie"))
 }
 
+/// `skytie synth --preset tiny --seed SEED OPTIONS… --out OUT`, which must succeed.
+pub fn synth_tiny(out: &Path, seed: u64, options: &[&str]) {
+    run_ok(
+        skytie()
+            .args(["synth", "--preset", "tiny", "--seed", &seed.to_string()])
+            .args(options)
+            .arg("--out")
+            .arg(out),
+    );
+}
+
 /// Runs `cmd` to its end: its exit code (-1 when a signal ended it), stdout and stderr.
 pub fn finish(cmd: &mut Command) -> (i32, String, String) {
     let out = cmd.output().expect("start skytie");
@@ -90,4 +101,13 @@ pub fn output_files(root: &Path) -> std::collections::BTreeMap<String, Vec<u8>> 
 /// A JSON file, parsed.
 pub fn json(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
+/// A run's metrics.json without the engine's bookkeeping (node counts, seconds).
+pub fn results_of(metrics: &serde_json::Value) -> serde_json::Value {
+    let mut m = metrics.clone();
+    let obj = m.as_object_mut().unwrap();
+    obj.remove("engine");
+    obj.remove("stages");
+    m
 }

@@ -48,6 +48,15 @@ pub fn add_toy(b: &mut DagBuilder, items: &[PathBuf], cfg: &ToyConfig) -> Handle
     h
 }
 
+/// A temporary folder holding the toy item files with `values` (see [`make_items`]), and the path of a cache
+/// folder inside it.
+pub fn toy_workspace(values: &[f64]) -> (tempfile::TempDir, PathBuf, Vec<PathBuf>) {
+    let dir = tempfile::tempdir().unwrap();
+    let items = make_items(dir.path(), values);
+    let cache = dir.path().join("cache");
+    (dir, cache, items)
+}
+
 /// The toy DAG of one configuration.
 pub fn toy_dag(items: &[PathBuf], cfg: &ToyConfig) -> (Dag, Handle<ToySummary>) {
     let mut b = DagBuilder::new();
@@ -58,6 +67,13 @@ pub fn toy_dag(items: &[PathBuf], cfg: &ToyConfig) -> (Dag, Handle<ToySummary>) 
 /// Execute `dag` against the cache at `cache` (silent progress).
 pub fn run(cache: &Path, dag: &Dag, mode: Mode) -> Outcome {
     SilentEngine::open(cache).unwrap().execute(dag, mode)
+}
+
+/// Builds the toy DAG of one configuration and runs it against the cache at `cache`: the outcome and the sum's
+/// handle.
+pub fn run_toy(cache: &Path, items: &[PathBuf], cfg: &ToyConfig) -> (Outcome, Handle<ToySummary>) {
+    let (dag, h) = toy_dag(items, cfg);
+    (run(cache, &dag, Mode::Run), h)
 }
 
 /// Executed count per stage name of an outcome, as (parse, scale, sum).

@@ -81,20 +81,26 @@ pub fn dump_dom(chromium: &Path, page: &Path, profile: &Path) -> String {
 
 /// Like [`dump_dom`] with a fragment (`#…`) appended to the page's address.
 pub fn dump_dom_fragment(chromium: &Path, page: &Path, fragment: &str, profile: &Path) -> String {
-    let out = headless(chromium, profile)
-        .arg("--dump-dom")
-        .arg(format!(
-            "file://{}{fragment}",
-            page.canonicalize().unwrap().display()
-        ))
-        .output()
-        .expect("start chromium");
+    let mut cmd = headless(chromium, profile);
+    cmd.arg("--dump-dom")
+        .arg(format!("{}{fragment}", file_url(page)));
+    String::from_utf8(succeed(&mut cmd, "--dump-dom")).unwrap()
+}
+
+/// The `file://` address of `page`.
+fn file_url(page: &Path) -> String {
+    format!("file://{}", page.canonicalize().unwrap().display())
+}
+
+/// Runs the Chromium command `cmd` (its main option `what`), which must succeed; returns its stdout.
+fn succeed(cmd: &mut Command, what: &str) -> Vec<u8> {
+    let out = cmd.output().expect("start chromium");
     assert!(
         out.status.success(),
-        "chromium --dump-dom failed: {}",
+        "chromium {what} failed: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    String::from_utf8(out.stdout).unwrap()
+    out.stdout
 }
 
 /// Screenshot of `page` into `png` (window `width` × `height` px).
@@ -106,18 +112,12 @@ pub fn screenshot(
     width: u32,
     height: u32,
 ) {
-    let out = headless(chromium, profile)
-        .arg(format!("--screenshot={}", png.display()))
+    let mut cmd = headless(chromium, profile);
+    cmd.arg(format!("--screenshot={}", png.display()))
         .arg(format!("--window-size={width},{height}"))
         .arg("--hide-scrollbars")
-        .arg(format!("file://{}", page.canonicalize().unwrap().display()))
-        .output()
-        .expect("start chromium");
-    assert!(
-        out.status.success(),
-        "chromium --screenshot failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .arg(file_url(page));
+    succeed(&mut cmd, "--screenshot");
 }
 
 /// Per `<img>` of a dumped DOM: (src, natural width, natural height) as recorded by the page's script. The

@@ -10,6 +10,8 @@ use clap::Subcommand;
 use nadir::*;
 use oblique::*;
 use skytie_stages::campaign::{read_campaign, Recording};
+use skytie_stages::imaging::io::load_gray;
+use skytie_stages::imaging::GrayImage;
 use skytie_stages::params::Violation;
 use skytie_util::fsutil::atomic_write;
 use std::path::{Path, PathBuf};
@@ -67,6 +69,23 @@ pub fn main(cmd: &ToolCommand) -> i32 {
 pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), String> {
     atomic_write(path, text.as_bytes())
         .map_err(|e| format!("{}: cannot write: {e}", path.display()))
+}
+
+/// Write a CSV listing atomically and say on stdout how many `what` (e.g. "corners") it holds.
+pub(crate) fn write_listing(
+    path: &Path,
+    csv: &str,
+    count: usize,
+    what: &str,
+) -> Result<(), String> {
+    write_text(path, csv)?;
+    println!("{count} {what} -> {}", path.display());
+    Ok(())
+}
+
+/// An input image as grey values, or the decoder's message.
+pub(crate) fn read_gray(path: &Path) -> Result<GrayImage, String> {
+    load_gray(path).map_err(|e| e.to_string())
 }
 
 /// The recording `id` of the campaign folder `campaign` and the path of its panorama file; a missing or rejected

@@ -1,11 +1,11 @@
 //! `skytie tool` building blocks of the nadir pipeline (thesis ch. 3): ortho, kaze, forstner, wallis, phasecorr,
 //! ncc.
 
-use super::{campaign_recording, option_errors, write_text};
+use super::{campaign_recording, option_errors, read_gray, write_listing};
 use clap::Args;
 use skytie_stages::features::forstner::{forstner_corners, ForstnerParams};
 use skytie_stages::features::kaze::{detect_and_describe, KazeParams};
-use skytie_stages::imaging::io::{load_gray, save_gray};
+use skytie_stages::imaging::io::save_gray;
 use skytie_stages::imaging::wallis::{wallis_filter, WallisParams};
 use skytie_stages::matching::ncc::match_template;
 use skytie_stages::matching::phase_correlation::{phase_correlate, PhaseCorrelationParams};
@@ -85,7 +85,7 @@ pub struct NccArgs {
 
 pub fn ortho(a: &OrthoArgs) -> Result<(), String> {
     let (rec, pano_path) = campaign_recording(&a.campaign, &a.recording)?;
-    let pano = load_gray(&pano_path).map_err(|e| e.to_string())?;
+    let pano = read_gray(&pano_path)?;
     let mut params = OrthoParams {
         gsd_m: a.gsd,
         rotation_deg: a.rotate_deg,
@@ -113,7 +113,7 @@ pub fn ortho(a: &OrthoArgs) -> Result<(), String> {
 }
 
 pub fn kaze(a: &KazeArgs) -> Result<(), String> {
-    let img = load_gray(&a.image).map_err(|e| e.to_string())?;
+    let img = read_gray(&a.image)?;
     if a.octaves == 0 || a.octaves > 8 || !(a.threshold.is_finite() && a.threshold > 0.0) {
         return Err("--octaves must be in 1..=8 and --threshold finite and > 0".into());
     }
@@ -141,13 +141,11 @@ pub fn kaze(a: &KazeArgs) -> Result<(), String> {
         }
         s.push('\n');
     }
-    write_text(&a.out, &s)?;
-    println!("{} keypoints -> {}", f.len(), a.out.display());
-    Ok(())
+    write_listing(&a.out, &s, f.len(), "keypoints")
 }
 
 pub fn forstner(a: &ForstnerArgs) -> Result<(), String> {
-    let img = load_gray(&a.image).map_err(|e| e.to_string())?;
+    let img = read_gray(&a.image)?;
     let p = ForstnerParams {
         max_corners: a.max,
         ..ForstnerParams::default()
@@ -157,13 +155,11 @@ pub fn forstner(a: &ForstnerArgs) -> Result<(), String> {
     for c in &corners {
         let _ = writeln!(s, "{},{},{},{}", c.u_px, c.v_px, c.weight, c.roundness);
     }
-    write_text(&a.out, &s)?;
-    println!("{} corners -> {}", corners.len(), a.out.display());
-    Ok(())
+    write_listing(&a.out, &s, corners.len(), "corners")
 }
 
 pub fn wallis(a: &WallisArgs) -> Result<(), String> {
-    let img = load_gray(&a.image).map_err(|e| e.to_string())?;
+    let img = read_gray(&a.image)?;
     let p = WallisParams {
         window_px: a.window,
         ..WallisParams::default()
@@ -175,8 +171,8 @@ pub fn wallis(a: &WallisArgs) -> Result<(), String> {
 }
 
 pub fn phasecorr(a: &PairArgs) -> Result<(), String> {
-    let ia = load_gray(&a.a).map_err(|e| e.to_string())?;
-    let ib = load_gray(&a.b).map_err(|e| e.to_string())?;
+    let ia = read_gray(&a.a)?;
+    let ib = read_gray(&a.b)?;
     let s =
         phase_correlate(&ia, &ib, &PhaseCorrelationParams::default()).map_err(|e| e.to_string())?;
     println!("{} {} {}", s.dx_px, s.dy_px, s.peak);
@@ -184,8 +180,8 @@ pub fn phasecorr(a: &PairArgs) -> Result<(), String> {
 }
 
 pub fn ncc(a: &NccArgs) -> Result<(), String> {
-    let t = load_gray(&a.template).map_err(|e| e.to_string())?;
-    let i = load_gray(&a.image).map_err(|e| e.to_string())?;
+    let t = read_gray(&a.template)?;
+    let i = read_gray(&a.image)?;
     // A constant template has no normalised correlation anywhere (every score would be 0 at an arbitrary place).
     if t.data.windows(2).all(|p| p[0] == p[1]) {
         return Err(format!(

@@ -2,14 +2,14 @@
 //! Each tool calls the same stages-crate function the pipeline uses (`features::agast`, `features::daisy`,
 //! `oblique::patch_registration::search::mi_search`, `geometry::perspective`).
 
-use super::{campaign_recording, option_errors, write_text};
+use super::{campaign_recording, option_errors, read_gray, write_listing, write_text};
 use clap::{Args, ValueEnum};
 use skytie_stages::estimators::one_plus_one::OnePlusOneParams;
 use skytie_stages::features::agast::{detect_agast, AgastParams};
 use skytie_stages::features::daisy::{DaisyExtractor, DaisyNormalization, DaisyParams};
 use skytie_stages::geometry::perspective::PerspectiveView;
 use skytie_stages::geometry::PanoramaCamera;
-use skytie_stages::imaging::io::{load_gray, load_rgb, save_rgb};
+use skytie_stages::imaging::io::{load_rgb, save_rgb};
 use skytie_stages::matching::mattes_mi::MiError;
 use skytie_stages::oblique::patch_registration::search::mi_search;
 use skytie_stages::params::Params;
@@ -137,15 +137,13 @@ pub fn agast(a: &AgastArgs) -> Result<(), String> {
     };
     p.validate()
         .map_err(|errs| option_errors(&errs, &[("max_corners", "max")]))?;
-    let img = load_gray(&a.image).map_err(|e| e.to_string())?;
+    let img = read_gray(&a.image)?;
     let corners = detect_agast(&img, &p);
     let mut s = String::from("x,y,score\n");
     for c in &corners {
         let _ = writeln!(s, "{},{},{}", c.x_px, c.y_px, c.score);
     }
-    write_text(&a.out, &s)?;
-    println!("{} corners -> {}", corners.len(), a.out.display());
-    Ok(())
+    write_listing(&a.out, &s, corners.len(), "corners")
 }
 
 pub fn daisy(a: &DaisyArgs) -> Result<(), String> {
@@ -156,7 +154,7 @@ pub fn daisy(a: &DaisyArgs) -> Result<(), String> {
     };
     p.validate().map_err(|errs| option_errors(&errs, &[]))?;
     let points = read_points(&a.points)?;
-    let img = load_gray(&a.image).map_err(|e| e.to_string())?;
+    let img = read_gray(&a.image)?;
     let ex = DaisyExtractor::new(&img, &p);
     let len = ex.descriptor_len();
     let mut s = String::from("x,y,inside");
@@ -262,8 +260,8 @@ pub fn mi_register(a: &MiRegisterArgs) -> Result<(), String> {
     if a.samples == Some(0) {
         return Err("--samples: must be ≥ 1 (omit it to use every pixel)".into());
     }
-    let fixed = load_gray(&a.fixed).map_err(|e| e.to_string())?;
-    let moving = load_gray(&a.moving).map_err(|e| e.to_string())?;
+    let fixed = read_gray(&a.fixed)?;
+    let moving = read_gray(&a.moving)?;
     let r = mi_search(
         &fixed,
         &moving,

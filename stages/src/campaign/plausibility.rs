@@ -50,6 +50,28 @@ impl Extent {
     fn distance_m(&self, x: f64, y: f64) -> f64 {
         (x - self.x).hypot(y - self.y)
     }
+
+    /// `rows` without those farther than [`Extent::limit_m`] from the middle (`xy` gives a row's position),
+    /// each reported as lying outside the area `what` (e.g. "recordings") must lie in.
+    fn keep_inside<T>(
+        &self,
+        rows: Vec<Sourced<T>>,
+        xy: impl Fn(&T) -> (f64, f64),
+        what: &str,
+        problems: &mut Vec<Problem>,
+    ) -> Vec<Sourced<T>> {
+        rows.into_iter()
+            .filter(|r| {
+                let (x, y) = xy(&r.item);
+                let d = self.distance_m(x, y);
+                let inside = d <= self.limit_m();
+                if !inside {
+                    problems.push(far_away(&r.file, r.row, d, self, what));
+                }
+                inside
+            })
+            .collect()
+    }
 }
 
 /// Recordings (sorted by time) without those far outside the campaign or jumping away from both neighbours.
@@ -58,17 +80,7 @@ pub(crate) fn check_trajectory(
     problems: &mut Vec<Problem>,
 ) -> Vec<Sourced<Recording>> {
     let rows = match Extent::of(&rows) {
-        Some(e) => rows
-            .into_iter()
-            .filter(|r| {
-                let d = e.distance_m(r.item.x, r.item.y);
-                let inside = d <= e.limit_m();
-                if !inside {
-                    problems.push(far_away(&r.file, r.row, d, &e, "recordings"));
-                }
-                inside
-            })
-            .collect(),
+        Some(e) => e.keep_inside(rows, |r| (r.x, r.y), "recordings", problems),
         None => rows,
     };
     let jumps: Vec<bool> = rows
@@ -166,17 +178,7 @@ pub(crate) fn check_checkpoints(
     let Some(e) = Extent::of(recordings) else {
         return points;
     };
-    points
-        .into_iter()
-        .filter(|p| {
-            let d = e.distance_m(p.item.x, p.item.y);
-            let inside = d <= e.limit_m();
-            if !inside {
-                problems.push(far_away(&p.file, p.row, d, &e, "check points"));
-            }
-            inside
-        })
-        .collect()
+    e.keep_inside(points, |p| (p.x, p.y), "check points", problems)
 }
 
 /// One image file referred to by a row: where the row is and the file's path on disk.

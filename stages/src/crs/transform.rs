@@ -28,48 +28,61 @@ pub struct TransformError {
 /// A transformation from one CRS's native coordinates to another's.
 #[derive(Clone)]
 pub struct HorizontalTransform {
-    from: Proj,
-    to: Proj,
-    from_geographic: bool,
-    to_geographic: bool,
-    from_name: String,
-    to_name: String,
+    from: Side,
+    to: Side,
+}
+
+/// One side of a transformation: the coordinates' definition, whether they are latitude/longitude, and the
+/// name errors give them.
+#[derive(Clone)]
+struct Side {
+    proj: Proj,
+    geographic: bool,
+    name: String,
+}
+
+impl Side {
+    /// `crs`'s native coordinates.
+    fn native(crs: &Crs) -> Self {
+        Self {
+            proj: crs.proj.clone(),
+            geographic: crs.kind == HorizontalKind::Geographic,
+            name: format!("EPSG:{}", crs.horizontal_code),
+        }
+    }
+
+    /// Latitude/longitude on `crs`'s own datum.
+    fn own_geographic(crs: &Crs) -> Self {
+        Self {
+            proj: crs.geographic.clone(),
+            geographic: true,
+            name: format!("EPSG:{} geographic", crs.horizontal_code),
+        }
+    }
 }
 
 impl HorizontalTransform {
     /// From `from`'s native coordinates to `to`'s.
     pub fn new(from: &Crs, to: &Crs) -> Self {
         Self {
-            from: from.proj.clone(),
-            to: to.proj.clone(),
-            from_geographic: from.kind == HorizontalKind::Geographic,
-            to_geographic: to.kind == HorizontalKind::Geographic,
-            from_name: format!("EPSG:{}", from.horizontal_code),
-            to_name: format!("EPSG:{}", to.horizontal_code),
+            from: Side::native(from),
+            to: Side::native(to),
         }
     }
 
     /// From `crs`'s native coordinates to latitude/longitude on its own datum (map → geographic).
     pub fn to_own_geographic(crs: &Crs) -> Self {
         Self {
-            from: crs.proj.clone(),
-            to: crs.geographic.clone(),
-            from_geographic: crs.kind == HorizontalKind::Geographic,
-            to_geographic: true,
-            from_name: format!("EPSG:{}", crs.horizontal_code),
-            to_name: format!("EPSG:{} geographic", crs.horizontal_code),
+            from: Side::native(crs),
+            to: Side::own_geographic(crs),
         }
     }
 
     /// From latitude/longitude on `crs`'s own datum to its native coordinates (geographic → map).
     pub fn from_own_geographic(crs: &Crs) -> Self {
         Self {
-            from: crs.geographic.clone(),
-            to: crs.proj.clone(),
-            from_geographic: true,
-            to_geographic: crs.kind == HorizontalKind::Geographic,
-            from_name: format!("EPSG:{} geographic", crs.horizontal_code),
-            to_name: format!("EPSG:{}", crs.horizontal_code),
+            from: Side::own_geographic(crs),
+            to: Side::native(crs),
         }
     }
 
@@ -84,14 +97,14 @@ impl HorizontalTransform {
         let fail = |reason: String| TransformError {
             a,
             b,
-            from: self.from_name.clone(),
-            to: self.to_name.clone(),
+            from: self.from.name.clone(),
+            to: self.to.name.clone(),
             reason,
         };
         if !a.is_finite() || !b.is_finite() {
             return Err(fail("not a finite number".into()));
         }
-        let mut p = if self.from_geographic {
+        let mut p = if self.from.geographic {
             if !(-90.0..=90.0).contains(&a) || !(-360.0..=360.0).contains(&b) {
                 return Err(fail(
                     "latitude must lie in [−90°, 90°], longitude in [−360°, 360°]".into(),
@@ -101,9 +114,9 @@ impl HorizontalTransform {
         } else {
             (a, b, h_m)
         };
-        proj4rs::transform::transform(&self.from, &self.to, &mut p)
+        proj4rs::transform::transform(&self.from.proj, &self.to.proj, &mut p)
             .map_err(|e| fail(e.to_string()))?;
-        let out = if self.to_geographic {
+        let out = if self.to.geographic {
             (p.1.to_degrees(), p.0.to_degrees(), p.2)
         } else {
             (p.0, p.1, p.2)

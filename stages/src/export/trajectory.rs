@@ -16,6 +16,7 @@ use super::corrections::CorrectionSeries;
 use crate::adjustment::AdjustmentRun;
 use crate::campaign::Recording;
 use crate::fsutil::atomic_write;
+use crate::positions::positions_by;
 use std::collections::HashMap;
 use std::io;
 use std::path::Path;
@@ -146,12 +147,7 @@ pub fn write_adjusted_trajectory(
         ]
         .map(|n| cols.fresh(n)),
     );
-    let by_id: HashMap<&str, usize> = run
-        .recordings
-        .iter()
-        .enumerate()
-        .map(|(i, r)| (r.image_id.as_str(), i))
-        .collect();
+    let by_id = positions_by(&run.recordings, |r| r.image_id.as_str());
     let mut w = csv::WriterBuilder::new()
         .flexible(true)
         .from_writer(Vec::new());

@@ -7,6 +7,7 @@
 use super::pyramid::builder::{Chain, TileSink};
 use super::pyramid::layout::{PyramidLayout, SampleDepth, DEFAULT_TILE_SIDE};
 use super::pyramid::reader::{PyramidError, PyramidHeader, TileId, TileSource};
+use super::pyramid::sample::{narrow_row, widen_row};
 use crate::imaging::decode::{decode_grey, limits, GreyInfo, GreyRowSink};
 use crate::imaging::io_error::ImageIoError;
 use std::collections::HashMap;
@@ -149,9 +150,7 @@ impl<F: FnOnce(&PyramidLayout) -> Vec<Region>> GreyRowSink for PartialBuild<F> {
         match self.chain.as_mut() {
             Some(PartialChain::U8(c)) => c.push_row(row),
             Some(PartialChain::U16(c)) => {
-                self.scratch16.clear();
-                self.scratch16
-                    .extend(row.iter().map(|&v| u16::from(v) * 257));
+                widen_row(row, &mut self.scratch16);
                 c.push_row(&self.scratch16)
             }
             None => Err(io::Error::other("internal: rows before the size")),
@@ -162,9 +161,7 @@ impl<F: FnOnce(&PyramidLayout) -> Vec<Region>> GreyRowSink for PartialBuild<F> {
         match self.chain.as_mut() {
             Some(PartialChain::U16(c)) => c.push_row(row),
             Some(PartialChain::U8(c)) => {
-                self.scratch8.clear();
-                self.scratch8
-                    .extend(row.iter().map(|&v| ((u32::from(v) + 128) / 257) as u8));
+                narrow_row(row, &mut self.scratch8);
                 c.push_row(&self.scratch8)
             }
             None => Err(io::Error::other("internal: rows before the size")),

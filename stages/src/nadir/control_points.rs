@@ -31,8 +31,6 @@
 //! Points seen in one aerial image are kept with `point_world: None` (a bundle with fixed aerial orientation
 //! can still use them). Output order: the window's tie-point order; observations sorted by aerial `image_id`.
 
-use std::collections::HashMap;
-
 use super::registration::{AerialRefinement, MmWindowMatch};
 use crate::campaign::AerialImage;
 use crate::correspondence::{AerialControlPoint, AerialObservation};
@@ -41,6 +39,7 @@ use crate::geometry::{
     intersect_ray_plane, triangulate_rays, FrameCamera, Plane, Ray, Triangulation,
 };
 use crate::params::{Params, StageId};
+use crate::positions::positions_by;
 use nalgebra::{Matrix3, Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
@@ -233,12 +232,7 @@ pub fn aerial_control_points_in(
     if p.validate().is_err() {
         return Vec::new();
     }
-    let index: HashMap<&str, usize> = window
-        .tie_points
-        .iter()
-        .enumerate()
-        .map(|(i, tp)| (tp.id.as_str(), i))
-        .collect();
+    let index = positions_by(&window.tie_points, |tp| tp.id.as_str());
     // Per tie point: (aerial row, observation, level located at), at most one per aerial image (best score).
     let mut per_point: Vec<Vec<(&AerialImage, &AerialObservation, usize)>> =
         vec![Vec::new(); window.tie_points.len()];

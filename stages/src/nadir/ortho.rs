@@ -180,54 +180,36 @@ impl RowMap {
     /// The panorama pixel (`us`, `vs`) of every column's ground point and `valid` = 1, or NaN and 0 where the
     /// vehicle hides the point (or it is the projection centre itself). Branch-free, so it vectorises (with AVX2
     /// where the CPU has it; no FMA, so the values are the same either way).
-    fn fill(
-        &self,
-        camera: &PanoramaCamera,
-        vehicle: &VehicleMask,
-        heading: (f64, f64),
-        us: &mut [f64],
-        vs: &mut [f64],
-        valid: &mut [u8],
-    ) {
+    fn fill(&self, view: &RowView, out: RowPixels) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { self.fill_avx2(camera, vehicle, heading, us, vs, valid) };
+            return unsafe { self.fill_avx2(view, out) };
         }
-        self.fill_impl(camera, vehicle, heading, us, vs, valid)
+        self.fill_impl(view, out)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn fill_avx2(
-        &self,
-        camera: &PanoramaCamera,
-        vehicle: &VehicleMask,
-        heading: (f64, f64),
-        us: &mut [f64],
-        vs: &mut [f64],
-        valid: &mut [u8],
-    ) {
-        self.fill_impl(camera, vehicle, heading, us, vs, valid)
+    unsafe fn fill_avx2(&self, view: &RowView, out: RowPixels) {
+        self.fill_impl(view, out)
     }
 
     #[inline(always)]
-    fn fill_impl(
-        &self,
-        camera: &PanoramaCamera,
-        vehicle: &VehicleMask,
-        heading: (f64, f64),
-        us: &mut [f64],
-        vs: &mut [f64],
-        valid: &mut [u8],
-    ) {
-        let cols = us.iter_mut().zip(vs.iter_mut()).zip(valid.iter_mut());
+    fn fill_impl(&self, view: &RowView, out: RowPixels) {
+        let cols = out
+            .us
+            .iter_mut()
+            .zip(out.vs.iter_mut())
+            .zip(out.valid.iter_mut());
         for (col, ((u, v), valid)) in cols.enumerate() {
-            let hidden = vehicle.hides_direction(heading, &self.direction_world(col));
+            let hidden = view
+                .vehicle
+                .hides_direction(view.heading, &self.direction_world(col));
             let d = self.d0_pano + self.d_step_pano * col as f64;
             let norm_sq = d.norm_squared();
             let ok = (norm_sq > 0.0) & norm_sq.is_finite() & !hidden;
-            let (pu, pv) = camera.ray_pano_to_pixel_fast(&d);
+            let (pu, pv) = view.camera.ray_pano_to_pixel_fast(&d);
             *u = if ok { pu } else { f64::NAN };
             *v = if ok { pv } else { f64::NAN };
             *valid = u8::from(ok);
@@ -242,6 +224,22 @@ impl RowMap {
         let norm_sq = d.norm_squared();
         (norm_sq > 0.0 && norm_sq.is_finite()).then(|| camera.ray_pano_to_pixel_fast(&d))
     }
+}
+
+/// What one panorama sees of the ground: its camera, the recording vehicle's mask and the vehicle's heading
+/// (sin, cos).
+struct RowView<'a> {
+    camera: &'a PanoramaCamera,
+    vehicle: &'a VehicleMask,
+    heading: (f64, f64),
+}
+
+/// [`RowMap::fill`]'s output along one ortho row: the panorama pixel (`us`, `vs`) of each column and its
+/// validity.
+struct RowPixels<'a> {
+    us: &'a mut [f64],
+    vs: &'a mut [f64],
+    valid: &'a mut [u8],
 }
 
 /// The pyramid level for an ortho pixel of `gsd_m` whose ground point lies at `dir_world` from the projection
@@ -354,7 +352,11 @@ pub fn ortho_project(
         recording.z - recording.camera_height_m,
     ];
     let georef = OrthoGeoref::new(foot, params);
-    let heading = recording.heading_deg.to_radians().sin_cos();
+    let view = RowView {
+        camera: &camera,
+        vehicle: &params.vehicle,
+        heading: recording.heading_deg.to_radians().sin_cos(),
+    };
     let delta = camera.pixel_angle_rad();
     let max_level = panorama.max_level();
     let (w, h) = (georef.width_px, georef.height_px);
@@ -370,7 +372,8 @@ pub fn ortho_project(
             |(us, vs, scratch), (row, (out, ok))| {
                 // Pass 1: the panorama pixel of every ortho pixel (NaN where the vehicle hides the ground).
                 let map = RowMap::new(&georef, &camera, row);
-                map.fill(&camera, &params.vehicle, heading, us, vs, ok);
+                let pixels = RowPixels { us, vs, valid: ok };
+                map.fill(&view, pixels);
                 // Pass 2: bilinear sampling, run by run of columns sharing a pyramid level; the seam columns and
                 // pole rows wrap/clamp.
                 let level_at = |col: usize| {
@@ -533,32 +536,22 @@ mod tests {
             return;
         }
         let (rec, camera, params, georef) = setup(0.05, 33.0, 141.0);
-        let heading = rec.heading_deg.to_radians().sin_cos();
+        let view = RowView {
+            camera: &camera,
+            vehicle: &params.vehicle,
+            heading: rec.heading_deg.to_radians().sin_cos(),
+        };
         let n = georef.width_px;
         let mut hidden = 0;
         for row in 0..georef.height_px {
             let map = RowMap::new(&georef, &camera, row);
             let mut a = (vec![0.0; n], vec![0.0; n], vec![0u8; n]);
             let mut b = a.clone();
-            map.fill_impl(
-                &camera,
-                &params.vehicle,
-                heading,
-                &mut a.0,
-                &mut a.1,
-                &mut a.2,
-            );
+            let (us, vs, valid) = (&mut a.0, &mut a.1, &mut a.2);
+            map.fill_impl(&view, RowPixels { us, vs, valid });
+            let (us, vs, valid) = (&mut b.0, &mut b.1, &mut b.2);
             // SAFETY: AVX2 was detected above.
-            unsafe {
-                map.fill_avx2(
-                    &camera,
-                    &params.vehicle,
-                    heading,
-                    &mut b.0,
-                    &mut b.1,
-                    &mut b.2,
-                )
-            };
+            unsafe { map.fill_avx2(&view, RowPixels { us, vs, valid }) };
             assert_eq!(a.2, b.2, "row {row}: validity");
             for col in 0..n {
                 assert_eq!(

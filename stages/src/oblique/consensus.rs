@@ -44,6 +44,7 @@ use crate::geometry::aerial_intersection::{
 };
 use crate::geometry::FrameCamera;
 use crate::params::{Params, StageId};
+use crate::positions::positions_by;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
@@ -161,11 +162,7 @@ pub fn consensus_with_diagnostics(
         .iter()
         .map(|s| s.matches.iter().filter(|m| m.rejected_coarse).count())
         .sum();
-    let rank: HashMap<&str, usize> = recordings
-        .iter()
-        .enumerate()
-        .map(|(i, r)| (r.image_id.as_str(), i))
-        .collect();
+    let rank = positions_by(recordings, |r| r.image_id.as_str());
     diag.sets_unknown_recording = sets
         .iter()
         .filter(|s| !rank.contains_key(s.recording.as_str()))

@@ -8,6 +8,7 @@ use skytie_stages::campaign::{AerialImage, Recording};
 use skytie_stages::geometry::{look_at_matrix, matrix_to_opk};
 
 pub mod adjusted;
+pub mod campaign_files;
 pub mod ortho_pair;
 pub mod texture;
 pub mod tiny;

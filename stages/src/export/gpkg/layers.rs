@@ -20,6 +20,7 @@ use crate::correction::support::recording_support;
 use crate::correspondence::AerialControlPoint;
 use crate::export::checkpoints::CheckPointRow;
 use crate::export::corrections::CorrectionSeries;
+use crate::positions::positions_by;
 use std::collections::HashMap;
 
 /// Everything the layers are made of.
@@ -62,11 +63,7 @@ fn segment_status(recordings: &[Recording], v: Option<&Verification>) -> Vec<(Va
     let Some(v) = v else {
         return out;
     };
-    let index: HashMap<&str, usize> = recordings
-        .iter()
-        .enumerate()
-        .map(|(i, r)| (r.image_id.as_str(), i))
-        .collect();
+    let index = positions_by(recordings, |r| r.image_id.as_str());
     for s in &v.segments {
         if let (Some(&a), Some(&b)) = (
             index.get(s.first_image_id.as_str()),
@@ -300,12 +297,7 @@ fn verification_layer(x: &RunLayers<'_>) -> Layer {
         ]),
         features: Vec::new(),
     };
-    let index: HashMap<&str, usize> = x
-        .recordings
-        .iter()
-        .enumerate()
-        .map(|(i, r)| (r.image_id.as_str(), i))
-        .collect();
+    let index = positions_by(x.recordings, |r| r.image_id.as_str());
     for (name, v) in [
         ("recorded", x.verification),
         ("adjusted", x.verification_adjusted),

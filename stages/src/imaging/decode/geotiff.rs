@@ -28,37 +28,23 @@ pub struct GeoTiffTags {
 impl GeoTiffTags {
     /// The tags of the decoder's current image; `None` when it has none of them.
     pub fn read<R: Read + Seek>(decoder: &mut Decoder<R>) -> Option<Self> {
-        let mut f64s = |tag: Tag| {
-            decoder
-                .find_tag(tag)
-                .ok()
-                .flatten()
-                .and_then(|v| v.into_f64_vec().ok())
-        };
-        let model_pixel_scale = f64s(Tag::ModelPixelScaleTag);
-        let model_tiepoints = f64s(Tag::ModelTiepointTag);
-        let model_transformation = f64s(Tag::ModelTransformationTag);
-        let geo_double_params = f64s(Tag::GeoDoubleParamsTag);
-        let geo_key_directory = decoder
-            .find_tag(Tag::GeoKeyDirectoryTag)
-            .ok()
-            .flatten()
-            .and_then(|v| v.into_u16_vec().ok());
-        let mut text = |tag: Tag| {
-            decoder
-                .find_tag(tag)
-                .ok()
-                .flatten()
-                .and_then(|v| v.into_string().ok())
-        };
+        let mut tag = |tag: Tag| decoder.find_tag(tag).ok().flatten();
+        let model_pixel_scale = tag(Tag::ModelPixelScaleTag).and_then(|v| v.into_f64_vec().ok());
+        let model_tiepoints = tag(Tag::ModelTiepointTag).and_then(|v| v.into_f64_vec().ok());
+        let model_transformation =
+            tag(Tag::ModelTransformationTag).and_then(|v| v.into_f64_vec().ok());
+        let geo_double_params = tag(Tag::GeoDoubleParamsTag).and_then(|v| v.into_f64_vec().ok());
+        let geo_key_directory = tag(Tag::GeoKeyDirectoryTag).and_then(|v| v.into_u16_vec().ok());
+        let geo_ascii_params = tag(Tag::GeoAsciiParamsTag).and_then(|v| v.into_string().ok());
+        let gdal_nodata = tag(Tag::GdalNodata).and_then(|v| v.into_string().ok());
         let tags = Self {
             model_pixel_scale,
             model_tiepoints,
             model_transformation,
             geo_key_directory,
             geo_double_params,
-            geo_ascii_params: text(Tag::GeoAsciiParamsTag),
-            gdal_nodata: text(Tag::GdalNodata),
+            geo_ascii_params,
+            gdal_nodata,
         };
         (tags != Self::default()).then_some(tags)
     }

@@ -198,6 +198,41 @@ enum Samples {
     U16(Vec<u16>),
 }
 
+impl Samples {
+    fn u8(&self) -> Option<&[u8]> {
+        match self {
+            Samples::U8(v) => Some(v),
+            Samples::U16(_) => None,
+        }
+    }
+
+    fn u16(&self) -> Option<&[u16]> {
+        match self {
+            Samples::U16(v) => Some(v),
+            Samples::U8(_) => None,
+        }
+    }
+}
+
+/// Gathers the samples of pixels `0..dw` of a planar chunk's row, which starts at `start` in every plane, into
+/// `out`, pixel by pixel (one sample of each plane); `None` where a plane is of another depth (`plane` gives
+/// its samples of the wanted depth) or holds too few samples.
+fn interleave<T: Copy>(
+    planes: &[Samples],
+    plane: fn(&Samples) -> Option<&[T]>,
+    start: usize,
+    dw: usize,
+    out: &mut Vec<T>,
+) -> Option<()> {
+    out.clear();
+    for i in 0..dw {
+        for p in planes {
+            out.push(*plane(p)?.get(start + i)?);
+        }
+    }
+    Some(())
+}
+
 fn samples(path: &Path, r: DecodingResult) -> Result<Samples, ImageIoError> {
     match r {
         DecodingResult::U8(v) => Ok(Samples::U8(v)),
@@ -365,15 +400,8 @@ impl Band {
                     grey_row8(src, channels, &mut self.grey8);
                 }
                 (SampleDepth::U8, planes, _) => {
-                    self.pixel8.clear();
-                    for i in 0..dw {
-                        for p in planes {
-                            let Samples::U8(v) = p else {
-                                return Err(short());
-                            };
-                            self.pixel8.push(*v.get(r * stride + i).ok_or_else(short)?);
-                        }
-                    }
+                    interleave(planes, Samples::u8, r * stride, dw, &mut self.pixel8)
+                        .ok_or_else(short)?;
                     grey_row8(&self.pixel8, channels, &mut self.grey8);
                 }
                 (SampleDepth::U16, [Samples::U16(v)], _) => {
@@ -381,15 +409,8 @@ impl Band {
                     grey_row16(src, channels, &mut self.grey16);
                 }
                 (SampleDepth::U16, planes, _) => {
-                    self.pixel16.clear();
-                    for i in 0..dw {
-                        for p in planes {
-                            let Samples::U16(v) = p else {
-                                return Err(short());
-                            };
-                            self.pixel16.push(*v.get(r * stride + i).ok_or_else(short)?);
-                        }
-                    }
+                    interleave(planes, Samples::u16, r * stride, dw, &mut self.pixel16)
+                        .ok_or_else(short)?;
                     grey_row16(&self.pixel16, channels, &mut self.grey16);
                 }
             }

@@ -7,7 +7,7 @@
 //! temporary file.
 
 use super::layout::{PyramidLayout, SampleDepth, HEADER_LEN, TILE_HASH_LEN};
-use super::sample::{reduce_rows, Sample};
+use super::sample::{narrow_row, reduce_rows, widen_row, Sample};
 use rayon::prelude::*;
 use std::fs::{self, File, OpenOptions};
 use std::io;
@@ -352,9 +352,7 @@ impl PyramidBuilder {
         match self.chain.as_mut().expect("not finished") {
             AnyChain::U8(c) => c.push_row(row),
             AnyChain::U16(c) => {
-                self.scratch16.clear();
-                self.scratch16
-                    .extend(row.iter().map(|&v| u16::from(v) * 257));
+                widen_row(row, &mut self.scratch16);
                 c.push_row(&self.scratch16)
             }
         }
@@ -365,9 +363,7 @@ impl PyramidBuilder {
         match self.chain.as_mut().expect("not finished") {
             AnyChain::U16(c) => c.push_row(row),
             AnyChain::U8(c) => {
-                self.scratch8.clear();
-                self.scratch8
-                    .extend(row.iter().map(|&v| ((u32::from(v) + 128) / 257) as u8));
+                narrow_row(row, &mut self.scratch8);
                 c.push_row(&self.scratch8)
             }
         }

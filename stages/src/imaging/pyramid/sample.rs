@@ -1,5 +1,5 @@
-//! The two sample types a pyramid stores (u8, u16): their byte encoding and the 2 × 2 box average that makes
-//! the next level.
+//! The two sample types a pyramid stores (u8, u16): their byte encoding, the 2 × 2 box average that makes
+//! the next level, and rows of one depth stored at the other.
 
 /// A stored sample type.
 pub trait Sample: Copy + Default + PartialEq + Send + Sync + 'static {
@@ -80,6 +80,18 @@ pub fn reduce_rows<S: Sample>(a: &[S], b: &[S], out: &mut Vec<S>) {
         let i = w - 1;
         out.push(S::average4(a[i], a[i], b[i], b[i]));
     }
+}
+
+/// An 8-bit row as 16-bit samples (`v · 257`, so 255 becomes 65535), into `out`.
+pub fn widen_row(row: &[u8], out: &mut Vec<u16>) {
+    out.clear();
+    out.extend(row.iter().map(|&v| u16::from(v) * 257));
+}
+
+/// A 16-bit row as 8-bit samples (`v / 257`, rounded), into `out`.
+pub fn narrow_row(row: &[u16], out: &mut Vec<u8>) {
+    out.clear();
+    out.extend(row.iter().map(|&v| ((u32::from(v) + 128) / 257) as u8));
 }
 
 #[cfg(test)]

@@ -22,29 +22,29 @@ pub struct Entry {
 
 impl Entry {
     pub fn shorts(tag: u16, values: &[u16]) -> Self {
-        Self {
-            tag,
-            field_type: FieldType::Short,
-            count: values.len() as u64,
-            bytes: values.iter().flat_map(|v| v.to_le_bytes()).collect(),
-        }
+        Self::numbers(tag, FieldType::Short, values, u16::to_le_bytes)
     }
 
     pub fn longs(tag: u16, values: &[u32]) -> Self {
-        Self {
-            tag,
-            field_type: FieldType::Long,
-            count: values.len() as u64,
-            bytes: values.iter().flat_map(|v| v.to_le_bytes()).collect(),
-        }
+        Self::numbers(tag, FieldType::Long, values, u32::to_le_bytes)
     }
 
     pub fn doubles(tag: u16, values: &[f64]) -> Self {
+        Self::numbers(tag, FieldType::Double, values, f64::to_le_bytes)
+    }
+
+    /// `values` of `field_type`, each written as its little-endian bytes by `le_bytes`.
+    fn numbers<T: Copy, const N: usize>(
+        tag: u16,
+        field_type: FieldType,
+        values: &[T],
+        le_bytes: fn(T) -> [u8; N],
+    ) -> Self {
         Self {
             tag,
-            field_type: FieldType::Double,
+            field_type,
             count: values.len() as u64,
-            bytes: values.iter().flat_map(|v| v.to_le_bytes()).collect(),
+            bytes: values.iter().flat_map(|&v| le_bytes(v)).collect(),
         }
     }
 

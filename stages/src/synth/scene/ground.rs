@@ -60,19 +60,31 @@ pub struct GroundHit {
 
 const MAX_LINES: usize = 12;
 
+/// The shape of a street's ground: the sloped base plane, the carriageway's crown and kerbs, an optional cross
+/// street and canal.
+#[derive(Clone, Copy, Debug)]
+pub struct StreetShape {
+    /// Height of the base plane at the local origin, m.
+    pub z0: f64,
+    /// Slope of the base plane along local x and y.
+    pub gx: f64,
+    pub gy: f64,
+    /// Fall of the carriageway from its crown towards the kerbs (height per metre).
+    pub crossfall: f64,
+    /// Kerb height, m.
+    pub kerb_m: f64,
+    /// Half width of the main carriageway, m.
+    pub half_width_m: f64,
+    /// (x of crown, half width, y_min, y_max) of the cross street.
+    pub cross: Option<(f64, f64, f64, f64)>,
+    /// (y_lo, y_hi, drop) of the canal.
+    pub canal: Option<(f64, f64, f64)>,
+}
+
 /// The ground height field (local frame).
 #[derive(Clone, Debug)]
 pub struct Ground {
-    z0: f64,
-    gx: f64,
-    gy: f64,
-    crossfall: f64,
-    kerb_m: f64,
-    half_width_m: f64,
-    /// (x of crown, half width, y_min, y_max) of the cross street.
-    cross: Option<(f64, f64, f64, f64)>,
-    /// (y_lo, y_hi, drop) of the canal.
-    canal: Option<(f64, f64, f64)>,
+    shape: StreetShape,
     /// Flat ground: no carriageway at all (everything "Raised" at z0 + slopes).
     flat: bool,
     lines: [Line; MAX_LINES],
@@ -84,20 +96,9 @@ pub struct Ground {
 }
 
 impl Ground {
-    /// A street ground; `cross` = (crown x, half width, y range), `canal` = (y range, drop).
-    #[allow(clippy::too_many_arguments)]
-    pub fn street(
-        z0: f64,
-        gx: f64,
-        gy: f64,
-        crossfall: f64,
-        kerb_m: f64,
-        half_width_m: f64,
-        cross: Option<(f64, f64, f64, f64)>,
-        canal: Option<(f64, f64, f64)>,
-    ) -> Self {
-        let mut g = Self {
-            z0,
+    /// The ground of a street of `shape`.
+    pub fn street(shape: StreetShape) -> Self {
+        let StreetShape {
             gx,
             gy,
             crossfall,
@@ -105,6 +106,10 @@ impl Ground {
             half_width_m,
             cross,
             canal,
+            ..
+        } = shape;
+        let mut g = Self {
+            shape,
             flat: false,
             lines: [Line {
                 nx: 0.0,
@@ -149,7 +154,16 @@ impl Ground {
 
     /// A flat, sloped-free plane at height `z` (no carriageway, no kerbs).
     pub fn flat(z: f64) -> Self {
-        let mut g = Self::street(z, 0.0, 0.0, 0.0, 0.0, 0.0, None, None);
+        let mut g = Self::street(StreetShape {
+            z0: z,
+            gx: 0.0,
+            gy: 0.0,
+            crossfall: 0.0,
+            kerb_m: 0.0,
+            half_width_m: 0.0,
+            cross: None,
+            canal: None,
+        });
         g.flat = true;
         g.n_lines = 0;
         g
@@ -157,7 +171,7 @@ impl Ground {
 
     #[inline]
     fn cross_active(&self, x: f64, y: f64) -> Option<f64> {
-        match self.cross {
+        match self.shape.cross {
             Some((xj, _, y0, y1)) if y > y0 && y < y1 => Some(x - xj),
             _ => None,
         }
@@ -169,10 +183,10 @@ impl Ground {
         if self.flat {
             return false;
         }
-        if y.abs() < self.half_width_m {
+        if y.abs() < self.shape.half_width_m {
             return true;
         }
-        match self.cross {
+        match self.shape.cross {
             Some((xj, hwc, y0, y1)) => (x - xj).abs() < hwc && y > y0 && y < y1,
             None => false,
         }
@@ -186,8 +200,8 @@ impl Ground {
         if self.on_road(x, y) {
             return 0.0;
         }
-        let mut d = y.abs() - self.half_width_m;
-        if let Some((xj, hwc, y0, y1)) = self.cross {
+        let mut d = y.abs() - self.shape.half_width_m;
+        if let Some((xj, hwc, y0, y1)) = self.shape.cross {
             if y > y0 && y < y1 {
                 d = d.min((x - xj).abs() - hwc);
             }
@@ -199,16 +213,16 @@ impl Ground {
     #[inline]
     pub fn piece(&self, x: f64, y: f64) -> (Plane, GroundClass) {
         let raised = Plane {
-            a: self.z0 - self.crossfall * self.half_width_m + self.kerb_m,
-            b: self.gx,
-            c: self.gy,
+            a: self.shape.z0 - self.shape.crossfall * self.shape.half_width_m + self.shape.kerb_m,
+            b: self.shape.gx,
+            c: self.shape.gy,
         };
         if self.flat {
             return (
                 Plane {
-                    a: self.z0,
-                    b: self.gx,
-                    c: self.gy,
+                    a: self.shape.z0,
+                    b: self.shape.gx,
+                    c: self.shape.gy,
                 },
                 GroundClass::Raised,
             );
@@ -221,9 +235,9 @@ impl Ground {
                     let xj = x - dx;
                     return (
                         Plane {
-                            a: self.z0 + self.crossfall * s * xj,
-                            b: self.gx - self.crossfall * s,
-                            c: self.gy,
+                            a: self.shape.z0 + self.shape.crossfall * s * xj,
+                            b: self.shape.gx - self.shape.crossfall * s,
+                            c: self.shape.gy,
                         },
                         GroundClass::Road,
                     );
@@ -232,14 +246,14 @@ impl Ground {
             let s = if y >= 0.0 { 1.0 } else { -1.0 };
             return (
                 Plane {
-                    a: self.z0,
-                    b: self.gx,
-                    c: self.gy - self.crossfall * s,
+                    a: self.shape.z0,
+                    b: self.shape.gx,
+                    c: self.shape.gy - self.shape.crossfall * s,
                 },
                 GroundClass::Road,
             );
         }
-        if let Some((lo, hi, drop)) = self.canal {
+        if let Some((lo, hi, drop)) = self.shape.canal {
             if y > lo && y < hi {
                 return (
                     Plane {
@@ -266,14 +280,18 @@ impl Ground {
         let mut hi = f64::NEG_INFINITY;
         for x in [min[0], max[0]] {
             for y in [min[1], max[1]] {
-                let b = self.z0 + self.gx * x + self.gy * y;
+                let b = self.shape.z0 + self.shape.gx * x + self.shape.gy * y;
                 lo = lo.min(b);
                 hi = hi.max(b);
             }
         }
-        let w = self.crossfall * self.half_width_m.max(self.cross.map_or(0.0, |c| c.1));
-        let drop = self.canal.map_or(0.0, |c| c.2);
-        (lo - w - drop, hi + self.kerb_m.max(0.0))
+        let w = self.shape.crossfall
+            * self
+                .shape
+                .half_width_m
+                .max(self.shape.cross.map_or(0.0, |c| c.1));
+        let drop = self.shape.canal.map_or(0.0, |c| c.2);
+        (lo - w - drop, hi + self.shape.kerb_m.max(0.0))
     }
 
     /// First intersection of the ray `o + t·d` (local frame) with the ground for t in (t_min, t_max).
@@ -288,7 +306,8 @@ impl Ground {
         // Cull with the bound h(p) ≤ base(o) + relief_max + |∇base|·|p − o|_xy: a hit needs
         // t·(d_z − |∇base|·|d_xy|) ≤ base(o) + relief_max − o_z.
         let (mut t_min, mut t_max) = (t_min, t_max);
-        let num = self.z0 + self.gx * o.x + self.gy * o.y + self.relief_max_m - o.z;
+        let num =
+            self.shape.z0 + self.shape.gx * o.x + self.shape.gy * o.y + self.relief_max_m - o.z;
         let denom = d.z - self.base_slope * (d.x * d.x + d.y * d.y).sqrt();
         if denom >= 0.0 {
             if num < 0.0 {
@@ -380,16 +399,16 @@ mod tests {
     use super::*;
 
     fn ground() -> Ground {
-        Ground::street(
-            1.0,
-            0.01,
-            0.0,
-            0.02,
-            0.12,
-            4.0,
-            Some((50.0, 3.0, -40.0, 40.0)),
-            None,
-        )
+        Ground::street(StreetShape {
+            z0: 1.0,
+            gx: 0.01,
+            gy: 0.0,
+            crossfall: 0.02,
+            kerb_m: 0.12,
+            half_width_m: 4.0,
+            cross: Some((50.0, 3.0, -40.0, 40.0)),
+            canal: None,
+        })
     }
 
     #[test]

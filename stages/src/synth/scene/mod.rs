@@ -23,7 +23,7 @@ pub mod spec;
 
 use accel::Grid;
 use frame::LocalFrame;
-use ground::{Ground, GroundClass};
+use ground::{Ground, GroundClass, StreetShape};
 use markings::{StreetAxis, StreetMarkingInput, StreetMarkings};
 use nalgebra::Vector3;
 use objects::{Material, Object, Shape, IN_AERIAL, IN_BOTH, IN_MM};
@@ -162,16 +162,16 @@ impl Scene {
             let q = hw + sw + c.quay_width_m;
             (-(q + c.width_m), -q, c.drop_m)
         });
-        let ground = Ground::street(
-            spec.base_height_m,
-            spec.slope_x,
-            spec.slope_y,
-            spec.crossfall,
-            spec.kerb_height_m,
-            hw,
+        let ground = Ground::street(StreetShape {
+            z0: spec.base_height_m,
+            gx: spec.slope_x,
+            gy: spec.slope_y,
+            crossfall: spec.crossfall,
+            kerb_m: spec.kerb_height_m,
+            half_width_m: hw,
             cross,
             canal,
-        );
+        });
         let phase = |k: u64| crate::synth::noise::unit_f64(crate::synth::noise::mix64(seed ^ k));
         let mut streets = vec![StreetMarkings::layout(&StreetMarkingInput {
             axis: StreetAxis::AlongX,
