@@ -80,6 +80,11 @@ pub fn add_adjust(
             Some(o) => (o.clouds.clone(), o.result.into_iter().collect()),
             None => (Vec::new(), Vec::new()),
         };
+        // The DTM, read only when the recordings' heights are observed from it.
+        let dtm = match config.dtm_height {
+            true => super::orthophoto::campaign_dtm(b, root, cx.snapshot)?,
+            false => None,
+        };
         let report = b.add(
             AdjustStage,
             config.sources.label(),
@@ -91,6 +96,7 @@ pub fn add_adjust(
                 optional_all(&control),
                 optional_all(&clouds),
                 optional_all(&oblique_result),
+                dtm.into_iter().map(|d| d.0).collect::<Vec<_>>(),
             ),
         )?;
         b.metrics(report, "adjust", |r: &AdjustReport| r.metrics());
