@@ -94,8 +94,7 @@ pub fn add_adjust(
                 pano_images.clone(),
                 optional_all(&windows),
                 optional_all(&control),
-                optional_all(&clouds),
-                optional_all(&oblique_result),
+                (optional_all(&clouds), optional_all(&oblique_result)),
                 dtm.into_iter().map(|d| d.0).collect::<Vec<_>>(),
             ),
         )?;

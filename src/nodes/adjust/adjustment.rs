@@ -95,7 +95,7 @@ impl AdjustReport {
             "cost": r.final_cost,
             "variance_factor": r.variance_factor,
             "redundancy": r.redundancy,
-            "build": r.build,
+            "build": build_metrics(r),
             "relative_sigma": r.relative_sigma,
             "height_observations": r.config.dtm_height.then(|| serde_json::json!({
                 "source": r.build.heights.source.label(),
@@ -108,6 +108,19 @@ impl AdjustReport {
             "verdict": self.verdict().label(),
         }})
     }
+}
+
+/// The `build` counts; the height observations are under their own key, and the weak control dropped only
+/// when the check ran.
+fn build_metrics(r: &AdjustmentRun) -> serde_json::Value {
+    let mut v = serde_json::to_value(r.build).unwrap_or_default();
+    if let Some(m) = v.as_object_mut() {
+        m.remove("heights");
+        if r.config.weak_control_tolerance_m.is_none() {
+            m.remove("weak_control_dropped");
+        }
+    }
+    v
 }
 
 /// How far the adjustment moved the recordings and how well it determined them: counts, horizontal shift
@@ -195,17 +208,17 @@ fn spread(mut values: Vec<f64>) -> serde_json::Value {
 
 /// The adjustment node. Inputs: snapshot, ingested panoramas (snapshot order: their sizes and detail levels),
 /// the nadir windows' tie points and
-/// the recordings' aerial control points, the oblique chain's sparse clouds (MM tie points) and its consensus
+/// the recordings' aerial control points, the oblique chain's sparse clouds (MM tie points) with its consensus
 /// output (oblique control points) — empty lists for a source that is not used — and the campaign's DTM (none
 /// or one; read with `dtm_height`).
 pub struct AdjustStage;
 
 impl Stage for AdjustStage {
     crate::nodes::stage_types!(skytie_stages::adjustment::from_correspondences::STAGE, AdjustConfig => AdjustReport,
-        inputs: (Handle<CampaignSnapshot>, Vec<Handle<IngestedImage>>, Vec<Optional<MmWindowMatch>>, Vec<Optional<RecordingControl>>, Vec<Optional<SparseCloud>>, Vec<Optional<ObliqueOutput>>, Vec<Handle<Dtm>>));
+        inputs: (Handle<CampaignSnapshot>, Vec<Handle<IngestedImage>>, Vec<Optional<MmWindowMatch>>, Vec<Optional<RecordingControl>>, (Vec<Optional<SparseCloud>>, Vec<Optional<ObliqueOutput>>), Vec<Handle<Dtm>>));
 
     fn run(&self, config: &AdjustConfig, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
-        let (snap, panos, windows, control, clouds, oblique, dtm) = inputs;
+        let (snap, panos, windows, control, (clouds, oblique), dtm) = inputs;
         // Items whose nodes failed are absent: the adjustment uses the rest (the failures are counted).
         let (windows, control, clouds, oblique) =
             (flat(windows), flat(control), flat(clouds), flat(oblique));
