@@ -420,20 +420,20 @@ impl<'a> AerialCameras<'a> {
     }
 }
 
+/// The recordings' index by image id, the block's recordings and what their height observations were.
+type BlockRecordings<'a> = (
+    HashMap<&'a str, usize>,
+    Vec<BlockRecording>,
+    HeightObservations,
+);
+
 /// The block's recordings (recorded poses as weak priors, thesis 5.4.3, and with `dtm_height` their observed
 /// heights) and their index by image id; refuses a size or height list that does not match and duplicate
 /// image ids.
 fn block_recordings<'a>(
     inputs: &AdjustInputs<'a>,
     config: &AdjustConfig,
-) -> Result<
-    (
-        HashMap<&'a str, usize>,
-        Vec<BlockRecording>,
-        HeightObservations,
-    ),
-    AdjustError,
-> {
+) -> Result<BlockRecordings<'a>, AdjustError> {
     let n_rec = inputs.recordings.len();
     for (item, len, what) in [
         (
