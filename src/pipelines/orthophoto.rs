@@ -138,7 +138,7 @@ impl<'a> OrthophotoRoute<'a> {
     }
 }
 
-/// The campaign's DTM tiles loaded once, cropped to the recordings' area grown by [`DTM_MARGIN_M`] (one node,
+/// The campaign's DTM tiles loaded once, cropped to the recordings' area grown by 100 m (one node,
 /// shared by every caller), with its stated σ in metres; `None` when the campaign declares no DTM or has no
 /// recordings.
 pub fn campaign_dtm(
