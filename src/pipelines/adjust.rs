@@ -80,6 +80,11 @@ pub fn add_adjust(
             Some(o) => (o.clouds.clone(), o.result.into_iter().collect()),
             None => (Vec::new(), Vec::new()),
         };
+        // The DTM, read only when the recordings' heights are observed from it.
+        let dtm = match config.dtm_height {
+            true => super::orthophoto::campaign_dtm(b, root, cx.snapshot)?,
+            false => None,
+        };
         let report = b.add(
             AdjustStage,
             config.sources.label(),
@@ -89,8 +94,8 @@ pub fn add_adjust(
                 pano_images.clone(),
                 optional_all(&windows),
                 optional_all(&control),
-                optional_all(&clouds),
-                optional_all(&oblique_result),
+                (optional_all(&clouds), optional_all(&oblique_result)),
+                dtm.into_iter().map(|d| d.0).collect::<Vec<_>>(),
             ),
         )?;
         b.metrics(report, "adjust", |r: &AdjustReport| r.metrics());

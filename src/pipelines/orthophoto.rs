@@ -52,27 +52,7 @@ impl<'a> OrthophotoRoute<'a> {
         let params: OrthophotoParams = wf
             .params(skytie_stages::orthophoto::STAGE.name, variant)
             .map_err(wf_err)?;
-        let recs = &snapshot.campaign.recordings;
-        let dtm = match (&snapshot.campaign.dtm, recs.is_empty()) {
-            (Some(d), false) => {
-                let fold = |f: fn(f64, f64) -> f64, pick: fn(&Recording) -> f64, init| {
-                    recs.iter().map(pick).fold(init, f)
-                };
-                let area_m = [
-                    fold(f64::min, |r| r.x, f64::INFINITY) - DTM_MARGIN_M,
-                    fold(f64::min, |r| r.y, f64::INFINITY) - DTM_MARGIN_M,
-                    fold(f64::max, |r| r.x, f64::NEG_INFINITY) + DTM_MARGIN_M,
-                    fold(f64::max, |r| r.y, f64::NEG_INFINITY) + DTM_MARGIN_M,
-                ];
-                let files: Vec<RawFile> = d.tiles.iter().map(|t| RawFile(t.path(root))).collect();
-                let p = DtmParams {
-                    tiles: d.tiles.iter().map(|t| t.file.clone()).collect(),
-                    area_m,
-                };
-                Some((b.add(LoadDtm, "", p, files)?, d.sigma_m))
-            }
-            _ => None,
-        };
+        let dtm = campaign_dtm(b, root, snapshot)?;
         Ok(Some(Self {
             root,
             source,
@@ -156,4 +136,33 @@ impl<'a> OrthophotoRoute<'a> {
         b.metrics(summary, "orthophoto", |s: &OrthophotoSummary| s.metrics());
         Ok(())
     }
+}
+
+/// The campaign's DTM tiles loaded once, cropped to the recordings' area grown by 100 m (one node,
+/// shared by every caller), with its stated σ in metres; `None` when the campaign declares no DTM or has no
+/// recordings.
+pub fn campaign_dtm(
+    b: &mut DagBuilder,
+    root: &Path,
+    snapshot: &CampaignSnapshot,
+) -> Result<Option<(Handle<Dtm>, f64)>, PipelineError> {
+    let recs = &snapshot.campaign.recordings;
+    let (Some(d), false) = (&snapshot.campaign.dtm, recs.is_empty()) else {
+        return Ok(None);
+    };
+    let fold = |f: fn(f64, f64) -> f64, pick: fn(&Recording) -> f64, init| {
+        recs.iter().map(pick).fold(init, f)
+    };
+    let area_m = [
+        fold(f64::min, |r| r.x, f64::INFINITY) - DTM_MARGIN_M,
+        fold(f64::min, |r| r.y, f64::INFINITY) - DTM_MARGIN_M,
+        fold(f64::max, |r| r.x, f64::NEG_INFINITY) + DTM_MARGIN_M,
+        fold(f64::max, |r| r.y, f64::NEG_INFINITY) + DTM_MARGIN_M,
+    ];
+    let files: Vec<RawFile> = d.tiles.iter().map(|t| RawFile(t.path(root))).collect();
+    let p = DtmParams {
+        tiles: d.tiles.iter().map(|t| t.file.clone()).collect(),
+        area_m,
+    };
+    Ok(Some((b.add(LoadDtm, "", p, files)?, d.sigma_m)))
 }

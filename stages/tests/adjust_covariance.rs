@@ -21,6 +21,7 @@ fn recording(x: f64, sigma_xy: Option<f64>, sigma_z: Option<f64>) -> BlockRecord
         ),
         prior_sigma_xy_m: sigma_xy,
         prior_sigma_z_m: sigma_z,
+        height_observation: None,
     }
 }
 

@@ -83,6 +83,7 @@ impl Rows {
             control: &self.control,
             nadir: &s.aerial,
             oblique: &[],
+            heights: None,
         }
     }
 }

@@ -17,6 +17,7 @@ use skytie_stages::adjustment::evaluate::MULTI_VIEW_RADIUS_M;
 use skytie_stages::adjustment::from_correspondences::{
     prior_sigmas_m, run_in_frame, AdjustInputs, AdjustmentRun,
 };
+use skytie_stages::adjustment::height_observation::{dtm_height_sigma_m, terrain_heights};
 use skytie_stages::adjustment::{RmseSummary, ViewSelection};
 use skytie_stages::correction::{widen_off_control_sigma, OffControlSigma};
 use skytie_stages::correspondence::{AerialControlPoint, MmTiePoint};
@@ -24,6 +25,7 @@ use skytie_stages::crs::MapFrame;
 use skytie_stages::export::{checkpoint_rows, recording_support, CheckPointRow, Support};
 use skytie_stages::nadir::{MmWindowMatch, RecordingControl};
 use skytie_stages::oblique::SparseCloud;
+use skytie_stages::orthophoto::Dtm;
 use std::sync::Arc;
 
 /// σ of a check-point observation in the panorama, pixels (the synthetic campaigns add N(0, 0.5 px)).
@@ -93,13 +95,32 @@ impl AdjustReport {
             "cost": r.final_cost,
             "variance_factor": r.variance_factor,
             "redundancy": r.redundancy,
-            "build": r.build,
+            "build": build_metrics(r),
             "relative_sigma": r.relative_sigma,
+            "height_observations": r.config.dtm_height.then(|| serde_json::json!({
+                "source": r.build.heights.source.label(),
+                "observed": r.build.heights.observed,
+                "without_terrain": r.build.heights.without_terrain,
+                "sigma_m": r.build.heights.sigma_m,
+            })),
             "off_control_sigma": self.off_control_sigma,
             "trajectory": recording_metrics(r),
             "verdict": self.verdict().label(),
         }})
     }
+}
+
+/// The `build` counts; the height observations are under their own key, and the weak control dropped only
+/// when the check ran.
+fn build_metrics(r: &AdjustmentRun) -> serde_json::Value {
+    let mut v = serde_json::to_value(r.build).unwrap_or_default();
+    if let Some(m) = v.as_object_mut() {
+        m.remove("heights");
+        if r.config.weak_control_tolerance_m.is_none() {
+            m.remove("weak_control_dropped");
+        }
+    }
+    v
 }
 
 /// How far the adjustment moved the recordings and how well it determined them: counts, horizontal shift
@@ -187,16 +208,17 @@ fn spread(mut values: Vec<f64>) -> serde_json::Value {
 
 /// The adjustment node. Inputs: snapshot, ingested panoramas (snapshot order: their sizes and detail levels),
 /// the nadir windows' tie points and
-/// the recordings' aerial control points, the oblique chain's sparse clouds (MM tie points) and its consensus
-/// output (oblique control points) — empty lists for a source that is not used.
+/// the recordings' aerial control points, the oblique chain's sparse clouds (MM tie points) with its consensus
+/// output (oblique control points) — empty lists for a source that is not used — and the campaign's DTM (none
+/// or one; read with `dtm_height`).
 pub struct AdjustStage;
 
 impl Stage for AdjustStage {
     crate::nodes::stage_types!(skytie_stages::adjustment::from_correspondences::STAGE, AdjustConfig => AdjustReport,
-        inputs: (Handle<CampaignSnapshot>, Vec<Handle<IngestedImage>>, Vec<Optional<MmWindowMatch>>, Vec<Optional<RecordingControl>>, Vec<Optional<SparseCloud>>, Vec<Optional<ObliqueOutput>>));
+        inputs: (Handle<CampaignSnapshot>, Vec<Handle<IngestedImage>>, Vec<Optional<MmWindowMatch>>, Vec<Optional<RecordingControl>>, (Vec<Optional<SparseCloud>>, Vec<Optional<ObliqueOutput>>), Vec<Handle<Dtm>>));
 
     fn run(&self, config: &AdjustConfig, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
-        let (snap, panos, windows, control, clouds, oblique) = inputs;
+        let (snap, panos, windows, control, (clouds, oblique), dtm) = inputs;
         // Items whose nodes failed are absent: the adjustment uses the rest (the failures are counted).
         let (windows, control, clouds, oblique) =
             (flat(windows), flat(control), flat(clouds), flat(oblique));
@@ -233,6 +255,15 @@ impl Stage for AdjustStage {
                     .flat_map(|o| o.result.control.iter().cloned()),
             )
             .collect();
+        // The recordings' heights from the DTM, when asked for and the campaign has one.
+        let heights = match (config.dtm_height, dtm.first(), &c.dtm) {
+            (true, Some(terrain), Some(source)) => Some(terrain_heights(
+                &c.recordings,
+                |x, y| terrain.height_at(x, y),
+                dtm_height_sigma_m(source.sigma_m, config.camera_height_sigma_m),
+            )),
+            _ => None,
+        };
         let inputs = AdjustInputs {
             recordings: &c.recordings,
             pano_size_px: &sizes,
@@ -241,6 +272,7 @@ impl Stage for AdjustStage {
             control: &control_points,
             nadir: &c.nadir,
             oblique: &c.oblique,
+            heights: heights.as_deref(),
         };
         // With aerial observations in the bundle, it runs in the campaign's Cartesian frame.
         let frame = MapFrame::from_spec(&campaign_frame_spec(c).0)

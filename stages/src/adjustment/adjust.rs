@@ -41,6 +41,7 @@ pub struct ObservationCounts {
     pub control: usize,
     /// Aerial image observations.
     pub aerial: usize,
+    /// Prior components of the recorded positions, and observed heights of the recordings.
     pub priors: usize,
     pub relative: usize,
 }
@@ -194,6 +195,7 @@ pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, Adju
         .map(|r| {
             usize::from(r.prior_sigma_xy_m.is_some()) * 2
                 + usize::from(r.prior_sigma_z_m.is_some() && !options.horizontal_only)
+                + usize::from(r.height_observation.is_some() && !options.horizontal_only)
         })
         .sum();
     Ok(Adjustment {

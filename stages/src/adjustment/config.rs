@@ -129,6 +129,24 @@ crate::params! {
         relative_loss_scale: f64 = 3.0, above 0.0;
         /// Consecutive recordings farther apart than this are not linked (a gap in the trajectory).
         relative_max_gap_m: f64 = 15.0, unit "m", above 0.0;
+        /// Observe each recording's height as the campaign DTM's height under its recorded position plus
+        /// its `camera_height`, with σ = √(the DTM's stated σ² + `camera_height_sigma_m`²), beside the
+        /// recorded height's prior: it holds a recording's position along the rays of its control points.
+        /// Without a `[dtm]` in the campaign no height is observed (`adjust.<sources>.height_observations`
+        /// says so).
+        dtm_height: bool = false;
+        /// σ of a recording's camera height above the DTM's ground (mounting, tyres, the road surface
+        /// against the DTM's), for `dtm_height`.
+        camera_height_sigma_m: f64 = 0.02, unit "m", above 0.0;
+        /// Check weak orthophoto control against the strong control along the trajectory
+        /// (`adjustment::weak_control`): a control point whose orthophoto correlation peak is below
+        /// `weak_control_below` and whose correction (control XY − its XY from the recorded poses) differs by
+        /// more than this from the correction interpolated between the nearest recordings with strong control
+        /// is not used as control (counted in `build.weak_control_dropped`); absent = no check.
+        weak_control_tolerance_m: Option<f64> = None, unit "m", above 0.0;
+        /// Orthophoto control points whose phase-correlation peak is below this are weak, for
+        /// `weak_control_tolerance_m` (the orthophoto refinement's `min_peak`).
+        weak_control_below: f64 = 0.75, min 0.0, max 1.0;
         /// Estimate a yaw correction per recording.
         estimate_yaw: bool = false;
         /// σ of the zero prior on each yaw correction.

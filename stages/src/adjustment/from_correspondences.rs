@@ -12,12 +12,14 @@
 use super::adjust::{adjust, ObservationCounts};
 use super::config::{AdjustConfig, ControlWeighting};
 use super::error::AdjustError;
+use super::height_observation::{HeightObservations, HeightSource};
 use super::in_frame::{adjustment_to_map, block_to_local};
 use super::problem::{
-    AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, PanoObservation,
-    RelativeConstraint,
+    AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, HeightObservation,
+    PanoObservation, RelativeConstraint,
 };
 use super::relative_noise::RelativeSigma;
+use super::weak_control::{keep_consistent, ControlEvidence};
 use crate::campaign::{AerialImage, AerialKind, Recording};
 use crate::correspondence::{AerialControlPoint, MmTiePoint};
 use crate::crs::MapFrame;
@@ -29,7 +31,7 @@ use std::collections::HashMap;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("adjust", "7");
+pub const STAGE: StageId = StageId::new("adjust", "8");
 
 /// The inputs of one adjustment.
 #[derive(Clone, Copy, Debug)]
@@ -49,6 +51,10 @@ pub struct AdjustInputs<'a> {
     /// `aerial/nadir/cameras.csv` and `aerial/oblique/cameras.csv` rows (fixed orientations).
     pub nadir: &'a [AerialImage],
     pub oblique: &'a [AerialImage],
+    /// Observed heights of the recordings (one per recording, `None` where there is none) from the campaign's
+    /// terrain model ([`super::height_observation::terrain_heights`]), used with `dtm_height`; `None` when the
+    /// campaign has no terrain model.
+    pub heights: Option<&'a [Option<HeightObservation>]>,
 }
 
 /// What a tie-point unknown is.
@@ -82,7 +88,7 @@ pub struct AerialImageRef {
 }
 
 /// How the correspondences entered the block.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct BuildCounts {
     pub tie_points: usize,
     pub control_points: usize,
@@ -96,6 +102,11 @@ pub struct BuildCounts {
     /// Aerial observations left out because the point's initial position is not in front of that camera.
     pub aerial_observations_skipped: usize,
     pub relative_constraints: usize,
+    /// The recordings' observed heights (`dtm_height`).
+    pub heights: HeightObservations,
+    /// Weak orthophoto control points not used because they disagree with the strong control along the
+    /// trajectory (`weak_control_tolerance_m`).
+    pub weak_control_dropped: usize,
 }
 
 /// A block with the names of its unknowns.
@@ -176,14 +187,17 @@ pub fn build_block(
             problem: describe(&problems),
         });
     }
-    let (recording_index, recordings) = block_recordings(inputs, config)?;
+    let (recording_index, recordings, heights) = block_recordings(inputs, config)?;
     let mut block = Block {
         recordings,
         ..Block::default()
     };
     let mut points: Vec<BlockPoint> = Vec::new();
     let mut point_index: HashMap<String, usize> = HashMap::new();
-    let mut counts = BuildCounts::default();
+    let mut counts = BuildCounts {
+        heights,
+        ..BuildCounts::default()
+    };
     // σ of each recording's panorama observations, full-resolution pixels (pixels of its detail level).
     let sigma_px: Vec<f64> = (0..block.recordings.len())
         .map(|r| {
@@ -213,6 +227,8 @@ pub fn build_block(
     }
 
     let mut cameras = AerialCameras::default();
+    // Per control point of the block: the correction it implies, its recordings and whether it is weak.
+    let mut evidence: Vec<ControlEvidence> = Vec::new();
     for cp in inputs.control {
         counts.control_points += 1;
         let owner = format!("aerial control point '{}'", cp.tie_point_id);
@@ -271,9 +287,30 @@ pub fn build_block(
                 covariance_m2: control_covariance(config, cp, &owner)?,
             });
             counts.control_as_gcp += 1;
+            let initial = block.points_initial_world[p];
+            let mut recordings: Vec<usize> = points[p].pano.iter().map(|o| o.0).collect();
+            recordings.sort_unstable();
+            recordings.dedup();
+            evidence.push(ControlEvidence {
+                correction_m: nalgebra::Vector2::new(xyz[0] - initial.x, xyz[1] - initial.y),
+                recordings,
+                weak: cp
+                    .map
+                    .as_ref()
+                    .is_some_and(|m| m.score < config.weak_control_below),
+            });
         } else {
             counts.control_unused += 1;
         }
+    }
+    if let Some(tolerance_m) = config.weak_control_tolerance_m {
+        drop_inconsistent_weak_control(
+            &mut block,
+            &mut points,
+            &evidence,
+            tolerance_m,
+            &mut counts,
+        );
     }
     block.aerial_cameras = cameras
         .rows
@@ -305,6 +342,37 @@ pub fn build_block(
         counts,
         relative_sigma,
     })
+}
+
+/// Removes the weak control points [`keep_consistent`] rejects (`evidence` is parallel to the block's control
+/// points); a point left without control becomes a tie point again.
+fn drop_inconsistent_weak_control(
+    block: &mut Block,
+    points: &mut [BlockPoint],
+    evidence: &[ControlEvidence],
+    tolerance_m: f64,
+    counts: &mut BuildCounts,
+) {
+    let keep = keep_consistent(evidence, block.recordings.len(), tolerance_m);
+    let mut kept = Vec::with_capacity(block.control_points.len());
+    for (c, k) in block.control_points.iter().zip(&keep) {
+        if *k {
+            kept.push(*c);
+        } else {
+            counts.weak_control_dropped += 1;
+            counts.control_as_gcp -= 1;
+        }
+    }
+    block.control_points = kept;
+    let mut still_control = vec![false; points.len()];
+    for c in &block.control_points {
+        still_control[c.point] = true;
+    }
+    for (p, point) in points.iter_mut().enumerate() {
+        if point.kind == PointKind::Control && !still_control[p] && point.aerial.is_empty() {
+            point.kind = PointKind::Tie;
+        }
+    }
 }
 
 /// The aerial cameras the control points use, numbered in order of first use.
@@ -352,22 +420,47 @@ impl<'a> AerialCameras<'a> {
     }
 }
 
-/// The block's recordings (recorded poses as weak priors, thesis 5.4.3) and their index by image id; refuses
-/// a size list that does not match and duplicate image ids.
+/// The recordings' index by image id, the block's recordings and what their height observations were.
+type BlockRecordings<'a> = (
+    HashMap<&'a str, usize>,
+    Vec<BlockRecording>,
+    HeightObservations,
+);
+
+/// The block's recordings (recorded poses as weak priors, thesis 5.4.3, and with `dtm_height` their observed
+/// heights) and their index by image id; refuses a size or height list that does not match and duplicate
+/// image ids.
 fn block_recordings<'a>(
     inputs: &AdjustInputs<'a>,
     config: &AdjustConfig,
-) -> Result<(HashMap<&'a str, usize>, Vec<BlockRecording>), AdjustError> {
+) -> Result<BlockRecordings<'a>, AdjustError> {
     let n_rec = inputs.recordings.len();
-    if inputs.pano_size_px.len() != n_rec {
-        return Err(AdjustError::InvalidInput {
-            item: "panorama sizes".to_string(),
-            problem: format!(
-                "{} sizes for {n_rec} recordings; pass one (width, height) per recording",
-                inputs.pano_size_px.len()
-            ),
-        });
+    for (item, len, what) in [
+        (
+            "panorama sizes",
+            Some(inputs.pano_size_px.len()),
+            "(width, height)",
+        ),
+        (
+            "recording heights",
+            inputs.heights.map(<[_]>::len),
+            "height or none",
+        ),
+    ] {
+        if let Some(len) = len.filter(|&l| l != n_rec) {
+            return Err(AdjustError::InvalidInput {
+                item: item.to_string(),
+                problem: format!(
+                    "{len} {item} for {n_rec} recordings; pass one {what} per recording"
+                ),
+            });
+        }
     }
+    let (source, heights) = match (config.dtm_height, inputs.heights) {
+        (false, _) => (HeightSource::Off, &[][..]),
+        (true, None) => (HeightSource::NoDtm, &[][..]),
+        (true, Some(h)) => (HeightSource::Dtm, h),
+    };
     let mut recording_index: HashMap<&str, usize> = HashMap::with_capacity(n_rec);
     let mut recordings = Vec::with_capacity(n_rec);
     for (i, (rec, &(w, h))) in inputs
@@ -387,9 +480,11 @@ fn block_recordings<'a>(
             camera: PanoramaCamera::from_recording(rec, w, h),
             prior_sigma_xy_m: Some(prior_xy),
             prior_sigma_z_m: Some(prior_z),
+            height_observation: heights.get(i).copied().flatten(),
         });
     }
-    Ok((recording_index, recordings))
+    let summary = HeightObservations::of(source, heights);
+    Ok((recording_index, recordings, summary))
 }
 
 /// The σ of a recording's position prior, m: horizontal, vertical (the workflow's override, else the

@@ -7,8 +7,8 @@
 //! earth's curvature (`crate::crs::error_budget`: centimetres at 500–1000 m flying height); projected in the
 //! tangent frame, it does not. Everything else the block holds converts with it — recording centres and
 //! attitudes (turned by the meridian convergence), initial tie points, control points and their covariances,
-//! the fixed aerial cameras — so the panorama observations, priors and relative constraints mean the same in
-//! both frames. Priors keep their σ: horizontal σ are the same in every horizontal direction, and the tangent
+//! the fixed aerial cameras, observed heights — so the panorama observations, priors and relative constraints
+//! mean the same in both frames. Priors keep their σ: horizontal σ are the same in every horizontal direction, and the tangent
 //! frame's vertical tilts from the local vertical by distance/earth radius (1.6·10⁻⁴ rad at 1 km).
 //!
 //! Back in map coordinates, a posterior σ vector (x, y, z) is turned as the diagonal of a covariance
@@ -16,7 +16,7 @@
 
 use super::adjust::Adjustment;
 use super::error::AdjustError;
-use super::problem::{Block, BlockRecording, ControlPoint};
+use super::problem::{Block, BlockRecording, ControlPoint, HeightObservation};
 use crate::crs::{FrameError, MapFrame};
 use nalgebra::{Matrix3, Vector3};
 
@@ -36,8 +36,21 @@ pub fn block_to_local(block: &Block, frame: &MapFrame) -> Result<Block, AdjustEr
         .recordings
         .iter()
         .map(|r| {
+            // An observed height is the frame's Z of the point at that height above the recorded position.
+            let height_observation = match r.height_observation {
+                Some(h) => {
+                    let mut p = r.camera.center_world;
+                    p.z = h.z_world;
+                    Some(HeightObservation {
+                        z_world: frame.point_to_local(&p)?.z,
+                        ..h
+                    })
+                }
+                None => None,
+            };
             Ok(BlockRecording {
                 camera: frame.panorama_to_local(&r.camera)?,
+                height_observation,
                 ..r.clone()
             })
         })

@@ -14,7 +14,9 @@
 //! normalised residuals, re-solve), [`evaluate`] (check-point triangulation and RMSE), [`synthetic_block`]
 //! (known-answer test blocks). On top: [`config`] (the adjust node's params), [`in_frame`] (a block
 //! in the campaign's tangent frame and its results back in map coordinates), [`from_correspondences`]
-//! (correspondences → block → [`AdjustmentRun`]), [`verify`] (thesis Table 5-13 verification per trajectory
+//! (correspondences → block → [`AdjustmentRun`]), [`height_observation`] (recording heights from a terrain
+//! model), [`weak_control`] (weak orthophoto control checked against the strong control along the trajectory),
+//! [`verify`] (thesis Table 5-13 verification per trajectory
 //! segment) and [`synthetic_campaign`] (a synthetic block as campaign rows and correspondences, with aerial
 //! images, for known-answer tests).
 //!
@@ -29,6 +31,7 @@ pub mod covariance;
 pub mod error;
 pub mod evaluate;
 pub mod from_correspondences;
+pub mod height_observation;
 pub mod in_frame;
 pub mod layout;
 pub mod linearization;
@@ -46,6 +49,7 @@ pub mod synthetic_campaign;
 pub mod synthetic_streets;
 pub mod trajectory_errors;
 pub mod verify;
+pub mod weak_control;
 pub mod weighting;
 
 pub use adjust::{adjust, AdjustedRecording, Adjustment, ObservationCounts, RoundReport};
@@ -60,8 +64,8 @@ pub use from_correspondences::{
     BuildCounts, PointKind, RunPoint, RunRecording,
 };
 pub use problem::{
-    AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, LmOptions,
-    PanoObservation, RelativeConstraint,
+    AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, HeightObservation,
+    LmOptions, PanoObservation, RelativeConstraint,
 };
 pub use robust::RobustLoss;
 pub use solver::Termination;

@@ -66,6 +66,8 @@ pub struct Prepared {
     pub recorded_local: Vec<Vector3<f64>>,
     pub prior_sigma_xy_m: Vec<Option<f64>>,
     pub prior_sigma_z_m: Vec<Option<f64>>,
+    /// Observed heights of the recordings' centres: (Z in the local frame, σ in metres).
+    pub height_observations: Vec<Option<(f64, f64)>>,
     pub yaw_prior_sigma_rad: Option<f64>,
     pub pano: Vec<PreparedPano>,
     pub control: Vec<PreparedControl>,
@@ -236,6 +238,17 @@ impl Prepared {
                 .map(|r| r.prior_sigma_xy_m)
                 .collect(),
             prior_sigma_z_m: block.recordings.iter().map(|r| r.prior_sigma_z_m).collect(),
+            height_observations: block
+                .recordings
+                .iter()
+                .map(|r| {
+                    r.height_observation.map(|h| {
+                        let mut c = r.camera.center_world;
+                        c.z = h.z_world;
+                        (state.origin.to_local(&c).z, h.sigma_m)
+                    })
+                })
+                .collect(),
             yaw_prior_sigma_rad: options
                 .estimate_yaw
                 .then_some(options.yaw_prior_sigma_deg.map(f64::to_radians))
@@ -302,16 +315,22 @@ impl Prepared {
         c.whitening * (state.points_local[c.point] - c.position_local)
     }
 
-    /// Whitened prior residuals of recording `c`: (axis, residual, 1/σ) for each prior axis.
-    pub(super) fn prior_terms(&self, c: usize, state: &State) -> [(usize, f64, f64); 3] {
+    /// Whitened prior residuals of recording `c`: (axis, residual, 1/σ) for each prior axis, then its height
+    /// observation (axis 2); unused entries have 1/σ = 0.
+    pub(super) fn prior_terms(&self, c: usize, state: &State) -> [(usize, f64, f64); 4] {
         let d = state.centers_local[c] - self.recorded_local[c];
-        let mut out = [(0, 0.0, 0.0); 3];
+        let mut out = [(0, 0.0, 0.0); 4];
         if let Some(s) = self.prior_sigma_xy_m[c] {
             out[0] = (0, d.x / s, 1.0 / s);
             out[1] = (1, d.y / s, 1.0 / s);
         }
-        if let (Some(s), false) = (self.prior_sigma_z_m[c], self.horizontal_only) {
-            out[2] = (2, d.z / s, 1.0 / s);
+        if !self.horizontal_only {
+            if let Some(s) = self.prior_sigma_z_m[c] {
+                out[2] = (2, d.z / s, 1.0 / s);
+            }
+            if let Some((z_local, s)) = self.height_observations[c] {
+                out[3] = (2, (state.centers_local[c].z - z_local) / s, 1.0 / s);
+            }
         }
         out
     }

@@ -23,6 +23,18 @@ pub struct BlockRecording {
     pub prior_sigma_xy_m: Option<f64>,
     /// σ of the recorded Z as a weak prior, metres; `None` = no vertical prior.
     pub prior_sigma_z_m: Option<f64>,
+    /// An observation of the projection centre's height independent of the recorded one (e.g. a terrain
+    /// model's height under the recording plus the camera height); `None` = none.
+    pub height_observation: Option<HeightObservation>,
+}
+
+/// An observed height of a recording's projection centre with its standard deviation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeightObservation {
+    /// Observed Z of the projection centre, world frame, metres.
+    pub z_world: f64,
+    /// Standard deviation of `z_world`, metres.
+    pub sigma_m: f64,
 }
 
 /// A panorama observation of a tie point: continuous pixel (u, v) in recording `recording`.
@@ -234,6 +246,29 @@ impl Block {
                             field,
                             value: s,
                             hint: "a prior sigma must be finite and > 0, or absent",
+                        });
+                    }
+                }
+            }
+            if let Some(h) = rec.height_observation {
+                for (field, value, ok) in [
+                    (
+                        "height_observation.z_world",
+                        h.z_world,
+                        h.z_world.is_finite(),
+                    ),
+                    (
+                        "height_observation.sigma_m",
+                        h.sigma_m,
+                        positive_finite(h.sigma_m),
+                    ),
+                ] {
+                    if !ok {
+                        return Err(AdjustError::InvalidRecording {
+                            index,
+                            field,
+                            value,
+                            hint: "a height observation needs a finite height and a finite σ > 0",
                         });
                     }
                 }

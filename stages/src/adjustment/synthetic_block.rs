@@ -149,6 +149,7 @@ impl SyntheticBlockSpec {
                 camera: PanoramaCamera::new(width, height, recorded, recorded_yaw, pitch, roll),
                 prior_sigma_xy_m: Some(self.prior_sigma_xy_m),
                 prior_sigma_z_m: Some(self.prior_sigma_z_m),
+                height_observation: None,
             });
         }
         // Tie points anchored at each recording, seen by 2–4 consecutive recordings.

@@ -71,6 +71,7 @@ impl SyntheticCampaign {
             control: &self.control,
             nadir: &self.nadir,
             oblique: &[],
+            heights: None,
         }
     }
 }

@@ -116,6 +116,7 @@ impl StreetBlockSpec {
                 camera: camera(r, recorded[r]),
                 prior_sigma_xy_m: Some(self.prior_sigma_xy_m),
                 prior_sigma_z_m: Some(self.prior_sigma_z_m),
+                height_observation: None,
             })
             .collect();
         let per_recording = self.observations_per_recording as f64 / 3.0;
