@@ -3,18 +3,20 @@
 //! A stretch of trajectory before the first or after the last recording that observes control has no
 //! correction of its own: the adjustment carries one into it through the panorama tie points and the relative
 //! constraints between consecutive recordings. The tie points fix each recording relative to the next to
-//! centimetres, but their small errors add up along the chain — a slight scale or heading drift that takes a
-//! stretch of eight recordings from 0.12 to 0.25 m off — while the consecutive relative constraints, each
-//! σ_rel, let the end of the stretch wander by σ_rel · √k after k recordings and so do not hold it.
+//! centimetres, but their small errors add up along the chain — a slight scale or heading drift that took a
+//! stretch of eight recordings of the orthophoto route from 0.12 to 0.25 m off — and the consecutive relative
+//! constraints, whose σ_rel allows the stretch's end to wander by σ_rel · √k after k recordings, are too weak
+//! against the tie points to hold it.
 //!
 //! The recorded trajectory's error is mostly common to neighbouring recordings, so the best guess for a
 //! recording k recordings beyond the nearest recording with control (its anchor) is the anchor's correction.
 //! With `extrapolation_anchor` each such recording is also tied directly to its anchor: the recorded
-//! difference between the two is kept with σ_rel · k^`growth` (a relative constraint from the anchor to it),
-//! so the correction is carried unchanged into the stretch, with less weight the farther a recording is from
-//! its anchor, and the tie points keep the recordings' relative geometry. The recordings stay flagged
-//! `extrapolated` in the outputs ([`crate::correction::support`]). A stretch ends at a gap in the trajectory
-//! (consecutive recordings farther apart than `relative_max_gap_m`, as for the relative constraints).
+//! difference between the two is kept with σ_rel · k^`growth` (a relative constraint from the anchor to it,
+//! under the relative constraints' robust loss), so the correction is carried into the stretch with less
+//! weight the farther a recording is from its anchor, and the tie points keep the stretch's shape. The
+//! recordings stay flagged `extrapolated` in the outputs ([`crate::correction::support`]). A stretch ends at
+//! a gap in the trajectory (consecutive recordings farther apart than `relative_max_gap_m`, as for the
+//! relative constraints).
 
 use super::config::AdjustConfig;
 use super::problem::{Block, RelativeConstraint};

@@ -323,7 +323,9 @@ pub fn build_block(
     );
     counts.weak_control_dropped = selection.weak;
     counts.inconsistent_control_dropped = selection.inconsistent;
-    drop_control(&mut block, &mut points, &selection.keep, &mut counts);
+    if selection.keep.contains(&false) {
+        drop_control(&mut block, &mut points, &selection.keep, &mut counts);
+    }
     block.aerial_cameras = cameras
         .rows
         .iter()
