@@ -181,18 +181,23 @@ mod tests {
         pts.push(point([0.60, 1.15], &[11, 12], false));
         pts.push(point([0.59, 1.12], &[12], true));
         let all = vec![true; pts.len()];
+        // Within 10 recordings, recording 2's point has only recordings 4, 11 and 12 as neighbours, two of
+        // them wrong: it deviates from their median as much as the wrong ones from theirs, and goes too.
         let keep = keep_locally_consistent(&pts, &all, 30, 10, tolerance_m(0.15));
+        assert_eq!(keep, [false, true, true, true, true, true, false, false, false]);
+        // Within 20 the correct recordings outvote the pair.
+        let keep = keep_locally_consistent(&pts, &all, 30, 20, tolerance_m(0.15));
         assert_eq!(keep[..6], [true; 6]);
         assert_eq!(keep[6..], [false, false, false]);
         // A point 0.30 m off (within 0.39 m) is kept.
         pts.push(point([0.45, 1.00], &[10], false));
         let all = vec![true; pts.len()];
-        let keep = keep_locally_consistent(&pts, &all, 30, 10, tolerance_m(0.15));
+        let keep = keep_locally_consistent(&pts, &all, 30, 20, tolerance_m(0.15));
         assert!(keep[9]);
         // Already dropped points stay dropped and are nobody's neighbours.
         let mut given = vec![true; pts.len()];
         given[0] = false;
-        let keep = keep_locally_consistent(&pts, &given, 30, 10, tolerance_m(0.15));
+        let keep = keep_locally_consistent(&pts, &given, 30, 20, tolerance_m(0.15));
         assert!(!keep[0] && keep[1]);
     }
 
