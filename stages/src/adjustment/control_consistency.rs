@@ -184,7 +184,10 @@ mod tests {
         // Within 10 recordings, recording 2's point has only recordings 4, 11 and 12 as neighbours, two of
         // them wrong: it deviates from their median as much as the wrong ones from theirs, and goes too.
         let keep = keep_locally_consistent(&pts, &all, 30, 10, tolerance_m(0.15));
-        assert_eq!(keep, [false, true, true, true, true, true, false, false, false]);
+        assert_eq!(
+            keep,
+            [false, true, true, true, true, true, false, false, false]
+        );
         // Within 20 the correct recordings outvote the pair.
         let keep = keep_locally_consistent(&pts, &all, 30, 20, tolerance_m(0.15));
         assert_eq!(keep[..6], [true; 6]);
