@@ -110,14 +110,20 @@ impl AdjustReport {
     }
 }
 
-/// The `build` counts; the height observations are under their own key, and the weak control dropped only
-/// when the check ran.
+/// The `build` counts; the height observations are under their own key, and the counts of the control checks
+/// and of the extrapolation anchors only when they ran.
 fn build_metrics(r: &AdjustmentRun) -> serde_json::Value {
     let mut v = serde_json::to_value(r.build).unwrap_or_default();
     if let Some(m) = v.as_object_mut() {
         m.remove("heights");
         if r.config.weak_control_tolerance_m.is_none() {
             m.remove("weak_control_dropped");
+        }
+        if r.config.control_consistency_window.is_none() {
+            m.remove("inconsistent_control_dropped");
+        }
+        if !r.config.extrapolation_anchor {
+            m.remove("extrapolation_anchors");
         }
     }
     v

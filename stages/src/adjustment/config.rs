@@ -147,6 +147,21 @@ crate::params! {
         /// Orthophoto control points whose phase-correlation peak is below this are weak, for
         /// `weak_control_tolerance_m` (the orthophoto refinement's `min_peak`).
         weak_control_below: f64 = 0.75, min 0.0, max 1.0;
+        /// Check every control point, strong or weak, against the control of the other recordings within
+        /// this many recordings before and after it (`adjustment::control_consistency`): a point whose
+        /// correction differs from their median correction by more than 2.63 × the relative σ (the 99.9 %
+        /// quantile of the recordings' scatter about a common correction) is not used as control (counted in
+        /// `build.inconsistent_control_dropped`); absent = no check.
+        control_consistency_window: Option<usize> = None, min 1;
+        /// Tie each recording before the first or after the last recording with control directly to that
+        /// recording (`adjustment::extrapolation_anchor`): the recorded difference between the two is kept
+        /// with σ = the relative σ × k^`extrapolation_anchor_growth` for a recording k recordings away, so
+        /// the stretch keeps the nearest correction instead of drifting with the tie-point chain (counted in
+        /// `build.extrapolation_anchors`).
+        extrapolation_anchor: bool = false;
+        /// How the σ of `extrapolation_anchor` grows with the number of recordings k from the anchor: σ_rel ×
+        /// k^this (0.5: like k consecutive relative constraints; 0: the same σ at every distance).
+        extrapolation_anchor_growth: f64 = 0.5, min 0.0, max 2.0;
         /// Estimate a yaw correction per recording.
         estimate_yaw: bool = false;
         /// σ of the zero prior on each yaw correction.

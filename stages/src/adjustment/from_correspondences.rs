@@ -11,7 +11,9 @@
 
 use super::adjust::{adjust, ObservationCounts};
 use super::config::{AdjustConfig, ControlWeighting};
+use super::control_consistency::select_control;
 use super::error::AdjustError;
+use super::extrapolation_anchor::tail_anchors;
 use super::height_observation::{HeightObservations, HeightSource};
 use super::in_frame::{adjustment_to_map, block_to_local};
 use super::problem::{
@@ -19,7 +21,7 @@ use super::problem::{
     PanoObservation, RelativeConstraint,
 };
 use super::relative_noise::RelativeSigma;
-use super::weak_control::{keep_consistent, ControlEvidence};
+use super::weak_control::ControlEvidence;
 use crate::campaign::{AerialImage, AerialKind, Recording};
 use crate::correspondence::{AerialControlPoint, MmTiePoint};
 use crate::crs::MapFrame;
@@ -31,7 +33,7 @@ use std::collections::HashMap;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("adjust", "8");
+pub const STAGE: StageId = StageId::new("adjust", "9");
 
 /// The inputs of one adjustment.
 #[derive(Clone, Copy, Debug)]
@@ -107,6 +109,11 @@ pub struct BuildCounts {
     /// Weak orthophoto control points not used because they disagree with the strong control along the
     /// trajectory (`weak_control_tolerance_m`).
     pub weak_control_dropped: usize,
+    /// Control points not used because their correction disagrees with the control of the neighbouring
+    /// recordings (`control_consistency_window`).
+    pub inconsistent_control_dropped: usize,
+    /// Recordings beyond the first or last recording with control tied to it (`extrapolation_anchor`).
+    pub extrapolation_anchors: usize,
 }
 
 /// A block with the names of its unknowns.
@@ -303,14 +310,21 @@ pub fn build_block(
             counts.control_unused += 1;
         }
     }
-    if let Some(tolerance_m) = config.weak_control_tolerance_m {
-        drop_inconsistent_weak_control(
-            &mut block,
-            &mut points,
-            &evidence,
-            tolerance_m,
-            &mut counts,
-        );
+    let relative_sigma = RelativeSigma::resolve(
+        config.relative_sigma_m,
+        inputs.recordings,
+        config.relative_max_gap_m,
+    );
+    let selection = select_control(
+        &evidence,
+        block.recordings.len(),
+        config,
+        relative_sigma.sigma_m,
+    );
+    counts.weak_control_dropped = selection.weak;
+    counts.inconsistent_control_dropped = selection.inconsistent;
+    if selection.keep.contains(&false) {
+        drop_control(&mut block, &mut points, &selection.keep, &mut counts);
     }
     block.aerial_cameras = cameras
         .rows
@@ -318,15 +332,15 @@ pub fn build_block(
         .map(|r| FrameCamera::from_aerial(r))
         .collect();
 
-    let relative_sigma = RelativeSigma::resolve(
-        config.relative_sigma_m,
-        inputs.recordings,
-        config.relative_max_gap_m,
-    );
     if config.relative_constraints {
         block.relative_constraints =
             relative_constraints(inputs.recordings, config, relative_sigma.sigma_m);
         counts.relative_constraints = block.relative_constraints.len();
+    }
+    if config.extrapolation_anchor {
+        let anchors = tail_anchors(&block, inputs.recordings, config, relative_sigma.sigma_m);
+        counts.extrapolation_anchors = anchors.len();
+        block.relative_constraints.extend(anchors);
     }
     block.validate()?;
     Ok(BlockBuild {
@@ -344,22 +358,19 @@ pub fn build_block(
     })
 }
 
-/// Removes the weak control points [`keep_consistent`] rejects (`evidence` is parallel to the block's control
-/// points); a point left without control becomes a tie point again.
-fn drop_inconsistent_weak_control(
+/// Removes the control points `keep` rejects (parallel to the block's control points); a point left without
+/// control becomes a tie point again.
+fn drop_control(
     block: &mut Block,
     points: &mut [BlockPoint],
-    evidence: &[ControlEvidence],
-    tolerance_m: f64,
+    keep: &[bool],
     counts: &mut BuildCounts,
 ) {
-    let keep = keep_consistent(evidence, block.recordings.len(), tolerance_m);
     let mut kept = Vec::with_capacity(block.control_points.len());
-    for (c, k) in block.control_points.iter().zip(&keep) {
+    for (c, k) in block.control_points.iter().zip(keep) {
         if *k {
             kept.push(*c);
         } else {
-            counts.weak_control_dropped += 1;
             counts.control_as_gcp -= 1;
         }
     }

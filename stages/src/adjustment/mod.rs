@@ -16,6 +16,8 @@
 //! in the campaign's tangent frame and its results back in map coordinates), [`from_correspondences`]
 //! (correspondences → block → [`AdjustmentRun`]), [`height_observation`] (recording heights from a terrain
 //! model), [`weak_control`] (weak orthophoto control checked against the strong control along the trajectory),
+//! [`control_consistency`] (every control point checked against the neighbouring recordings' control),
+//! [`extrapolation_anchor`] (recordings beyond the outermost control tied to its correction),
 //! [`verify`] (thesis Table 5-13 verification per trajectory
 //! segment) and [`synthetic_campaign`] (a synthetic block as campaign rows and correspondences, with aerial
 //! images, for known-answer tests).
@@ -27,9 +29,11 @@ pub mod adjust;
 pub mod aerial;
 pub mod campaign_checkpoints;
 pub mod config;
+pub mod control_consistency;
 pub mod covariance;
 pub mod error;
 pub mod evaluate;
+pub mod extrapolation_anchor;
 pub mod from_correspondences;
 pub mod height_observation;
 pub mod in_frame;

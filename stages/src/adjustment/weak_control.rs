@@ -29,7 +29,7 @@ pub struct ControlEvidence {
 }
 
 /// Component-wise median of `v` (not empty).
-fn median2(v: &[Vector2<f64>]) -> Vector2<f64> {
+pub(crate) fn median2(v: &[Vector2<f64>]) -> Vector2<f64> {
     let med = |mut xs: Vec<f64>| {
         xs.sort_by(f64::total_cmp);
         let n = xs.len();
