@@ -16,6 +16,7 @@
 //! in the campaign's tangent frame and its results back in map coordinates), [`from_correspondences`]
 //! (correspondences → block → [`AdjustmentRun`]), [`height_observation`] (recording heights from a terrain
 //! model), [`weak_control`] (weak orthophoto control checked against the strong control along the trajectory),
+//! [`second_pass`] (the shifted inputs of a second registration pass around the adjusted trajectory),
 //! [`verify`] (thesis Table 5-13 verification per trajectory
 //! segment) and [`synthetic_campaign`] (a synthetic block as campaign rows and correspondences, with aerial
 //! images, for known-answer tests).
@@ -42,6 +43,7 @@ pub mod relative_noise;
 pub mod residuals;
 pub mod robust;
 pub mod schur;
+pub mod second_pass;
 pub mod solver;
 pub mod sparse;
 pub mod synthetic_block;
