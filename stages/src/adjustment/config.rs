@@ -147,6 +147,12 @@ crate::params! {
         /// Orthophoto control points whose phase-correlation peak is below this are weak, for
         /// `weak_control_tolerance_m` (the orthophoto refinement's `min_peak`).
         weak_control_below: f64 = 0.75, min 0.0, max 1.0;
+        /// Leave out the control of a recording whose correction (the median of what its control points
+        /// imply: aerial XY − XY from the recorded poses) misses the correction interpolated from its
+        /// nearest controlled neighbours along the trajectory by more than this many σ, σ derived from the
+        /// relative constraints' σ and the campaign's own scatter (`adjustment::control_consistency`); absent
+        /// = no check. Catches a registration consistent with a drifted pose in the middle of a drifted stretch.
+        control_consistency_sigmas: Option<f64> = None, above 0.0;
         /// Estimate a yaw correction per recording.
         estimate_yaw: bool = false;
         /// σ of the zero prior on each yaw correction.

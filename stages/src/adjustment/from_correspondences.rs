@@ -11,6 +11,7 @@
 
 use super::adjust::{adjust, ObservationCounts};
 use super::config::{AdjustConfig, ControlWeighting};
+use super::control_consistency::{inconsistent_recordings, median2, RecordingCorrection};
 use super::error::AdjustError;
 use super::height_observation::{HeightObservations, HeightSource};
 use super::in_frame::{adjustment_to_map, block_to_local};
@@ -31,7 +32,7 @@ use std::collections::HashMap;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("adjust", "8");
+pub const STAGE: StageId = StageId::new("adjust", "9");
 
 /// The inputs of one adjustment.
 #[derive(Clone, Copy, Debug)]
@@ -107,6 +108,12 @@ pub struct BuildCounts {
     /// Weak orthophoto control points not used because they disagree with the strong control along the
     /// trajectory (`weak_control_tolerance_m`).
     pub weak_control_dropped: usize,
+    /// Recordings whose control disagrees with their neighbours' along the trajectory
+    /// (`control_consistency_sigmas`), and the control points observed by them that were therefore not used.
+    #[serde(default)]
+    pub inconsistent_recordings: usize,
+    #[serde(default)]
+    pub inconsistent_control_dropped: usize,
 }
 
 /// A block with the names of its unknowns.
@@ -229,6 +236,8 @@ pub fn build_block(
     let mut cameras = AerialCameras::default();
     // Per control point of the block: the correction it implies, its recordings and whether it is weak.
     let mut evidence: Vec<ControlEvidence> = Vec::new();
+    // Per control point with a world position: its block point and the correction it implies.
+    let mut implied: Vec<(usize, nalgebra::Vector2<f64>)> = Vec::new();
     for cp in inputs.control {
         counts.control_points += 1;
         let owner = format!("aerial control point '{}'", cp.tie_point_id);
@@ -275,6 +284,13 @@ pub fn build_block(
         points[p]
             .aerial
             .extend(aerial.iter().map(|&(camera, u, v, _)| (camera, u, v)));
+        if let Some(xyz) = cp.point_world {
+            let initial = block.points_initial_world[p];
+            implied.push((
+                p,
+                nalgebra::Vector2::new(xyz[0] - initial.x, xyz[1] - initial.y),
+            ));
+        }
         if config.aerial_observations && cp.map.is_none() {
             add_aerial_observations(&mut block, &cameras.rows, p, &aerial, &mut counts);
         } else if let Some(xyz) = cp
@@ -323,6 +339,16 @@ pub fn build_block(
         inputs.recordings,
         config.relative_max_gap_m,
     );
+    if let Some(k) = config.control_consistency_sigmas {
+        drop_inconsistent_control(
+            &mut block,
+            &mut points,
+            (inputs.recordings, config.relative_max_gap_m),
+            &implied,
+            (relative_sigma.sigma_m, k),
+            &mut counts,
+        );
+    }
     if config.relative_constraints {
         block.relative_constraints =
             relative_constraints(inputs.recordings, config, relative_sigma.sigma_m);
@@ -371,6 +397,61 @@ fn drop_inconsistent_weak_control(
     for (p, point) in points.iter_mut().enumerate() {
         if point.kind == PointKind::Control && !still_control[p] && point.aerial.is_empty() {
             point.kind = PointKind::Tie;
+        }
+    }
+}
+
+/// Leaves out the control of the recordings whose control disagrees with their neighbours' along the
+/// trajectory by more than `k` σ (`control_consistency::inconsistent_recordings`, σ = `sigma_rel_m` or the
+/// campaign's own scatter): every control point one of them observes loses its aerial observations and its
+/// control position and becomes a tie point. `implied` holds per control point with a world position its
+/// block point and implied correction.
+fn drop_inconsistent_control(
+    block: &mut Block,
+    points: &mut [BlockPoint],
+    (recordings, max_gap_m): (&[Recording], f64),
+    implied: &[(usize, nalgebra::Vector2<f64>)],
+    (sigma_rel_m, k): (f64, f64),
+    counts: &mut BuildCounts,
+) {
+    let mut per: Vec<Vec<nalgebra::Vector2<f64>>> = vec![Vec::new(); recordings.len()];
+    for (p, c) in implied {
+        let mut observed: Vec<usize> = points[*p].pano.iter().map(|o| o.0).collect();
+        observed.sort_unstable();
+        observed.dedup();
+        for r in observed {
+            if let Some(list) = per.get_mut(r) {
+                list.push(*c);
+            }
+        }
+    }
+    let recs: Vec<RecordingCorrection> = (0..recordings.len())
+        .map(|i| RecordingCorrection {
+            correction_m: (!per[i].is_empty()).then(|| median2(&per[i])),
+            linked_to_previous: i > 0 && {
+                let (a, b) = (&recordings[i - 1], &recordings[i]);
+                (a.x - b.x).hypot(a.y - b.y) <= max_gap_m
+            },
+        })
+        .collect();
+    let flagged = inconsistent_recordings(&recs, sigma_rel_m, k);
+    counts.inconsistent_recordings = flagged.iter().filter(|&&f| f).count();
+    if counts.inconsistent_recordings == 0 {
+        return;
+    }
+    let dropped: Vec<bool> = points
+        .iter()
+        .map(|pt| {
+            pt.kind != PointKind::Tie && pt.pano.iter().any(|o| flagged.get(o.0) == Some(&true))
+        })
+        .collect();
+    counts.inconsistent_control_dropped = dropped.iter().filter(|&&d| d).count();
+    block.control_points.retain(|c| !dropped[c.point]);
+    block.aerial_observations.retain(|o| !dropped[o.point]);
+    for (point, d) in points.iter_mut().zip(&dropped) {
+        if *d {
+            point.kind = PointKind::Tie;
+            point.aerial.clear();
         }
     }
 }

@@ -16,6 +16,7 @@
 //! in the campaign's tangent frame and its results back in map coordinates), [`from_correspondences`]
 //! (correspondences → block → [`AdjustmentRun`]), [`height_observation`] (recording heights from a terrain
 //! model), [`weak_control`] (weak orthophoto control checked against the strong control along the trajectory),
+//! [`control_consistency`] (control that disagrees with its neighbours' along the trajectory),
 //! [`second_pass`] (the shifted inputs of a second registration pass around the adjusted trajectory),
 //! [`verify`] (thesis Table 5-13 verification per trajectory
 //! segment) and [`synthetic_campaign`] (a synthetic block as campaign rows and correspondences, with aerial
@@ -28,6 +29,7 @@ pub mod adjust;
 pub mod aerial;
 pub mod campaign_checkpoints;
 pub mod config;
+pub mod control_consistency;
 pub mod covariance;
 pub mod error;
 pub mod evaluate;
