@@ -79,7 +79,10 @@ fn a_tiny_street_with_road_markings_is_corrected() {
     let first = num(passes, &["registered_first_pass"]);
     let windows = num(passes, &["recordings"]);
     assert!(windows >= 5.0, "{passes}");
-    assert!(num(passes, &["registered_second_pass"]) >= first, "{passes}");
+    assert!(
+        num(passes, &["registered_second_pass"]) >= first,
+        "{passes}"
+    );
     assert!(
         num(passes, &["searched_again"]) <= windows - first,
         "only unregistered recordings are searched again: {passes}"
