@@ -1,17 +1,18 @@
 //! The nodes of the second registration pass around the adjusted trajectory
 //! (`skytie_stages::adjustment::second_pass`): per recording its shift from the first adjustment
-//! (`pass_prior`), its tie-point window and aerial-oriented ortho images translated by it (`pass_window`,
-//! `pass_ortho`), and the counts of both passes (`registration_passes`). A recording the first pass registered
-//! gets a zero shift, so its translated inputs equal the first pass's and every node below them is found in
-//! the cache.
+//! (`pass_prior`), its row, tie-point window and aerial-oriented ortho images (its own and its neighbours')
+//! translated by it (`pass_row`, `pass_window`, `pass_ortho`), and the counts of both passes
+//! (`registration_passes`). A recording the first pass registered gets a zero shift, so its translated inputs
+//! equal the first pass's and every node below them is found in the cache.
 
 use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage};
 use crate::nodes::adjust::adjustment::{AdjustReport, Verdict};
 use crate::nodes::campaign::summary::SummaryParams;
 use skytie_stages::adjustment::second_pass::{
-    pass_shift, registered, shift_ortho, shift_window, PassShift, RegistrationPasses, PASSES_STAGE,
-    PRIOR_STAGE, SHIFT_ORTHO_STAGE, SHIFT_WINDOW_STAGE,
+    pass_shift, registered, shift_ortho, shift_row, shift_window, PassShift, RegistrationPasses,
+    PASSES_STAGE, PRIOR_STAGE, SHIFT_ORTHO_STAGE, SHIFT_ROW_STAGE, SHIFT_WINDOW_STAGE,
 };
+use skytie_stages::campaign::Recording;
 use skytie_stages::nadir::{MmWindowMatch, OrthoImage, RecordingControl};
 
 crate::serde_artifact!(PassShift, RegistrationPasses);
@@ -57,7 +58,23 @@ impl Stage for ShiftWindow {
     }
 }
 
-/// A recording's aerial-oriented ortho image translated by its shift.
+/// A recording's row translated by its shift. The second pass's per-recording nodes read it (and the other
+/// translated inputs) instead of the first pass's nodes, so that sharding (`crate::dag::shard`) leaves them,
+/// like the adjustment they follow, to the merge.
+pub struct ShiftRow;
+
+impl Stage for ShiftRow {
+    crate::nodes::stage_types!(SHIFT_ROW_STAGE, SummaryParams => Recording,
+        inputs: (Handle<Recording>, Handle<PassShift>));
+
+    fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (row, shift) = inputs;
+        Ok(shift_row(&row, &shift))
+    }
+}
+
+/// An aerial-oriented ortho image (the recording's, or a neighbour's for the parallax check) translated by the
+/// recording's shift.
 pub struct ShiftOrtho;
 
 impl Stage for ShiftOrtho {

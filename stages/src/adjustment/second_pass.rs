@@ -7,14 +7,17 @@
 //! can start there with the normal windows. Moving a recording horizontally by `shift_world` moves its ortho
 //! image's ground plane by the same vector and leaves its pixels unchanged (the projection depends only on the
 //! position relative to the camera), so the second pass reuses the first pass's ortho images and tie points,
-//! translated ([`shift_ortho`], [`shift_window`]): the tie points' panorama observations, the only thing the
-//! adjustment reads of them, are unchanged.
+//! translated ([`shift_ortho`], [`shift_window`], [`shift_row`]): the tie points' panorama observations, the
+//! only thing the adjustment reads of them, are unchanged. The neighbours' ortho images that the refinement's
+//! parallax check reads are translated by the same shift as the recording's window, so the check sees them
+//! as in the first pass.
 //!
 //! The pass is a graph construction of the pipeline; this module holds its pure parts: the shift of one
 //! recording ([`pass_shift`]), the translated inputs, and the counts of the two passes
 //! ([`RegistrationPasses`]).
 
 use super::from_correspondences::RunRecording;
+use crate::campaign::Recording;
 use crate::nadir::{MmWindowMatch, OrthoImage, RecordingControl};
 use crate::params::StageId;
 use serde::{Deserialize, Serialize};
@@ -23,6 +26,8 @@ use serde::{Deserialize, Serialize};
 pub const PRIOR_STAGE: StageId = StageId::new("pass_prior", "1");
 /// The identity of the node that translates a recording's tie-point window by its shift.
 pub const SHIFT_WINDOW_STAGE: StageId = StageId::new("pass_window", "1");
+/// The identity of the node that translates a recording's row by its shift.
+pub const SHIFT_ROW_STAGE: StageId = StageId::new("pass_row", "1");
 /// The identity of the node that translates a recording's aerial-oriented ortho image by its shift.
 pub const SHIFT_ORTHO_STAGE: StageId = StageId::new("pass_ortho", "1");
 /// The identity of the node that counts the registered recordings of both passes.
@@ -89,16 +94,30 @@ pub fn shift_ortho(ortho: &OrthoImage, shift: &PassShift) -> OrthoImage {
     out
 }
 
-/// The tie-point window of a recording moved by `shift`: the corners on the recording's own ground plane are
-/// translated (where the aerial stages look for them); the neighbours' views stay on the neighbours' unshifted
-/// ortho images (the parallax check compares them relative to each other); the tie points themselves, whose
-/// panorama observations the adjustment reads, are unchanged.
+/// The tie-point window of a recording moved by `shift`: the corners on the recording's own ground plane
+/// (where the aerial stages look for them) and the neighbours' views of them (which the parallax check looks
+/// up in the neighbours' ortho images, translated by the same `shift`: the check compares them relative to
+/// each other) are translated; the tie points themselves, whose panorama observations the adjustment reads,
+/// are unchanged.
 pub fn shift_window(window: &MmWindowMatch, shift: &PassShift) -> MmWindowMatch {
+    let [dx, dy] = shift.shift_world;
     let mut out = window.clone();
     for g in &mut out.ground_world {
-        g[0] += shift.shift_world[0];
-        g[1] += shift.shift_world[1];
+        g[0] += dx;
+        g[1] += dy;
     }
+    for view in out.neighbour_ground_world.iter_mut().flatten() {
+        view.ground_world[0] += dx;
+        view.ground_world[1] += dy;
+    }
+    out
+}
+
+/// A recording's row moved by `shift` (its recorded position translated horizontally).
+pub fn shift_row(row: &Recording, shift: &PassShift) -> Recording {
+    let mut out = row.clone();
+    out.x += shift.shift_world[0];
+    out.y += shift.shift_world[1];
     out
 }
 
@@ -199,7 +218,7 @@ mod tests {
     }
 
     #[test]
-    fn a_shifted_window_moves_only_the_recordings_own_corners() {
+    fn a_shifted_window_moves_the_corners_and_the_neighbours_views_alike() {
         let window = MmWindowMatch {
             recording_id: "a".into(),
             pairs: Vec::new(),
@@ -217,7 +236,11 @@ mod tests {
         };
         let moved = shift_window(&window, &shift);
         assert_eq!(moved.ground_world, vec![[1.5, 1.75, 3.0]]);
-        assert_eq!(moved.neighbour_ground_world, window.neighbour_ground_world);
+        assert_eq!(
+            moved.neighbour_ground_world[0][0].ground_world,
+            [1.6, 1.85, 3.0]
+        );
+        assert_eq!(moved.tie_points, window.tie_points);
     }
 
     #[test]
