@@ -27,7 +27,7 @@ use crate::nodes::nadir::summary::SummarizeNadir;
 use crate::nodes::nadir::transform::InitialTransformStage;
 use crate::nodes::nadir::transform_agreement::TransformAgreementStage;
 use crate::workflow::Workflow;
-use skytie_stages::adjustment::second_pass::{PassShift, RegistrationPasses};
+use skytie_stages::adjustment::second_pass::RegistrationPasses;
 use skytie_stages::campaign::{AerialImage, AerialKind};
 use skytie_stages::nadir::aerial_overlap::NadirOverlap;
 use skytie_stages::nadir::baseline::BaselineParams;
@@ -233,7 +233,7 @@ pub fn add_nadir(
         let margin_m = chain.options.overlap_margin_m;
         let pairs = chain.add_pairs(b, item, overlap.overlapping(item.recording, margin_m))?;
         let bases: Vec<PairBase> = pairs.iter().map(AerialPair::base).collect();
-        let refined = chain.add_refinements(b, pairs, (window, None), &members)?;
+        let refined = chain.add_refinements(b, pairs, window, &members)?;
         chain.recordings.push(RecordingNadir {
             item: i,
             neighbours: (i + 1..i + members.len()).collect(),
@@ -314,14 +314,13 @@ impl NadirChain<'_, '_> {
     }
 
     /// The recording's transforms checked against each other (`nadir::transform_agreement`), then refined
-    /// (thesis 3.4.5.3) against the MM matching `window` of `members` (the recording, then its neighbours); in a
-    /// second pass, `shift` translates the neighbours' ortho images like the (translated) window.
+    /// (thesis 3.4.5.3) against the MM matching `window` of `members` (the recording, then its neighbours).
     /// Returns the recording's refinements with their aerial images.
     fn add_refinements(
         &mut self,
         b: &mut DagBuilder,
         pairs: Vec<AerialPair>,
-        (window, shift): (Handle<MmWindowMatch>, Option<Handle<PassShift>>),
+        window: Handle<MmWindowMatch>,
         members: &[&RecordingItem<'_>],
     ) -> Result<Refined, PipelineError> {
         let mut rec_refinements = Vec::new();
@@ -346,23 +345,12 @@ impl NadirChain<'_, '_> {
                     let neighbour_orthos = members[1..]
                         .iter()
                         .map(|n| {
-                            let label = pair_label(&n.recording.image_id, &p.aerial_id);
-                            let ortho = b.add(
+                            b.add(
                                 OrthoForAerial,
-                                &label,
+                                &pair_label(&n.recording.image_id, &p.aerial_id),
                                 self.ortho_base.clone(),
                                 (n.row, n.pano_image, p.aerial, p.aerial_file),
-                            )?;
-                            // In a second pass: translated like the recording's window.
-                            match shift {
-                                Some(s) => b.add(
-                                    ShiftOrtho,
-                                    &format!("{label} pass 2 of {}", p.label),
-                                    SummaryParams::default(),
-                                    (ortho, s),
-                                ),
-                                None => Ok(ortho),
-                            }
+                            )
                         })
                         .collect::<Result<Vec<_>, _>>()?;
                     let (o, f, a, t, w) = inputs;
@@ -444,9 +432,9 @@ pub struct SecondPass {
 /// The second registration pass around the first adjustment `report` (`skytie_stages::adjustment::second_pass`):
 /// per recording with a window, its shift (zero when the first pass registered it), its window and
 /// aerial-oriented ortho images translated by it, then the initial transform, the agreement check, the
-/// refinement and the control points again, with the normal search windows. The second pass's nodes read only
-/// translated inputs (never a recording's row or a first-pass per-item node directly), so a sharded run leaves
-/// them to the merge, after the first adjustment. The overlapping nadir images are
+/// refinement and the control points again, with the normal search windows; the refinement's parallax check
+/// reads the neighbours' first-pass ortho images with the window's untranslated neighbour views. The
+/// overlapping nadir images are
 /// the first pass's (`overlap_margin_m` around the recorded position; an image's footprint is far larger than
 /// the shift).
 pub fn add_second_pass(
@@ -531,7 +519,7 @@ pub fn add_second_pass(
             .chain(rec.neighbours.iter().copied())
             .map(|i| &cx.items[i])
             .collect();
-        let refined = chain.add_refinements(b, pairs, (window, Some(shift)), &members)?;
+        let refined = chain.add_refinements(b, pairs, window, &members)?;
         let c = b.add(
             ControlStage,
             &label,

@@ -1,7 +1,6 @@
 //! The nodes of the second registration pass around the adjusted trajectory
 //! (`skytie_stages::adjustment::second_pass`): per recording its shift from the first adjustment
-//! (`pass_prior`), its row, tie-point window and aerial-oriented ortho images (its own and its neighbours')
-//! translated by it (`pass_row`, `pass_window`, `pass_ortho`), and the counts of both passes
+//! (`pass_prior`), its row, tie-point window and aerial-oriented ortho images translated by it (`pass_row`, `pass_window`, `pass_ortho`), and the counts of both passes
 //! (`registration_passes`). A recording the first pass registered gets a zero shift, so its translated inputs
 //! equal the first pass's and every node below them is found in the cache.
 
@@ -58,9 +57,7 @@ impl Stage for ShiftWindow {
     }
 }
 
-/// A recording's row translated by its shift. The second pass's per-recording nodes read it (and the other
-/// translated inputs) instead of the first pass's nodes, so that sharding (`crate::dag::shard`) leaves them,
-/// like the adjustment they follow, to the merge.
+/// A recording's row translated by its shift (the second pass's initial transform reads it).
 pub struct ShiftRow;
 
 impl Stage for ShiftRow {
@@ -73,8 +70,7 @@ impl Stage for ShiftRow {
     }
 }
 
-/// An aerial-oriented ortho image (the recording's, or a neighbour's for the parallax check) translated by the
-/// recording's shift.
+/// A recording's aerial-oriented ortho image translated by its shift.
 pub struct ShiftOrtho;
 
 impl Stage for ShiftOrtho {

@@ -9,8 +9,7 @@
 //! position relative to the camera), so the second pass reuses the first pass's ortho images and tie points,
 //! translated ([`shift_ortho`], [`shift_window`], [`shift_row`]): the tie points' panorama observations, the
 //! only thing the adjustment reads of them, are unchanged. The neighbours' ortho images that the refinement's
-//! parallax check reads are translated by the same shift as the recording's window, so the check sees them
-//! as in the first pass.
+//! parallax check reads stay the first pass's, with the window's untranslated neighbour views.
 //!
 //! The pass is a graph construction of the pipeline; this module holds its pure parts: the shift of one
 //! recording ([`pass_shift`]), the translated inputs, and the counts of the two passes
@@ -95,20 +94,15 @@ pub fn shift_ortho(ortho: &OrthoImage, shift: &PassShift) -> OrthoImage {
 }
 
 /// The tie-point window of a recording moved by `shift`: the corners on the recording's own ground plane
-/// (where the aerial stages look for them) and the neighbours' views of them (which the parallax check looks
-/// up in the neighbours' ortho images, translated by the same `shift`: the check compares them relative to
-/// each other) are translated; the tie points themselves, whose panorama observations the adjustment reads,
-/// are unchanged.
+/// (where the aerial stages look for them) are translated; the neighbours' views of them stay where the
+/// neighbours' own (untranslated) ortho images show them, for the parallax check; the tie points themselves,
+/// whose panorama observations the adjustment reads, are unchanged.
 pub fn shift_window(window: &MmWindowMatch, shift: &PassShift) -> MmWindowMatch {
     let [dx, dy] = shift.shift_world;
     let mut out = window.clone();
     for g in &mut out.ground_world {
         g[0] += dx;
         g[1] += dy;
-    }
-    for view in out.neighbour_ground_world.iter_mut().flatten() {
-        view.ground_world[0] += dx;
-        view.ground_world[1] += dy;
     }
     out
 }
@@ -218,7 +212,7 @@ mod tests {
     }
 
     #[test]
-    fn a_shifted_window_moves_the_corners_and_the_neighbours_views_alike() {
+    fn a_shifted_window_moves_only_the_recordings_own_corners() {
         let window = MmWindowMatch {
             recording_id: "a".into(),
             pairs: Vec::new(),
