@@ -73,6 +73,21 @@ fn a_tiny_street_with_road_markings_is_corrected() {
         m["nadir"]
     );
 
+    // The default workflow's second registration pass: every recording with a window is counted, the
+    // recordings the first pass left without control are searched again, and none is lost.
+    let passes = &m["registration_passes"];
+    let first = num(passes, &["registered_first_pass"]);
+    let windows = num(passes, &["recordings"]);
+    assert!(windows >= 5.0, "{passes}");
+    assert!(
+        num(passes, &["registered_second_pass"]) >= first,
+        "{passes}"
+    );
+    assert!(
+        num(passes, &["searched_again"]) <= windows - first,
+        "only unregistered recordings are searched again: {passes}"
+    );
+
     // Adjustment (thesis ch. 5): every recording corrected, the error at least 5× smaller, none left > 0.15 m.
     let a = &m["adjust"]["combined"];
     assert_eq!(a["verdict"].as_str(), Some("corrected"), "{a}");

@@ -15,6 +15,7 @@ use crate::nodes::campaign::summary::SummaryParams;
 use crate::nodes::nadir::grade::TRUTH_RECORDINGS;
 use skytie_stages::adjustment::verify::{Verification, VerifyConfig};
 use skytie_stages::adjustment::{AdjustConfig, Sources};
+use skytie_stages::nadir::{OrthoParams, RecordingControl};
 
 /// Handles of the adjustment outputs (for the exports written after the run).
 pub struct AdjustHandles {
@@ -23,14 +24,21 @@ pub struct AdjustHandles {
     pub verification: Option<Handle<Verification>>,
     /// The adjusted trajectory verified the same way (when both `adjust` and `verify` run).
     pub verification_adjusted: Option<Handle<Verification>>,
+    /// The nadir control after a second registration pass (`[adjust] passes = 2`): what the adjustment, the
+    /// verification of the adjusted trajectory and the exports use; `None` with one pass.
+    pub second_pass_control: Option<Vec<Handle<RecordingControl>>>,
 }
 
-/// Add `adjust`, `grade_adjust` and `verify` for the variant of `cx` when the workflow enables them.
+/// Add `adjust`, `grade_adjust` and `verify` for the variant of `cx` when the workflow enables them. With
+/// `[adjust] passes = 2` the adjustment runs twice: first on the first registration pass's control, then on the
+/// control after a second pass around the first adjustment (`nadir::add_second_pass`); grading, verification
+/// and the exports read the second.
 pub fn add_adjust(
     b: &mut DagBuilder,
     cx: &VariantContext<'_>,
     nadir: Option<&NadirHandles>,
     oblique: Option<&ObliqueHandles>,
+    ortho: &OrthoParams,
 ) -> Result<AdjustHandles, PipelineError> {
     let (wf, root, snap, items) = (cx.wf, cx.root, cx.snap, cx.items);
     let on = |s: &str| cx.on(s);
@@ -38,6 +46,7 @@ pub fn add_adjust(
         report: None,
         verification: None,
         verification_adjusted: None,
+        second_pass_control: None,
     };
     if !(on(stage::ADJUST) || on(stage::VERIFY) || on(stage::GRADE_ADJUST)) {
         return Ok(out);
@@ -85,19 +94,35 @@ pub fn add_adjust(
             true => super::orthophoto::campaign_dtm(b, root, cx.snapshot)?,
             false => None,
         };
-        let report = b.add(
-            AdjustStage,
-            config.sources.label(),
-            config,
-            (
-                snap,
-                pano_images.clone(),
-                optional_all(&windows),
-                optional_all(&control),
-                (optional_all(&clouds), optional_all(&oblique_result)),
-                dtm.into_iter().map(|d| d.0).collect::<Vec<_>>(),
-            ),
-        )?;
+        let dtm: Vec<_> = dtm.into_iter().map(|d| d.0).collect();
+        let passes = config.passes;
+        // The node's params do not say how many passes built its control (the same control, the same key).
+        let config = AdjustConfig {
+            passes: 1,
+            ..config
+        };
+        let label = config.sources.label();
+        let add_stage = |b: &mut DagBuilder, label: &str, control: &[Handle<RecordingControl>]| {
+            b.add(
+                AdjustStage,
+                label,
+                config.clone(),
+                (
+                    snap,
+                    pano_images.clone(),
+                    optional_all(&windows),
+                    optional_all(control),
+                    (optional_all(&clouds), optional_all(&oblique_result)),
+                    dtm.clone(),
+                ),
+            )
+        };
+        let mut report = add_stage(b, label, &control)?;
+        if let (2, Some(n)) = (passes, nadir.filter(|_| use_nadir && on(stage::CONTROL))) {
+            let second = super::nadir::add_second_pass(b, cx, ortho, n, report)?;
+            report = add_stage(b, &format!("{label} pass 2"), &second.control)?;
+            out.second_pass_control = Some(second.control);
+        }
         b.metrics(report, "adjust", |r: &AdjustReport| r.metrics());
         out.report = Some(report);
         let truth = root.join(TRUTH_RECORDINGS);
@@ -133,16 +158,12 @@ pub fn add_adjust(
         b.metrics(v, "verify", verify_metrics);
         out.verification = Some(v);
         if let Some(report) = out.report {
+            let control = out.second_pass_control.as_ref().unwrap_or(&nadir.control);
             let v = b.add(
                 VerifyStage,
                 "adjusted",
                 config,
-                (
-                    snap,
-                    pano_images,
-                    optional_all(&nadir.control),
-                    vec![report],
-                ),
+                (snap, pano_images, optional_all(control), vec![report]),
             )?;
             b.metrics(v, "verify_adjusted", verify_metrics);
             out.verification_adjusted = Some(v);

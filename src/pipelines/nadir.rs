@@ -8,6 +8,10 @@ use super::orthophoto::OrthophotoRoute;
 use super::variant::{RecordingItem, VariantContext};
 use super::{distance_m, missing_upstream, stage, wf_err};
 use crate::dag::{optional_all, DagBuilder, Handle, PipelineError};
+use crate::nodes::adjust::adjustment::AdjustReport;
+use crate::nodes::adjust::second_pass::{
+    passes_metrics, CountPasses, PassPrior, PassPriorParams, ShiftOrtho, ShiftRow, ShiftWindow,
+};
 use crate::nodes::campaign::aerial::AerialRowNodes;
 use crate::nodes::campaign::ingest::{ingest_file, IngestedImage};
 use crate::nodes::campaign::map_frame::MapFrameStage;
@@ -23,6 +27,7 @@ use crate::nodes::nadir::summary::SummarizeNadir;
 use crate::nodes::nadir::transform::InitialTransformStage;
 use crate::nodes::nadir::transform_agreement::TransformAgreementStage;
 use crate::workflow::Workflow;
+use skytie_stages::adjustment::second_pass::RegistrationPasses;
 use skytie_stages::campaign::{AerialImage, AerialKind};
 use skytie_stages::nadir::aerial_overlap::NadirOverlap;
 use skytie_stages::nadir::baseline::BaselineParams;
@@ -51,6 +56,29 @@ pub const NADIR_STAGES: [&str; 7] = [
 pub struct NadirHandles {
     pub windows: Vec<Handle<MmWindowMatch>>,
     pub control: Vec<Handle<RecordingControl>>,
+    /// Per recording with a window, the nodes a second registration pass starts from.
+    pub recordings: Vec<RecordingNadir>,
+}
+
+/// One recording's nadir nodes that a second registration pass (`add_second_pass`) translates and re-runs.
+pub struct RecordingNadir {
+    /// Index into the variant's items.
+    item: usize,
+    /// The recording's neighbours in its window (item indices).
+    neighbours: Vec<usize>,
+    window: Handle<MmWindowMatch>,
+    pairs: Vec<PairBase>,
+    /// Index of its aerial control into `NadirHandles::control`.
+    control: Option<usize>,
+}
+
+/// A (recording × nadir image) pair's nodes up to its aerial-oriented ortho image.
+#[derive(Clone)]
+struct PairBase {
+    aerial: Handle<AerialImage>,
+    aerial_file: Handle<IngestedImage>,
+    ortho: Handle<OrthoImage>,
+    aerial_id: String,
 }
 
 /// Which nadir stages the workflow enables; an enabled stage whose upstream is not enabled is an error.
@@ -96,6 +124,17 @@ struct AerialPair {
     aerial_id: String,
 }
 
+impl AerialPair {
+    fn base(&self) -> PairBase {
+        PairBase {
+            aerial: self.aerial,
+            aerial_file: self.aerial_file,
+            ortho: self.ortho,
+            aerial_id: self.aerial_id.clone(),
+        }
+    }
+}
+
 /// One recording's refinements and the aerial image of each.
 struct Refined {
     refinements: Vec<Handle<AerialRefinement>>,
@@ -114,6 +153,7 @@ struct NadirChain<'c, 'a> {
     transforms: Vec<Handle<TransformOutcome>>,
     refinements: Vec<Handle<AerialRefinement>>,
     control: Vec<Handle<RecordingControl>>,
+    recordings: Vec<RecordingNadir>,
 }
 
 /// Add the nadir chain for the variant of `cx`.
@@ -139,6 +179,7 @@ pub fn add_nadir(
         transforms: Vec::new(),
         refinements: Vec::new(),
         control: Vec::new(),
+        recordings: Vec::new(),
     };
     let mm_params: MmMatchParams = cx.params(stage::MM_MATCH)?;
     let control_params: ControlParams = cx.params(stage::CONTROL)?;
@@ -191,7 +232,15 @@ pub fn add_nadir(
         }
         let margin_m = chain.options.overlap_margin_m;
         let pairs = chain.add_pairs(b, item, overlap.overlapping(item.recording, margin_m))?;
+        let bases: Vec<PairBase> = pairs.iter().map(AerialPair::base).collect();
         let refined = chain.add_refinements(b, pairs, window, &members)?;
+        chain.recordings.push(RecordingNadir {
+            item: i,
+            neighbours: (i + 1..i + members.len()).collect(),
+            window,
+            pairs: bases,
+            control: cx.on(stage::CONTROL).then_some(chain.control.len()),
+        });
         if cx.on(stage::CONTROL) {
             chain.control.push(b.add(
                 ControlStage,
@@ -213,6 +262,7 @@ pub fn add_nadir(
     Ok(NadirHandles {
         windows: chain.windows,
         control: chain.control,
+        recordings: chain.recordings,
     })
 }
 
@@ -368,4 +418,134 @@ impl NadirChain<'_, '_> {
 /// neighbour's own pair nodes through it.
 fn pair_label(recording_id: &str, aerial_id: &str) -> String {
     format!("rec {recording_id} × {aerial_id}")
+}
+
+/// What the second registration pass hands to the final adjustment.
+pub struct SecondPass {
+    /// The aerial control of every recording after the second pass (the first pass's control for the
+    /// recordings it registered, found again in the cache), in the order of `NadirHandles::control`.
+    pub control: Vec<Handle<RecordingControl>>,
+    /// The counts of both passes.
+    pub passes: Handle<RegistrationPasses>,
+}
+
+/// The second registration pass around the first adjustment `report` (`skytie_stages::adjustment::second_pass`):
+/// per recording with a window, its shift (zero when the first pass registered it), its window and
+/// aerial-oriented ortho images translated by it, then the initial transform, the agreement check, the
+/// refinement and the control points again, with the normal search windows; the refinement's parallax check
+/// reads the neighbours' first-pass ortho images with the window's untranslated neighbour views. The
+/// overlapping nadir images are
+/// the first pass's (`overlap_margin_m` around the recorded position; an image's footprint is far larger than
+/// the shift).
+pub fn add_second_pass(
+    b: &mut DagBuilder,
+    cx: &VariantContext<'_>,
+    ortho_base: &OrthoParams,
+    nadir: &NadirHandles,
+    report: Handle<AdjustReport>,
+) -> Result<SecondPass, PipelineError> {
+    let mut chain = NadirChain {
+        cx,
+        ortho_base,
+        options: cx.params(stage::NADIR)?,
+        transform_params: cx.params(stage::TRANSFORM)?,
+        refine_params: cx.params(stage::REFINE)?,
+        aerial_rows: AerialRowNodes::new(AerialKind::Nadir, cx.snap),
+        windows: Vec::new(),
+        transforms: Vec::new(),
+        refinements: Vec::new(),
+        control: Vec::new(),
+        recordings: Vec::new(),
+    };
+    let control_params: ControlParams = cx.params(stage::CONTROL)?;
+    let map_frame = b.add(MapFrameStage, "", SummaryParams::default(), cx.snap)?;
+    let mut control = nadir.control.clone();
+    let (mut first, mut second, mut shifts) = (Vec::new(), Vec::new(), Vec::new());
+    for rec in &nadir.recordings {
+        let (Some(ci), true) = (rec.control, cx.on(stage::TRANSFORM)) else {
+            continue;
+        };
+        let item = &cx.items[rec.item];
+        let label = format!("rec {} pass 2", item.recording.image_id);
+        let params = PassPriorParams {
+            image_id: item.recording.image_id.clone(),
+        };
+        let shift = b.add(
+            PassPrior,
+            &label,
+            params,
+            (report, nadir.control[ci].optional()),
+        )?;
+        let window = b.add(
+            ShiftWindow,
+            &label,
+            SummaryParams::default(),
+            (rec.window, shift),
+        )?;
+        let row = b.add(
+            ShiftRow,
+            &label,
+            SummaryParams::default(),
+            (item.row, shift),
+        )?;
+        let mut pairs = Vec::new();
+        for p in &rec.pairs {
+            let pair_label = format!(
+                "{} pass 2",
+                pair_label(&item.recording.image_id, &p.aerial_id)
+            );
+            let ortho = b.add(
+                ShiftOrtho,
+                &pair_label,
+                SummaryParams::default(),
+                (p.ortho, shift),
+            )?;
+            let outcome = b.add(
+                InitialTransformStage,
+                &pair_label,
+                chain.transform_params.clone(),
+                (row, ortho, p.aerial_file, p.aerial),
+            )?;
+            pairs.push(AerialPair {
+                aerial: p.aerial,
+                aerial_file: p.aerial_file,
+                label: pair_label,
+                ortho,
+                outcome,
+                aerial_id: p.aerial_id.clone(),
+            });
+        }
+        let members: Vec<&RecordingItem> = std::iter::once(rec.item)
+            .chain(rec.neighbours.iter().copied())
+            .map(|i| &cx.items[i])
+            .collect();
+        let refined = chain.add_refinements(b, pairs, window, &members)?;
+        let c = b.add(
+            ControlStage,
+            &label,
+            control_params.clone(),
+            (
+                window,
+                optional_all(&refined.refinements),
+                refined.aerials,
+                map_frame,
+            ),
+        )?;
+        first.push(nadir.control[ci]);
+        second.push(c);
+        shifts.push(shift);
+        control[ci] = c;
+    }
+    let passes = b.add(
+        CountPasses,
+        "",
+        SummaryParams::default(),
+        (
+            optional_all(&first),
+            optional_all(&second),
+            optional_all(&shifts),
+        ),
+    )?;
+    b.metrics(passes, "registration_passes", passes_metrics);
+    Ok(SecondPass { control, passes })
 }

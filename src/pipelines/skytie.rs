@@ -271,8 +271,18 @@ fn add_variant(
         true => Some(oblique::add_oblique(b, &cx)?),
         false => None,
     };
-    let adjust = adjust::add_adjust(b, &cx, nadir_handles.as_ref(), oblique_handles.as_ref())?;
-    let nadir_control = nadir_handles.map(|n| n.control).unwrap_or_default();
+    let adjust = adjust::add_adjust(
+        b,
+        &cx,
+        nadir_handles.as_ref(),
+        oblique_handles.as_ref(),
+        ortho,
+    )?;
+    // The exports write the control the adjustment used (after the second registration pass, if any).
+    let nadir_control = match &adjust.second_pass_control {
+        Some(c) => c.clone(),
+        None => nadir_handles.map(|n| n.control).unwrap_or_default(),
+    };
     let oblique = oblique_handles.and_then(|o| o.result);
     // The exports (correspondences.csv) read these values: request them, or cached runs would not load them.
     for c in &nadir_control {

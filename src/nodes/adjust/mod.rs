@@ -3,4 +3,5 @@
 
 pub mod adjustment;
 pub mod grade;
+pub mod second_pass;
 pub mod verify;

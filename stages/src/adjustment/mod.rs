@@ -18,6 +18,7 @@
 //! model), [`weak_control`] (weak orthophoto control checked against the strong control along the trajectory),
 //! [`control_consistency`] (every control point checked against the neighbouring recordings' control),
 //! [`extrapolation_anchor`] (recordings beyond the outermost control tied to its correction),
+//! [`second_pass`] (the shifted inputs of a second registration pass around the adjusted trajectory),
 //! [`verify`] (thesis Table 5-13 verification per trajectory
 //! segment) and [`synthetic_campaign`] (a synthetic block as campaign rows and correspondences, with aerial
 //! images, for known-answer tests).
@@ -46,6 +47,7 @@ pub mod relative_noise;
 pub mod residuals;
 pub mod robust;
 pub mod schur;
+pub mod second_pass;
 pub mod solver;
 pub mod sparse;
 pub mod synthetic_block;

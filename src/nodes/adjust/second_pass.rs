@@ -1,0 +1,106 @@
+//! The nodes of the second registration pass around the adjusted trajectory
+//! (`skytie_stages::adjustment::second_pass`): per recording its shift from the first adjustment
+//! (`pass_prior`), its row, tie-point window and aerial-oriented ortho images translated by it (`pass_row`, `pass_window`, `pass_ortho`), and the counts of both passes
+//! (`registration_passes`). A recording the first pass registered gets a zero shift, so its translated inputs
+//! equal the first pass's and every node below them is found in the cache.
+
+use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage};
+use crate::nodes::adjust::adjustment::{AdjustReport, Verdict};
+use crate::nodes::campaign::summary::SummaryParams;
+use skytie_stages::adjustment::second_pass::{
+    pass_shift, registered, shift_ortho, shift_row, shift_window, PassShift, RegistrationPasses,
+    PASSES_STAGE, PRIOR_STAGE, SHIFT_ORTHO_STAGE, SHIFT_ROW_STAGE, SHIFT_WINDOW_STAGE,
+};
+use skytie_stages::campaign::Recording;
+use skytie_stages::nadir::{MmWindowMatch, OrthoImage, RecordingControl};
+
+crate::serde_artifact!(PassShift, RegistrationPasses);
+
+skytie_stages::params! {
+    /// Parameters of a recording's second-pass shift (set by the pipeline).
+    pub struct PassPriorParams {
+        /// The recording's `image_id`.
+        image_id: String = String::new();
+    }
+}
+
+/// A recording's shift for the second pass. Inputs: the first adjustment and the recording's own first-pass
+/// control (absent when its node failed: then the recording counts as not registered).
+pub struct PassPrior;
+
+impl Stage for PassPrior {
+    crate::nodes::stage_types!(PRIOR_STAGE, PassPriorParams => PassShift,
+        inputs: (Handle<AdjustReport>, Optional<RecordingControl>));
+
+    fn run(&self, p: &PassPriorParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (report, control) = inputs;
+        let delivered = report.verdict() == Verdict::Corrected;
+        Ok(pass_shift(
+            &p.image_id,
+            &report.run.recordings,
+            registered(control.as_deref()),
+            delivered,
+        ))
+    }
+}
+
+/// A recording's tie-point window translated by its shift.
+pub struct ShiftWindow;
+
+impl Stage for ShiftWindow {
+    crate::nodes::stage_types!(SHIFT_WINDOW_STAGE, SummaryParams => MmWindowMatch,
+        inputs: (Handle<MmWindowMatch>, Handle<PassShift>));
+
+    fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (window, shift) = inputs;
+        Ok(shift_window(&window, &shift))
+    }
+}
+
+/// A recording's row translated by its shift (the second pass's initial transform reads it).
+pub struct ShiftRow;
+
+impl Stage for ShiftRow {
+    crate::nodes::stage_types!(SHIFT_ROW_STAGE, SummaryParams => Recording,
+        inputs: (Handle<Recording>, Handle<PassShift>));
+
+    fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (row, shift) = inputs;
+        Ok(shift_row(&row, &shift))
+    }
+}
+
+/// A recording's aerial-oriented ortho image translated by its shift.
+pub struct ShiftOrtho;
+
+impl Stage for ShiftOrtho {
+    crate::nodes::stage_types!(SHIFT_ORTHO_STAGE, SummaryParams => OrthoImage,
+        inputs: (Handle<OrthoImage>, Handle<PassShift>));
+
+    fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (ortho, shift) = inputs;
+        Ok(shift_ortho(&ortho, &shift))
+    }
+}
+
+/// The counts of both passes. Inputs: per recording with a window, its first-pass control, second-pass
+/// control and shift (parallel lists).
+pub struct CountPasses;
+
+impl Stage for CountPasses {
+    crate::nodes::stage_types!(PASSES_STAGE, SummaryParams => RegistrationPasses,
+        inputs: (Vec<Optional<RecordingControl>>, Vec<Optional<RecordingControl>>, Vec<Optional<PassShift>>));
+
+    fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let (first, second, shifts) = inputs;
+        let first: Vec<_> = first.iter().map(|c| c.as_deref()).collect();
+        let second: Vec<_> = second.iter().map(|c| c.as_deref()).collect();
+        let shifts: Vec<_> = shifts.iter().map(|s| s.as_deref()).collect();
+        Ok(RegistrationPasses::count(&first, &second, &shifts))
+    }
+}
+
+/// The `registration_passes` metrics.
+pub fn passes_metrics(p: &RegistrationPasses) -> serde_json::Value {
+    serde_json::to_value(p).unwrap_or_default()
+}
