@@ -168,6 +168,11 @@ crate::params! {
         yaw_prior_sigma_deg: f64 = 1.0, unit "deg", above 0.0;
         /// Largest number of Levenberg–Marquardt iterations per solve.
         max_iterations: usize = 100, min 1;
+        /// Registration passes (nadir chain): with 2, the recordings that found no aerial control are searched
+        /// again around the first adjustment's positions of them (`adjustment::second_pass`), with the normal
+        /// search windows, and the adjustment runs again on all control; recovers drift larger than the
+        /// windows once the neighbours are corrected (`registration_passes` in `metrics.json`).
+        passes: usize = 1, min 1, max 2;
     }
 }
 
