@@ -156,6 +156,25 @@ struct NadirChain<'c, 'a> {
     recordings: Vec<RecordingNadir>,
 }
 
+impl<'c, 'a> NadirChain<'c, 'a> {
+    /// An empty chain for the variant of `cx`, with its nadir, transform and refine parameters.
+    fn new(cx: &'c VariantContext<'a>, ortho_base: &'c OrthoParams) -> Result<Self, PipelineError> {
+        Ok(NadirChain {
+            cx,
+            ortho_base,
+            options: cx.params(stage::NADIR)?,
+            transform_params: cx.params(stage::TRANSFORM)?,
+            refine_params: cx.params(stage::REFINE)?,
+            aerial_rows: AerialRowNodes::new(AerialKind::Nadir, cx.snap),
+            windows: Vec::new(),
+            transforms: Vec::new(),
+            refinements: Vec::new(),
+            control: Vec::new(),
+            recordings: Vec::new(),
+        })
+    }
+}
+
 /// Add the nadir chain for the variant of `cx`.
 pub fn add_nadir(
     b: &mut DagBuilder,
@@ -168,19 +187,7 @@ pub fn add_nadir(
             cx.wf.path.display()
         )));
     };
-    let mut chain = NadirChain {
-        cx,
-        ortho_base,
-        options: cx.params(stage::NADIR)?,
-        transform_params: cx.params(stage::TRANSFORM)?,
-        refine_params: cx.params(stage::REFINE)?,
-        aerial_rows: AerialRowNodes::new(AerialKind::Nadir, cx.snap),
-        windows: Vec::new(),
-        transforms: Vec::new(),
-        refinements: Vec::new(),
-        control: Vec::new(),
-        recordings: Vec::new(),
-    };
+    let mut chain = NadirChain::new(cx, ortho_base)?;
     let mm_params: MmMatchParams = cx.params(stage::MM_MATCH)?;
     let control_params: ControlParams = cx.params(stage::CONTROL)?;
     // The frame the aerial rays of the control points are intersected in.
@@ -444,19 +451,7 @@ pub fn add_second_pass(
     nadir: &NadirHandles,
     report: Handle<AdjustReport>,
 ) -> Result<SecondPass, PipelineError> {
-    let mut chain = NadirChain {
-        cx,
-        ortho_base,
-        options: cx.params(stage::NADIR)?,
-        transform_params: cx.params(stage::TRANSFORM)?,
-        refine_params: cx.params(stage::REFINE)?,
-        aerial_rows: AerialRowNodes::new(AerialKind::Nadir, cx.snap),
-        windows: Vec::new(),
-        transforms: Vec::new(),
-        refinements: Vec::new(),
-        control: Vec::new(),
-        recordings: Vec::new(),
-    };
+    let mut chain = NadirChain::new(cx, ortho_base)?;
     let control_params: ControlParams = cx.params(stage::CONTROL)?;
     let map_frame = b.add(MapFrameStage, "", SummaryParams::default(), cx.snap)?;
     let mut control = nadir.control.clone();

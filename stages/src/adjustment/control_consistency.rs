@@ -153,13 +153,7 @@ pub fn select_control(
 mod tests {
     use super::*;
 
-    fn point(c: [f64; 2], recordings: &[usize], weak: bool) -> ControlEvidence {
-        ControlEvidence {
-            correction_m: Vector2::new(c[0], c[1]),
-            recordings: recordings.to_vec(),
-            weak,
-        }
-    }
+    use crate::adjustment::weak_control::test_point as point;
 
     #[test]
     fn tolerance_is_the_999_quantile_of_the_scatter_about_the_common_correction() {

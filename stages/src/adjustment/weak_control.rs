@@ -99,17 +99,22 @@ pub fn keep_consistent(
         .collect()
 }
 
+/// A control point with correction `c` (m) observed by `recordings`, for the tests of this check and of
+/// `control_consistency`.
+#[cfg(test)]
+pub(crate) fn test_point(c: [f64; 2], recordings: &[usize], weak: bool) -> ControlEvidence {
+    ControlEvidence {
+        correction_m: Vector2::new(c[0], c[1]),
+        recordings: recordings.to_vec(),
+        weak,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn point(c: [f64; 2], recordings: &[usize], weak: bool) -> ControlEvidence {
-        ControlEvidence {
-            correction_m: Vector2::new(c[0], c[1]),
-            recordings: recordings.to_vec(),
-            weak,
-        }
-    }
+    use super::test_point as point;
 
     #[test]
     fn weak_points_far_from_the_interpolated_strong_correction_are_dropped() {
