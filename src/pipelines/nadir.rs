@@ -10,7 +10,7 @@ use super::{distance_m, missing_upstream, stage, wf_err};
 use crate::dag::{optional_all, DagBuilder, Handle, PipelineError};
 use crate::nodes::adjust::adjustment::AdjustReport;
 use crate::nodes::adjust::second_pass::{
-    passes_metrics, CountPasses, PassPrior, PassPriorParams, ShiftOrtho, ShiftRow, ShiftWindow,
+    passes_metrics, CountPasses, PassPrior, PassPriorParams, Shift,
 };
 use crate::nodes::campaign::aerial::AerialRowNodes;
 use crate::nodes::campaign::ingest::{ingest_file, IngestedImage};
@@ -28,7 +28,8 @@ use crate::nodes::nadir::transform::InitialTransformStage;
 use crate::nodes::nadir::transform_agreement::TransformAgreementStage;
 use crate::workflow::Workflow;
 use skytie_stages::adjustment::second_pass::RegistrationPasses;
-use skytie_stages::campaign::{AerialImage, AerialKind};
+use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
+use skytie_stages::crs::MapFrameSpec;
 use skytie_stages::nadir::aerial_overlap::NadirOverlap;
 use skytie_stages::nadir::baseline::BaselineParams;
 use skytie_stages::nadir::control_points::ControlParams;
@@ -148,6 +149,9 @@ struct NadirChain<'c, 'a> {
     options: NadirOptions,
     transform_params: TransformParams,
     refine_params: RefineParams,
+    control_params: ControlParams,
+    /// The frame the aerial rays of the control points are intersected in.
+    map_frame: Handle<MapFrameSpec>,
     aerial_rows: AerialRowNodes,
     windows: Vec<Handle<MmWindowMatch>>,
     transforms: Vec<Handle<TransformOutcome>>,
@@ -157,14 +161,21 @@ struct NadirChain<'c, 'a> {
 }
 
 impl<'c, 'a> NadirChain<'c, 'a> {
-    /// An empty chain for the variant of `cx`, with its nadir, transform and refine parameters.
-    fn new(cx: &'c VariantContext<'a>, ortho_base: &'c OrthoParams) -> Result<Self, PipelineError> {
+    /// An empty chain for the variant of `cx`, with its nadir, transform, refine and control parameters and
+    /// the map-frame node.
+    fn new(
+        b: &mut DagBuilder,
+        cx: &'c VariantContext<'a>,
+        ortho_base: &'c OrthoParams,
+    ) -> Result<Self, PipelineError> {
         Ok(NadirChain {
             cx,
             ortho_base,
             options: cx.params(stage::NADIR)?,
             transform_params: cx.params(stage::TRANSFORM)?,
             refine_params: cx.params(stage::REFINE)?,
+            control_params: cx.params(stage::CONTROL)?,
+            map_frame: b.add(MapFrameStage, "", SummaryParams::default(), cx.snap)?,
             aerial_rows: AerialRowNodes::new(AerialKind::Nadir, cx.snap),
             windows: Vec::new(),
             transforms: Vec::new(),
@@ -187,11 +198,8 @@ pub fn add_nadir(
             cx.wf.path.display()
         )));
     };
-    let mut chain = NadirChain::new(cx, ortho_base)?;
+    let mut chain = NadirChain::new(b, cx, ortho_base)?;
     let mm_params: MmMatchParams = cx.params(stage::MM_MATCH)?;
-    let control_params: ControlParams = cx.params(stage::CONTROL)?;
-    // The frame the aerial rays of the control points are intersected in.
-    let map_frame = b.add(MapFrameStage, "", SummaryParams::default(), cx.snap)?;
     let mut photo_route = match cx.on(stage::CONTROL) {
         true => OrthophotoRoute::new(b, cx.wf, cx.variant, cx.root, cx.snapshot, ortho_base)?,
         false => None,
@@ -249,17 +257,8 @@ pub fn add_nadir(
             control: cx.on(stage::CONTROL).then_some(chain.control.len()),
         });
         if cx.on(stage::CONTROL) {
-            chain.control.push(b.add(
-                ControlStage,
-                &label,
-                control_params.clone(),
-                (
-                    window,
-                    optional_all(&refined.refinements),
-                    refined.aerials,
-                    map_frame,
-                ),
-            )?);
+            let c = chain.add_control(b, &label, window, refined)?;
+            chain.control.push(c);
         }
     }
     if let Some(route) = photo_route {
@@ -274,6 +273,23 @@ pub fn add_nadir(
 }
 
 impl NadirChain<'_, '_> {
+    /// The recording's control points (thesis 3.4.5.4) from its tie-point `window` and its refinements.
+    fn add_control(
+        &self,
+        b: &mut DagBuilder,
+        label: &str,
+        window: Handle<MmWindowMatch>,
+        refined: Refined,
+    ) -> Result<Handle<RecordingControl>, PipelineError> {
+        let inputs = (
+            window,
+            optional_all(&refined.refinements),
+            refined.aerials,
+            self.map_frame,
+        );
+        Ok(b.add(ControlStage, label, self.control_params.clone(), inputs)?)
+    }
+
     /// Per nadir image (campaign row index) overlapping `item`: the aerial-oriented ortho (thesis 3.4.5.1)
     /// and, when enabled, the initial transform (3.4.5.2).
     fn add_pairs(
@@ -451,9 +467,7 @@ pub fn add_second_pass(
     nadir: &NadirHandles,
     report: Handle<AdjustReport>,
 ) -> Result<SecondPass, PipelineError> {
-    let mut chain = NadirChain::new(cx, ortho_base)?;
-    let control_params: ControlParams = cx.params(stage::CONTROL)?;
-    let map_frame = b.add(MapFrameStage, "", SummaryParams::default(), cx.snap)?;
+    let mut chain = NadirChain::new(b, cx, ortho_base)?;
     let mut control = nadir.control.clone();
     let (mut first, mut second, mut shifts) = (Vec::new(), Vec::new(), Vec::new());
     for rec in &nadir.recordings {
@@ -472,13 +486,13 @@ pub fn add_second_pass(
             (report, nadir.control[ci].optional()),
         )?;
         let window = b.add(
-            ShiftWindow,
+            Shift::<MmWindowMatch>::new(),
             &label,
             SummaryParams::default(),
             (rec.window, shift),
         )?;
         let row = b.add(
-            ShiftRow,
+            Shift::<Recording>::new(),
             &label,
             SummaryParams::default(),
             (item.row, shift),
@@ -490,7 +504,7 @@ pub fn add_second_pass(
                 pair_label(&item.recording.image_id, &p.aerial_id)
             );
             let ortho = b.add(
-                ShiftOrtho,
+                Shift::<OrthoImage>::new(),
                 &pair_label,
                 SummaryParams::default(),
                 (p.ortho, shift),
@@ -515,17 +529,7 @@ pub fn add_second_pass(
             .map(|i| &cx.items[i])
             .collect();
         let refined = chain.add_refinements(b, pairs, window, &members)?;
-        let c = b.add(
-            ControlStage,
-            &label,
-            control_params.clone(),
-            (
-                window,
-                optional_all(&refined.refinements),
-                refined.aerials,
-                map_frame,
-            ),
-        )?;
+        let c = chain.add_control(b, &label, window, refined)?;
         first.push(nadir.control[ci]);
         second.push(c);
         shifts.push(shift);

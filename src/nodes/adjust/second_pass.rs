@@ -4,15 +4,15 @@
 //! (`registration_passes`). A recording the first pass registered gets a zero shift, so its translated inputs
 //! equal the first pass's and every node below them is found in the cache.
 
+use crate::codec::Artifact;
 use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage};
 use crate::nodes::adjust::adjustment::{AdjustReport, Verdict};
 use crate::nodes::campaign::summary::SummaryParams;
 use skytie_stages::adjustment::second_pass::{
-    pass_shift, registered, shift_ortho, shift_row, shift_window, PassShift, RegistrationPasses,
-    PASSES_STAGE, PRIOR_STAGE, SHIFT_ORTHO_STAGE, SHIFT_ROW_STAGE, SHIFT_WINDOW_STAGE,
+    pass_shift, registered, PassShift, RegistrationPasses, Shiftable, PASSES_STAGE, PRIOR_STAGE,
 };
-use skytie_stages::campaign::Recording;
-use skytie_stages::nadir::{MmWindowMatch, OrthoImage, RecordingControl};
+use skytie_stages::nadir::RecordingControl;
+use std::marker::PhantomData;
 
 crate::serde_artifact!(PassShift, RegistrationPasses);
 
@@ -44,42 +44,23 @@ impl Stage for PassPrior {
     }
 }
 
-/// A recording's tie-point window translated by its shift.
-pub struct ShiftWindow;
+/// One input of a recording's registration translated by its shift: its tie-point window, its row (the second
+/// pass's initial transform reads it) or an aerial-oriented ortho image. Each kind is its own stage.
+pub struct Shift<T>(PhantomData<fn() -> T>);
 
-impl Stage for ShiftWindow {
-    crate::nodes::stage_types!(SHIFT_WINDOW_STAGE, SummaryParams => MmWindowMatch,
-        inputs: (Handle<MmWindowMatch>, Handle<PassShift>));
-
-    fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
-        let (window, shift) = inputs;
-        Ok(shift_window(&window, &shift))
+impl<T> Shift<T> {
+    /// The stage that translates a `T`.
+    pub const fn new() -> Self {
+        Self(PhantomData)
     }
 }
 
-/// A recording's row translated by its shift (the second pass's initial transform reads it).
-pub struct ShiftRow;
-
-impl Stage for ShiftRow {
-    crate::nodes::stage_types!(SHIFT_ROW_STAGE, SummaryParams => Recording,
-        inputs: (Handle<Recording>, Handle<PassShift>));
+impl<T: Shiftable + Artifact> Stage for Shift<T> {
+    crate::nodes::stage_types!(T::STAGE, SummaryParams => T, inputs: (Handle<T>, Handle<PassShift>));
 
     fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
-        let (row, shift) = inputs;
-        Ok(shift_row(&row, &shift))
-    }
-}
-
-/// A recording's aerial-oriented ortho image translated by its shift.
-pub struct ShiftOrtho;
-
-impl Stage for ShiftOrtho {
-    crate::nodes::stage_types!(SHIFT_ORTHO_STAGE, SummaryParams => OrthoImage,
-        inputs: (Handle<OrthoImage>, Handle<PassShift>));
-
-    fn run(&self, _: &SummaryParams, inputs: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
-        let (ortho, shift) = inputs;
-        Ok(shift_ortho(&ortho, &shift))
+        let (item, shift) = inputs;
+        Ok(item.shifted(&shift))
     }
 }
 

@@ -7,7 +7,7 @@
 //! can start there with the normal windows. Moving a recording horizontally by `shift_world` moves its ortho
 //! image's ground plane by the same vector and leaves its pixels unchanged (the projection depends only on the
 //! position relative to the camera), so the second pass reuses the first pass's ortho images and tie points,
-//! translated ([`shift_ortho`], [`shift_window`], [`shift_row`]): the tie points' panorama observations, the
+//! translated ([`Shiftable`]): the tie points' panorama observations, the
 //! only thing the adjustment reads of them, are unchanged. The neighbours' ortho images that the refinement's
 //! parallax check reads stay the first pass's, with the window's untranslated neighbour views.
 //!
@@ -85,34 +85,52 @@ pub fn pass_shift(
     }
 }
 
+/// An input of the registration that the second pass translates by a recording's shift. Each kind is its own
+/// stage ([`Shiftable::STAGE`]), so its nodes keep their own cache identity.
+pub trait Shiftable: Clone {
+    /// The identity of the node that translates this kind.
+    const STAGE: StageId;
+    /// `self` moved horizontally by `shift`.
+    fn shifted(&self, shift: &PassShift) -> Self;
+}
+
 /// The ortho image of a recording moved by `shift`: the same pixels on a ground plane translated by it.
-pub fn shift_ortho(ortho: &OrthoImage, shift: &PassShift) -> OrthoImage {
-    let mut out = ortho.clone();
-    out.georef.foot_world[0] += shift.shift_world[0];
-    out.georef.foot_world[1] += shift.shift_world[1];
-    out
+impl Shiftable for OrthoImage {
+    const STAGE: StageId = SHIFT_ORTHO_STAGE;
+    fn shifted(&self, shift: &PassShift) -> Self {
+        let mut out = self.clone();
+        out.georef.foot_world[0] += shift.shift_world[0];
+        out.georef.foot_world[1] += shift.shift_world[1];
+        out
+    }
 }
 
 /// The tie-point window of a recording moved by `shift`: the corners on the recording's own ground plane
 /// (where the aerial stages look for them) are translated; the neighbours' views of them stay where the
 /// neighbours' own (untranslated) ortho images show them, for the parallax check; the tie points themselves,
 /// whose panorama observations the adjustment reads, are unchanged.
-pub fn shift_window(window: &MmWindowMatch, shift: &PassShift) -> MmWindowMatch {
-    let [dx, dy] = shift.shift_world;
-    let mut out = window.clone();
-    for g in &mut out.ground_world {
-        g[0] += dx;
-        g[1] += dy;
+impl Shiftable for MmWindowMatch {
+    const STAGE: StageId = SHIFT_WINDOW_STAGE;
+    fn shifted(&self, shift: &PassShift) -> Self {
+        let [dx, dy] = shift.shift_world;
+        let mut out = self.clone();
+        for g in &mut out.ground_world {
+            g[0] += dx;
+            g[1] += dy;
+        }
+        out
     }
-    out
 }
 
 /// A recording's row moved by `shift` (its recorded position translated horizontally).
-pub fn shift_row(row: &Recording, shift: &PassShift) -> Recording {
-    let mut out = row.clone();
-    out.x += shift.shift_world[0];
-    out.y += shift.shift_world[1];
-    out
+impl Shiftable for Recording {
+    const STAGE: StageId = SHIFT_ROW_STAGE;
+    fn shifted(&self, shift: &PassShift) -> Self {
+        let mut out = self.clone();
+        out.x += shift.shift_world[0];
+        out.y += shift.shift_world[1];
+        out
+    }
 }
 
 /// How many recordings each pass registered (own aerial control), and how many the second pass searched again
@@ -202,7 +220,7 @@ mod tests {
             recording_id: "a".into(),
             shift_world: [1.7, -2.3],
         };
-        let moved = shift_ortho(&ortho, &shift);
+        let moved = ortho.shifted(&shift);
         let p = Vector3::new(1003.2, 1998.1, 50.0);
         let q = Vector3::new(p.x + 1.7, p.y - 2.3, p.z);
         let (u0, v0) = ortho.georef.world_to_pixel(&p);
@@ -228,7 +246,7 @@ mod tests {
             recording_id: "a".into(),
             shift_world: [0.5, -0.25],
         };
-        let moved = shift_window(&window, &shift);
+        let moved = window.shifted(&shift);
         assert_eq!(moved.ground_world, vec![[1.5, 1.75, 3.0]]);
         assert_eq!(moved.neighbour_ground_world, window.neighbour_ground_world);
         assert_eq!(moved.tie_points, window.tie_points);
