@@ -721,6 +721,7 @@ mod tests {
             predicted_u_px: 1000.0,
             predicted_v_px: 2000.0,
             level: 0,
+            view_disagreement_px: None,
         }
     }
 
