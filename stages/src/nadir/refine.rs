@@ -23,6 +23,12 @@
 //! `max_shift_spread_px` of their median (a periodic template that locked onto the neighbouring zebra stripe
 //! stands out here; see [`RefineParams::max_shift_spread_px`]), and fewer than `min_located` located tie points
 //! keep none.
+//!
+//! Optional checks (off by the stage default): the **tie-point consistency** (`point_sigma_px`; on in
+//! `default.toml`) drops a corner whose aerial location minus its tie point's MM object point departs from the
+//! image's median of that difference by more than `point_k_sigma` σ (`consistent_residuals`); the **view
+//! check** (`view_sigma_px`) locates the corner again with re-centred templates and the neighbouring recordings'
+//! templates and drops a location that one of them contradicts.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -96,10 +102,10 @@ crate::params! {
         /// the image's corrections by more than this is dropped (with two located, both are dropped when they
         /// differ by more); 0 = no check.
         max_shift_spread_px: f64 = 5.0, unit "px", min 0.0;
-        /// View check (`nadir::view_check`): σ of one phase-correlation location (working-level px). The
-        /// corner is located again from each neighbouring recording's view of it; two locations of one
-        /// corner differ by √2·σ per axis, and a location that a neighbour's view contradicts by more than
-        /// `view_k_sigma` of that is dropped. 0 = no check.
+        /// View check: σ of one phase-correlation location (working-level px). The corner is located again
+        /// with the template re-centred a quarter off in four directions and from each neighbouring
+        /// recording's view of it; two locations of one corner differ by √2·σ per axis, and a location that
+        /// another template contradicts by more than `view_k_sigma` of that is dropped. 0 = no check.
         view_sigma_px: f64 = 0.0, unit "px", min 0.0, max 10.0;
         /// Rejection bound of the view check in standard deviations of the 2-D disagreement (√χ²₂: 2.45 keeps
         /// 95 %, 3.03 keeps 99 % of correct locations).
