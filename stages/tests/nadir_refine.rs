@@ -379,7 +379,10 @@ fn the_view_check_drops_exactly_the_corner_whose_template_shows_content_at_anoth
         .expect("without the check the perturbed corner is located");
     let t = true_aerial_px(&pair.ortho.georef, &pair.truth, g);
     let error_px = (wrong.observation.u_px - t.x).hypot(wrong.observation.v_px - t.y);
-    assert!(error_px > 1.0, "the perturbed corner is located {error_px} px off");
+    assert!(
+        error_px > 1.0,
+        "the perturbed corner is located {error_px} px off"
+    );
     let r = refine_window(&pair, &window, &pair.aerial, off, &checked);
     assert_eq!(r.view_inconsistent, 1);
     let kept: Vec<&str> = r.matches.iter().map(|m| m.tie_point_id.as_str()).collect();
@@ -390,6 +393,57 @@ fn the_view_check_drops_exactly_the_corner_whose_template_shows_content_at_anoth
         .filter(|id| *id != target)
         .collect();
     assert_eq!(kept, expected, "exactly the perturbed corner is dropped");
+}
+
+#[test]
+fn the_tie_point_consistency_drops_exactly_the_corner_whose_mm_point_is_off() {
+    let pair = make_pair(11, 0.01);
+    let ids: Vec<usize> = [1usize, 4, 7]
+        .iter()
+        .flat_map(|&j| [1usize, 4, 7].map(|i| j * 9 + i))
+        .collect();
+    let mut window = window_of_ids(&pair, &ids);
+    // The recording is off by (0.83, −0.61) aerial px: every corner's aerial location differs from its MM
+    // point by that offset.
+    let off = Similarity2::new(1.0, 0.0, 0.83, -0.61).compose(&pair.truth);
+    let checked = RefineParams {
+        point_sigma_px: 0.5,
+        ..params_at_peak_05()
+    };
+    let clean = refine_window(&pair, &window, &pair.aerial, off, &checked);
+    assert_eq!(
+        clean.point_inconsistent, 0,
+        "every consistent corner is kept"
+    );
+    assert!(clean.matches.len() >= 5, "{}", clean.matches.len());
+    // One tie point's MM object point 0.25 m (2.5 ortho px, 5 σ beyond the bound of 2.45 σ) off, as a
+    // panorama match off by a few pixels would put it; its aerial location is unchanged.
+    let target = clean.matches[clean.matches.len() / 2].tie_point_id.clone();
+    let k = window
+        .tie_points
+        .iter()
+        .position(|tp| tp.id == target)
+        .unwrap();
+    window.tie_points[k].point_world[0] += 0.25;
+    let r = refine_window(&pair, &window, &pair.aerial, off, &checked);
+    assert_eq!(r.point_inconsistent, 1);
+    let kept: Vec<&str> = r.matches.iter().map(|m| m.tie_point_id.as_str()).collect();
+    let expected: Vec<&str> = clean
+        .matches
+        .iter()
+        .map(|m| m.tie_point_id.as_str())
+        .filter(|id| *id != target)
+        .collect();
+    assert_eq!(kept, expected, "exactly the inconsistent corner is dropped");
+    // The locations themselves do not change.
+    for m in &r.matches {
+        let c = clean
+            .matches
+            .iter()
+            .find(|c| c.tie_point_id == m.tie_point_id)
+            .unwrap();
+        assert_eq!(m.observation, c.observation);
+    }
 }
 
 #[test]

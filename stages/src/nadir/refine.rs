@@ -514,11 +514,8 @@ pub fn refine_in_image(
         // σ in working pixels; the residuals are in full-resolution pixels.
         let bound_px = p.point_k_sigma * p.point_sigma_px * aerial_window.window.scale();
         let residuals = point_residuals_px(&result.matches, window, mm_ortho, &tf);
-        result.matches = consistent_residuals(
-            std::mem::take(&mut result.matches),
-            &residuals,
-            bound_px,
-        );
+        result.matches =
+            consistent_residuals(std::mem::take(&mut result.matches), &residuals, bound_px);
         result.point_inconsistent = before - result.matches.len();
     }
     if p.max_shift_spread_px > 0.0 {
@@ -579,10 +576,20 @@ fn view_disagreement_px(
         }
     };
     let quarter = (p.template_px / 4) as f64;
-    for (ox, oy) in [(quarter, 0.0), (-quarter, 0.0), (0.0, quarter), (0.0, -quarter)] {
+    for (ox, oy) in [
+        (quarter, 0.0),
+        (-quarter, 0.0),
+        (0.0, quarter),
+        (0.0, -quarter),
+    ] {
         let (rx0, ry0) = (x0 + ox, y0 + oy);
-        if cut_ortho_template(ortho, rx0 as isize, ry0 as isize, p.template_px, &mut buf.view)
-            && grey_std(&buf.view) >= p.min_template_std
+        if cut_ortho_template(
+            ortho,
+            rx0 as isize,
+            ry0 as isize,
+            p.template_px,
+            &mut buf.view,
+        ) && grey_std(&buf.view) >= p.min_template_std
         {
             compare(buf, (rx0, ry0));
         }
@@ -602,7 +609,13 @@ fn view_disagreement_px(
         // The neighbour's template: its top-left pixel placed like the detecting one's relative to the corner.
         let (nx0, ny0) = (u_n - (u_o - x0), v_n - (v_o - y0));
         let (ix0, iy0) = (nx0.round(), ny0.round());
-        if !cut_ortho_template(nb.ortho, ix0 as isize, iy0 as isize, p.template_px, &mut buf.view) {
+        if !cut_ortho_template(
+            nb.ortho,
+            ix0 as isize,
+            iy0 as isize,
+            p.template_px,
+            &mut buf.view,
+        ) {
             continue;
         }
         // On the detecting grid the neighbour's corner then lies on (u_o, v_o).
@@ -766,9 +779,23 @@ mod tests {
             ["a", "b", "d"]
         );
         // Two that agree are kept, two that do not are both dropped, one alone is kept.
-        assert_eq!(ids(&consistent_residuals(m[..2].to_vec(), &residuals[..2], bound_px)), ["a", "b"]);
+        assert_eq!(
+            ids(&consistent_residuals(
+                m[..2].to_vec(),
+                &residuals[..2],
+                bound_px
+            )),
+            ["a", "b"]
+        );
         assert!(consistent_residuals(m[1..3].to_vec(), &residuals[1..3], bound_px).is_empty());
-        assert_eq!(ids(&consistent_residuals(m[2..3].to_vec(), &residuals[2..3], bound_px)), ["c"]);
+        assert_eq!(
+            ids(&consistent_residuals(
+                m[2..3].to_vec(),
+                &residuals[2..3],
+                bound_px
+            )),
+            ["c"]
+        );
     }
 
     #[test]
