@@ -68,6 +68,7 @@ fn a_shifted_aerial_observation_is_graded_wrong_and_listed() {
             predicted_u_px: u,
             predicted_v_px: v,
             level: 0,
+            view_disagreement_px: None,
         });
         r
     };

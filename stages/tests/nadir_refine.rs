@@ -317,6 +317,135 @@ fn a_tie_point_located_alone_in_an_image_is_not_kept_unless_min_located_is_1() {
     );
 }
 
+/// The window of `pair` reduced to the tie points `ids` (their templates, re-centred a quarter off, do not
+/// overlap when the ids are three grid cells apart).
+fn window_of_ids(pair: &Pair, ids: &[usize]) -> MmWindowMatch {
+    let mut w = pair.window.clone();
+    w.tie_points = ids
+        .iter()
+        .map(|&i| pair.window.tie_points[i].clone())
+        .collect();
+    w.ground_world = ids.iter().map(|&i| pair.window.ground_world[i]).collect();
+    w.neighbour_ground_world = ids.iter().map(|_| Vec::new()).collect();
+    w
+}
+
+#[test]
+fn the_view_check_drops_exactly_the_corner_whose_template_shows_content_at_another_position() {
+    let mut pair = make_pair(11, 0.01);
+    let ids: Vec<usize> = [1usize, 4, 7]
+        .iter()
+        .flat_map(|&j| [1usize, 4, 7].map(|i| j * 9 + i))
+        .collect();
+    let window = window_of_ids(&pair, &ids);
+    let off = Similarity2::new(1.0, 0.0, 0.83, -0.61).compose(&pair.truth);
+    let checked = RefineParams {
+        view_sigma_px: 0.25,
+        ..params_at_peak_05()
+    };
+    let clean = refine_window(&pair, &window, &pair.aerial, off, &checked);
+    assert_eq!(clean.view_inconsistent, 0, "every clean corner agrees");
+    let (rms, _) = errors_px(&pair, &clean);
+    assert!(rms < 0.1, "rms {rms}");
+    // The first corner with a verdict: the right three quarters of its template now show the ground 4 px further
+    // right (content at another position, as the top of a kerb at another height would).
+    let target = clean
+        .matches
+        .iter()
+        .find(|m| m.view_disagreement_px.is_some())
+        .expect("a corner with a view verdict")
+        .tie_point_id
+        .clone();
+    let g = pair.window.ground_world[tie_index(&target)];
+    let (u, v) = pair
+        .ortho
+        .georef
+        .world_to_pixel(&Vector3::new(g[0], g[1], g[2]));
+    let (w, before) = (pair.ortho.image.width, pair.ortho.image.clone());
+    for r in (v as usize - 16)..(v as usize + 16) {
+        for c in (u as usize - 4)..(u as usize + 20) {
+            pair.ortho.image.data[r * w + c] = before.data[r * w + c + 4];
+        }
+    }
+    let unchecked = RefineParams {
+        view_sigma_px: 0.0,
+        ..checked.clone()
+    };
+    let plain = refine_window(&pair, &window, &pair.aerial, off, &unchecked);
+    let wrong = plain
+        .matches
+        .iter()
+        .find(|m| m.tie_point_id == target)
+        .expect("without the check the perturbed corner is located");
+    let t = true_aerial_px(&pair.ortho.georef, &pair.truth, g);
+    let error_px = (wrong.observation.u_px - t.x).hypot(wrong.observation.v_px - t.y);
+    assert!(
+        error_px > 1.0,
+        "the perturbed corner is located {error_px} px off"
+    );
+    let r = refine_window(&pair, &window, &pair.aerial, off, &checked);
+    assert_eq!(r.view_inconsistent, 1);
+    let kept: Vec<&str> = r.matches.iter().map(|m| m.tie_point_id.as_str()).collect();
+    let expected: Vec<&str> = clean
+        .matches
+        .iter()
+        .map(|m| m.tie_point_id.as_str())
+        .filter(|id| *id != target)
+        .collect();
+    assert_eq!(kept, expected, "exactly the perturbed corner is dropped");
+}
+
+#[test]
+fn the_tie_point_consistency_drops_exactly_the_corner_whose_mm_point_is_off() {
+    let pair = make_pair(11, 0.01);
+    let ids: Vec<usize> = [1usize, 4, 7]
+        .iter()
+        .flat_map(|&j| [1usize, 4, 7].map(|i| j * 9 + i))
+        .collect();
+    let mut window = window_of_ids(&pair, &ids);
+    // The recording is off by (0.83, −0.61) aerial px: every corner's aerial location differs from its MM
+    // point by that offset.
+    let off = Similarity2::new(1.0, 0.0, 0.83, -0.61).compose(&pair.truth);
+    let checked = RefineParams {
+        point_sigma_px: 0.5,
+        ..params_at_peak_05()
+    };
+    let clean = refine_window(&pair, &window, &pair.aerial, off, &checked);
+    assert_eq!(
+        clean.point_inconsistent, 0,
+        "every consistent corner is kept"
+    );
+    assert!(clean.matches.len() >= 5, "{}", clean.matches.len());
+    // One tie point's MM object point 0.25 m (2.5 ortho px, 5 σ beyond the bound of 2.45 σ) off, as a
+    // panorama match off by a few pixels would put it; its aerial location is unchanged.
+    let target = clean.matches[clean.matches.len() / 2].tie_point_id.clone();
+    let k = window
+        .tie_points
+        .iter()
+        .position(|tp| tp.id == target)
+        .unwrap();
+    window.tie_points[k].point_world[0] += 0.25;
+    let r = refine_window(&pair, &window, &pair.aerial, off, &checked);
+    assert_eq!(r.point_inconsistent, 1);
+    let kept: Vec<&str> = r.matches.iter().map(|m| m.tie_point_id.as_str()).collect();
+    let expected: Vec<&str> = clean
+        .matches
+        .iter()
+        .map(|m| m.tie_point_id.as_str())
+        .filter(|id| *id != target)
+        .collect();
+    assert_eq!(kept, expected, "exactly the inconsistent corner is dropped");
+    // The locations themselves do not change.
+    for m in &r.matches {
+        let c = clean
+            .matches
+            .iter()
+            .find(|c| c.tie_point_id == m.tie_point_id)
+            .unwrap();
+        assert_eq!(m.observation, c.observation);
+    }
+}
+
 #[test]
 fn refine_params_validate_and_reject_unknown_keys() {
     assert!(RefineParams::default().validate().is_ok());
@@ -384,6 +513,8 @@ fn refinement_at(
         tried: obs.len(),
         parallax_rejected: 0,
         shift_inconsistent: 0,
+        view_inconsistent: 0,
+        point_inconsistent: 0,
         unconfirmed: 0,
         matches: obs
             .iter()
@@ -400,6 +531,7 @@ fn refinement_at(
                 predicted_u_px: *u,
                 predicted_v_px: *v,
                 level,
+                view_disagreement_px: None,
             })
             .collect(),
     }

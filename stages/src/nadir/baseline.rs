@@ -42,7 +42,7 @@ use nalgebra::{Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("baseline", "6");
+pub const STAGE: StageId = StageId::new("baseline", "7");
 
 crate::params! {
     /// Parameters of [`baseline_matches`]; thesis 2.2.3 values as defaults.
@@ -242,6 +242,7 @@ pub fn baseline_matches(
                         predicted_u_px: predicted.x,
                         predicted_v_px: predicted.y,
                         level: aerial_window.window.level,
+                        view_disagreement_px: None,
                     }),
                 )
             },

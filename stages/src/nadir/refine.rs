@@ -23,6 +23,12 @@
 //! `max_shift_spread_px` of their median (a periodic template that locked onto the neighbouring zebra stripe
 //! stands out here; see [`RefineParams::max_shift_spread_px`]), and fewer than `min_located` located tie points
 //! keep none.
+//!
+//! Optional checks (off by the stage default): the **tie-point consistency** (`point_sigma_px`; on in
+//! `default.toml`) drops a corner whose aerial location minus its tie point's MM object point departs from the
+//! image's median of that difference by more than `point_k_sigma` σ (`consistent_residuals`); the **view
+//! check** (`view_sigma_px`) locates the corner again with re-centred templates and the neighbouring recordings'
+//! templates and drops a location that one of them contradicts.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -47,7 +53,7 @@ use nalgebra::{Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("refine", "9");
+pub const STAGE: StageId = StageId::new("refine", "10");
 
 /// Taper applied before the Fourier transform (serialisable mirror of [`WindowKind`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -96,6 +102,23 @@ crate::params! {
         /// the image's corrections by more than this is dropped (with two located, both are dropped when they
         /// differ by more); 0 = no check.
         max_shift_spread_px: f64 = 5.0, unit "px", min 0.0;
+        /// View check: σ of one phase-correlation location (working-level px). The corner is located again
+        /// with the template re-centred a quarter off in four directions and from each neighbouring
+        /// recording's view of it; two locations of one corner differ by √2·σ per axis, and a location that
+        /// another template contradicts by more than `view_k_sigma` of that is dropped. 0 = no check.
+        view_sigma_px: f64 = 0.0, unit "px", min 0.0, max 10.0;
+        /// Rejection bound of the view check in standard deviations of the 2-D disagreement (√χ²₂: 2.45 keeps
+        /// 95 %, 3.03 keeps 99 % of correct locations).
+        view_k_sigma: f64 = 3.03, min 1.0, max 100.0;
+        /// Tie-point consistency (working-level px; 0 = no check): σ of one located corner. The corner located
+        /// in the aerial image and the tie point's MM object point (triangulated from all its panoramas) must
+        /// differ by the same offset for every tie point of the recording in the image — the recording's
+        /// position error; a tie point whose difference departs from the image's median by more than
+        /// `point_k_sigma` σ is dropped (with two located, both when they differ by more than √2 times that).
+        /// The aerial tables' default `sigma_px` is 0.5.
+        point_sigma_px: f64 = 0.0, unit "px", min 0.0, max 10.0;
+        /// Rejection bound of the tie-point consistency in σ (√χ²₂: 2.45 keeps 95 % of correct corners).
+        point_k_sigma: f64 = 2.45, min 1.0, max 100.0;
     }
 }
 
@@ -198,6 +221,8 @@ pub fn grey_std(img: &GrayImage) -> f64 {
 /// Reusable per-thread buffers of one tie point's matching.
 struct Buffers {
     template: GrayImage,
+    /// A neighbouring recording's template of the same corner (view check).
+    view: GrayImage,
     search: GrayImage,
     parallax: ParallaxScratch,
 }
@@ -205,6 +230,7 @@ struct Buffers {
 fn new_buffers() -> Buffers {
     Buffers {
         template: GrayImage::filled(0, 0, 0.0),
+        view: GrayImage::filled(0, 0, 0.0),
         search: GrayImage::filled(0, 0, 0.0),
         parallax: ParallaxScratch::default(),
     }
@@ -219,6 +245,8 @@ enum Outcome {
     /// Tried, but left out before phase correlation: a neighbouring view shows the template's structure
     /// differently (parallax check).
     Parallax,
+    /// Located, but a neighbouring recording's view of the corner lands elsewhere (view check).
+    ViewInconsistent,
     Located(AerialMatch),
 }
 
@@ -245,17 +273,18 @@ fn cut_template(
         .then_some((x0, y0))
 }
 
-/// Phase-correlation location of the template in `buf.template`, whose top-left ortho pixel is (`x0`, `y0`),
-/// in `aerial`, which `tf` maps from ortho pixels (steps 3–5). Returns the shift of the template centre (ortho
-/// px) and the peak, or nothing when the window leaves the aerial image, the shift exceeds the margin or the
-/// peak is weak.
+/// Phase-correlation location of `template`, whose top-left pixel lies at (`x0`, `y0`) on the ortho grid
+/// (continuous), in `aerial`, which `tf` maps from ortho pixels (steps 3–5); `search` is scratch. Returns the
+/// shift of the template centre (ortho px) and the peak, or nothing when the window leaves the aerial image,
+/// the shift exceeds the margin or the peak is weak.
 fn search_template(
     aerial: &GrayImage,
     tf: &Similarity2,
+    template: &GrayImage,
     (x0, y0): (f64, f64),
     p: &RefineParams,
     phase: &PhaseCorrelationParams,
-    buf: &mut Buffers,
+    search: &mut GrayImage,
 ) -> Option<(f64, f64, f64)> {
     let half = p.template_px as f64 / 2.0;
     let margin = p.search_margin_px as f64;
@@ -272,11 +301,11 @@ fn search_template(
             y0 - margin + dy,
             side,
             side,
-            &mut buf.search,
+            search,
         ) {
             return None;
         }
-        let loc = locate_template(&buf.template, &buf.search, phase).ok()?;
+        let loc = locate_template(template, search, phase).ok()?;
         // Template centre in ortho-grid coordinates, and where it was found.
         let step_x = (x0 - margin + dx + loc.u_px) - (x0 + half) - dx;
         let step_y = (y0 - margin + dy + loc.v_px) - (y0 + half) - dy;
@@ -417,11 +446,33 @@ pub fn refine_in_image(
                     }
                 }
             }
-            let Some((dx, dy, peak)) =
-                search_template(aerial_img, &tf_window, corner, p, &phase, buf)
-            else {
+            let Some((dx, dy, peak)) = search_template(
+                aerial_img,
+                &tf_window,
+                &buf.template,
+                corner,
+                p,
+                &phase,
+                &mut buf.search,
+            ) else {
                 return Outcome::Rejected;
             };
+            let views = window.neighbour_ground_world.get(i).map_or(&[][..], |v| v);
+            let disagreement = (p.view_sigma_px > 0.0)
+                .then(|| {
+                    let found = ViewLocation {
+                        corner_ortho_px: (u_o, v_o),
+                        template_origin: corner,
+                        shift_px: (dx, dy),
+                    };
+                    view_disagreement_px(
+                        &found, views, mm_ortho, neighbours, aerial_img, &tf_window, p, &phase, buf,
+                    )
+                })
+                .flatten();
+            if disagreement.is_some_and(|d| d > view_bound_px(p)) {
+                return Outcome::ViewInconsistent;
+            }
             let observed = tf.apply(&Vector2::new(u_o + dx, v_o + dy));
             Outcome::Located(AerialMatch {
                 tie_point_id: window.tie_points[i].id.clone(),
@@ -436,6 +487,7 @@ pub fn refine_in_image(
                 predicted_u_px: predicted.x,
                 predicted_v_px: predicted.y,
                 level: aerial_window.window.level,
+                view_disagreement_px: disagreement,
             })
         })
         .collect();
@@ -447,11 +499,24 @@ pub fn refine_in_image(
                 result.tried += 1;
                 result.parallax_rejected += 1;
             }
+            Outcome::ViewInconsistent => {
+                result.tried += 1;
+                result.view_inconsistent += 1;
+            }
             Outcome::Located(m) => {
                 result.tried += 1;
                 result.matches.push(m);
             }
         }
+    }
+    if p.point_sigma_px > 0.0 {
+        let before = result.matches.len();
+        // σ in working pixels; the residuals are in full-resolution pixels.
+        let bound_px = p.point_k_sigma * p.point_sigma_px * aerial_window.window.scale();
+        let residuals = point_residuals_px(&result.matches, window, mm_ortho, &tf);
+        result.matches =
+            consistent_residuals(std::mem::take(&mut result.matches), &residuals, bound_px);
+        result.point_inconsistent = before - result.matches.len();
     }
     if p.max_shift_spread_px > 0.0 {
         let before = result.matches.len();
@@ -465,6 +530,161 @@ pub fn refine_in_image(
         result.matches.clear();
     }
     Ok(result)
+}
+
+/// Where the detecting recording's template found a corner: the corner on the ortho grid, the template's
+/// top-left pixel and the shift of the template found in the aerial window (ortho px).
+struct ViewLocation {
+    corner_ortho_px: (f64, f64),
+    template_origin: (f64, f64),
+    shift_px: (f64, f64),
+}
+
+/// The largest disagreement (ortho px ≈ working-level aerial px) between `found` and the same corner located
+/// by other templates (`None` when none of them could be cut or located):
+/// - **re-centred**: templates of the same size cut from the detecting ortho with the corner a quarter
+///   template off centre (four directions). They share most of the corner's content but not the border, so a
+///   location that depends on what lies at one edge of the template (another height, a near-periodic pattern)
+///   moves;
+/// - **neighbours' views**: each neighbouring recording's template around the corner as that recording saw it
+///   (`views`, their orthos in `neighbours`), placed on the detecting ortho grid so that its corner falls on
+///   the detecting one — another rendering of the same corner (another blur, another parallax).
+///
+/// All of them show the same corner, so all must land on the same aerial position.
+#[allow(clippy::too_many_arguments)]
+fn view_disagreement_px(
+    found: &ViewLocation,
+    views: &[super::registration::ViewGround],
+    ortho: &OrthoImage,
+    neighbours: &[NeighbourOrtho],
+    aerial: &GrayImage,
+    tf: &Similarity2,
+    p: &RefineParams,
+    phase: &PhaseCorrelationParams,
+    buf: &mut Buffers,
+) -> Option<f64> {
+    let (u_o, v_o) = found.corner_ortho_px;
+    let (x0, y0) = found.template_origin;
+    let mut worst: Option<f64> = None;
+    let mut compare = |buf: &mut Buffers, origin: (f64, f64)| {
+        if let Some((dx, dy, _)) =
+            search_template(aerial, tf, &buf.view, origin, p, phase, &mut buf.search)
+        {
+            // `dx, dy` move this template's centre; the corner moves with it.
+            let d = (dx - found.shift_px.0).hypot(dy - found.shift_px.1);
+            worst = Some(worst.map_or(d, |w: f64| w.max(d)));
+        }
+    };
+    let quarter = (p.template_px / 4) as f64;
+    for (ox, oy) in [
+        (quarter, 0.0),
+        (-quarter, 0.0),
+        (0.0, quarter),
+        (0.0, -quarter),
+    ] {
+        let (rx0, ry0) = (x0 + ox, y0 + oy);
+        if cut_ortho_template(
+            ortho,
+            rx0 as isize,
+            ry0 as isize,
+            p.template_px,
+            &mut buf.view,
+        ) && grey_std(&buf.view) >= p.min_template_std
+        {
+            compare(buf, (rx0, ry0));
+        }
+    }
+    for view in views {
+        let Some(nb) = neighbours
+            .iter()
+            .find(|n| n.recording_id == view.recording_id)
+        else {
+            continue;
+        };
+        let gv = view.ground_world;
+        let (u_n, v_n) = nb
+            .ortho
+            .georef
+            .world_to_pixel(&Vector3::new(gv[0], gv[1], gv[2]));
+        // The neighbour's template: its top-left pixel placed like the detecting one's relative to the corner.
+        let (nx0, ny0) = (u_n - (u_o - x0), v_n - (v_o - y0));
+        let (ix0, iy0) = (nx0.round(), ny0.round());
+        if !cut_ortho_template(
+            nb.ortho,
+            ix0 as isize,
+            iy0 as isize,
+            p.template_px,
+            &mut buf.view,
+        ) {
+            continue;
+        }
+        // On the detecting grid the neighbour's corner then lies on (u_o, v_o).
+        compare(buf, (x0 + (ix0 - nx0), y0 + (iy0 - ny0)));
+    }
+    worst
+}
+
+/// The view check's bound on the disagreement of two locations, ortho px: `view_k_sigma` standard deviations
+/// of the difference of two locations of σ = `view_sigma_px` each.
+fn view_bound_px(p: &RefineParams) -> f64 {
+    p.view_k_sigma * std::f64::consts::SQRT_2 * p.view_sigma_px
+}
+
+/// Per match: its observation minus the tie point's MM object point (`MmTiePoint::point_world`, from all its
+/// panoramas) mapped into the aerial image through the ortho grid and `tf`, full aerial px. Correct
+/// correspondences of one recording share this difference (the recording's position error, a few pixels); a
+/// corner whose MM triangulation and aerial location disagree — a panorama match or an aerial location off by
+/// a pixel or two — departs from it. Non-finite for a tie point not in the window.
+fn point_residuals_px(
+    matches: &[AerialMatch],
+    window: &MmWindowMatch,
+    mm_ortho: &OrthoImage,
+    tf: &Similarity2,
+) -> Vec<[f64; 2]> {
+    let index = crate::positions::positions_by(&window.tie_points, |tp| tp.id.as_str());
+    matches
+        .iter()
+        .map(|m| {
+            let Some(&i) = index.get(m.tie_point_id.as_str()) else {
+                return [f64::NAN, f64::NAN];
+            };
+            let x = Vector3::from(window.tie_points[i].point_world);
+            let (u, v) = mm_ortho.georef.world_to_pixel(&x);
+            let at = tf.apply(&Vector2::new(u, v));
+            [m.observation.u_px - at.x, m.observation.v_px - at.y]
+        })
+        .collect()
+}
+
+/// The matches whose residual (parallel to `matches`) lies within `bound_px` of the component-wise median
+/// residual; with two, both if they differ by at most √2·`bound_px` (the difference of two observations), else
+/// none; a single one is kept (nothing to compare it with).
+fn consistent_residuals(
+    matches: Vec<AerialMatch>,
+    residuals: &[[f64; 2]],
+    bound_px: f64,
+) -> Vec<AerialMatch> {
+    match matches.len() {
+        0 | 1 => matches,
+        2 => {
+            let d = (residuals[0][0] - residuals[1][0]).hypot(residuals[0][1] - residuals[1][1]);
+            if d <= std::f64::consts::SQRT_2 * bound_px {
+                matches
+            } else {
+                Vec::new()
+            }
+        }
+        _ => {
+            let Some(consensus) = median_consensus(residuals, bound_px) else {
+                return Vec::new();
+            };
+            matches
+                .into_iter()
+                .zip(consensus.inliers)
+                .filter_map(|(m, inlier)| inlier.then_some(m))
+                .collect()
+        }
+    }
 }
 
 /// The matches whose correction (observed − predicted, aerial px) lies within `spread_px` of the component-wise
@@ -520,6 +740,7 @@ mod tests {
             predicted_u_px: 1000.0,
             predicted_v_px: 2000.0,
             level: 0,
+            view_disagreement_px: None,
         }
     }
 
@@ -536,6 +757,45 @@ mod tests {
             located("c", (1.9, -0.8)),
         ];
         assert_eq!(ids(&consistent_shifts(m, 5.0)), ["a", "b", "c"]);
+    }
+
+    #[test]
+    fn the_one_corner_whose_aerial_location_departs_from_its_mm_point_is_dropped() {
+        // Four corners of one recording in one image: the recording is off by (2.3, −1.1) px, located with
+        // ±0.3 px noise; corner "c" is located 1.6 px away from its MM point's offset (5.3 σ at σ = 0.3 px).
+        let m = vec![
+            located("a", (2.1, -1.0)),
+            located("b", (2.5, -1.3)),
+            located("c", (3.9, -1.0)),
+            located("d", (2.2, -0.9)),
+        ];
+        let residuals: Vec<[f64; 2]> = [(2.1, -1.0), (2.5, -1.3), (3.9, -1.0), (2.2, -0.9)]
+            .iter()
+            .map(|&(u, v)| [u, v])
+            .collect();
+        let bound_px = 2.45 * 0.3;
+        assert_eq!(
+            ids(&consistent_residuals(m.clone(), &residuals, bound_px)),
+            ["a", "b", "d"]
+        );
+        // Two that agree are kept, two that do not are both dropped, one alone is kept.
+        assert_eq!(
+            ids(&consistent_residuals(
+                m[..2].to_vec(),
+                &residuals[..2],
+                bound_px
+            )),
+            ["a", "b"]
+        );
+        assert!(consistent_residuals(m[1..3].to_vec(), &residuals[1..3], bound_px).is_empty());
+        assert_eq!(
+            ids(&consistent_residuals(
+                m[2..3].to_vec(),
+                &residuals[2..3],
+                bound_px
+            )),
+            ["c"]
+        );
     }
 
     #[test]

@@ -109,6 +109,11 @@ pub struct AerialMatch {
     /// pixels): the observation's precision is the image's `sigma_px` in pixels of this level.
     #[serde(default)]
     pub level: usize,
+    /// The largest disagreement (working-level px) between this location and the locations of the same corner
+    /// found from the neighbouring recordings' views of it (`RefineParams::view_sigma_px`); `None` when no
+    /// neighbour's view could be located.
+    #[serde(default)]
+    pub view_disagreement_px: Option<f64>,
 }
 
 /// All refined correspondences of one (recording, aerial image).
@@ -125,6 +130,14 @@ pub struct AerialRefinement {
     /// (`RefineParams::max_shift_spread_px`).
     #[serde(default)]
     pub shift_inconsistent: usize,
+    /// Of `tried`: located, but dropped because a neighbouring recording's view of the same corner lands
+    /// elsewhere in the aerial image (`RefineParams::view_sigma_px`).
+    #[serde(default)]
+    pub view_inconsistent: usize,
+    /// Of `tried`: located, but dropped because the located corner departs from the tie point's MM object point
+    /// by more than the image's other tie points do (`RefineParams::point_sigma_px`).
+    #[serde(default)]
+    pub point_inconsistent: usize,
     /// Of `tried`: located, but dropped because fewer than `RefineParams::min_located` tie points were located
     /// in this image (a lone located template has no other to confirm the pair's registration).
     pub unconfirmed: usize,
@@ -140,6 +153,8 @@ impl AerialRefinement {
             tried: 0,
             parallax_rejected: 0,
             shift_inconsistent: 0,
+            view_inconsistent: 0,
+            point_inconsistent: 0,
             unconfirmed: 0,
             matches: Vec::new(),
         }

@@ -12,7 +12,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("nadir", "5");
+pub const STAGE: StageId = StageId::new("nadir", "6");
 
 /// See the module documentation. Counts, not grades.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -38,6 +38,15 @@ pub struct NadirSummary {
     /// Tie points × aerial images located but dropped: their correction disagrees with the other tie points of
     /// the recording in that image (`RefineParams::max_shift_spread_px`).
     pub shift_inconsistent: usize,
+    /// Tie points × aerial images located but dropped: a neighbouring recording's view of the corner lands
+    /// elsewhere in the aerial image (`RefineParams::view_sigma_px`).
+    #[serde(default)]
+    pub view_inconsistent: usize,
+    /// Tie points × aerial images located but dropped: the located corner departs from the tie point's MM
+    /// object point by more than the other tie points of the recording in that image do
+    /// (`RefineParams::point_sigma_px`).
+    #[serde(default)]
+    pub point_inconsistent: usize,
     /// Tie points × aerial images located but dropped: too few located in that image (`RefineParams::min_located`).
     pub unconfirmed: usize,
     /// Recordings with at least one MM–aerial correspondence.
@@ -117,6 +126,8 @@ impl NadirSummary {
             s.tie_points += r.matches.len();
             s.parallax_rejected += r.parallax_rejected;
             s.shift_inconsistent += r.shift_inconsistent;
+            s.view_inconsistent += r.view_inconsistent;
+            s.point_inconsistent += r.point_inconsistent;
             s.unconfirmed += r.unconfirmed;
             if !r.matches.is_empty() {
                 images_per_recording
@@ -155,6 +166,8 @@ impl NadirSummary {
             "tie_points": self.tie_points,
             "parallax_rejected": self.parallax_rejected,
             "shift_inconsistent": self.shift_inconsistent,
+            "view_inconsistent": self.view_inconsistent,
+            "point_inconsistent": self.point_inconsistent,
             "unconfirmed": self.unconfirmed,
             "mean_aerial_images_per_recording": self.mean_aerial_images_per_recording,
             "control_points": self.control_points,

@@ -150,6 +150,7 @@ mod tests {
             predicted_u_px: 500.0,
             predicted_v_px: 700.0,
             level: 0,
+            view_disagreement_px: None,
         }
     }
 
