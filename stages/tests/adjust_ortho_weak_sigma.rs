@@ -100,7 +100,10 @@ fn weak_control_displaced_alike_is_weighted_by_its_measured_sigma() {
         }
     }
     c.control.retain(|cp| cp.point_world.is_some());
-    assert!(weak_in_stretch >= 4 && elsewhere >= 5, "{weak_in_stretch} {elsewhere}");
+    assert!(
+        weak_in_stretch >= 4 && elsewhere >= 5,
+        "{weak_in_stretch} {elsewhere}"
+    );
     let plain = run(&c.adjust_inputs(), &config()).unwrap();
     let weighted = run(
         &c.adjust_inputs(),
@@ -115,14 +118,14 @@ fn weak_control_displaced_alike_is_weighted_by_its_measured_sigma() {
     // σ = 0.20 / √2 per axis.
     assert!(estimate.samples >= 5, "{estimate:?}");
     let sigma = estimate.sigma_m.expect("enough samples");
-    assert!((sigma - WEAK_OFFSET_M / 2f64.sqrt()).abs() < 0.01, "{sigma}");
+    assert!(
+        (sigma - WEAK_OFFSET_M / 2f64.sqrt()).abs() < 0.01,
+        "{sigma}"
+    );
     assert!(plain.build.weak_control_sigma.is_none());
     let (before, after) = (errors_m(&plain, &c), errors_m(&weighted, &c));
     let rms = |e: &[f64]| (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt();
-    let (b, a) = (
-        rms(&before[10..=17]),
-        rms(&after[10..=17]),
-    );
+    let (b, a) = (rms(&before[10..=17]), rms(&after[10..=17]));
     println!("recordings 10–17: RMS error {b:.3} m with the stated σ, {a:.3} m with the measured σ ({sigma:.3} m)");
     // With the stated σ the stretch follows its weak control almost all the way.
     assert!(b > 0.6 * WEAK_OFFSET_M, "{before:?}");

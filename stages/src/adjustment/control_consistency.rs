@@ -11,13 +11,14 @@
 //! within `window` recordings before and after it — the recordings observing the point itself left out, so a
 //! wrong cluster cannot vouch for itself — and does not use it as control when the two differ by more than
 //! the 99.9 % quantile of the point's own scatter about the common correction ([`normalised_deviation`]):
-//! a 2-D normal with covariance σ_rel² / 2 · S + σ_c² I, where σ_c is the control point's stated σ and S says
-//! how the recordings' errors move its triangulated position ([`ControlEvidence::spread`], at least the
-//! identity: a point seen along two nearly parallel rays moves farther than either recording, along the rays,
-//! and its correction scatters more in that direction only). For a point of one recording and an exact
-//! control point the bound is √χ²₂(0.999) · σ_rel / √2 ≈ 2.63 σ_rel (0.39 m for σ_rel = 0.15 m) in every
-//! direction. A correct recording is rejected about once in a thousand; a wrong one whose error exceeds the
-//! bound is not used, and its recordings are flagged like any other without control.
+//! a 2-D normal with covariance σ_rel² / 2 · S, where S says how the recordings' errors move the point's
+//! triangulated position ([`ControlEvidence::spread`], at least the identity: a point seen along two nearly
+//! parallel rays moves farther than either recording, along the rays, and its correction scatters more in
+//! that direction only). For a point of one recording the bound is √χ²₂(0.999) · σ_rel / √2 ≈ 2.63 σ_rel
+//! (0.39 m for σ_rel = 0.15 m) in every direction. The control point's own σ is not added: the check is
+//! meant for orthophoto control, whose stated σ (a few centimetres) is small against σ_rel / √2. A correct
+//! recording is rejected about once in a thousand; a wrong one whose error exceeds the bound is not used, and
+//! its recordings are flagged like any other without control.
 //!
 //! The point deviating most goes first, and the deviations are measured again without it, until none exceeds
 //! the tolerance: a wrong recording near a correct one would otherwise, as its neighbour, pull the median
@@ -42,14 +43,15 @@ pub fn tolerance_m(relative_sigma_m: f64) -> f64 {
 }
 
 /// Point `p`'s deviation `d` (its correction minus its neighbours' median, m) in units of the 99.9 % bound:
-/// √(dᵀ C⁻¹ d) / √χ²₂(0.999), C = σ_rel² / 2 · S + σ_c² I, S = `p.spread` with its eigenvalues raised to at
-/// least 1 (a point never scatters less than one recording) and σ_c = `p.sigma_m`. Above 1: beyond the bound.
+/// √(dᵀ C⁻¹ d) / √χ²₂(0.999), C = σ_rel² / 2 · S, S = `p.spread` with its eigenvalues raised to at least 1 (a
+/// point never scatters less than one recording). Above 1: beyond the bound.
 pub fn normalised_deviation(p: &ControlEvidence, d: Vector2<f64>, relative_sigma_m: f64) -> f64 {
     let eig = nalgebra::SymmetricEigen::new(p.spread);
-    let floored = eig.eigenvalues.map(|l| if l.is_finite() { l.max(1.0) } else { 1.0 });
+    let floored = eig
+        .eigenvalues
+        .map(|l| if l.is_finite() { l.max(1.0) } else { 1.0 });
     let s = eig.eigenvectors * Matrix2::from_diagonal(&floored) * eig.eigenvectors.transpose();
-    let c = s * (relative_sigma_m * relative_sigma_m / 2.0)
-        + Matrix2::identity() * (p.sigma_m * p.sigma_m);
+    let c = s * (relative_sigma_m * relative_sigma_m / 2.0);
     let m2 = c
         .try_inverse()
         .map_or(f64::INFINITY, |inv| (d.transpose() * inv * d)[(0, 0)]);
@@ -232,10 +234,6 @@ mod tests {
         let across = normalised_deviation(&p, Vector2::new(0.0, 1.1 * bound), 0.15);
         assert!((along - 2.5 / 3.0).abs() < 1e-9, "{along}");
         assert!((across - 1.1).abs() < 1e-9, "{across}");
-        // The control point's own σ widens the bound in every direction.
-        p.sigma_m = 0.15 / 2f64.sqrt();
-        let across = normalised_deviation(&p, Vector2::new(0.0, 1.1 * bound), 0.15);
-        assert!((across - 1.1 / 2f64.sqrt()).abs() < 1e-9, "{across}");
     }
 
     #[test]

@@ -311,7 +311,6 @@ pub fn build_block(
                     .as_ref()
                     .is_some_and(|m| m.score < config.weak_control_below),
                 spread: recording_spread(&block, &points[p].pano, sigma_px),
-                sigma_m: covariance_m2[(0, 0)].max(covariance_m2[(1, 1)]).max(0.0).sqrt(),
             });
         } else {
             counts.control_unused += 1;
@@ -333,8 +332,11 @@ pub fn build_block(
     if config.weak_control_sigma_estimated {
         let estimate = weak_control_sigma::estimate(&evidence, &selection.keep);
         if let Some(sigma_m) = estimate.sigma_m {
-            let given: Vec<Matrix3<f64>> =
-                block.control_points.iter().map(|c| c.covariance_m2).collect();
+            let given: Vec<Matrix3<f64>> = block
+                .control_points
+                .iter()
+                .map(|c| c.covariance_m2)
+                .collect();
             let raised =
                 weak_control_sigma::weak_covariances(&evidence, &selection.keep, &given, sigma_m);
             for (c, cov) in block.control_points.iter_mut().zip(raised) {

@@ -31,8 +31,6 @@ pub struct ControlEvidence {
     /// recording i (the identity for a point fixed by one recording; stretched along the rays for two nearly
     /// parallel rays, whose intersection moves farther than either recording).
     pub spread: Matrix2<f64>,
-    /// The control point's own horizontal σ per axis (its stated accuracy), m.
-    pub sigma_m: f64,
 }
 
 /// Component-wise median of `v` (not empty).
@@ -115,7 +113,6 @@ pub(crate) fn test_point(c: [f64; 2], recordings: &[usize], weak: bool) -> Contr
         recordings: recordings.to_vec(),
         weak,
         spread: Matrix2::identity(),
-        sigma_m: 0.0,
     }
 }
 

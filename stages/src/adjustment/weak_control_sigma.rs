@@ -147,7 +147,11 @@ mod tests {
             point([0.8, 0.1], &[6, 7], true),
             point([0.8, 0.1], &[8, 9], true),
         ];
-        let stated = Matrix3::from_diagonal(&nalgebra::Vector3::new(0.03f64.powi(2), 0.03f64.powi(2), 0.0025));
+        let stated = Matrix3::from_diagonal(&nalgebra::Vector3::new(
+            0.03f64.powi(2),
+            0.03f64.powi(2),
+            0.0025,
+        ));
         let mut keep = vec![true; pts.len()];
         keep[5] = false;
         let c = weak_covariances(&pts, &keep, &[stated; 6], 0.1);
