@@ -149,9 +149,10 @@ crate::params! {
         weak_control_below: f64 = 0.75, min 0.0, max 1.0;
         /// Check every control point, strong or weak, against the control of the other recordings within
         /// this many recordings before and after it (`adjustment::control_consistency`): a point whose
-        /// correction differs from their median correction by more than 2.63 × the relative σ (the 99.9 %
-        /// quantile of the recordings' scatter about a common correction) is not used as control (counted in
-        /// `build.inconsistent_control_dropped`); absent = no check.
+        /// correction differs from their median correction by more than the 99.9 % bound of its own scatter
+        /// about a common correction (2.63 × the relative σ for a point of one recording, wider along the rays
+        /// of a point whose triangulation the recordings' errors move farther) is not used as control
+        /// (counted in `build.inconsistent_control_dropped`); absent = no check.
         control_consistency_window: Option<usize> = None, min 1;
         /// Measure the σ of weak orthophoto control (peak below `weak_control_below`) against the strong
         /// control of the same recordings and weight the weak points with it
