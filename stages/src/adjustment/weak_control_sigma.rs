@@ -9,8 +9,10 @@
 //! peak, but the campaign measures it: two control points observed from the same recording imply the same
 //! correction of it up to their own errors (the recording's error is common to both), so where a recording
 //! observes strong and weak control, each weak point's correction minus the median correction of the strong
-//! points of its recordings is a sample of the weak points' error (plus the strong median's, small). The RMS
-//! of those differences per axis is the weak points' σ ([`estimate`]).
+//! points of its recordings is a sample of the weak points' error (plus the strong median's, small, and the
+//! part of the recordings' relative errors by which two points triangulated from different recordings differ,
+//! which the adjustment removes and so makes the estimate an upper bound). The RMS of those differences per
+//! axis is the weak points' σ ([`estimate`]).
 //!
 //! With it, each weak point's horizontal σ becomes at least that σ; and because a recording's weak peaks are
 //! displaced alike, the weak points observed first from one recording count together as one observation of
