@@ -125,6 +125,9 @@ fn build_metrics(r: &AdjustmentRun) -> serde_json::Value {
         if !r.config.extrapolation_anchor {
             m.remove("extrapolation_anchors");
         }
+        if !r.config.weak_control_sigma_estimated {
+            m.remove("weak_control_sigma");
+        }
     }
     v
 }

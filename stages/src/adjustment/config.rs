@@ -149,10 +149,18 @@ crate::params! {
         weak_control_below: f64 = 0.75, min 0.0, max 1.0;
         /// Check every control point, strong or weak, against the control of the other recordings within
         /// this many recordings before and after it (`adjustment::control_consistency`): a point whose
-        /// correction differs from their median correction by more than 2.63 × the relative σ (the 99.9 %
-        /// quantile of the recordings' scatter about a common correction) is not used as control (counted in
-        /// `build.inconsistent_control_dropped`); absent = no check.
+        /// correction differs from their median correction by more than the 99.9 % bound of its own scatter
+        /// about a common correction (2.63 × the relative σ for a point of one recording, wider along the rays
+        /// of a point whose triangulation the recordings' errors move farther) is not used as control
+        /// (counted in `build.inconsistent_control_dropped`); absent = no check.
         control_consistency_window: Option<usize> = None, min 1;
+        /// Measure the σ of weak orthophoto control (peak below `weak_control_below`) against the strong
+        /// control of the same recordings and weight the weak points with it
+        /// (`adjustment::weak_control_sigma`): each weak point's horizontal σ becomes at least the RMS
+        /// difference per axis between weak points' corrections and the strong control's of their recordings,
+        /// and the weak points first seen from one recording count as one observation (σ × √their number),
+        /// because a recording's weak peaks are displaced alike. Reported in `build.weak_control_sigma`.
+        weak_control_sigma_estimated: bool = false;
         /// Tie each recording before the first or after the last recording with control directly to that
         /// recording (`adjustment::extrapolation_anchor`): the recorded difference between the two is kept
         /// with σ = the relative σ × k^`extrapolation_anchor_growth` for a recording k recordings away, so

@@ -22,6 +22,7 @@ use super::problem::{
 };
 use super::relative_noise::RelativeSigma;
 use super::weak_control::ControlEvidence;
+use super::weak_control_sigma::{self, WeakSigmaEstimate};
 use crate::campaign::{AerialImage, AerialKind, Recording};
 use crate::correspondence::{AerialControlPoint, MmTiePoint};
 use crate::crs::MapFrame;
@@ -33,7 +34,7 @@ use std::collections::HashMap;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("adjust", "9");
+pub const STAGE: StageId = StageId::new("adjust", "10");
 
 /// The inputs of one adjustment.
 #[derive(Clone, Copy, Debug)]
@@ -114,6 +115,9 @@ pub struct BuildCounts {
     pub inconsistent_control_dropped: usize,
     /// Recordings beyond the first or last recording with control tied to it (`extrapolation_anchor`).
     pub extrapolation_anchors: usize,
+    /// The weak control's σ measured against the strong control of the same recordings
+    /// (`weak_control_sigma_estimated`; `None` when off).
+    pub weak_control_sigma: Option<WeakSigmaEstimate>,
 }
 
 /// A block with the names of its unknowns.
@@ -288,10 +292,11 @@ pub fn build_block(
             .point_world
             .filter(|_| cp.aerial.len() >= 2 || cp.map.is_some())
         {
+            let covariance_m2 = control_covariance(config, cp, &owner)?;
             block.control_points.push(ControlPoint {
                 point: p,
                 position_world: Vector3::from(xyz),
-                covariance_m2: control_covariance(config, cp, &owner)?,
+                covariance_m2,
             });
             counts.control_as_gcp += 1;
             let initial = block.points_initial_world[p];
@@ -305,6 +310,7 @@ pub fn build_block(
                     .map
                     .as_ref()
                     .is_some_and(|m| m.score < config.weak_control_below),
+                spread: recording_spread(&block, &points[p].pano, sigma_px),
             });
         } else {
             counts.control_unused += 1;
@@ -323,6 +329,22 @@ pub fn build_block(
     );
     counts.weak_control_dropped = selection.weak;
     counts.inconsistent_control_dropped = selection.inconsistent;
+    if config.weak_control_sigma_estimated {
+        let estimate = weak_control_sigma::estimate(&evidence, &selection.keep);
+        if let Some(sigma_m) = estimate.sigma_m {
+            let given: Vec<Matrix3<f64>> = block
+                .control_points
+                .iter()
+                .map(|c| c.covariance_m2)
+                .collect();
+            let raised =
+                weak_control_sigma::weak_covariances(&evidence, &selection.keep, &given, sigma_m);
+            for (c, cov) in block.control_points.iter_mut().zip(raised) {
+                c.covariance_m2 = cov;
+            }
+        }
+        counts.weak_control_sigma = Some(estimate);
+    }
     if selection.keep.contains(&false) {
         drop_control(&mut block, &mut points, &selection.keep, &mut counts);
     }
@@ -672,6 +694,60 @@ fn relative_constraints(
             sigma_m,
         })
         .collect()
+}
+
+/// How the recordings' errors spread the horizontal position triangulated from the panorama observations
+/// `pano` (recording, u, v) with the recorded poses, relative to one recording's error: Σᵢ JᵢJᵢᵀ,
+/// Jᵢ = ∂(x, y)/∂(recording i's x, y) of the triangulated point (finite differences of 1 cm). The identity
+/// for a point of one recording (it moves with it) or one that cannot be triangulated.
+fn recording_spread(
+    block: &Block,
+    pano: &[(usize, f64, f64)],
+    sigma_px: &[f64],
+) -> nalgebra::Matrix2<f64> {
+    const STEP_M: f64 = 0.01;
+    let one = nalgebra::Matrix2::identity();
+    let mut recordings: Vec<usize> = pano.iter().map(|o| o.0).collect();
+    recordings.sort_unstable();
+    recordings.dedup();
+    if recordings.len() < 2 {
+        return one;
+    }
+    let triangulate = |shift: Option<(usize, Vector3<f64>)>| {
+        let rays: Vec<_> = pano
+            .iter()
+            .map(|&(r, u, v)| {
+                let mut ray = block.recordings[r].camera.pixel_ray(u, v);
+                if let Some((_, d)) = shift.filter(|s| s.0 == r) {
+                    ray.origin_world += d;
+                }
+                ray
+            })
+            .collect();
+        let sigmas: Vec<f64> = pano
+            .iter()
+            .map(|&(r, _, _)| block.recordings[r].camera.angular_sigma_rad(sigma_px[r]))
+            .collect();
+        triangulate_rays(&rays, &sigmas).ok().map(|t| t.point_world)
+    };
+    let Some(base) = triangulate(None) else {
+        return one;
+    };
+    let mut sum = nalgebra::Matrix2::<f64>::zeros();
+    for &r in &recordings {
+        let mut j = nalgebra::Matrix2::<f64>::zeros();
+        for axis in 0..2 {
+            let mut d = Vector3::zeros();
+            d[axis] = STEP_M;
+            let Some(moved) = triangulate(Some((r, d))) else {
+                return one;
+            };
+            j[(0, axis)] = (moved.x - base.x) / STEP_M;
+            j[(1, axis)] = (moved.y - base.y) / STEP_M;
+        }
+        sum += j * j.transpose();
+    }
+    sum
 }
 
 /// Initial coordinates of a point from its panorama rays with the recorded poses, else `fallback`.

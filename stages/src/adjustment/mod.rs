@@ -16,6 +16,7 @@
 //! in the campaign's tangent frame and its results back in map coordinates), [`from_correspondences`]
 //! (correspondences → block → [`AdjustmentRun`]), [`height_observation`] (recording heights from a terrain
 //! model), [`weak_control`] (weak orthophoto control checked against the strong control along the trajectory),
+//! [`weak_control_sigma`] (weak control weighted by its σ measured against the strong control),
 //! [`control_consistency`] (every control point checked against the neighbouring recordings' control),
 //! [`extrapolation_anchor`] (recordings beyond the outermost control tied to its correction),
 //! [`second_pass`] (the shifted inputs of a second registration pass around the adjusted trajectory),
@@ -56,6 +57,7 @@ pub mod synthetic_streets;
 pub mod trajectory_errors;
 pub mod verify;
 pub mod weak_control;
+pub mod weak_control_sigma;
 pub mod weighting;
 
 pub use adjust::{adjust, AdjustedRecording, Adjustment, ObservationCounts, RoundReport};

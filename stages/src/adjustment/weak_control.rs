@@ -15,7 +15,7 @@
 //! Strong control is frame control (triangulated from aerial images) and orthophoto control whose peak is
 //! at least `weak_control_below`. Without strong control anywhere, nothing is checked.
 
-use nalgebra::Vector2;
+use nalgebra::{Matrix2, Vector2};
 
 /// One control point as the check sees it.
 #[derive(Clone, Debug, PartialEq)]
@@ -26,6 +26,11 @@ pub struct ControlEvidence {
     pub recordings: Vec<usize>,
     /// Whether it is weak (an orthophoto peak below the threshold).
     pub weak: bool,
+    /// How the recordings' own errors spread this correction, relative to one recording's error (per axis,
+    /// σ²): Σᵢ JᵢJᵢᵀ, Jᵢ the horizontal change of the triangulated point per metre of horizontal shift of
+    /// recording i (the identity for a point fixed by one recording; stretched along the rays for two nearly
+    /// parallel rays, whose intersection moves farther than either recording).
+    pub spread: Matrix2<f64>,
 }
 
 /// Component-wise median of `v` (not empty).
@@ -107,6 +112,7 @@ pub(crate) fn test_point(c: [f64; 2], recordings: &[usize], weak: bool) -> Contr
         correction_m: Vector2::new(c[0], c[1]),
         recordings: recordings.to_vec(),
         weak,
+        spread: Matrix2::identity(),
     }
 }
 
