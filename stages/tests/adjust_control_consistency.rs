@@ -6,7 +6,7 @@
 
 use skytie_stages::adjustment::control_consistency::tolerance_m;
 use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
-use skytie_stages::adjustment::{run, AdjustConfig, AdjustmentRun, SyntheticBlockSpec};
+use skytie_stages::adjustment::{run, AdjustConfig, SyntheticBlockSpec};
 use skytie_stages::export::{recording_support, Support};
 
 /// Relative σ between consecutive recordings the tests state, metres.
@@ -37,36 +37,17 @@ fn config() -> AdjustConfig {
     }
 }
 
-/// The recordings (indices) a control point is observed from.
-fn observed_from(c: &SyntheticCampaign, k: usize) -> Vec<usize> {
-    c.control[k]
-        .mm
-        .iter()
-        .map(|o| {
-            c.recordings
-                .iter()
-                .position(|r| r.image_id == o.image_id)
-                .expect("a generated recording")
-        })
-        .collect()
-}
-
-/// Horizontal distance of each adjusted recording from the truth, metres.
-fn errors_m(run: &AdjustmentRun, c: &SyntheticCampaign) -> Vec<f64> {
-    run.recordings
-        .iter()
-        .zip(&c.truth.true_centers_world)
-        .map(|(r, t)| (r.adjusted_world[0] - t.x).hypot(r.adjusted_world[1] - t.y))
-        .collect()
-}
-
 #[test]
 fn control_wrong_together_on_neighbouring_recordings_is_not_used() {
     let mut c = campaign(0.05, 0.0, 5);
     // Every control point seen only from recordings 19–22 is moved 0.5 m east: strong, and consistent with
     // the others of its stretch — a template matched at a wrong place by several recordings.
     let wrong: Vec<usize> = (0..c.control.len())
-        .filter(|&k| observed_from(&c, k).iter().all(|r| (19..=22).contains(r)))
+        .filter(|&k| {
+            c.control_observed_from(k)
+                .iter()
+                .all(|r| (19..=22).contains(r))
+        })
         .collect();
     assert!(wrong.len() >= 2, "{wrong:?}");
     for &k in &wrong {
@@ -82,7 +63,10 @@ fn control_wrong_together_on_neighbouring_recordings_is_not_used() {
         },
     )
     .unwrap();
-    let (before, after) = (errors_m(&plain, &c), errors_m(&checked, &c));
+    let (before, after) = (
+        c.horizontal_errors_m(&plain),
+        c.horizontal_errors_m(&checked),
+    );
     let worst = |e: &[f64]| e[19..=22].iter().copied().fold(0.0, f64::max);
     println!(
         "recordings 19–22: worst error {:.3} m unchecked, {:.3} m checked (tolerance {:.3} m)",
@@ -132,7 +116,10 @@ fn a_stretch_beyond_the_last_control_keeps_its_correction_and_stays_flagged() {
         .iter()
         .all(|s| s.support == Support::Extrapolated));
     assert_eq!(anchored.build.extrapolation_anchors, tail.len());
-    let (before, after) = (errors_m(&plain, &c), errors_m(&anchored, &c));
+    let (before, after) = (
+        c.horizontal_errors_m(&plain),
+        c.horizontal_errors_m(&anchored),
+    );
     let rms = |e: &[f64]| (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt();
     println!(
         "stretch after recording {last}: RMS error {:.3} m by the tie-point chain, {:.3} m anchored; controlled \

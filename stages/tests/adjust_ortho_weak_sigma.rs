@@ -5,7 +5,7 @@
 //! it instead of following its weak control.
 
 use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
-use skytie_stages::adjustment::{run, AdjustConfig, AdjustmentRun, SyntheticBlockSpec};
+use skytie_stages::adjustment::{run, AdjustConfig, SyntheticBlockSpec};
 use skytie_stages::correspondence::{HeightSource, MapControl};
 
 /// The displacement of every weak control point (north), metres.
@@ -30,20 +30,6 @@ fn campaign() -> SyntheticCampaign {
     .generate()
 }
 
-/// The recordings (indices) a control point is observed from.
-fn observed_from(c: &SyntheticCampaign, k: usize) -> Vec<usize> {
-    c.control[k]
-        .mm
-        .iter()
-        .map(|o| {
-            c.recordings
-                .iter()
-                .position(|r| r.image_id == o.image_id)
-                .expect("a generated recording")
-        })
-        .collect()
-}
-
 /// Marks control point `k` as an orthophoto peak with correlation `score`, moved north by `offset_m`.
 fn as_orthophoto(c: &mut SyntheticCampaign, k: usize, score: f64, offset_m: f64) {
     let cp = &mut c.control[k];
@@ -57,15 +43,6 @@ fn as_orthophoto(c: &mut SyntheticCampaign, k: usize, score: f64, offset_m: f64)
     cp.aerial.clear();
     let p = cp.point_world.as_mut().expect("triangulated");
     p[1] += offset_m;
-}
-
-/// Horizontal distance of each adjusted recording from the truth, metres.
-fn errors_m(run: &AdjustmentRun, c: &SyntheticCampaign) -> Vec<f64> {
-    run.recordings
-        .iter()
-        .zip(&c.truth.true_centers_world)
-        .map(|(r, t)| (r.adjusted_world[0] - t.x).hypot(r.adjusted_world[1] - t.y))
-        .collect()
 }
 
 fn config() -> AdjustConfig {
@@ -85,7 +62,7 @@ fn weak_control_displaced_alike_is_weighted_by_its_measured_sigma() {
     let mut weak_in_stretch = 0;
     let mut elsewhere = 0;
     for k in 0..c.control.len() {
-        let recs = observed_from(&c, k);
+        let recs = c.control_observed_from(k);
         if recs.iter().any(|r| stretch.contains(r)) {
             if recs.iter().all(|r| stretch.contains(r)) {
                 as_orthophoto(&mut c, k, 0.6, WEAK_OFFSET_M);
@@ -125,7 +102,10 @@ fn weak_control_displaced_alike_is_weighted_by_its_measured_sigma() {
         "{sigma}"
     );
     assert!(plain.build.weak_control_sigma.is_none());
-    let (before, after) = (errors_m(&plain, &c), errors_m(&weighted, &c));
+    let (before, after) = (
+        c.horizontal_errors_m(&plain),
+        c.horizontal_errors_m(&weighted),
+    );
     let rms = |e: &[f64]| (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt();
     let (b, a) = (rms(&before[10..=17]), rms(&after[10..=17]));
     println!("recordings 10–17: RMS error {b:.3} m with the stated σ, {a:.3} m with the measured σ ({sigma:.3} m)");

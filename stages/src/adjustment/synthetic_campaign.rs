@@ -74,6 +74,28 @@ impl SyntheticCampaign {
             heights: None,
         }
     }
+
+    /// The recordings (indices into `recordings`) that observe control point `k`.
+    pub fn control_observed_from(&self, k: usize) -> Vec<usize> {
+        self.control[k]
+            .mm
+            .iter()
+            .filter_map(|o| {
+                self.recordings
+                    .iter()
+                    .position(|r| r.image_id == o.image_id)
+            })
+            .collect()
+    }
+
+    /// Horizontal distance of each adjusted recording of `run` from its true position, metres.
+    pub fn horizontal_errors_m(&self, run: &super::AdjustmentRun) -> Vec<f64> {
+        run.recordings
+            .iter()
+            .zip(&self.truth.true_centers_world)
+            .map(|(r, t)| (r.adjusted_world[0] - t.x).hypot(r.adjusted_world[1] - t.y))
+            .collect()
+    }
 }
 
 /// `image_id` of recording `r`.
