@@ -55,6 +55,12 @@ impl<T> Shift<T> {
     }
 }
 
+impl<T> Default for Shift<T> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl<T: Shiftable + Artifact> Stage for Shift<T> {
     crate::nodes::stage_types!(T::STAGE, SummaryParams => T, inputs: (Handle<T>, Handle<PassShift>));
 
