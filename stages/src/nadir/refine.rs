@@ -322,6 +322,22 @@ fn search_template(
     (peak >= p.min_peak).then_some((dx, dy, peak))
 }
 
+/// The neighbour among `neighbours` that saw the corner of `view`, with that view's pixel in its ortho image.
+fn neighbour_view<'n, 'a>(
+    neighbours: &'n [NeighbourOrtho<'a>],
+    view: &super::registration::ViewGround,
+) -> Option<(&'n NeighbourOrtho<'a>, (f64, f64))> {
+    let nb = neighbours
+        .iter()
+        .find(|n| n.recording_id == view.recording_id)?;
+    let g = view.ground_world;
+    let px = nb
+        .ortho
+        .georef
+        .world_to_pixel(&Vector3::new(g[0], g[1], g[2]));
+    Some((nb, px))
+}
+
 /// A neighbouring recording's ortho image for the same aerial image (same GSD and orientation as the
 /// detecting recording's), for the parallax check.
 pub struct NeighbourOrtho<'a> {
@@ -426,17 +442,9 @@ pub fn refine_in_image(
             if p.max_parallax_share < 1.0 {
                 let views = window.neighbour_ground_world.get(i).map_or(&[][..], |v| v);
                 for view in views {
-                    let Some(nb) = neighbours
-                        .iter()
-                        .find(|n| n.recording_id == view.recording_id)
-                    else {
+                    let Some((nb, (u_n, v_n))) = neighbour_view(neighbours, view) else {
                         continue;
                     };
-                    let gv = view.ground_world;
-                    let (u_n, v_n) = nb
-                        .ortho
-                        .georef
-                        .world_to_pixel(&Vector3::new(gv[0], gv[1], gv[2]));
                     // The template's top-left corner, placed relative to the corner as the neighbour saw it.
                     let (nx0, ny0) = (u_n - (u_o - corner.0), v_n - (v_o - corner.1));
                     if parallax_share(&buf.template, nb.ortho, nx0, ny0, &mut buf.parallax)
@@ -595,17 +603,9 @@ fn view_disagreement_px(
         }
     }
     for view in views {
-        let Some(nb) = neighbours
-            .iter()
-            .find(|n| n.recording_id == view.recording_id)
-        else {
+        let Some((nb, (u_n, v_n))) = neighbour_view(neighbours, view) else {
             continue;
         };
-        let gv = view.ground_world;
-        let (u_n, v_n) = nb
-            .ortho
-            .georef
-            .world_to_pixel(&Vector3::new(gv[0], gv[1], gv[2]));
         // The neighbour's template: its top-left pixel placed like the detecting one's relative to the corner.
         let (nx0, ny0) = (u_n - (u_o - x0), v_n - (v_o - y0));
         let (ix0, iy0) = (nx0.round(), ny0.round());
