@@ -136,6 +136,27 @@ fn refine(
     refine_window(pair, &pair.window, aerial, initial, params)
 }
 
+/// Asserts that `after` keeps the matches of `before`, in order, except the one of tie point `dropped`.
+fn assert_exactly_dropped(
+    before: &AerialRefinement,
+    after: &AerialRefinement,
+    dropped: &str,
+    what: &str,
+) {
+    let kept: Vec<&str> = after
+        .matches
+        .iter()
+        .map(|m| m.tie_point_id.as_str())
+        .collect();
+    let expected: Vec<&str> = before
+        .matches
+        .iter()
+        .map(|m| m.tie_point_id.as_str())
+        .filter(|id| *id != dropped)
+        .collect();
+    assert_eq!(kept, expected, "{what}");
+}
+
 /// [`refine`] of any window over `pair`'s ortho image.
 fn refine_window(
     pair: &Pair,
@@ -385,14 +406,12 @@ fn the_view_check_drops_exactly_the_corner_whose_template_shows_content_at_anoth
     );
     let r = refine_window(&pair, &window, &pair.aerial, off, &checked);
     assert_eq!(r.view_inconsistent, 1);
-    let kept: Vec<&str> = r.matches.iter().map(|m| m.tie_point_id.as_str()).collect();
-    let expected: Vec<&str> = clean
-        .matches
-        .iter()
-        .map(|m| m.tie_point_id.as_str())
-        .filter(|id| *id != target)
-        .collect();
-    assert_eq!(kept, expected, "exactly the perturbed corner is dropped");
+    assert_exactly_dropped(
+        &clean,
+        &r,
+        &target,
+        "exactly the perturbed corner is dropped",
+    );
 }
 
 #[test]
@@ -427,14 +446,12 @@ fn the_tie_point_consistency_drops_exactly_the_corner_whose_mm_point_is_off() {
     window.tie_points[k].point_world[0] += 0.25;
     let r = refine_window(&pair, &window, &pair.aerial, off, &checked);
     assert_eq!(r.point_inconsistent, 1);
-    let kept: Vec<&str> = r.matches.iter().map(|m| m.tie_point_id.as_str()).collect();
-    let expected: Vec<&str> = clean
-        .matches
-        .iter()
-        .map(|m| m.tie_point_id.as_str())
-        .filter(|id| *id != target)
-        .collect();
-    assert_eq!(kept, expected, "exactly the inconsistent corner is dropped");
+    assert_exactly_dropped(
+        &clean,
+        &r,
+        &target,
+        "exactly the inconsistent corner is dropped",
+    );
     // The locations themselves do not change.
     for m in &r.matches {
         let c = clean
