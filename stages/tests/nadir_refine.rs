@@ -309,22 +309,18 @@ fn a_tie_point_located_alone_in_an_image_is_not_kept_unless_min_located_is_1() {
         .take(2)
         .map(|m| tie_index(&m.tie_point_id))
         .collect();
-    let window_of_ids = |ids: &[usize]| {
-        let mut w = pair.window.clone();
-        w.tie_points = ids
-            .iter()
-            .map(|&i| pair.window.tie_points[i].clone())
-            .collect();
-        w.ground_world = ids.iter().map(|&i| pair.window.ground_world[i]).collect();
-        w.neighbour_ground_world = ids.iter().map(|_| Vec::new()).collect();
-        w
-    };
     let run = |ids: &[usize], min_located: usize| {
         let q = RefineParams {
             min_located,
             ..p.clone()
         };
-        refine_window(&pair, &window_of_ids(ids), &pair.aerial, pair.truth, &q)
+        refine_window(
+            &pair,
+            &window_of_ids(&pair, ids),
+            &pair.aerial,
+            pair.truth,
+            &q,
+        )
     };
     let two = run(&keep, 2);
     assert_eq!((two.tried, two.matches.len(), two.unconfirmed), (2, 2, 0));

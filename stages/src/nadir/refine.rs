@@ -53,7 +53,7 @@ use nalgebra::{Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("refine", "10");
+pub const STAGE: StageId = StageId::new("refine", "11");
 
 /// Taper applied before the Fourier transform (serialisable mirror of [`WindowKind`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -119,11 +119,12 @@ crate::params! {
         point_sigma_px: f64 = 0.0, unit "px", min 0.0, max 10.0;
         /// Rejection bound of the tie-point consistency in σ (√χ²₂: 2.45 keeps 95 % of correct corners).
         point_k_sigma: f64 = 2.45, min 1.0, max 100.0;
-        /// Tie-point consistency with σ measured per aerial image: with three or more located corners, σ is the
-        /// larger of `point_sigma_px` and the robust spread of the image's differences about their median
-        /// (median distance / √(2 ln 2), the Rayleigh median). Errors that do not shift every corner alike —
-        /// a heading error, tie points triangulated from drifting neighbours, unknown lens distortion — widen
-        /// the spread of correct corners, and the bound follows them instead of dropping them.
+        /// Tie-point consistency with σ measured per aerial image: σ is the larger of `point_sigma_px` and the
+        /// robust spread of the image's differences about their median (median distance / √(2 ln 2), the
+        /// Rayleigh median); with fewer than three located corners there is no spread to measure and all are
+        /// kept. Errors that do not shift every corner alike — a heading error, tie points triangulated from
+        /// drifting neighbours, unknown lens distortion — widen the spread of correct corners, and the bound
+        /// follows them instead of dropping them.
         point_sigma_estimated: bool = false;
     }
 }
@@ -528,14 +529,17 @@ pub fn refine_in_image(
         let residuals = point_residuals_px(&result.matches, window, mm_ortho, &tf);
         // σ in working pixels; the residuals are in full-resolution pixels.
         let floor_px = p.point_sigma_px * aerial_window.window.scale();
+        // With σ measured, fewer than three corners have no spread to measure: they are kept, as a lone one is.
         let sigma_px = if p.point_sigma_estimated {
-            floor_px.max(robust_spread_px(&residuals).unwrap_or(0.0))
+            robust_spread_px(&residuals).map(|s| s.max(floor_px))
         } else {
-            floor_px
+            Some(floor_px)
         };
-        let bound_px = p.point_k_sigma * sigma_px;
-        result.matches =
-            consistent_residuals(std::mem::take(&mut result.matches), &residuals, bound_px);
+        if let Some(sigma_px) = sigma_px {
+            let bound_px = p.point_k_sigma * sigma_px;
+            result.matches =
+                consistent_residuals(std::mem::take(&mut result.matches), &residuals, bound_px);
+        }
         result.point_inconsistent = before - result.matches.len();
     }
     if p.max_shift_spread_px > 0.0 {
