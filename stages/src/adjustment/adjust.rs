@@ -229,7 +229,7 @@ fn solve_with_rejection(
             for (i, o) in prep.aerial.iter().enumerate() {
                 if o.active {
                     let value = prep
-                        .aerial_whitened(i, &state)
+                        .aerial_whitened(i, state)
                         .map_or(f64::INFINITY, |(r, _)| r.amax());
                     offer(o.point, value, Candidate::Aerial(i));
                 }

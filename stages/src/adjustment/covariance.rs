@@ -27,6 +27,9 @@ pub struct RecordingCovariances {
     pub redundancy: i64,
 }
 
+/// A-priori cross-covariance blocks over (x, y, z, ψ) of pairs of recordings, `None` where not computed.
+pub type CrossCovariances = Vec<Option<Matrix4<f64>>>;
+
 /// Computes [`RecordingCovariances`] at the solution `state`.
 pub fn recording_covariances(
     prep: &Prepared,
@@ -42,7 +45,7 @@ pub fn recording_covariances_with_pairs(
     prep: &Prepared,
     state: &State,
     pairs: &[(usize, usize)],
-) -> Result<(RecordingCovariances, Vec<Option<Matrix4<f64>>>), AdjustError> {
+) -> Result<(RecordingCovariances, CrossCovariances), AdjustError> {
     let lin = linearize(prep, state);
     let mut system = ReducedSystem::new(prep);
     system.reduce(prep, &lin, 0.0).map_err(|e| match e {
