@@ -8,12 +8,15 @@
 //! the same for every weighting method), the pixel residual of an aerial observation in units of its σ_px and
 //! the whitened coordinate residual `L⁻¹·e` of a control point. We do
 //! not divide by σ̂0 (exact synthetic data would make it 0) nor by the redundancy numbers (they would need the
-//! full inverse). Priors and relative constraints are never rejected.
+//! full inverse). Priors and relative constraints are never rejected; with
+//! [`AdjustOptions::relative_release_threshold`] the relative constraints that the evidence contradicts are
+//! widened before the adjustment ([`super::relative_release`]).
 
-use super::covariance::recording_covariances;
+use super::covariance::{recording_covariances, recording_covariances_with_pairs};
 use super::error::AdjustError;
 use super::prepared::{Prepared, Rejected};
 use super::problem::{AdjustOptions, Block};
+use super::relative_release::{release, Evidence};
 use super::residuals::{pano_residual, State};
 use super::solver::{solve, SolveReport, Termination};
 use nalgebra::Vector3;
@@ -83,6 +86,9 @@ pub struct Adjustment {
     /// Panorama observations unused in the final solve although not rejected (undetermined point, or
     /// weight 0 under weighting method 2).
     pub unused_pano: usize,
+    /// Relative constraints whose σ was widened because the evidence contradicts their step
+    /// ([`AdjustOptions::relative_release_threshold`]; 0 without).
+    pub released_relative: usize,
 }
 
 /// Adjusts `block` with `options`.
@@ -91,85 +97,20 @@ pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, Adju
     options.validate()?;
     let mut state = State::initial(block).ok_or(AdjustError::NoRecordings)?;
     let origin = state.origin;
-    let mut rejected = Rejected::none(block);
-    let mut rounds = Vec::new();
-    let max_rounds = if options.rejection_threshold.is_some() {
-        options.max_rejection_rounds + 1
-    } else {
-        1
+    let released_block;
+    let mut released_relative = 0;
+    let threshold = options
+        .relative_release_threshold
+        .filter(|_| !block.relative_constraints.is_empty());
+    let block = match threshold.and_then(|t| release_contradicted(block, options, &state, t)) {
+        Some((relaxed, released)) => {
+            released_relative = released;
+            released_block = relaxed;
+            &released_block
+        }
+        None => block,
     };
-    let mut prep;
-    loop {
-        prep = Prepared::new(block, options, &state, &rejected)?;
-        let report = solve(&prep, &mut state, &options.lm)?;
-        let mut round = RoundReport {
-            solve: report,
-            rejected_pano: 0,
-            rejected_control: 0,
-            rejected_aerial: 0,
-        };
-        if let Some(k) = options
-            .rejection_threshold
-            .filter(|_| rounds.len() + 1 < max_rounds)
-        {
-            // Per tie point, only its worst observation above k is rejected per round (one gross error at a
-            // time, as in data snooping): a gross error also inflates the residuals of the other rays of
-            // its point, which must not be rejected with it.
-            let mut worst: Vec<Option<(f64, Candidate)>> = vec![None; prep.point_active.len()];
-            let mut offer = |point: usize, value: f64, candidate: Candidate| {
-                if value > k && worst[point].is_none_or(|(w, _)| value > w) {
-                    worst[point] = Some((value, candidate));
-                }
-            };
-            for (i, o) in prep.pano.iter().enumerate() {
-                if o.active {
-                    offer(
-                        o.point,
-                        pano_normalised(&prep, i, &state),
-                        Candidate::Pano(i),
-                    );
-                }
-            }
-            for (i, o) in prep.aerial.iter().enumerate() {
-                if o.active {
-                    let value = prep
-                        .aerial_whitened(i, &state)
-                        .map_or(f64::INFINITY, |(r, _)| r.amax());
-                    offer(o.point, value, Candidate::Aerial(i));
-                }
-            }
-            for (i, c) in prep.control.iter().enumerate() {
-                if c.active {
-                    offer(
-                        c.point,
-                        prep.control_whitened(i, &state).amax(),
-                        Candidate::Control(i),
-                    );
-                }
-            }
-            for (_, candidate) in worst.into_iter().flatten() {
-                match candidate {
-                    Candidate::Pano(i) => {
-                        rejected.pano[i] = true;
-                        round.rejected_pano += 1;
-                    }
-                    Candidate::Control(i) => {
-                        rejected.control[i] = true;
-                        round.rejected_control += 1;
-                    }
-                    Candidate::Aerial(i) => {
-                        rejected.aerial[i] = true;
-                        round.rejected_aerial += 1;
-                    }
-                }
-            }
-        }
-        let done = round.rejected_pano + round.rejected_control + round.rejected_aerial == 0;
-        rounds.push(round);
-        if done {
-            break;
-        }
-    }
+    let (prep, rejected, rounds) = solve_with_rejection(block, options, &mut state)?;
     let cov = recording_covariances(&prep, &state)?;
     let recordings = (0..block.recordings.len())
         .map(|c| {
@@ -235,7 +176,148 @@ pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, Adju
         rejected_control,
         rejected_aerial,
         rounds,
+        released_relative,
     })
+}
+
+/// Solve with LM from `state`, reject the worst observation per tie point above the threshold, re-solve, until
+/// nothing is rejected or the round limit is reached.
+fn solve_with_rejection(
+    block: &Block,
+    options: &AdjustOptions,
+    state: &mut State,
+) -> Result<(Prepared, Rejected, Vec<RoundReport>), AdjustError> {
+    let mut rejected = Rejected::none(block);
+    let mut rounds = Vec::new();
+    let max_rounds = if options.rejection_threshold.is_some() {
+        options.max_rejection_rounds + 1
+    } else {
+        1
+    };
+    let mut prep;
+    loop {
+        prep = Prepared::new(block, options, state, &rejected)?;
+        let report = solve(&prep, state, &options.lm)?;
+        let mut round = RoundReport {
+            solve: report,
+            rejected_pano: 0,
+            rejected_control: 0,
+            rejected_aerial: 0,
+        };
+        if let Some(k) = options
+            .rejection_threshold
+            .filter(|_| rounds.len() + 1 < max_rounds)
+        {
+            // Per tie point, only its worst observation above k is rejected per round (one gross error at a
+            // time, as in data snooping): a gross error also inflates the residuals of the other rays of
+            // its point, which must not be rejected with it.
+            let mut worst: Vec<Option<(f64, Candidate)>> = vec![None; prep.point_active.len()];
+            let mut offer = |point: usize, value: f64, candidate: Candidate| {
+                if value > k && worst[point].is_none_or(|(w, _)| value > w) {
+                    worst[point] = Some((value, candidate));
+                }
+            };
+            for (i, o) in prep.pano.iter().enumerate() {
+                if o.active {
+                    offer(
+                        o.point,
+                        pano_normalised(&prep, i, state),
+                        Candidate::Pano(i),
+                    );
+                }
+            }
+            for (i, o) in prep.aerial.iter().enumerate() {
+                if o.active {
+                    let value = prep
+                        .aerial_whitened(i, state)
+                        .map_or(f64::INFINITY, |(r, _)| r.amax());
+                    offer(o.point, value, Candidate::Aerial(i));
+                }
+            }
+            for (i, c) in prep.control.iter().enumerate() {
+                if c.active {
+                    offer(
+                        c.point,
+                        prep.control_whitened(i, state).amax(),
+                        Candidate::Control(i),
+                    );
+                }
+            }
+            for (_, candidate) in worst.into_iter().flatten() {
+                match candidate {
+                    Candidate::Pano(i) => {
+                        rejected.pano[i] = true;
+                        round.rejected_pano += 1;
+                    }
+                    Candidate::Control(i) => {
+                        rejected.control[i] = true;
+                        round.rejected_control += 1;
+                    }
+                    Candidate::Aerial(i) => {
+                        rejected.aerial[i] = true;
+                        round.rejected_aerial += 1;
+                    }
+                }
+            }
+        }
+        let done = round.rejected_pano + round.rejected_control + round.rejected_aerial == 0;
+        rounds.push(round);
+        if done {
+            break;
+        }
+    }
+    Ok((prep, rejected, rounds))
+}
+
+/// [`super::relative_release`]: solves `block` without its relative constraints from `recorded`, and returns
+/// the block with the constraints that solution contradicts widened and how many were; `None` when that solve
+/// or its covariance fails (the adjustment then keeps the constraints as they are).
+fn release_contradicted(
+    block: &Block,
+    options: &AdjustOptions,
+    recorded: &State,
+    threshold: f64,
+) -> Option<(Block, usize)> {
+    let mut free = Block {
+        relative_constraints: Vec::new(),
+        ..block.clone()
+    };
+    let mut state = recorded.clone();
+    let (prep, _, _) = solve_with_rejection(&free, options, &mut state).ok()?;
+    let pairs: Vec<(usize, usize)> = block
+        .relative_constraints
+        .iter()
+        .map(|rc| (rc.from, rc.to))
+        .collect();
+    let (cov, cross) = recording_covariances_with_pairs(&prep, &state, &pairs).ok()?;
+    let evidence = Evidence {
+        state: &state,
+        recorded,
+        aerial: &aerial_evidence(&prep),
+        covariance: &cov.a_priori,
+        cross: &cross,
+        variance_scale: cov.variance_factor.map_or(1.0, |f| f.max(1.0)),
+    };
+    let out = release(block, &evidence, threshold);
+    free.relative_constraints = out.constraints;
+    Some((free, out.released))
+}
+
+/// Whether each recording observes, with an active observation, a tie point that has active aerial evidence
+/// (a control point or aerial image observations).
+fn aerial_evidence(prep: &Prepared) -> Vec<bool> {
+    let mut anchored = vec![false; prep.point_active.len()];
+    for c in prep.control.iter().filter(|c| c.active) {
+        anchored[c.point] = true;
+    }
+    for o in prep.aerial.iter().filter(|o| o.active) {
+        anchored[o.point] = true;
+    }
+    let mut out = vec![false; prep.recorded_local.len()];
+    for o in prep.pano.iter().filter(|o| o.active && anchored[o.point]) {
+        out[o.recording] = true;
+    }
+    out
 }
 
 /// An observation that may be rejected.

@@ -129,6 +129,13 @@ crate::params! {
         relative_loss_scale: f64 = 3.0, above 0.0;
         /// Consecutive recordings farther apart than this are not linked (a gap in the trajectory).
         relative_max_gap_m: f64 = 15.0, unit "m", above 0.0;
+        /// Release the relative constraints that the evidence contradicts beyond its uncertainty: the block is
+        /// solved without them first, and a constraint whose step that solution changes by a χ² statistic
+        /// (2 degrees of freedom, against σ² plus the solution's own variance of the step) above this value
+        /// gets the σ at which the statistic equals its expectation (`adjustment::relative_release`). A
+        /// smooth drift (a GNSS outage) does not show in the second differences the σ is estimated from.
+        /// Absent = every constraint keeps its σ.
+        relative_release_threshold: Option<f64> = None, above 0.0;
         /// Observe each recording's height as the campaign DTM's height under its recorded position plus
         /// its `camera_height`, with σ = √(the DTM's stated σ² + `camera_height_sigma_m`²), beside the
         /// recorded height's prior: it holds a recording's position along the rays of its control points.
@@ -217,6 +224,7 @@ impl AdjustConfig {
             weighting: self.weighting(),
             loss: robust_loss(self.loss, self.loss_scale),
             relative_loss: robust_loss(self.relative_loss, self.relative_loss_scale),
+            relative_release_threshold: self.relative_release_threshold,
             rejection_threshold: self.rejection_threshold,
             max_rejection_rounds: self.max_rejection_rounds,
             lm: LmOptions {

@@ -27,11 +27,25 @@ pub struct RecordingCovariances {
     pub redundancy: i64,
 }
 
+/// A-priori cross-covariance blocks over (x, y, z, ψ) of pairs of recordings, `None` where not computed.
+pub type CrossCovariances = Vec<Option<Matrix4<f64>>>;
+
 /// Computes [`RecordingCovariances`] at the solution `state`.
 pub fn recording_covariances(
     prep: &Prepared,
     state: &State,
 ) -> Result<RecordingCovariances, AdjustError> {
+    recording_covariances_with_pairs(prep, state, &[]).map(|(cov, _)| cov)
+}
+
+/// [`recording_covariances`] and, for each pair `(a, b)` of recordings, the a-priori cross-covariance block
+/// Cov(a, b) over (x, y, z, ψ) when it lies on the factor's structure (recordings that share tie points or are
+/// linked by a constraint), else `None`.
+pub fn recording_covariances_with_pairs(
+    prep: &Prepared,
+    state: &State,
+    pairs: &[(usize, usize)],
+) -> Result<(RecordingCovariances, CrossCovariances), AdjustError> {
     let lin = linearize(prep, state);
     let mut system = ReducedSystem::new(prep);
     system.reduce(prep, &lin, 0.0).map_err(|e| match e {
@@ -49,26 +63,31 @@ pub fn recording_covariances(
     let inverse = SelectedInverse::new(symbolic, &system.factor);
     let active = &prep.parameterization.active;
     let n_rec = prep.recorded_local.len();
-    let a_priori: Vec<Matrix4<f64>> = (0..n_rec)
-        .map(|c| {
-            let z = inverse.diagonal(symbolic, c);
-            Matrix4::from_fn(|i, j| {
-                if active.contains(&i) && active.contains(&j) {
-                    z[(i, j)]
-                } else {
-                    0.0
-                }
-            })
+    let masked = |z: Matrix4<f64>| {
+        Matrix4::from_fn(|i, j| {
+            if active.contains(&i) && active.contains(&j) {
+                z[(i, j)]
+            } else {
+                0.0
+            }
         })
+    };
+    let a_priori: Vec<Matrix4<f64>> = (0..n_rec)
+        .map(|c| masked(inverse.diagonal(symbolic, c)))
+        .collect();
+    let cross = pairs
+        .iter()
+        .map(|&(a, b)| inverse.get(symbolic, a, b).map(masked))
         .collect();
     let n = n_rec * active.len();
     let (sum_sq, components) = prep.plain_sum_of_squares(state);
     let unknowns = n + 3 * prep.point_active.iter().filter(|&&a| a).count();
     let redundancy = components as i64 - unknowns as i64;
     let variance_factor = (redundancy > 0).then(|| sum_sq / redundancy as f64);
-    Ok(RecordingCovariances {
+    let cov = RecordingCovariances {
         a_priori,
         variance_factor,
         redundancy,
-    })
+    };
+    Ok((cov, cross))
 }

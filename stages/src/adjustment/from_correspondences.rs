@@ -34,7 +34,7 @@ use std::collections::HashMap;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("adjust", "10");
+pub const STAGE: StageId = StageId::new("adjust", "11");
 
 /// The inputs of one adjustment.
 #[derive(Clone, Copy, Debug)]
@@ -848,6 +848,9 @@ pub fn run_in_frame(
         redundancy: adj.redundancy,
         rejection_rounds: adj.rounds.len(),
         build: build.counts,
-        relative_sigma: build.relative_sigma,
+        relative_sigma: RelativeSigma {
+            released: adj.released_relative,
+            ..build.relative_sigma
+        },
     })
 }

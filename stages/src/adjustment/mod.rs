@@ -45,6 +45,7 @@ pub mod parallel;
 pub mod prepared;
 pub mod problem;
 pub mod relative_noise;
+pub mod relative_release;
 pub mod residuals;
 pub mod robust;
 pub mod schur;

@@ -148,6 +148,9 @@ pub struct AdjustOptions {
     /// step of the recorded trajectory that the aerial evidence contradicts (a jump when GNSS is re-acquired,
     /// drift during an outage) linearly instead of quadratically.
     pub relative_loss: RobustLoss,
+    /// Widen the relative constraints whose step the solution without them contradicts, by a χ² statistic
+    /// (2 degrees of freedom) above this ([`super::relative_release`]); `None` = keep every σ.
+    pub relative_release_threshold: Option<f64>,
     /// Reject observations whose |normalised residual| exceeds this and re-solve (`None` = no rejection).
     pub rejection_threshold: Option<f64>,
     /// Largest number of rejection rounds (re-solves after rejections).
@@ -164,6 +167,7 @@ impl Default for AdjustOptions {
             weighting: ResidualWeighting::default(),
             loss: RobustLoss::Squared,
             relative_loss: RobustLoss::Squared,
+            relative_release_threshold: None,
             rejection_threshold: None,
             max_rejection_rounds: 10,
             lm: LmOptions::default(),
@@ -367,6 +371,15 @@ impl AdjustOptions {
                     field: "yaw_prior_sigma_deg",
                     value: s,
                     hint: "must be finite and > 0, or absent",
+                });
+            }
+        }
+        if let Some(t) = self.relative_release_threshold {
+            if !positive_finite(t) {
+                return Err(AdjustError::InvalidOption {
+                    field: "relative_release_threshold",
+                    value: t,
+                    hint: "must be finite and > 0 (e.g. 9.21, the 99 % quantile of χ² with 2 degrees of freedom), or absent",
                 });
             }
         }

@@ -47,6 +47,10 @@ pub struct RelativeSigma {
     pub source: RelativeSigmaSource,
     /// Consecutive triples the estimate used (0 when given).
     pub triples: usize,
+    /// Relative constraints whose σ the adjustment widened because the evidence contradicts their step
+    /// (`[adjust] relative_release_threshold`, `super::relative_release`).
+    #[serde(default)]
+    pub released: usize,
 }
 
 /// The stage default of a healthy GNSS/INS trajectory, used as such ([`RelativeSigmaSource::Default`]).
@@ -56,6 +60,7 @@ impl Default for RelativeSigma {
             sigma_m: DEFAULT_RELATIVE_SIGMA_M,
             source: RelativeSigmaSource::Default,
             triples: 0,
+            released: 0,
         }
     }
 }
@@ -69,6 +74,7 @@ impl RelativeSigma {
                 sigma_m,
                 source: RelativeSigmaSource::Given,
                 triples: 0,
+                released: 0,
             },
             None => estimate(recordings, max_gap_m),
         }
@@ -84,6 +90,7 @@ pub fn estimate(recordings: &[Recording], max_gap_m: f64) -> RelativeSigma {
             sigma_m: DEFAULT_RELATIVE_SIGMA_M,
             source: RelativeSigmaSource::Default,
             triples,
+            released: 0,
         };
     }
     let sigma_d = MAD_TO_SIGMA * median_absolute_deviation(cross_track);
@@ -91,6 +98,7 @@ pub fn estimate(recordings: &[Recording], max_gap_m: f64) -> RelativeSigma {
         sigma_m: (sigma_d / 3f64.sqrt()).max(MIN_RELATIVE_SIGMA_M),
         source: RelativeSigmaSource::Estimated,
         triples,
+        released: 0,
     }
 }
 
