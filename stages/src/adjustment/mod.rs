@@ -54,6 +54,7 @@ pub mod sparse;
 pub mod synthetic_block;
 pub mod synthetic_campaign;
 pub mod synthetic_streets;
+pub mod tie_point_heights;
 pub mod trajectory_errors;
 pub mod verify;
 pub mod weak_control;
