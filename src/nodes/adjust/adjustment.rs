@@ -27,6 +27,7 @@ use skytie_stages::export::{checkpoint_rows, recording_support, CheckPointRow, S
 use skytie_stages::nadir::{MmWindowMatch, RecordingControl};
 use skytie_stages::oblique::SparseCloud;
 use skytie_stages::orthophoto::Dtm;
+use std::collections::HashMap;
 use std::sync::Arc;
 
 /// σ of a check-point observation in the panorama, pixels (the synthetic campaigns add N(0, 0.5 px)).
@@ -281,12 +282,31 @@ impl Stage for AdjustStage {
         // the DTM, when asked for and the campaign has one.
         let nadir_tie_points: usize = windows.iter().map(|w| w.tie_points.len()).sum();
         let tie_point_heights = match (config.dtm_tie_heights, dtm.first(), &c.dtm) {
-            (true, Some(terrain), Some(source)) => Some(terrain_under_tie_points(
-                &tie_points,
-                |k| k < nadir_tie_points,
-                |x, y| terrain.height_at(x, y),
-                source.sigma_m,
-            )),
+            (true, Some(terrain), Some(source)) => {
+                // A tie point's XY comes from the recorded poses: it is as uncertain as the stated σ of the
+                // recording that sees it first.
+                let sigma_xy: HashMap<&str, f64> = c
+                    .recordings
+                    .iter()
+                    .map(|r| {
+                        let s = r.sigma_xy_m.unwrap_or(config.default_prior_sigma_xy_m);
+                        (r.image_id.as_str(), s)
+                    })
+                    .collect();
+                Some(terrain_under_tie_points(
+                    &tie_points,
+                    |k| k < nadir_tie_points,
+                    |x, y| terrain.height_at(x, y),
+                    source.sigma_m,
+                    |k| {
+                        tie_points[k]
+                            .observations
+                            .first()
+                            .and_then(|o| sigma_xy.get(o.image_id.as_str()).copied())
+                            .unwrap_or(0.0)
+                    },
+                ))
+            }
             _ => None,
         };
         let inputs = AdjustInputs {

@@ -74,7 +74,7 @@ pub use from_correspondences::{
 };
 pub use problem::{
     AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, HeightObservation,
-    LmOptions, PanoObservation, RelativeConstraint,
+    LmOptions, PanoObservation, PointHeight, RelativeConstraint,
 };
 pub use robust::RobustLoss;
 pub use solver::Termination;

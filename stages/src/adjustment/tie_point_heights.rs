@@ -14,8 +14,10 @@
 //!
 //! The DTM is sampled at the tie point's position triangulated with the recorded poses, like the recordings'
 //! heights at their recorded positions: both are off by the recordings' error alike, and on a 2 % slope a
-//! 0.8 m offset changes the terrain by 0.016 m. A tie point that is not on the ground (a kerb's edge) is
-//! reduced by the observations' robust loss. Points that are control already have the DTM's height in their
+//! 0.8 m offset changes the terrain by 0.016 m; but next to a kerb or on a verge the terrain changes by
+//! decimetres within that offset, so each height's σ also holds the terrain's largest change within the
+//! recorded poses' stated σ of the point ([`terrain_under_tie_points`]). A tie point that is not on the
+//! ground is reduced by the observations' robust loss. Points that are control already have the DTM's height in their
 //! control position and get no second one; the oblique sparse cloud's points (façades) get none.
 
 use super::from_correspondences::{BlockPoint, PointKind};
@@ -48,12 +50,16 @@ pub fn tie_point_heights(
 }
 
 /// Per tie point of `tie_points`, the terrain's height under it (`terrain_z_m` at its triangulated XY,
-/// `None` where the terrain has none) with σ `sigma_m`, for the points `on_ground` says are ground points.
+/// `None` where the terrain has none) for the points `on_ground` says are ground points. Its σ is
+/// √(`dtm_sigma_m`² + Δ²), Δ the largest change of the terrain within `sample_sigma_m(k)` (the horizontal σ of
+/// the position it is sampled at: the recorded poses' stated σ) east, west, north or south of it — on a
+/// kerb's or a verge's slope the height at a position off by that much is off by as much.
 pub fn terrain_under_tie_points(
     tie_points: &[MmTiePoint],
     on_ground: impl Fn(usize) -> bool,
     terrain_z_m: impl Fn(f64, f64) -> Option<f64>,
-    sigma_m: f64,
+    dtm_sigma_m: f64,
+    sample_sigma_m: impl Fn(usize) -> f64,
 ) -> Vec<Option<HeightObservation>> {
     tie_points
         .iter()
@@ -63,12 +69,52 @@ pub fn terrain_under_tie_points(
                 return None;
             }
             let [x, y, _] = tp.point_world;
-            terrain_z_m(x, y)
-                .filter(|z| z.is_finite())
-                .map(|z| HeightObservation {
-                    z_world: z,
-                    sigma_m,
-                })
+            let z = terrain_z_m(x, y).filter(|z| z.is_finite())?;
+            let s = sample_sigma_m(k);
+            let change = [(s, 0.0), (-s, 0.0), (0.0, s), (0.0, -s)]
+                .iter()
+                .filter_map(|(dx, dy)| terrain_z_m(x + dx, y + dy).filter(|v| v.is_finite()))
+                .map(|v| (v - z).abs())
+                .fold(0.0, f64::max);
+            Some(HeightObservation {
+                z_world: z,
+                sigma_m: dtm_sigma_m.hypot(change),
+            })
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tie_point(id: &str, x: f64, y: f64) -> MmTiePoint {
+        MmTiePoint {
+            id: id.to_string(),
+            observations: Vec::new(),
+            point_world: [x, y, 0.0],
+            covariance_m2: [[0.0; 3]; 3],
+            max_angle_deg: 10.0,
+        }
+    }
+
+    #[test]
+    fn the_sigma_grows_with_the_terrain_change_within_the_sampling_sigma() {
+        // A road at 10 m whose kerb rises 0.12 m at x = 5 (a sidewalk beyond), no terrain beyond x = 20.
+        let terrain = |x: f64, _y: f64| (x < 20.0).then_some(if x < 5.0 { 10.0 } else { 10.12 });
+        let tps = [
+            tie_point("road", 2.0, 0.0),
+            tie_point("near_kerb", 4.5, 0.0),
+            tie_point("facade", 3.0, 0.0),
+            tie_point("outside", 25.0, 0.0),
+        ];
+        let h = terrain_under_tie_points(&tps, |k| k != 2, terrain, 0.05, |_| 1.0);
+        let road = h[0].unwrap();
+        assert_eq!((road.z_world, road.sigma_m), (10.0, 0.05));
+        // 1 m east of the point near the kerb the terrain is 0.12 m higher: σ = √(0.05² + 0.12²) = 0.13.
+        let kerb = h[1].unwrap();
+        assert_eq!(kerb.z_world, 10.0);
+        assert!((kerb.sigma_m - 0.13).abs() < 1e-12, "{kerb:?}");
+        assert!(h[2].is_none() && h[3].is_none());
+    }
 }
