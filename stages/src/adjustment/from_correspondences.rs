@@ -21,7 +21,7 @@ use super::problem::{
     PanoObservation, RelativeConstraint,
 };
 use super::relative_noise::RelativeSigma;
-use super::tie_point_heights::tie_point_heights;
+use super::tie_point_heights::{controlled_recordings, tie_point_heights};
 use super::weak_control::ControlEvidence;
 use super::weak_control_sigma::{self, WeakSigmaEstimate};
 use crate::campaign::{AerialImage, AerialKind, Recording};
@@ -357,7 +357,9 @@ pub fn build_block(
         drop_control(&mut block, &mut points, &selection.keep, &mut counts);
     }
     if let (true, Some(heights)) = (config.dtm_tie_heights, inputs.tie_point_heights) {
-        block.point_heights = tie_point_heights(inputs.tie_points, heights, &point_index, &points);
+        let controlled = controlled_recordings(&block);
+        block.point_heights =
+            tie_point_heights(inputs.tie_points, heights, &point_index, &points, &controlled);
         counts.tie_point_heights = block.point_heights.len();
     }
     block.aerial_cameras = cameras
