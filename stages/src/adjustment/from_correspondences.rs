@@ -358,8 +358,13 @@ pub fn build_block(
     }
     if let (true, Some(heights)) = (config.dtm_tie_heights, inputs.tie_point_heights) {
         let controlled = controlled_recordings(&block);
-        block.point_heights =
-            tie_point_heights(inputs.tie_points, heights, &point_index, &points, &controlled);
+        block.point_heights = tie_point_heights(
+            inputs.tie_points,
+            heights,
+            &point_index,
+            &points,
+            &controlled,
+        );
         counts.tie_point_heights = block.point_heights.len();
     }
     block.aerial_cameras = cameras
