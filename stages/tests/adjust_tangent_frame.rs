@@ -84,6 +84,7 @@ impl Rows {
             nadir: &s.aerial,
             oblique: &[],
             heights: None,
+            tie_point_heights: None,
         }
     }
 }

@@ -18,6 +18,7 @@ use skytie_stages::adjustment::from_correspondences::{
     prior_sigmas_m, run_in_frame, AdjustInputs, AdjustmentRun,
 };
 use skytie_stages::adjustment::height_observation::{dtm_height_sigma_m, terrain_heights};
+use skytie_stages::adjustment::tie_point_heights::terrain_under_tie_points;
 use skytie_stages::adjustment::{RmseSummary, ViewSelection};
 use skytie_stages::correction::{widen_off_control_sigma, OffControlSigma};
 use skytie_stages::correspondence::{AerialControlPoint, MmTiePoint};
@@ -26,6 +27,7 @@ use skytie_stages::export::{checkpoint_rows, recording_support, CheckPointRow, S
 use skytie_stages::nadir::{MmWindowMatch, RecordingControl};
 use skytie_stages::oblique::SparseCloud;
 use skytie_stages::orthophoto::Dtm;
+use std::collections::HashMap;
 use std::sync::Arc;
 
 /// σ of a check-point observation in the panorama, pixels (the synthetic campaigns add N(0, 0.5 px)).
@@ -116,6 +118,9 @@ fn build_metrics(r: &AdjustmentRun) -> serde_json::Value {
     let mut v = serde_json::to_value(r.build).unwrap_or_default();
     if let Some(m) = v.as_object_mut() {
         m.remove("heights");
+        if !r.config.dtm_tie_heights {
+            m.remove("tie_point_heights");
+        }
         if r.config.weak_control_tolerance_m.is_none() {
             m.remove("weak_control_dropped");
         }
@@ -273,6 +278,37 @@ impl Stage for AdjustStage {
             )),
             _ => None,
         };
+        // The nadir matching's tie points (the first of `tie_points`) are ground points: their heights from
+        // the DTM, when asked for and the campaign has one.
+        let nadir_tie_points: usize = windows.iter().map(|w| w.tie_points.len()).sum();
+        let tie_point_heights = match (config.dtm_tie_heights, dtm.first(), &c.dtm) {
+            (true, Some(terrain), Some(source)) => {
+                // A tie point's XY comes from the recorded poses: it is as uncertain as the stated σ of the
+                // recording that sees it first.
+                let sigma_xy: HashMap<&str, f64> = c
+                    .recordings
+                    .iter()
+                    .map(|r| {
+                        let s = r.sigma_xy_m.unwrap_or(config.default_prior_sigma_xy_m);
+                        (r.image_id.as_str(), s)
+                    })
+                    .collect();
+                Some(terrain_under_tie_points(
+                    &tie_points,
+                    |k| k < nadir_tie_points,
+                    |x, y| terrain.height_at(x, y),
+                    source.sigma_m,
+                    |k| {
+                        tie_points[k]
+                            .observations
+                            .first()
+                            .and_then(|o| sigma_xy.get(o.image_id.as_str()).copied())
+                            .unwrap_or(0.0)
+                    },
+                ))
+            }
+            _ => None,
+        };
         let inputs = AdjustInputs {
             recordings: &c.recordings,
             pano_size_px: &sizes,
@@ -282,6 +318,7 @@ impl Stage for AdjustStage {
             nadir: &c.nadir,
             oblique: &c.oblique,
             heights: heights.as_deref(),
+            tie_point_heights: tie_point_heights.as_deref(),
         };
         // With aerial observations in the bundle, it runs in the campaign's Cartesian frame.
         let frame = MapFrame::from_spec(&campaign_frame_spec(c).0)

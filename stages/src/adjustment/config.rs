@@ -145,6 +145,13 @@ crate::params! {
         /// σ of a recording's camera height above the DTM's ground (mounting, tyres, the road surface
         /// against the DTM's), for `dtm_height`.
         camera_height_sigma_m: f64 = 0.02, unit "m", above 0.0;
+        /// Observe the height of the nadir matching's tie points (points of the road surface) seen from a
+        /// recording without control of its own as the campaign DTM's height under them, σ from the DTM's
+        /// stated σ and the terrain's change within the recorded poses' σ (`adjustment::tie_point_heights`):
+        /// two panoramas seeing the same ground points fix the direction of their baseline, not its length,
+        /// so such a recording is otherwise held along the trajectory by the relative constraints alone.
+        /// Without a `[dtm]` in the campaign no height is observed.
+        dtm_tie_heights: bool = false;
         /// Check weak orthophoto control against the strong control along the trajectory
         /// (`adjustment::weak_control`): a control point whose orthophoto correlation peak is below
         /// `weak_control_below` and whose correction (control XY − its XY from the recorded poses) differs by

@@ -21,6 +21,7 @@ use super::problem::{
     PanoObservation, RelativeConstraint,
 };
 use super::relative_noise::RelativeSigma;
+use super::tie_point_heights::{controlled_recordings, tie_point_heights};
 use super::weak_control::ControlEvidence;
 use super::weak_control_sigma::{self, WeakSigmaEstimate};
 use crate::campaign::{AerialImage, AerialKind, Recording};
@@ -58,6 +59,11 @@ pub struct AdjustInputs<'a> {
     /// terrain model ([`super::height_observation::terrain_heights`]), used with `dtm_height`; `None` when the
     /// campaign has no terrain model.
     pub heights: Option<&'a [Option<HeightObservation>]>,
+    /// Observed heights of the tie points (one per entry of `tie_points`, `None` where there is none: no
+    /// terrain there, or not a ground point) from the campaign's terrain model
+    /// ([`super::tie_point_heights::terrain_under_tie_points`]), used with `dtm_tie_heights`; `None` when the
+    /// campaign has no terrain model.
+    pub tie_point_heights: Option<&'a [Option<HeightObservation>]>,
 }
 
 /// What a tie-point unknown is.
@@ -115,6 +121,8 @@ pub struct BuildCounts {
     pub inconsistent_control_dropped: usize,
     /// Recordings beyond the first or last recording with control tied to it (`extrapolation_anchor`).
     pub extrapolation_anchors: usize,
+    /// Tie points whose height was observed from the terrain model (`dtm_tie_heights`).
+    pub tie_point_heights: usize,
     /// The weak control's σ measured against the strong control of the same recordings
     /// (`weak_control_sigma_estimated`; `None` when off).
     pub weak_control_sigma: Option<WeakSigmaEstimate>,
@@ -347,6 +355,17 @@ pub fn build_block(
     }
     if selection.keep.contains(&false) {
         drop_control(&mut block, &mut points, &selection.keep, &mut counts);
+    }
+    if let (true, Some(heights)) = (config.dtm_tie_heights, inputs.tie_point_heights) {
+        let controlled = controlled_recordings(&block);
+        block.point_heights = tie_point_heights(
+            inputs.tie_points,
+            heights,
+            &point_index,
+            &points,
+            &controlled,
+        );
+        counts.tie_point_heights = block.point_heights.len();
     }
     block.aerial_cameras = cameras
         .rows

@@ -16,7 +16,7 @@
 
 use super::adjust::Adjustment;
 use super::error::AdjustError;
-use super::problem::{Block, BlockRecording, ControlPoint, HeightObservation};
+use super::problem::{Block, BlockRecording, ControlPoint, HeightObservation, PointHeight};
 use crate::crs::{FrameError, MapFrame};
 use nalgebra::{Matrix3, Vector3};
 
@@ -56,6 +56,20 @@ pub fn block_to_local(block: &Block, frame: &MapFrame) -> Result<Block, AdjustEr
         })
         .collect::<Result<Vec<_>, FrameError>>()
         .map_err(frame_error)?;
+    // An observed point height is the frame's Z of the point at that height above its initial position.
+    let point_heights = block
+        .point_heights
+        .iter()
+        .map(|h| {
+            let mut p = block.points_initial_world[h.point];
+            p.z = h.z_world;
+            Ok(PointHeight {
+                z_world: frame.point_to_local(&p)?.z,
+                ..*h
+            })
+        })
+        .collect::<Result<Vec<_>, FrameError>>()
+        .map_err(frame_error)?;
     let points_initial_world = block
         .points_initial_world
         .iter()
@@ -88,6 +102,7 @@ pub fn block_to_local(block: &Block, frame: &MapFrame) -> Result<Block, AdjustEr
         relative_constraints: block.relative_constraints.clone(),
         aerial_cameras,
         aerial_observations: block.aerial_observations.clone(),
+        point_heights,
     })
 }
 

@@ -90,7 +90,7 @@ pub fn linearize(prep: &Prepared, state: &State) -> Linearization {
     }
 }
 
-/// Control points and aerial rays: they touch only their point (aerial cameras are fixed), so they enter
+/// Control points, aerial rays and observed point heights: they touch only their point (aerial cameras are fixed), so they enter
 /// the Schur complement through V alone.
 fn add_point_terms(
     prep: &Prepared,
@@ -118,6 +118,15 @@ fn add_point_terms(
         let w = prep.loss.weight(r.norm_squared());
         point_diag[o.point] += w * j.transpose() * j;
         point_rhs[o.point] -= w * j.transpose() * r;
+    }
+    for (i, h) in prep.point_heights.iter().enumerate() {
+        if !h.active {
+            continue;
+        }
+        let r = prep.point_height_whitened(i, state);
+        let w = prep.loss.weight(r * r);
+        point_diag[h.point][(2, 2)] += w * h.whitening * h.whitening;
+        point_rhs[h.point].z -= w * h.whitening * r;
     }
 }
 

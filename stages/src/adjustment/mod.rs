@@ -55,6 +55,7 @@ pub mod sparse;
 pub mod synthetic_block;
 pub mod synthetic_campaign;
 pub mod synthetic_streets;
+pub mod tie_point_heights;
 pub mod trajectory_errors;
 pub mod verify;
 pub mod weak_control;
@@ -74,7 +75,7 @@ pub use from_correspondences::{
 };
 pub use problem::{
     AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, HeightObservation,
-    LmOptions, PanoObservation, RelativeConstraint,
+    LmOptions, PanoObservation, PointHeight, RelativeConstraint,
 };
 pub use robust::RobustLoss;
 pub use solver::Termination;

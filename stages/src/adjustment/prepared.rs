@@ -41,6 +41,17 @@ pub struct PreparedControl {
     pub active: bool,
 }
 
+/// An observed tie-point height ready for evaluation.
+#[derive(Clone, Copy, Debug)]
+pub struct PreparedPointHeight {
+    pub point: usize,
+    /// Observed Z, local frame.
+    pub z_local: f64,
+    /// 1 / σ (m⁻¹): whitens the height residual.
+    pub whitening: f64,
+    pub active: bool,
+}
+
 /// An aerial image observation ready for evaluation (the aerial orientation is fixed).
 #[derive(Clone, Copy, Debug)]
 pub struct PreparedAerial {
@@ -71,6 +82,8 @@ pub struct Prepared {
     pub yaw_prior_sigma_rad: Option<f64>,
     pub pano: Vec<PreparedPano>,
     pub control: Vec<PreparedControl>,
+    /// Observed tie-point heights (inactive for undetermined points and horizontal-only solves).
+    pub point_heights: Vec<PreparedPointHeight>,
     /// Fixed aerial cameras in the local frame.
     pub aerial_cameras: Vec<FixedFrameCamera>,
     pub aerial: Vec<PreparedAerial>,
@@ -209,6 +222,7 @@ impl Prepared {
         for o in aerial.iter_mut() {
             o.active &= point_active[o.point];
         }
+        let point_heights = prepare_point_heights(block, state, &point_active, options)?;
         let layout = ObservationLayout::new(
             n_rec,
             n_pts,
@@ -255,6 +269,7 @@ impl Prepared {
                 .flatten(),
             pano,
             control,
+            point_heights,
             aerial_cameras,
             aerial,
             relative,
@@ -313,6 +328,12 @@ impl Prepared {
     pub fn control_whitened(&self, i: usize, state: &State) -> Vector3<f64> {
         let c = &self.control[i];
         c.whitening * (state.points_local[c.point] - c.position_local)
+    }
+
+    /// Whitened residual of observed point height `i`.
+    pub fn point_height_whitened(&self, i: usize, state: &State) -> f64 {
+        let h = &self.point_heights[i];
+        (state.points_local[h.point].z - h.z_local) * h.whitening
     }
 
     /// Whitened prior residuals of recording `c`: (axis, residual, 1/σ) for each prior axis, then its height
@@ -376,6 +397,11 @@ impl Prepared {
                 None => return f64::INFINITY,
             }
         }
+        for (i, h) in self.point_heights.iter().enumerate() {
+            if h.active {
+                total += self.loss.rho(self.point_height_whitened(i, state).powi(2));
+            }
+        }
         total += self.prior_terms_sum(state);
         for i in 0..self.relative.len() {
             total += self
@@ -433,6 +459,12 @@ impl Prepared {
                 }
             }
         }
+        for (i, h) in self.point_heights.iter().enumerate() {
+            if h.active {
+                total += self.point_height_whitened(i, state).powi(2);
+                count += 1;
+            }
+        }
         for c in 0..self.recorded_local.len() {
             count += self
                 .prior_terms(c, state)
@@ -446,6 +478,41 @@ impl Prepared {
         count += self.relative.len() * self.position_axes();
         (total, count)
     }
+}
+
+/// The block's observed point heights in the local frame of `state`, each active when its point is
+/// determined by its rays (a height alone does not determine a point) and the solve is not horizontal-only.
+fn prepare_point_heights(
+    block: &Block,
+    state: &State,
+    point_active: &[bool],
+    options: &AdjustOptions,
+) -> Result<Vec<PreparedPointHeight>, AdjustError> {
+    block
+        .point_heights
+        .iter()
+        .enumerate()
+        .map(|(index, h)| {
+            let invalid = |problem: &str| AdjustError::InvalidInput {
+                item: format!("point height {index}"),
+                problem: problem.to_string(),
+            };
+            let Some(initial) = block.points_initial_world.get(h.point) else {
+                return Err(invalid("names a point the block does not have"));
+            };
+            if !(h.sigma_m > 0.0 && h.sigma_m.is_finite() && h.z_world.is_finite()) {
+                return Err(invalid("height and σ must be finite, σ > 0"));
+            }
+            let mut p = *initial;
+            p.z = h.z_world;
+            Ok(PreparedPointHeight {
+                point: h.point,
+                z_local: state.origin.to_local(&p).z,
+                whitening: 1.0 / h.sigma_m,
+                active: point_active[h.point] && !options.horizontal_only,
+            })
+        })
+        .collect()
 }
 
 /// Observations removed by rejection rounds, per kind (indices as in the [`Block`]).

@@ -37,6 +37,17 @@ pub struct HeightObservation {
     pub sigma_m: f64,
 }
 
+/// An observed height of a tie point independent of the panoramas' rays (e.g. a terrain model's height under a
+/// point on the ground), with its standard deviation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointHeight {
+    pub point: usize,
+    /// Observed Z of the point, world frame, metres.
+    pub z_world: f64,
+    /// Standard deviation of `z_world`, metres.
+    pub sigma_m: f64,
+}
+
 /// A panorama observation of a tie point: continuous pixel (u, v) in recording `recording`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PanoObservation {
@@ -105,6 +116,8 @@ pub struct Block {
     pub aerial_cameras: Vec<FrameCamera>,
     /// Observations of tie points in the fixed aerial images.
     pub aerial_observations: Vec<AerialImageObservation>,
+    /// Observed heights of tie points (under the observations' robust loss; they do not determine a point).
+    pub point_heights: Vec<PointHeight>,
 }
 
 /// Levenberg–Marquardt settings and convergence criteria.

@@ -326,6 +326,7 @@ impl SyntheticBlockSpec {
                 relative_constraints: Vec::new(),
                 aerial_cameras: Vec::new(),
                 aerial_observations: Vec::new(),
+                point_heights: Vec::new(),
             },
             true_centers_world: true_centers,
             true_yaw_correction_deg: yaw_corr,

@@ -72,6 +72,7 @@ impl SyntheticCampaign {
             nadir: &self.nadir,
             oblique: &[],
             heights: None,
+            tie_point_heights: None,
         }
     }
 
