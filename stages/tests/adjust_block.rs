@@ -3,7 +3,7 @@
 
 use nalgebra::Vector3;
 use skytie_stages::adjustment::{
-    adjust, evaluate_checkpoints, AdjustOptions, Adjustment, RelativeConstraint, RobustLoss,
+    adjust, consecutive_constraints, evaluate_checkpoints, AdjustOptions, Adjustment, RobustLoss,
     SyntheticBlock, SyntheticBlockSpec, Termination, ViewSelection,
 };
 use skytie_stages::geometry::PanoramaCamera;
@@ -267,13 +267,7 @@ fn a_drifted_stretch_follows_its_control_with_a_cauchy_loss_on_the_relative_cons
             r.camera.center_world.x += 1.5 * (std::f64::consts::PI * t).sin().powi(2);
         }
     }
-    synth.block.relative_constraints = (1..n)
-        .map(|i| RelativeConstraint {
-            from: i - 1,
-            to: i,
-            sigma_m: 0.02,
-        })
-        .collect();
+    synth.block.relative_constraints = consecutive_constraints(n, 0.02);
     let before = max_initial_error_m(&synth);
     let error_with = |relative_loss| {
         let options = AdjustOptions {

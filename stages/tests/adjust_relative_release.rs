@@ -3,7 +3,7 @@
 //! and without a recording that has no evidence of its own inside the drift, and a trajectory without drift.
 
 use skytie_stages::adjustment::{
-    adjust, AdjustOptions, Adjustment, RelativeConstraint, RobustLoss, SyntheticBlock,
+    adjust, consecutive_constraints, AdjustOptions, Adjustment, RobustLoss, SyntheticBlock,
     SyntheticBlockSpec,
 };
 
@@ -48,13 +48,7 @@ fn outage_block(seed: u64) -> SyntheticBlock {
         }
     }
     let n = synth.block.recordings.len();
-    synth.block.relative_constraints = (1..n)
-        .map(|i| RelativeConstraint {
-            from: i - 1,
-            to: i,
-            sigma_m: SIGMA_REL_M,
-        })
-        .collect();
+    synth.block.relative_constraints = consecutive_constraints(n, SIGMA_REL_M);
     synth
 }
 
@@ -142,13 +136,7 @@ fn a_trajectory_without_drift_keeps_its_constraints() {
     };
     let mut synth = spec.generate();
     let n = synth.block.recordings.len();
-    synth.block.relative_constraints = (1..n)
-        .map(|i| RelativeConstraint {
-            from: i - 1,
-            to: i,
-            sigma_m: SIGMA_REL_M,
-        })
-        .collect();
+    synth.block.relative_constraints = consecutive_constraints(n, SIGMA_REL_M);
     let held = adjust(&synth.block, &options(false)).unwrap();
     let released = adjust(&synth.block, &options(true)).unwrap();
     assert_eq!(released.released_relative, 0);

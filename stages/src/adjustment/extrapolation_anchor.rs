@@ -20,6 +20,7 @@
 
 use super::config::AdjustConfig;
 use super::problem::{Block, RelativeConstraint};
+use super::tie_point_heights::controlled_recordings;
 use crate::campaign::Recording;
 
 /// The anchor constraints of `block` (its control points already chosen): a recording has control when it
@@ -31,20 +32,7 @@ pub fn tail_anchors(
     config: &AdjustConfig,
     relative_sigma_m: f64,
 ) -> Vec<RelativeConstraint> {
-    let mut is_control = vec![false; block.points_initial_world.len()];
-    for c in &block.control_points {
-        if let Some(flag) = is_control.get_mut(c.point) {
-            *flag = true;
-        }
-    }
-    let mut controlled = vec![false; block.recordings.len()];
-    for o in &block.pano_observations {
-        if is_control.get(o.point).copied().unwrap_or(false) {
-            if let Some(flag) = controlled.get_mut(o.recording) {
-                *flag = true;
-            }
-        }
-    }
+    let controlled = controlled_recordings(block);
     let linked: Vec<bool> = (0..recordings.len())
         .map(|i| {
             i > 0 && {

@@ -79,5 +79,5 @@ pub use problem::{
 };
 pub use robust::RobustLoss;
 pub use solver::Termination;
-pub use synthetic_block::{SyntheticBlock, SyntheticBlockSpec};
+pub use synthetic_block::{consecutive_constraints, SyntheticBlock, SyntheticBlockSpec};
 pub use weighting::{ResidualWeighting, WeightingMethod};

@@ -8,7 +8,7 @@
 //! recorded poses (as the pipeline would). Deterministic for a given seed.
 
 use super::evaluate::CheckObservation;
-use super::problem::{Block, BlockRecording, ControlPoint, PanoObservation};
+use super::problem::{Block, BlockRecording, ControlPoint, PanoObservation, RelativeConstraint};
 use crate::geometry::{triangulate_rays, PanoramaCamera};
 use crate::rng::SplitMix64;
 use nalgebra::Vector3;
@@ -339,4 +339,16 @@ impl SyntheticBlockSpec {
             recorded_attitude_deg,
         }
     }
+}
+
+/// Relative constraints of σ `sigma_m` between each of `n` recordings and the next, in order (a trajectory
+/// without gaps).
+pub fn consecutive_constraints(n: usize, sigma_m: f64) -> Vec<RelativeConstraint> {
+    (1..n)
+        .map(|i| RelativeConstraint {
+            from: i - 1,
+            to: i,
+            sigma_m,
+        })
+        .collect()
 }
