@@ -10,6 +10,7 @@
 //! rely on). Everything an adjust node reports is in [`AdjustmentRun`] (serde, so it can be cached).
 
 use super::adjust::{adjust, ObservationCounts};
+pub use super::block_point::{BlockPoint, PointKind};
 use super::config::{AdjustConfig, ControlWeighting};
 use super::control_consistency::select_control;
 use super::error::AdjustError;
@@ -64,29 +65,6 @@ pub struct AdjustInputs<'a> {
     /// ([`super::tie_point_heights::terrain_under_tie_points`]), used with `dtm_tie_heights`; `None` when the
     /// campaign has no terrain model.
     pub tie_point_heights: Option<&'a [Option<HeightObservation>]>,
-}
-
-/// What a tie-point unknown is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum PointKind {
-    /// MM tie point without aerial observations.
-    Tie,
-    /// Aerial control point seen in ≥ 2 aerial images.
-    Control,
-    /// Aerial control point seen in a single aerial image.
-    SingleAerial,
-}
-
-/// One tie-point unknown and its observations (indices into the run's recordings and aerial images).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct BlockPoint {
-    /// `MmTiePoint::id` / `AerialControlPoint::tie_point_id`.
-    pub id: String,
-    pub kind: PointKind,
-    /// (recording index, u, v) panorama pixels.
-    pub pano: Vec<(usize, f64, f64)>,
-    /// (aerial image index, u, v) aerial pixels (all aerial observations of the point, used or not).
-    pub aerial: Vec<(usize, f64, f64)>,
 }
 
 /// An aerial image referenced by the block.

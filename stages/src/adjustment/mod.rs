@@ -29,6 +29,7 @@
 
 pub mod adjust;
 pub mod aerial;
+pub mod block_point;
 pub mod campaign_checkpoints;
 pub mod config;
 pub mod control_consistency;

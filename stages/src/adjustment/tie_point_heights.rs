@@ -26,7 +26,7 @@
 //! ground is reduced by the observations' robust loss. Points that are control already have the DTM's height in their
 //! control position and get no second one; the oblique sparse cloud's points (façades) get none.
 
-use super::from_correspondences::{BlockPoint, PointKind};
+use super::block_point::{BlockPoint, PointKind};
 use super::problem::{Block, HeightObservation, PointHeight};
 use crate::correspondence::MmTiePoint;
 use std::collections::HashMap;
