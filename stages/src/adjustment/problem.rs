@@ -226,6 +226,22 @@ fn positive_finite(x: f64) -> bool {
     x.is_finite() && x > 0.0
 }
 
+/// An option that is absent or finite and > 0; otherwise the error naming `field` with `hint`.
+fn optional_positive(
+    field: &'static str,
+    value: Option<f64>,
+    hint: &'static str,
+) -> Result<(), AdjustError> {
+    match value {
+        Some(v) if !positive_finite(v) => Err(AdjustError::InvalidOption {
+            field,
+            value: v,
+            hint,
+        }),
+        _ => Ok(()),
+    }
+}
+
 impl Block {
     /// Checks indices, finiteness and positivity of all inputs; the error names the first bad item.
     pub fn validate(&self) -> Result<(), AdjustError> {
@@ -378,33 +394,21 @@ impl Block {
 impl AdjustOptions {
     /// Checks the numeric options.
     pub fn validate(&self) -> Result<(), AdjustError> {
-        if let Some(s) = self.yaw_prior_sigma_deg {
-            if !positive_finite(s) {
-                return Err(AdjustError::InvalidOption {
-                    field: "yaw_prior_sigma_deg",
-                    value: s,
-                    hint: "must be finite and > 0, or absent",
-                });
-            }
-        }
-        if let Some(t) = self.relative_release_threshold {
-            if !positive_finite(t) {
-                return Err(AdjustError::InvalidOption {
-                    field: "relative_release_threshold",
-                    value: t,
-                    hint: "must be finite and > 0 (e.g. 9.21, the 99 % quantile of χ² with 2 degrees of freedom), or absent",
-                });
-            }
-        }
-        if let Some(k) = self.rejection_threshold {
-            if !positive_finite(k) {
-                return Err(AdjustError::InvalidOption {
-                    field: "rejection_threshold",
-                    value: k,
-                    hint: "must be finite and > 0 (e.g. 3), or absent",
-                });
-            }
-        }
+        optional_positive(
+            "yaw_prior_sigma_deg",
+            self.yaw_prior_sigma_deg,
+            "must be finite and > 0, or absent",
+        )?;
+        optional_positive(
+            "relative_release_threshold",
+            self.relative_release_threshold,
+            "must be finite and > 0 (e.g. 9.21, the 99 % quantile of χ² with 2 degrees of freedom), or absent",
+        )?;
+        optional_positive(
+            "rejection_threshold",
+            self.rejection_threshold,
+            "must be finite and > 0 (e.g. 3), or absent",
+        )?;
         self.weighting.validate()?;
         self.loss.validate()?;
         self.relative_loss.validate()?;
