@@ -32,7 +32,7 @@ pub fn parse_age(text: &str) -> Result<Duration, String> {
 /// The key a node record (JSON) names: the roots of the remote collection.
 fn record_key(payload: &[u8]) -> Option<NodeKey> {
     let record: NodeRecord = serde_json::from_slice(payload).ok()?;
-    ContentHash::from_hex(&record.key).ok()
+    ContentHash::from_hex(&record.ran_with.key).ok()
 }
 
 /// Parses a size such as `10G`, `500M`, `1.5GiB`, `64k`, `0` or `123456` (bytes). Suffixes K, M, G, T are

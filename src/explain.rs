@@ -84,7 +84,7 @@ pub fn explain(session: &Session<'_>, query: &str) -> Result<String, String> {
                     let _ = writeln!(
                         out,
                         "last run  [{v}] key {} output {} ran {:.3} s, recorded at unix {} by skytie {}",
-                        rec.key, rec.output_hash, rec.seconds, rec.recorded_unix_s, rec.skytie_version
+                        rec.ran_with.key, rec.output_hash, rec.seconds, rec.recorded_unix_s, rec.skytie_version
                     );
                 }
                 None => {

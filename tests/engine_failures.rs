@@ -64,9 +64,9 @@ fn plan_says_a_node_failed_last_time_until_it_succeeds() {
     let store = Store::open(&cache).unwrap();
     let f: FailureRecord = record::load_failure(&store, "toy_scale[item_001]", "default").unwrap();
     assert_eq!(f.error, "toy failure injected on item item_001");
-    assert_eq!(f.key.len(), 64);
-    assert_eq!(f.stage_version, "1");
-    assert_eq!(f.params["faults"]["fail_item"], "item_001");
+    assert_eq!(f.ran_with.key.len(), 64);
+    assert_eq!(f.ran_with.stage_version, "1");
+    assert_eq!(f.ran_with.params["faults"]["fail_item"], "item_001");
     assert!(record::load_failure(&store, "toy_scale[item_000]", "default").is_none());
 
     // The fix is a param change: the plan names the failure and what changed since.

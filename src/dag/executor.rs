@@ -24,7 +24,7 @@ use crate::dag::inputs::{absent_hash, InputRef, InputValue, NodeId, RawFileValue
 use crate::dag::key::node_key;
 use crate::dag::node::{AnyValue, Node};
 use crate::dag::progress::Progress;
-use crate::dag::record::{self, NodeRecord, RecordedInput};
+use crate::dag::record::{self, Ingredients, NodeRecord, RecordedInput};
 use crate::dag::record_pack::{name_hash, PackWriter, RecordIndex};
 use crate::dag::stage::{dirs_root, tmp_dir_for, NodeCtx};
 pub use crate::dag::status::NodeStatus;
@@ -656,7 +656,7 @@ impl<'a> Exec<'a> {
             _ if self.mode == Mode::Plan => {
                 let prev = self.load_record(node, variant);
                 Check::WillRun(record::reasons(
-                    prev.as_ref(),
+                    prev.as_ref().map(|r| &r.ran_with),
                     node.version,
                     &node.params_json,
                     &self.recorded_now(id),
@@ -672,7 +672,12 @@ impl<'a> Exec<'a> {
         let node = &self.dag.nodes[id];
         let prev = self.load_record(node, variant);
         let recorded = self.recorded_now(id);
-        let mut why = record::reasons(prev.as_ref(), node.version, &node.params_json, &recorded);
+        let mut why = record::reasons(
+            prev.as_ref().map(|r| &r.ran_with),
+            node.version,
+            &node.params_json,
+            &recorded,
+        );
         why.retain(|w| !w.starts_with("same ingredients") && !w.starts_with("upstream will run"));
         if prev.is_some() {
             const SHOWN: usize = 5;
@@ -1002,12 +1007,14 @@ impl<'a> Exec<'a> {
         let Some(writer) = pack.as_mut() else { return };
         for variant in &node.variants {
             let rec = NodeRecord {
-                identity: identity.clone(),
-                variant: variant.clone(),
-                key: key.to_string(),
-                stage_version: node.version.to_string(),
-                params: (*node.params_json).clone(),
-                inputs: inputs.clone(),
+                ran_with: Ingredients {
+                    identity: identity.clone(),
+                    variant: variant.clone(),
+                    key: key.to_string(),
+                    stage_version: node.version.to_string(),
+                    params: (*node.params_json).clone(),
+                    inputs: inputs.clone(),
+                },
                 output_hash: hash.to_string(),
                 seconds,
                 recorded_unix_s: now_unix_s(),

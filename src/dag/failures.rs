@@ -3,7 +3,7 @@
 
 use crate::dag::builder::Dag;
 use crate::dag::executor::{recorded_inputs, NodeReport};
-use crate::dag::record::{save_failure, FailureRecord};
+use crate::dag::record::{save_failure, FailureRecord, Ingredients};
 use crate::dag::status::NodeStatus;
 use crate::store::Store;
 
@@ -24,16 +24,18 @@ pub fn save_failures(store: &Store, dag: &Dag, reports: &[NodeReport]) -> Result
             continue;
         };
         let failure = FailureRecord {
-            identity: report.identity.clone(),
-            variant: node
-                .variants
-                .first()
-                .cloned()
-                .unwrap_or_else(|| "default".to_string()),
-            key: report.key.map(|k| k.to_string()).unwrap_or_default(),
-            stage_version: node.version.to_string(),
-            params: (*node.params_json).clone(),
-            inputs: recorded_inputs(dag, reports, report.id),
+            ran_with: Ingredients {
+                identity: report.identity.clone(),
+                variant: node
+                    .variants
+                    .first()
+                    .cloned()
+                    .unwrap_or_else(|| "default".to_string()),
+                key: report.key.map(|k| k.to_string()).unwrap_or_default(),
+                stage_version: node.version.to_string(),
+                params: (*node.params_json).clone(),
+                inputs: recorded_inputs(dag, reports, report.id),
+            },
             error: error.clone(),
             recorded_unix_s: now,
             skytie_version: env!("CARGO_PKG_VERSION").to_string(),

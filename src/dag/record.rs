@@ -27,15 +27,25 @@ pub struct RecordedInput {
     pub hash: String,
 }
 
-/// The ingredients and provenance of a node's last successful run.
+/// What a node ran with: its identity and variant, the key of the attempt, and the ingredients of that key.
+/// Both the record of a success and that of a failure start with it (flattened: the JSON keeps one level).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct NodeRecord {
+pub struct Ingredients {
     pub identity: String,
     pub variant: String,
+    /// Key of the attempt (hex); empty when a node failed before its key was known (e.g. an input file could
+    /// not be read).
     pub key: String,
     pub stage_version: String,
     pub params: serde_json::Value,
     pub inputs: Vec<RecordedInput>,
+}
+
+/// The ingredients and provenance of a node's last successful run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NodeRecord {
+    #[serde(flatten)]
+    pub ran_with: Ingredients,
     pub output_hash: String,
     /// Seconds the stage ran when it was computed (0 if it was found in the cache by this run).
     pub seconds: f64,
@@ -47,37 +57,13 @@ pub struct NodeRecord {
 /// A node's last failed run: the error and the ingredients it failed with.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FailureRecord {
-    pub identity: String,
-    pub variant: String,
-    /// Key of the failed attempt (hex); empty when the node failed before its key was known (e.g. an input
-    /// file could not be read).
-    pub key: String,
-    pub stage_version: String,
-    pub params: serde_json::Value,
-    pub inputs: Vec<RecordedInput>,
+    #[serde(flatten)]
+    pub ran_with: Ingredients,
     /// The stage's error (or panic) message.
     pub error: String,
     /// When the failure was recorded, seconds since the Unix epoch.
     pub recorded_unix_s: u64,
     pub skytie_version: String,
-}
-
-impl FailureRecord {
-    /// The ingredients of the failed attempt as a [`NodeRecord`], to compare with through [`reasons`].
-    fn as_ingredients(&self) -> NodeRecord {
-        NodeRecord {
-            identity: self.identity.clone(),
-            variant: self.variant.clone(),
-            key: self.key.clone(),
-            stage_version: self.stage_version.clone(),
-            params: self.params.clone(),
-            inputs: self.inputs.clone(),
-            output_hash: String::new(),
-            seconds: 0.0,
-            recorded_unix_s: self.recorded_unix_s,
-            skytie_version: self.skytie_version.clone(),
-        }
-    }
 }
 
 /// Record name of a node identity in a variant.
@@ -103,7 +89,7 @@ pub fn record_in(
     variant: &str,
 ) -> Option<NodeRecord> {
     let rec: NodeRecord = serde_json::from_slice(&index.record_bytes(identity, variant)?).ok()?;
-    (rec.identity == identity && rec.variant == variant).then_some(rec)
+    (rec.ran_with.identity == identity && rec.ran_with.variant == variant).then_some(rec)
 }
 
 /// A record of its own of node `identity` in `variant` (as [`save_record`] writes, and earlier versions did
@@ -124,7 +110,7 @@ pub fn any_failure_recorded(store: &Store) -> bool {
 /// recorded for the node is removed (it succeeded since).
 pub fn save_record(store: &Store, record: &NodeRecord) -> Result<(), String> {
     let bytes = serde_json::to_vec(record).map_err(|e| e.to_string())?;
-    let name = record_name(&record.identity, &record.variant);
+    let name = record_name(&record.ran_with.identity, &record.ran_with.variant);
     store
         .put_record(NODES_NS, &name, &bytes)
         .map_err(|e| e.to_string())?;
@@ -144,7 +130,7 @@ pub fn save_failure(store: &Store, failure: &FailureRecord) -> Result<(), String
     store
         .put_record(
             FAILURES_NS,
-            &record_name(&failure.identity, &failure.variant),
+            &record_name(&failure.ran_with.identity, &failure.ran_with.variant),
             &bytes,
         )
         .map_err(|e| e.to_string())
@@ -161,14 +147,9 @@ pub fn failure_reasons(
     let first_line = failure.error.lines().next().unwrap_or_default();
     let mut why = vec![format!("failed last time: {first_line}")];
     why.extend(
-        reasons(
-            Some(&failure.as_ingredients()),
-            stage_version,
-            params,
-            inputs,
-        )
-        .into_iter()
-        .filter(|w| !w.starts_with("same ingredients")),
+        reasons(Some(&failure.ran_with), stage_version, params, inputs)
+            .into_iter()
+            .filter(|w| !w.starts_with("same ingredients")),
     );
     why
 }
@@ -188,7 +169,7 @@ pub fn save_output_hash(store: &Store, key: &NodeKey, hash: &ContentHash) -> Res
 /// Why a node whose key is not in the cache will run, compared with its last record. `upstream_changed`
 /// lists the identities of upstream nodes that will run or whose output changed.
 pub fn reasons(
-    previous: Option<&NodeRecord>,
+    previous: Option<&Ingredients>,
     stage_version: &str,
     params: &serde_json::Value,
     inputs: &[RecordedInput],
@@ -261,7 +242,7 @@ mod tests {
 
     #[test]
     fn reasons_name_version_param_and_input() {
-        let prev = NodeRecord {
+        let prev = Ingredients {
             identity: "s[i]".into(),
             variant: "default".into(),
             key: "k".into(),
@@ -272,10 +253,6 @@ mod tests {
                 source: "file a.txt".into(),
                 hash: "h1".into(),
             }],
-            output_hash: "o".into(),
-            seconds: 0.0,
-            recorded_unix_s: 0,
-            skytie_version: "0".into(),
         };
         let inputs = vec![RecordedInput {
             label: "0".into(),

@@ -215,7 +215,7 @@ pub fn check_complete(
         let failed_before = report.key.is_some_and(|key| {
             let variant = node.variants.first().map_or("default", String::as_str);
             load_failure(env.store, &report.identity, variant)
-                .is_some_and(|f| f.key == key.to_string())
+                .is_some_and(|f| f.ran_with.key == key.to_string())
         });
         tainted[id] = failed_before || node.upstream_ids().iter().any(|&u| tainted[u]);
         let (Some(o), NodeStatus::WillRun { .. }) = (owner[id], &report.status) else {
