@@ -10,6 +10,8 @@
 //! `correspondences.csv` of the result folder, the campaign's images and (optionally) `truth/`.
 
 pub mod canvas;
+mod nadir_view;
+mod oblique_view;
 pub mod truth;
 
 use super::html::Page;
@@ -17,30 +19,19 @@ use super::image_cache::ImageCache;
 use super::inputs::{read_csv_opt, CsvTable, ResultSet};
 use super::tables::{fmt_count, Origin, Table};
 use super::{slug, Builder};
-use canvas::{
-    crop_scaled, line, resample_on_ground, ring, side_by_side, Black, Rgb, BLUE, GREEN, RED, YELLOW,
-};
+use canvas::{Rgb, BLUE, GREEN, RED, YELLOW};
+use nadir_view::nadir_view;
 use nalgebra::Vector3;
-use skytie_stages::campaign::read_aerial_csv;
+use oblique_view::{load_oblique_truth, load_scene, oblique_view};
 use skytie_stages::campaign::{
     read_campaign, read_recordings_csv, AerialImage, Campaign, Recording,
 };
-use skytie_stages::correspondence::PanoObservation;
-use skytie_stages::geometry::{FrameCamera, PanoramaCamera};
-use skytie_stages::imaging::equirect::PanoramaLevels;
 use skytie_stages::imaging::image::RgbImage;
 use skytie_stages::imaging::io::{dimensions, save_rgb};
-use skytie_stages::imaging::partial::{PartialPyramid, Region};
-use skytie_stages::imaging::pyramid::layout::MAX_LEVELS;
-use skytie_stages::imaging::pyramid::{footprint_level, PyramidLayout, ScaledWindow, TileSource};
-use skytie_stages::nadir::ortho::panorama_bands;
-use skytie_stages::nadir::{ortho_project, OrthoGeoref, OrthoImage, OrthoParams};
-use skytie_stages::oblique::grading::Truth as StageTruth;
-use skytie_stages::synth::scene_truth::{SceneOracle, SceneTruth, SCENE_TRUTH_FILE};
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 use std::sync::{Arc, Mutex};
-use truth::{oblique_verdict, true_point, verdict, ObliqueTruth, TruePanoObservation, Verdict};
+use truth::{true_point, ObliqueTruth, TruePanoObservation, Verdict};
 
 /// One observation row of correspondences.csv.
 #[derive(Clone, Debug)]
@@ -432,314 +423,6 @@ fn save(path: &Path, img: &RgbImage) -> Result<(), String> {
     save_rgb(path, img, 90).map_err(|e| e.to_string())
 }
 
-/// Ortho image | aerial nadir crop of the same ground.
-fn nadir_view(
-    ctx: &Context<'_>,
-    rec: &Recording,
-    points: &[&ControlPoint],
-    out: &Path,
-) -> Result<(String, ViewCounts), String> {
-    let aerial_id = best_aerial(points, "nadir").ok_or("no nadir observation")?;
-    let aerial = ctx
-        .aerial("nadir", &aerial_id)
-        .ok_or_else(|| format!("nadir image {aerial_id} is not in the campaign"))?;
-    let (ortho, pano_size) =
-        ortho_of_panorama(&ctx.campaign.root.join("mm/panoramas").join(&rec.file), rec)?;
-    let g = &ortho.georef;
-    let left = crop_scaled(
-        &ortho.image,
-        0.0,
-        0.0,
-        g.width_px as f64,
-        g.height_px as f64,
-        1.0,
-    );
-    let cam = FrameCamera::from_aerial(aerial);
-    cam.project_world(&Vector3::from(g.foot_world))
-        .ok_or("the recording is not in front of the aerial camera")?;
-    // The aerial side on the same north-up ground grid as the ortho image (each pixel's ground point projected
-    // into the aerial image), so both halves share orientation and scale and the lines run side to side.
-    let project = |c: f64, r: f64| cam.project_world(&g.pixel_to_world(c, r));
-    let aerial_path = ctx.aerial_path("nadir", aerial);
-    let right = match ground_window(ctx.images, &aerial_path, aerial, g, &project)? {
-        Some(window) => resample_on_ground(window.as_ref(), g.width_px, g.height_px, project),
-        None => resample_on_ground(&Black, g.width_px, g.height_px, project),
-    };
-    let gap = 12;
-    let mut img = side_by_side(&left, &right, gap);
-    let x_off = (left.width + gap) as f64;
-    let pano_cam = PanoramaCamera::from_recording(rec, pano_size.0 as u32, pano_size.1 as u32);
-    let ground_z = rec.z - rec.camera_height_m;
-    let mut counts = ViewCounts::default();
-    for p in points {
-        let Some(mo) = p.pano.iter().find(|o| o.image_id == rec.image_id) else {
-            continue;
-        };
-        let Some(ao) = p
-            .aerial
-            .iter()
-            .find(|o| o.kind == "nadir" && o.image_id == aerial_id)
-        else {
-            continue;
-        };
-        let Some(ground) =
-            truth::ground_intersection(&pano_cam.pixel_ray(mo.u_px, mo.v_px), ground_z)
-        else {
-            continue;
-        };
-        let a = g.world_to_pixel(&ground);
-        // The aerial observation on the same ground grid: its ray meets the ortho plane.
-        let Some(aerial_ground) =
-            truth::ground_intersection(&cam.pixel_ray(ao.u_px, ao.v_px), g.foot_world[2])
-        else {
-            continue;
-        };
-        let (bu, bv) = g.world_to_pixel(&aerial_ground);
-        let bpt = (x_off + bu, bv);
-        let x = ctx.true_point(p);
-        let colour = counts.add(verdict(x.as_ref(), aerial, ao.u_px, ao.v_px));
-        line(&mut img, a, bpt, colour, 1);
-        ring(&mut img, a, 7.0, colour);
-        ring(&mut img, bpt, 7.0, colour);
-    }
-    save(out, &img)?;
-    Ok((aerial_id, counts))
-}
-
-/// The recording's north-up ortho image at the default ortho parameters, from the bands of the panorama at
-/// `path` that the projection samples (the panorama is decoded once; only those bands are kept), and the
-/// panorama's size in pixels.
-fn ortho_of_panorama(path: &Path, rec: &Recording) -> Result<(OrthoImage, (usize, usize)), String> {
-    let params = OrthoParams::default();
-    let bands_of = |layout: &PyramidLayout| {
-        panorama_bands(
-            rec,
-            &params,
-            (layout.width, layout.height),
-            layout.levels() - 1,
-        )
-    };
-    let pyramid = PartialPyramid::decode(path, |layout| {
-        bands_of(layout)
-            .into_iter()
-            .map(|(level, (v0, v1))| Region::window(level, [0.0, v0, layout.width as f64, v1]))
-            .collect()
-    })
-    .map_err(|e| e.to_string())?;
-    let layout = pyramid.layout();
-    let panorama = PanoramaLevels::read_bands(&pyramid, &bands_of(layout))
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    let size = (layout.width, layout.height);
-    drop(pyramid);
-    Ok((ortho_project(&panorama, rec, &params), size))
-}
-
-/// The window of the aerial image at `path` that the ground grid `g` projects into (`project`: ortho pixel
-/// centre → full-resolution aerial pixel), at the pyramid level matching an ortho pixel's footprint in the
-/// aerial image; `None` when the grid misses the image.
-fn ground_window(
-    images: &ImageCache,
-    path: &Path,
-    aerial: &AerialImage,
-    g: &OrthoGeoref,
-    project: &dyn Fn(f64, f64) -> Option<(f64, f64)>,
-) -> Result<Option<Arc<ScaledWindow>>, String> {
-    let (cx, cy) = (g.width_px as f64 / 2.0, g.height_px as f64 / 2.0);
-    let footprint_px = match (project(cx, cy), project(cx + 1.0, cy)) {
-        (Some(a), Some(b)) => (b.0 - a.0).hypot(b.1 - a.1),
-        _ => 1.0,
-    };
-    let level = footprint_level(1.0, footprint_px, MAX_LEVELS);
-    let margin = 2.0 * (1u64 << level) as f64;
-    let (w, h) = (aerial.width_px as f64, aerial.height_px as f64);
-    let mut b: Option<[f64; 4]> = None;
-    for r in 0..g.height_px {
-        for c in 0..g.width_px {
-            let Some((u, v)) = project(c as f64 + 0.5, r as f64 + 0.5) else {
-                continue;
-            };
-            if u < -margin || v < -margin || u > w + margin || v > h + margin {
-                continue;
-            }
-            let x = b.get_or_insert([u, v, u, v]);
-            *x = [x[0].min(u), x[1].min(v), x[2].max(u), x[3].max(v)];
-        }
-    }
-    let Some([u0, v0, u1, v1]) = b else {
-        return Ok(None);
-    };
-    images.window(
-        path,
-        level,
-        [u0 - margin, v0 - margin, u1 + margin, v1 + margin],
-    )
-}
-
-/// The crop (x0, y0, w, h) of the image at `path` scaled by `scale` ([`crop_scaled`]), read at the pyramid
-/// level matching an output pixel's footprint.
-fn crop_of(
-    images: &ImageCache,
-    path: &Path,
-    (x0, y0, w, h): (f64, f64, f64, f64),
-    scale: f64,
-) -> Result<RgbImage, String> {
-    let level = footprint_level(1.0, 1.0 / scale, MAX_LEVELS);
-    let margin = 2.0 * (1u64 << level) as f64;
-    let b = [x0 - margin, y0 - margin, x0 + w + margin, y0 + h + margin];
-    Ok(match images.window(path, level, b)? {
-        Some(window) => crop_scaled(window.as_ref(), x0, y0, w, h, scale),
-        None => crop_scaled(&Black, x0, y0, w, h, scale),
-    })
-}
-
-/// Bounding box (x0, y0, w, h) of observations, padded, at least `min` pixels wide and high.
-fn bbox(obs: &[(f64, f64)], pad: f64, min: f64) -> (f64, f64, f64, f64) {
-    let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
-    for &(u, v) in obs {
-        x0 = x0.min(u);
-        y0 = y0.min(v);
-        x1 = x1.max(u);
-        y1 = y1.max(v);
-    }
-    let (cx, cy) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
-    let w = (x1 - x0 + 2.0 * pad).max(min);
-    let h = (y1 - y0 + 2.0 * pad).max(min);
-    (cx - w / 2.0, cy - h / 2.0, w, h)
-}
-
-/// Panorama crop | oblique image crop around the observations, both scaled to 420 px high.
-fn oblique_view(
-    ctx: &Context<'_>,
-    rec: &Recording,
-    points: &[&ControlPoint],
-    out: &Path,
-) -> Result<(String, ViewCounts), String> {
-    const HEIGHT: f64 = 420.0;
-    let aerial_id = best_aerial(points, "oblique").ok_or("no oblique observation")?;
-    let aerial = ctx
-        .aerial("oblique", &aerial_id)
-        .ok_or_else(|| format!("oblique image {aerial_id} is not in the campaign"))?;
-    let pairs: Vec<(&CorrObs, &CorrObs, &ControlPoint)> = points
-        .iter()
-        .filter_map(|p| {
-            let mo = p.pano.iter().find(|o| o.image_id == rec.image_id)?;
-            let ao = p
-                .aerial
-                .iter()
-                .find(|o| o.kind == "oblique" && o.image_id == aerial_id)?;
-            Some((mo, ao, *p))
-        })
-        .collect();
-    if pairs.is_empty() {
-        return Err("no control point seen in both images".into());
-    }
-    let positions_px = |left: bool| -> Vec<(f64, f64)> {
-        pairs
-            .iter()
-            .map(|(m, a, _)| {
-                if left {
-                    (m.u_px, m.v_px)
-                } else {
-                    (a.u_px, a.v_px)
-                }
-            })
-            .collect()
-    };
-    let lb = bbox(&positions_px(true), 60.0, 200.0);
-    let rb = bbox(&positions_px(false), 40.0, 120.0);
-    let (ls, rs) = (HEIGHT / lb.3, HEIGHT / rb.3);
-    let pano_path = ctx.campaign.root.join("mm/panoramas").join(&rec.file);
-    let left = crop_of(ctx.images, &pano_path, lb, ls)?;
-    let right = crop_of(ctx.images, &ctx.aerial_path("oblique", aerial), rb, rs)?;
-    let gap = 12;
-    let mut img = side_by_side(&left, &right, gap);
-    let x_off = (left.width + gap) as f64;
-    let mut counts = ViewCounts::default();
-    for (mo, ao, p) in pairs {
-        let a = ((mo.u_px - lb.0) * ls, (mo.v_px - lb.1) * ls);
-        let bpt = (x_off + (ao.u_px - rb.0) * rs, (ao.v_px - rb.1) * rs);
-        let v = match &ctx.oblique_truth {
-            Some(t) => {
-                let tie: Vec<PanoObservation> = p.pano.iter().map(pano_observation).collect();
-                oblique_verdict(
-                    t,
-                    &tie,
-                    &pano_observation(mo),
-                    &aerial_id,
-                    [ao.u_px, ao.v_px],
-                )
-            }
-            None => Verdict::Ungraded,
-        };
-        let colour = counts.add(v);
-        line(&mut img, a, bpt, colour, 1);
-        ring(&mut img, a, 7.0, colour);
-        ring(&mut img, bpt, 7.0, colour);
-    }
-    save(out, &img)?;
-    Ok((aerial_id, counts))
-}
-
-fn pano_observation(o: &CorrObs) -> PanoObservation {
-    PanoObservation {
-        image_id: o.image_id.clone(),
-        u_px: o.u_px,
-        v_px: o.v_px,
-    }
-}
-
-/// The oblique grading rule's truth without the scene ([`load_scene`] adds it): true poses
-/// (`truth/recordings.csv`, panorama sizes) and
-/// true oblique poses (`truth/aerial_oblique.csv`, else the campaign's, which synthetic campaigns keep true).
-fn load_oblique_truth(
-    root: &Path,
-    campaign: &Campaign,
-    truth: &BTreeMap<String, Recording>,
-    pano_sizes: &BTreeMap<String, (u32, u32)>,
-) -> Result<ObliqueTruth, String> {
-    let aerial_path = root.join("truth/aerial_oblique.csv");
-    let aerial: Vec<AerialImage> = if aerial_path.exists() {
-        let (rows, problems) = read_aerial_csv(&aerial_path);
-        if let Some(p) = problems.first() {
-            return Err(format!("truth is unreadable: {p}"));
-        }
-        rows
-    } else {
-        campaign.oblique.clone()
-    };
-    Ok(ObliqueTruth {
-        truth: StageTruth {
-            recordings: truth
-                .iter()
-                .filter_map(|(id, r)| {
-                    let (w, h) = *pano_sizes.get(id)?;
-                    Some((id.clone(), (r.clone(), w, h)))
-                })
-                .collect(),
-            aerial: aerial
-                .into_iter()
-                .map(|a| (a.image_id.clone(), a))
-                .collect(),
-        },
-        scene: None,
-    })
-}
-
-/// The scene of the campaign's `truth/scene.toml` (None without that file; an error when it cannot be rebuilt,
-/// e.g. written by another generator version).
-fn load_scene(root: &Path) -> Result<Option<SceneOracle>, String> {
-    let scene_path = root.join(SCENE_TRUTH_FILE);
-    if !scene_path.exists() {
-        return Ok(None);
-    }
-    let text = std::fs::read_to_string(&scene_path)
-        .map_err(|e| format!("{}: {e}", scene_path.display()))?;
-    SceneTruth::parse(&text)
-        .and_then(|s| s.rebuild())
-        .map(Some)
-        .map_err(|e| format!("{}: {e}", scene_path.display()))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -760,12 +443,5 @@ mod tests {
         let n = &p[&("nadir".to_string(), "p1".to_string())];
         assert_eq!((n.pano.len(), n.aerial.len()), (1, 2));
         assert_eq!(best_aerial(&[n], "nadir").as_deref(), Some("n1"));
-    }
-
-    #[test]
-    fn bbox_pads_and_enforces_minimum() {
-        let (x0, y0, w, h) = bbox(&[(100.0, 100.0), (110.0, 300.0)], 10.0, 50.0);
-        assert_eq!((w, h), (50.0, 220.0));
-        assert_eq!((x0, y0), (80.0, 90.0));
     }
 }
