@@ -106,6 +106,15 @@ pub struct SyntheticBlock {
 }
 
 impl SyntheticBlockSpec {
+    /// The observed pixel of the true projection (u, v): Gaussian noise of σ `pixel_noise_px` drawn from
+    /// `rng` for u, then for v, and u wrapped into the panorama's width.
+    fn observed_pixel(&self, u: f64, v: f64, rng: &mut SplitMix64) -> (f64, f64) {
+        let u_px = (u + self.pixel_noise_px * rng.next_gaussian())
+            .rem_euclid(f64::from(self.image_width_px));
+        let v_px = v + self.pixel_noise_px * rng.next_gaussian();
+        (u_px, v_px)
+    }
+
     /// Generates the block.
     pub fn generate(&self) -> SyntheticBlock {
         let mut rng = SplitMix64::new(self.seed);
@@ -188,12 +197,12 @@ impl SyntheticBlockSpec {
                     .project_world(&true_points[p])
                     .expect("point off centre");
                 point_obs[p].push(observations.len());
+                let (u_px, v_px) = self.observed_pixel(u, vv, &mut rng);
                 observations.push(PanoObservation {
                     recording: r,
                     point: p,
-                    u_px: (u + self.pixel_noise_px * rng.next_gaussian())
-                        .rem_euclid(f64::from(width)),
-                    v_px: vv + self.pixel_noise_px * rng.next_gaussian(),
+                    u_px,
+                    v_px,
                     sigma_px: self.sigma_px,
                 });
             }
@@ -306,12 +315,12 @@ impl SyntheticBlockSpec {
                 let cam = &true_cameras[r];
                 if (cam.center_world - cp).norm() <= 20.0 {
                     let (u, v) = cam.project_world(&cp).expect("check point off centre");
+                    let (u_px, v_px) = self.observed_pixel(u, v, &mut rng);
                     check_observations.push(CheckObservation {
                         check_point: id,
                         recording: r,
-                        u_px: (u + self.pixel_noise_px * rng.next_gaussian())
-                            .rem_euclid(f64::from(width)),
-                        v_px: v + self.pixel_noise_px * rng.next_gaussian(),
+                        u_px,
+                        v_px,
                     });
                 }
             }
