@@ -1,20 +1,15 @@
 //! Known-answer tests of the bundle adjustment core on synthetic blocks (thesis 5.4, 5.7): exact data with
 //! perturbed poses, gross outliers with the robust variant, horizontal-only, yaw recovery, check points.
 
+mod common_adjust;
+
+use common_adjust::max_position_error_m;
 use nalgebra::Vector3;
 use skytie_stages::adjustment::{
-    adjust, consecutive_constraints, evaluate_checkpoints, AdjustOptions, Adjustment, RobustLoss,
+    adjust, consecutive_constraints, evaluate_checkpoints, AdjustOptions, RobustLoss,
     SyntheticBlock, SyntheticBlockSpec, Termination, ViewSelection,
 };
 use skytie_stages::geometry::PanoramaCamera;
-
-fn max_position_error_m(block: &SyntheticBlock, adj: &Adjustment) -> f64 {
-    adj.recordings
-        .iter()
-        .zip(&block.true_centers_world)
-        .map(|(r, t)| (r.position_world - t).norm())
-        .fold(0.0, f64::max)
-}
 
 fn max_initial_error_m(block: &SyntheticBlock) -> f64 {
     block

@@ -1,0 +1,57 @@
+//! Fixtures shared by the adjustment's integration tests (`adjust_*`): the largest position error of an
+//! adjustment against its synthetic block's truth, and the synthetic campaign with weak recorded-position
+//! priors that the control tests (consistency, orthophoto control) adjust with relative constraints.
+//! Each test file uses what it needs.
+
+#![allow(dead_code)]
+
+use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
+use skytie_stages::adjustment::{AdjustConfig, Adjustment, SyntheticBlock, SyntheticBlockSpec};
+
+/// Largest 3-D distance of an adjusted recording from its true position, metres.
+pub fn max_position_error_m(block: &SyntheticBlock, adj: &Adjustment) -> f64 {
+    adj.recordings
+        .iter()
+        .zip(&block.true_centers_world)
+        .map(|(r, t)| (r.position_world - t).norm())
+        .fold(0.0, f64::max)
+}
+
+/// σ of the relative constraints between consecutive recordings in [`relative_config`], metres.
+pub const RELATIVE_SIGMA_M: f64 = 0.15;
+
+/// A synthetic campaign whose recorded positions are weak priors (σ 3 m horizontal, 0.3 m vertical) with
+/// `control_points` aerial control points, each seen in at least two aerial images (no single-image
+/// points); the recorded positions share the default systematic offset plus a random one of up to
+/// `random_offset_m`, and the panorama observations carry Gaussian noise of σ `pixel_noise_px`.
+pub fn weak_prior_campaign(
+    control_points: usize,
+    random_offset_m: f64,
+    pixel_noise_px: f64,
+    seed: u64,
+) -> SyntheticCampaign {
+    SyntheticCampaignSpec {
+        block: SyntheticBlockSpec {
+            control_points,
+            random_offset_m,
+            pixel_noise_px,
+            prior_sigma_xy_m: 3.0,
+            prior_sigma_z_m: 0.3,
+            seed,
+            ..SyntheticBlockSpec::default()
+        },
+        single_aerial_every: 0,
+        ..SyntheticCampaignSpec::default()
+    }
+    .generate()
+}
+
+/// The default adjustment with relative constraints of σ [`RELATIVE_SIGMA_M`] between consecutive
+/// recordings.
+pub fn relative_config() -> AdjustConfig {
+    AdjustConfig {
+        relative_constraints: true,
+        relative_sigma_m: Some(RELATIVE_SIGMA_M),
+        ..AdjustConfig::default()
+    }
+}
