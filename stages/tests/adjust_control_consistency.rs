@@ -6,9 +6,8 @@
 
 mod common_adjust;
 
-use common_adjust::{relative_config, weak_prior_campaign, RELATIVE_SIGMA_M};
+use common_adjust::{runs_without_and_with, weak_prior_campaign, RELATIVE_SIGMA_M};
 use skytie_stages::adjustment::control_consistency::tolerance_m;
-use skytie_stages::adjustment::{run, AdjustConfig};
 use skytie_stages::export::{recording_support, Support};
 
 #[test]
@@ -28,15 +27,9 @@ fn control_wrong_together_on_neighbouring_recordings_is_not_used() {
         let p = c.control[k].point_world.as_mut().expect("triangulated");
         p[0] += 0.5;
     }
-    let plain = run(&c.adjust_inputs(), &relative_config()).unwrap();
-    let checked = run(
-        &c.adjust_inputs(),
-        &AdjustConfig {
-            control_consistency_window: Some(20),
-            ..relative_config()
-        },
-    )
-    .unwrap();
+    let (plain, checked) = runs_without_and_with(&c.adjust_inputs(), |config| {
+        config.control_consistency_window = Some(20)
+    });
     let (before, after) = (
         c.horizontal_errors_m(&plain),
         c.horizontal_errors_m(&checked),
@@ -70,15 +63,9 @@ fn a_stretch_beyond_the_last_control_keeps_its_correction_and_stays_flagged() {
         .retain(|cp| cp.mm.iter().all(|o| o.image_id.as_str() < "pano_0028"));
     let ids: Vec<&str> = c.recordings.iter().map(|r| r.image_id.as_str()).collect();
     assert!(ids.windows(2).all(|w| w[0] < w[1]), "{ids:?}");
-    let plain = run(&c.adjust_inputs(), &relative_config()).unwrap();
-    let anchored = run(
-        &c.adjust_inputs(),
-        &AdjustConfig {
-            extrapolation_anchor: true,
-            ..relative_config()
-        },
-    )
-    .unwrap();
+    let (plain, anchored) = runs_without_and_with(&c.adjust_inputs(), |config| {
+        config.extrapolation_anchor = true
+    });
     let support = recording_support(&anchored);
     let last = support
         .iter()

@@ -6,11 +6,11 @@
 
 mod common_adjust;
 
-use common_adjust::{relative_config, weak_prior_campaign};
+use common_adjust::{relative_config_with, runs_without_and_with, weak_prior_campaign};
 use nalgebra::Vector3;
 use skytie_stages::adjustment::problem::HeightObservation;
 use skytie_stages::adjustment::synthetic_campaign::SyntheticCampaign;
-use skytie_stages::adjustment::{run, AdjustConfig, AdjustInputs};
+use skytie_stages::adjustment::{run, AdjustInputs};
 
 /// Recordings without control of their own.
 const STRETCH: std::ops::RangeInclusive<usize> = 10..=29;
@@ -74,15 +74,7 @@ fn observed_tie_point_heights_hold_a_stretch_without_control_along_the_trajector
         tie_point_heights: Some(&heights),
         ..c.adjust_inputs()
     };
-    let plain = run(&inputs, &relative_config()).unwrap();
-    let observed = run(
-        &inputs,
-        &AdjustConfig {
-            dtm_tie_heights: true,
-            ..relative_config()
-        },
-    )
-    .unwrap();
+    let (plain, observed) = runs_without_and_with(&inputs, |config| config.dtm_tie_heights = true);
     assert_eq!(plain.build.tie_point_heights, 0);
     // Every tie point seen from a recording without control gets one (a recording whose only control the
     // block does not use counts as without control there, so a few more may), and not those where every
@@ -157,10 +149,7 @@ fn tie_point_heights_need_the_key_and_skip_control_points_and_controlled_recordi
     };
     let r = run(
         &inputs,
-        &AdjustConfig {
-            dtm_tie_heights: true,
-            ..relative_config()
-        },
+        &relative_config_with(|config| config.dtm_tie_heights = true),
     )
     .unwrap();
     let expected = expected_heights(&c, |k| k % 2 == 0);

@@ -6,9 +6,8 @@
 
 mod common_adjust;
 
-use common_adjust::{relative_config, weak_prior_campaign};
+use common_adjust::{runs_without_and_with, weak_prior_campaign};
 use skytie_stages::adjustment::synthetic_campaign::SyntheticCampaign;
-use skytie_stages::adjustment::{run, AdjustConfig};
 use skytie_stages::correspondence::{HeightSource, MapControl};
 
 /// The displacement of every weak control point (north), metres.
@@ -61,15 +60,9 @@ fn weak_control_displaced_alike_is_weighted_by_its_measured_sigma() {
         weak_in_stretch >= 4 && elsewhere >= 5,
         "{weak_in_stretch} {elsewhere}"
     );
-    let plain = run(&c.adjust_inputs(), &relative_config()).unwrap();
-    let weighted = run(
-        &c.adjust_inputs(),
-        &AdjustConfig {
-            weak_control_sigma_estimated: true,
-            ..relative_config()
-        },
-    )
-    .unwrap();
+    let (plain, weighted) = runs_without_and_with(&c.adjust_inputs(), |config| {
+        config.weak_control_sigma_estimated = true
+    });
     let estimate = weighted.build.weak_control_sigma.expect("estimated");
     // Every sample is the 0.20 m displacement (the strong points and the triangulation exact to millimetres):
     // σ = 0.20 / √2 per axis.

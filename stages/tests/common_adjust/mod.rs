@@ -1,12 +1,15 @@
 //! Fixtures shared by the adjustment's integration tests (`adjust_*`): the largest position error of an
 //! adjustment against its synthetic block's truth, and the synthetic campaign with weak recorded-position
-//! priors that the control tests (consistency, orthophoto control) adjust with relative constraints.
+//! priors that the control tests (consistency, orthophoto control) adjust with relative constraints, with
+//! and without the option under test.
 //! Each test file uses what it needs.
 
 #![allow(dead_code)]
 
 use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
-use skytie_stages::adjustment::{AdjustConfig, Adjustment, SyntheticBlock, SyntheticBlockSpec};
+use skytie_stages::adjustment::{
+    run, AdjustConfig, AdjustInputs, Adjustment, AdjustmentRun, SyntheticBlock, SyntheticBlockSpec,
+};
 
 /// Largest 3-D distance of an adjusted recording from its true position, metres.
 pub fn max_position_error_m(block: &SyntheticBlock, adj: &Adjustment) -> f64 {
@@ -54,4 +57,22 @@ pub fn relative_config() -> AdjustConfig {
         relative_sigma_m: Some(RELATIVE_SIGMA_M),
         ..AdjustConfig::default()
     }
+}
+
+/// [`relative_config`] with `option` applied (the option under test turned on).
+pub fn relative_config_with(option: impl FnOnce(&mut AdjustConfig)) -> AdjustConfig {
+    let mut config = relative_config();
+    option(&mut config);
+    config
+}
+
+/// `inputs` adjusted with [`relative_config`] and with [`relative_config_with`] `option`: (without the
+/// option, with it).
+pub fn runs_without_and_with(
+    inputs: &AdjustInputs,
+    option: impl FnOnce(&mut AdjustConfig),
+) -> (AdjustmentRun, AdjustmentRun) {
+    let without = run(inputs, &relative_config()).unwrap();
+    let with = run(inputs, &relative_config_with(option)).unwrap();
+    (without, with)
 }
