@@ -3,11 +3,11 @@
 
 mod common_adjust;
 
-use common_adjust::max_position_error_m;
+use common_adjust::{drifted_block, max_position_error_m, outage_bump_m};
 use nalgebra::Vector3;
 use skytie_stages::adjustment::{
-    adjust, consecutive_constraints, evaluate_checkpoints, AdjustOptions, RobustLoss,
-    SyntheticBlock, SyntheticBlockSpec, Termination, ViewSelection,
+    adjust, evaluate_checkpoints, AdjustOptions, RobustLoss, SyntheticBlock, SyntheticBlockSpec,
+    Termination, ViewSelection,
 };
 use skytie_stages::geometry::PanoramaCamera;
 
@@ -254,15 +254,7 @@ fn a_drifted_stretch_follows_its_control_with_a_cauchy_loss_on_the_relative_cons
         seed: 11,
         ..SyntheticBlockSpec::default()
     };
-    let mut synth = spec.generate();
-    let n = synth.block.recordings.len();
-    for (i, r) in synth.block.recordings.iter_mut().enumerate() {
-        if (12..28).contains(&i) {
-            let t = (i - 12) as f64 / 16.0;
-            r.camera.center_world.x += 1.5 * (std::f64::consts::PI * t).sin().powi(2);
-        }
-    }
-    synth.block.relative_constraints = consecutive_constraints(n, 0.02);
+    let synth = drifted_block(spec, 0.02, |t| [outage_bump_m(t), 0.0]);
     let before = max_initial_error_m(&synth);
     let error_with = |relative_loss| {
         let options = AdjustOptions {
