@@ -13,6 +13,7 @@ use skytie_stages::adjustment::{
 const SIGMA_REL_M: f64 = 0.02;
 /// The 99 % quantile of χ² with 2 degrees of freedom.
 const THRESHOLD: f64 = 9.21;
+
 /// Horizontal error of each adjusted recording, m.
 fn errors_m(synth: &SyntheticBlock, adj: &Adjustment) -> Vec<f64> {
     adj.recordings
