@@ -1,20 +1,15 @@
 //! Known-answer tests of the bundle adjustment core on synthetic blocks (thesis 5.4, 5.7): exact data with
 //! perturbed poses, gross outliers with the robust variant, horizontal-only, yaw recovery, check points.
 
+mod common_adjust;
+
+use common_adjust::{drifted_block, max_position_error_m, outage_bump_m};
 use nalgebra::Vector3;
 use skytie_stages::adjustment::{
-    adjust, consecutive_constraints, evaluate_checkpoints, AdjustOptions, Adjustment, RobustLoss,
-    SyntheticBlock, SyntheticBlockSpec, Termination, ViewSelection,
+    adjust, evaluate_checkpoints, AdjustOptions, RobustLoss, SyntheticBlock, SyntheticBlockSpec,
+    Termination, ViewSelection,
 };
 use skytie_stages::geometry::PanoramaCamera;
-
-fn max_position_error_m(block: &SyntheticBlock, adj: &Adjustment) -> f64 {
-    adj.recordings
-        .iter()
-        .zip(&block.true_centers_world)
-        .map(|(r, t)| (r.position_world - t).norm())
-        .fold(0.0, f64::max)
-}
 
 fn max_initial_error_m(block: &SyntheticBlock) -> f64 {
     block
@@ -259,15 +254,7 @@ fn a_drifted_stretch_follows_its_control_with_a_cauchy_loss_on_the_relative_cons
         seed: 11,
         ..SyntheticBlockSpec::default()
     };
-    let mut synth = spec.generate();
-    let n = synth.block.recordings.len();
-    for (i, r) in synth.block.recordings.iter_mut().enumerate() {
-        if (12..28).contains(&i) {
-            let t = (i - 12) as f64 / 16.0;
-            r.camera.center_world.x += 1.5 * (std::f64::consts::PI * t).sin().powi(2);
-        }
-    }
-    synth.block.relative_constraints = consecutive_constraints(n, 0.02);
+    let synth = drifted_block(spec, 0.02, |t| [outage_bump_m(t), 0.0]);
     let before = max_initial_error_m(&synth);
     let error_with = |relative_loss| {
         let options = AdjustOptions {

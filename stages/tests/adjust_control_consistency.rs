@@ -4,42 +4,15 @@
 //! recording with control keeps that recording's correction instead of drifting with a noisy tie-point chain
 //! (`[adjust] extrapolation_anchor`), while staying flagged as extrapolated.
 
+mod common_adjust;
+
+use common_adjust::{runs_without_and_with, weak_prior_campaign, RELATIVE_SIGMA_M};
 use skytie_stages::adjustment::control_consistency::tolerance_m;
-use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
-use skytie_stages::adjustment::{run, AdjustConfig, SyntheticBlockSpec};
 use skytie_stages::export::{recording_support, Support};
-
-/// Relative σ between consecutive recordings the tests state, metres.
-const RELATIVE_SIGMA_M: f64 = 0.15;
-
-fn campaign(random_offset_m: f64, pixel_noise_px: f64, seed: u64) -> SyntheticCampaign {
-    SyntheticCampaignSpec {
-        block: SyntheticBlockSpec {
-            control_points: 30,
-            random_offset_m,
-            pixel_noise_px,
-            prior_sigma_xy_m: 3.0,
-            prior_sigma_z_m: 0.3,
-            seed,
-            ..SyntheticBlockSpec::default()
-        },
-        single_aerial_every: 0,
-        ..SyntheticCampaignSpec::default()
-    }
-    .generate()
-}
-
-fn config() -> AdjustConfig {
-    AdjustConfig {
-        relative_constraints: true,
-        relative_sigma_m: Some(RELATIVE_SIGMA_M),
-        ..AdjustConfig::default()
-    }
-}
 
 #[test]
 fn control_wrong_together_on_neighbouring_recordings_is_not_used() {
-    let mut c = campaign(0.05, 0.0, 5);
+    let mut c = weak_prior_campaign(30, 0.05, 0.0, 5);
     // Every control point seen only from recordings 19–22 is moved 0.5 m east: strong, and consistent with
     // the others of its stretch — a template matched at a wrong place by several recordings.
     let wrong: Vec<usize> = (0..c.control.len())
@@ -54,15 +27,9 @@ fn control_wrong_together_on_neighbouring_recordings_is_not_used() {
         let p = c.control[k].point_world.as_mut().expect("triangulated");
         p[0] += 0.5;
     }
-    let plain = run(&c.adjust_inputs(), &config()).unwrap();
-    let checked = run(
-        &c.adjust_inputs(),
-        &AdjustConfig {
-            control_consistency_window: Some(20),
-            ..config()
-        },
-    )
-    .unwrap();
+    let (plain, checked) = runs_without_and_with(&c.adjust_inputs(), |config| {
+        config.control_consistency_window = Some(20)
+    });
     let (before, after) = (
         c.horizontal_errors_m(&plain),
         c.horizontal_errors_m(&checked),
@@ -91,20 +58,14 @@ fn control_wrong_together_on_neighbouring_recordings_is_not_used() {
 fn a_stretch_beyond_the_last_control_keeps_its_correction_and_stays_flagged() {
     // The recorded error is one offset common to the whole trajectory, so the stretch's true correction is
     // the last controlled recording's; the panorama pixels are noisy, so the tie-point chain drifts.
-    let mut c = campaign(0.0, 1.5, 7);
+    let mut c = weak_prior_campaign(30, 0.0, 1.5, 7);
     c.control
         .retain(|cp| cp.mm.iter().all(|o| o.image_id.as_str() < "pano_0028"));
     let ids: Vec<&str> = c.recordings.iter().map(|r| r.image_id.as_str()).collect();
     assert!(ids.windows(2).all(|w| w[0] < w[1]), "{ids:?}");
-    let plain = run(&c.adjust_inputs(), &config()).unwrap();
-    let anchored = run(
-        &c.adjust_inputs(),
-        &AdjustConfig {
-            extrapolation_anchor: true,
-            ..config()
-        },
-    )
-    .unwrap();
+    let (plain, anchored) = runs_without_and_with(&c.adjust_inputs(), |config| {
+        config.extrapolation_anchor = true
+    });
     let support = recording_support(&anchored);
     let last = support
         .iter()

@@ -2,6 +2,9 @@
 //! tiny blocks, a Monte Carlo check of the a-priori σ on noisy synthetic blocks, the thesis 5.7 weighting
 //! methods on an exact block, and located errors for bad input.
 
+mod common_adjust;
+
+use common_adjust::max_position_error_m;
 use nalgebra::Vector3;
 use skytie_stages::adjustment::{
     adjust, AdjustError, AdjustOptions, Block, BlockRecording, PanoObservation, RelativeConstraint,
@@ -135,12 +138,7 @@ fn every_weighting_method_converges_on_exact_data() {
             ..AdjustOptions::default()
         };
         let adj = adjust(&synth.block, &options).unwrap();
-        let err = adj
-            .recordings
-            .iter()
-            .zip(&synth.true_centers_world)
-            .map(|(r, t)| (r.position_world - t).norm())
-            .fold(0.0, f64::max);
+        let err = max_position_error_m(&synth, &adj);
         // Method 2 drops rays at ≥ 15 m (evaluated at the initial estimate).
         let far = synth
             .block

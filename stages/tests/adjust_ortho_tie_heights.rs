@@ -4,30 +4,20 @@
 //! the recordings' own along-track error; with the heights of the tie points seen from recordings without
 //! control observed, the stretch is carried by the tie points to centimetres.
 
+mod common_adjust;
+
+use common_adjust::{relative_config_with, runs_without_and_with, weak_prior_campaign};
 use nalgebra::Vector3;
 use skytie_stages::adjustment::problem::HeightObservation;
-use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
-use skytie_stages::adjustment::{run, AdjustConfig, AdjustInputs, SyntheticBlockSpec};
+use skytie_stages::adjustment::synthetic_campaign::SyntheticCampaign;
+use skytie_stages::adjustment::{run, AdjustInputs};
 
 /// Recordings without control of their own.
 const STRETCH: std::ops::RangeInclusive<usize> = 10..=29;
 
 fn campaign() -> SyntheticCampaign {
-    let mut c = SyntheticCampaignSpec {
-        block: SyntheticBlockSpec {
-            control_points: 40,
-            // Each recording off by up to 0.3 m on its own, besides the common 0.8 m.
-            random_offset_m: 0.3,
-            pixel_noise_px: 0.0,
-            prior_sigma_xy_m: 3.0,
-            prior_sigma_z_m: 0.3,
-            seed: 5,
-            ..SyntheticBlockSpec::default()
-        },
-        single_aerial_every: 0,
-        ..SyntheticCampaignSpec::default()
-    }
-    .generate();
+    // Each recording off by up to 0.3 m on its own, besides the common 0.8 m.
+    let mut c = weak_prior_campaign(40, 0.3, 0.0, 5);
     // Two views per tie point: the first two recordings that see it.
     for tp in &mut c.tie_points {
         tp.observations.truncate(2);
@@ -46,14 +36,6 @@ fn campaign() -> SyntheticCampaign {
         !observed_in_stretch[k - 1]
     });
     c
-}
-
-fn config() -> AdjustConfig {
-    AdjustConfig {
-        relative_constraints: true,
-        relative_sigma_m: Some(0.15),
-        ..AdjustConfig::default()
-    }
 }
 
 /// Along-track error (m) of each adjusted recording of `run` against the truth.
@@ -92,15 +74,7 @@ fn observed_tie_point_heights_hold_a_stretch_without_control_along_the_trajector
         tie_point_heights: Some(&heights),
         ..c.adjust_inputs()
     };
-    let plain = run(&inputs, &config()).unwrap();
-    let observed = run(
-        &inputs,
-        &AdjustConfig {
-            dtm_tie_heights: true,
-            ..config()
-        },
-    )
-    .unwrap();
+    let (plain, observed) = runs_without_and_with(&inputs, |config| config.dtm_tie_heights = true);
     assert_eq!(plain.build.tie_point_heights, 0);
     // Every tie point seen from a recording without control gets one (a recording whose only control the
     // block does not use counts as without control there, so a few more may), and not those where every
@@ -175,10 +149,7 @@ fn tie_point_heights_need_the_key_and_skip_control_points_and_controlled_recordi
     };
     let r = run(
         &inputs,
-        &AdjustConfig {
-            dtm_tie_heights: true,
-            ..config()
-        },
+        &relative_config_with(|config| config.dtm_tie_heights = true),
     )
     .unwrap();
     let expected = expected_heights(&c, |k| k % 2 == 0);

@@ -4,31 +4,14 @@
 //! recordings controlled only by such weak points is carried by the tie points and the strong control around
 //! it instead of following its weak control.
 
-use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
-use skytie_stages::adjustment::{run, AdjustConfig, SyntheticBlockSpec};
+mod common_adjust;
+
+use common_adjust::{runs_without_and_with, weak_prior_campaign};
+use skytie_stages::adjustment::synthetic_campaign::SyntheticCampaign;
 use skytie_stages::correspondence::{HeightSource, MapControl};
 
 /// The displacement of every weak control point (north), metres.
 const WEAK_OFFSET_M: f64 = 0.20;
-
-fn campaign() -> SyntheticCampaign {
-    SyntheticCampaignSpec {
-        block: SyntheticBlockSpec {
-            control_points: 30,
-            // The recorded poses share one offset and no random part, so every correction is exact and each
-            // sample is the weak points' displacement alone.
-            random_offset_m: 0.0,
-            pixel_noise_px: 0.0,
-            prior_sigma_xy_m: 3.0,
-            prior_sigma_z_m: 0.3,
-            seed: 11,
-            ..SyntheticBlockSpec::default()
-        },
-        single_aerial_every: 0,
-        ..SyntheticCampaignSpec::default()
-    }
-    .generate()
-}
 
 /// Marks control point `k` as an orthophoto peak with correlation `score`, moved north by `offset_m`.
 fn as_orthophoto(c: &mut SyntheticCampaign, k: usize, score: f64, offset_m: f64) {
@@ -45,17 +28,11 @@ fn as_orthophoto(c: &mut SyntheticCampaign, k: usize, score: f64, offset_m: f64)
     p[1] += offset_m;
 }
 
-fn config() -> AdjustConfig {
-    AdjustConfig {
-        relative_constraints: true,
-        relative_sigma_m: Some(0.15),
-        ..AdjustConfig::default()
-    }
-}
-
 #[test]
 fn weak_control_displaced_alike_is_weighted_by_its_measured_sigma() {
-    let mut c = campaign();
+    // The recorded poses share one offset and no random part, so every correction is exact and each sample
+    // is the weak points' displacement alone.
+    let mut c = weak_prior_campaign(30, 0.0, 0.0, 11);
     // Recordings 10–17 are controlled only by weak peaks, all 0.20 m north of their content; elsewhere every
     // other control point is such a weak peak beside exact strong ones (the samples of the estimate).
     let stretch = 10..=17;
@@ -83,15 +60,9 @@ fn weak_control_displaced_alike_is_weighted_by_its_measured_sigma() {
         weak_in_stretch >= 4 && elsewhere >= 5,
         "{weak_in_stretch} {elsewhere}"
     );
-    let plain = run(&c.adjust_inputs(), &config()).unwrap();
-    let weighted = run(
-        &c.adjust_inputs(),
-        &AdjustConfig {
-            weak_control_sigma_estimated: true,
-            ..config()
-        },
-    )
-    .unwrap();
+    let (plain, weighted) = runs_without_and_with(&c.adjust_inputs(), |config| {
+        config.weak_control_sigma_estimated = true
+    });
     let estimate = weighted.build.weak_control_sigma.expect("estimated");
     // Every sample is the 0.20 m displacement (the strong points and the triangulation exact to millimetres):
     // σ = 0.20 / √2 per axis.

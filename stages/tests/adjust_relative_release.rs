@@ -2,17 +2,17 @@
 //! (`adjustment::relative_release`): a smooth GNSS-outage drift on a synthetic block whose truth is known, with
 //! and without a recording that has no evidence of its own inside the drift, and a trajectory without drift.
 
+mod common_adjust;
+
+use common_adjust::{constrained_block, drifted_block, outage_bump_m, OUTAGE};
 use skytie_stages::adjustment::{
-    adjust, consecutive_constraints, AdjustOptions, Adjustment, RobustLoss, SyntheticBlock,
-    SyntheticBlockSpec,
+    adjust, AdjustOptions, Adjustment, RobustLoss, SyntheticBlock, SyntheticBlockSpec,
 };
 
 /// σ of the relative constraints: what the second differences of a smoothly drifting trajectory suggest.
 const SIGMA_REL_M: f64 = 0.02;
 /// The 99 % quantile of χ² with 2 degrees of freedom.
 const THRESHOLD: f64 = 9.21;
-/// The drifted stretch: recordings 12–27.
-const OUTAGE: std::ops::Range<usize> = 12..28;
 
 /// Horizontal error of each adjusted recording, m.
 fn errors_m(synth: &SyntheticBlock, adj: &Adjustment) -> Vec<f64> {
@@ -38,18 +38,10 @@ fn outage_block(seed: u64) -> SyntheticBlock {
         seed,
         ..SyntheticBlockSpec::default()
     };
-    let mut synth = spec.generate();
-    for (i, r) in synth.block.recordings.iter_mut().enumerate() {
-        if OUTAGE.contains(&i) {
-            let t = (i - OUTAGE.start) as f64 / OUTAGE.len() as f64;
-            let bump = 1.5 * (std::f64::consts::PI * t).sin().powi(2);
-            r.camera.center_world.x += bump * (1.0 - 0.5 * t);
-            r.camera.center_world.y += bump * 0.5 * t;
-        }
-    }
-    let n = synth.block.recordings.len();
-    synth.block.relative_constraints = consecutive_constraints(n, SIGMA_REL_M);
-    synth
+    drifted_block(spec, SIGMA_REL_M, |t| {
+        let bump = outage_bump_m(t);
+        [bump * (1.0 - 0.5 * t), bump * 0.5 * t]
+    })
 }
 
 /// The stage's relative loss (Cauchy at 2 σ), with or without the release.
@@ -134,9 +126,7 @@ fn a_trajectory_without_drift_keeps_its_constraints() {
         seed: 5,
         ..SyntheticBlockSpec::default()
     };
-    let mut synth = spec.generate();
-    let n = synth.block.recordings.len();
-    synth.block.relative_constraints = consecutive_constraints(n, SIGMA_REL_M);
+    let synth = constrained_block(spec, SIGMA_REL_M);
     let held = adjust(&synth.block, &options(false)).unwrap();
     let released = adjust(&synth.block, &options(true)).unwrap();
     assert_eq!(released.released_relative, 0);

@@ -8,10 +8,10 @@ use super::evaluate::{
     evaluate_checkpoints, CheckObservation, CheckPointEvaluation, ViewSelection,
 };
 use super::from_correspondences::AdjustmentRun;
+use super::id_index::index_by_id;
 use crate::campaign::{CheckPoint, Observation, Recording};
 use crate::geometry::PanoramaCamera;
 use nalgebra::Vector3;
-use std::collections::HashMap;
 
 /// Before/after evaluation of the check points.
 #[derive(Clone, Debug, PartialEq)]
@@ -88,16 +88,8 @@ pub fn compare_checkpoints(
 ) -> Result<CheckPointComparison, String> {
     let before_cams = recorded_cameras(recordings, pano_size_px);
     let after_cams = adjusted_cameras(recordings, pano_size_px, run)?;
-    let rec_index: HashMap<&str, usize> = recordings
-        .iter()
-        .enumerate()
-        .map(|(i, r)| (r.image_id.as_str(), i))
-        .collect();
-    let cp_index: HashMap<&str, usize> = checkpoints
-        .iter()
-        .enumerate()
-        .map(|(i, c)| (c.point_id.as_str(), i))
-        .collect();
+    let rec_index = index_by_id(recordings, |r| r.image_id.as_str());
+    let cp_index = index_by_id(checkpoints, |c| c.point_id.as_str());
     let mut obs = Vec::with_capacity(observations.len());
     let mut skipped = 0;
     for o in observations {

@@ -30,70 +30,58 @@ fn frame_error(e: FrameError) -> AdjustError {
     }
 }
 
+/// Every item of `items` taken into the frame by `to_local`, in order; the first failure ends it.
+fn all_to_local<T, U>(
+    items: &[T],
+    to_local: impl FnMut(&T) -> Result<U, FrameError>,
+) -> Result<Vec<U>, AdjustError> {
+    items
+        .iter()
+        .map(to_local)
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(frame_error)
+}
+
 /// `block` (map coordinates) in `frame`.
 pub fn block_to_local(block: &Block, frame: &MapFrame) -> Result<Block, AdjustError> {
-    let recordings = block
-        .recordings
-        .iter()
-        .map(|r| {
-            // An observed height is the frame's Z of the point at that height above the recorded position.
-            let height_observation = match r.height_observation {
-                Some(h) => {
-                    let mut p = r.camera.center_world;
-                    p.z = h.z_world;
-                    Some(HeightObservation {
-                        z_world: frame.point_to_local(&p)?.z,
-                        ..h
-                    })
-                }
-                None => None,
-            };
-            Ok(BlockRecording {
-                camera: frame.panorama_to_local(&r.camera)?,
-                height_observation,
-                ..r.clone()
-            })
+    let recordings = all_to_local(&block.recordings, |r| {
+        // An observed height is the frame's Z of the point at that height above the recorded position.
+        let height_observation = match r.height_observation {
+            Some(h) => {
+                let mut p = r.camera.center_world;
+                p.z = h.z_world;
+                Some(HeightObservation {
+                    z_world: frame.point_to_local(&p)?.z,
+                    ..h
+                })
+            }
+            None => None,
+        };
+        Ok(BlockRecording {
+            camera: frame.panorama_to_local(&r.camera)?,
+            height_observation,
+            ..r.clone()
         })
-        .collect::<Result<Vec<_>, FrameError>>()
-        .map_err(frame_error)?;
+    })?;
     // An observed point height is the frame's Z of the point at that height above its initial position.
-    let point_heights = block
-        .point_heights
-        .iter()
-        .map(|h| {
-            let mut p = block.points_initial_world[h.point];
-            p.z = h.z_world;
-            Ok(PointHeight {
-                z_world: frame.point_to_local(&p)?.z,
-                ..*h
-            })
+    let point_heights = all_to_local(&block.point_heights, |h| {
+        let mut p = block.points_initial_world[h.point];
+        p.z = h.z_world;
+        Ok(PointHeight {
+            z_world: frame.point_to_local(&p)?.z,
+            ..*h
         })
-        .collect::<Result<Vec<_>, FrameError>>()
-        .map_err(frame_error)?;
-    let points_initial_world = block
-        .points_initial_world
-        .iter()
-        .map(|p| frame.point_to_local(p))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(frame_error)?;
-    let control_points = block
-        .control_points
-        .iter()
-        .map(|c| {
-            Ok(ControlPoint {
-                position_world: frame.point_to_local(&c.position_world)?,
-                covariance_m2: frame.covariance_to_local(&c.position_world, &c.covariance_m2)?,
-                ..*c
-            })
+    })?;
+    let points_initial_world =
+        all_to_local(&block.points_initial_world, |p| frame.point_to_local(p))?;
+    let control_points = all_to_local(&block.control_points, |c| {
+        Ok(ControlPoint {
+            position_world: frame.point_to_local(&c.position_world)?,
+            covariance_m2: frame.covariance_to_local(&c.position_world, &c.covariance_m2)?,
+            ..*c
         })
-        .collect::<Result<Vec<_>, FrameError>>()
-        .map_err(frame_error)?;
-    let aerial_cameras = block
-        .aerial_cameras
-        .iter()
-        .map(|c| frame.camera_to_local(c))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(frame_error)?;
+    })?;
+    let aerial_cameras = all_to_local(&block.aerial_cameras, |c| frame.camera_to_local(c))?;
     Ok(Block {
         recordings,
         points_initial_world,

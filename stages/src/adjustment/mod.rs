@@ -11,7 +11,8 @@
 //! cost), [`linearization`] (normal-equation blocks), [`schur`] (the reduced camera system), [`solver`]
 //! (Levenberg–Marquardt), [`relative_noise`] (the trajectory's relative accuracy from its own second differences),
 //! [`covariance`] (posterior σ per recording), [`adjust`](mod@adjust) (solve, reject by
-//! normalised residuals, re-solve), [`evaluate`] (check-point triangulation and RMSE), [`synthetic_block`]
+//! normalised residuals, re-solve), [`evaluate`] (check-point triangulation and RMSE), [`id_index`] (rows
+//! by their string id), [`synthetic_block`]
 //! (known-answer test blocks). On top: [`config`] (the adjust node's params), [`in_frame`] (a block
 //! in the campaign's tangent frame and its results back in map coordinates), [`from_correspondences`]
 //! (correspondences → block → [`AdjustmentRun`]), [`height_observation`] (recording heights from a terrain
@@ -39,6 +40,7 @@ pub mod evaluate;
 pub mod extrapolation_anchor;
 pub mod from_correspondences;
 pub mod height_observation;
+pub mod id_index;
 pub mod in_frame;
 pub mod layout;
 pub mod linearization;

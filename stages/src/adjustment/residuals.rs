@@ -186,38 +186,27 @@ mod tests {
         let x1 = point + Vector3::new(-0.3, 0.2, 0.1);
         let psi1 = 0.03;
         let (_, jc, jp) = pano_residual(obs, &r0, psi1, &c1, &x1).unwrap_or((r, jc, jp));
+        // Central differences over the camera's (x, y, z, ψ) and then the point's (x, y, z).
+        let residual_at = |k: usize, step: f64| {
+            let (mut c, mut psi, mut x) = (c1, psi1, x1);
+            match k {
+                0..=2 => c[k] += step,
+                3 => psi += step,
+                _ => x[k - 4] += step,
+            }
+            pano_residual(obs, &r0, psi, &c, &x).unwrap().0
+        };
         let h = 1e-6;
-        for k in 0..4 {
-            let (mut cp, mut cm) = (c1, c1);
-            let (mut yp, mut ym) = (psi1, psi1);
-            if k < 3 {
-                cp[k] += h;
-                cm[k] -= h;
-            } else {
-                yp += h;
-                ym -= h;
-            }
-            let rp = pano_residual(obs, &r0, yp, &cp, &x1).unwrap().0;
-            let rm = pano_residual(obs, &r0, ym, &cm, &x1).unwrap().0;
-            let numeric = (rp - rm) / (2.0 * h);
+        for k in 0..7 {
+            let numeric = (residual_at(k, h) - residual_at(k, -h)) / (2.0 * h);
+            let (analytic, label, column) = match k {
+                0..=3 => (jc.column(k).into_owned(), "camera", k),
+                _ => (jp.column(k - 4).into_owned(), "point", k - 4),
+            };
             for row in 0..2 {
                 assert!(
-                    (numeric[row] - jc[(row, k)]).abs() < 1e-8,
-                    "camera {k} row {row}"
-                );
-            }
-        }
-        for k in 0..3 {
-            let (mut xp, mut xm) = (x1, x1);
-            xp[k] += h;
-            xm[k] -= h;
-            let rp = pano_residual(obs, &r0, psi1, &c1, &xp).unwrap().0;
-            let rm = pano_residual(obs, &r0, psi1, &c1, &xm).unwrap().0;
-            let numeric = (rp - rm) / (2.0 * h);
-            for row in 0..2 {
-                assert!(
-                    (numeric[row] - jp[(row, k)]).abs() < 1e-8,
-                    "point {k} row {row}"
+                    (numeric[row] - analytic[row]).abs() < 1e-8,
+                    "{label} {column} row {row}"
                 );
             }
         }

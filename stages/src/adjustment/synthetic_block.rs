@@ -106,6 +106,15 @@ pub struct SyntheticBlock {
 }
 
 impl SyntheticBlockSpec {
+    /// The observed pixel of the true projection (u, v): Gaussian noise of σ `pixel_noise_px` drawn from
+    /// `rng` for u, then for v, and u wrapped into the panorama's width.
+    fn observed_pixel(&self, u: f64, v: f64, rng: &mut SplitMix64) -> (f64, f64) {
+        let u_px = (u + self.pixel_noise_px * rng.next_gaussian())
+            .rem_euclid(f64::from(self.image_width_px));
+        let v_px = v + self.pixel_noise_px * rng.next_gaussian();
+        (u_px, v_px)
+    }
+
     /// Generates the block.
     pub fn generate(&self) -> SyntheticBlock {
         let mut rng = SplitMix64::new(self.seed);
@@ -188,12 +197,12 @@ impl SyntheticBlockSpec {
                     .project_world(&true_points[p])
                     .expect("point off centre");
                 point_obs[p].push(observations.len());
+                let (u_px, v_px) = self.observed_pixel(u, vv, &mut rng);
                 observations.push(PanoObservation {
                     recording: r,
                     point: p,
-                    u_px: (u + self.pixel_noise_px * rng.next_gaussian())
-                        .rem_euclid(f64::from(width)),
-                    v_px: vv + self.pixel_noise_px * rng.next_gaussian(),
+                    u_px,
+                    v_px,
                     sigma_px: self.sigma_px,
                 });
             }
@@ -210,15 +219,12 @@ impl SyntheticBlockSpec {
                 continue;
             }
             is_control[p] = true;
-            let noise = Vector3::new(
-                rng.next_gaussian(),
-                rng.next_gaussian(),
-                rng.next_gaussian(),
-            ) * self.control_noise_m;
-            control_points.push(ControlPoint::isotropic(
+            control_points.push(surveyed_control(
                 p,
-                true_points[p] + noise,
+                true_points[p],
+                self.control_noise_m,
                 self.control_sigma_m,
+                &mut rng,
             ));
         }
         let mut outlier_controls = Vec::new();
@@ -258,25 +264,17 @@ impl SyntheticBlockSpec {
         // Initial tie points: triangulated with the recorded poses.
         let mut points_initial = Vec::with_capacity(n_pts);
         for (p, obs) in point_obs.iter().enumerate() {
-            let rays: Vec<_> = obs
+            let views: Vec<(usize, f64, f64)> = obs
                 .iter()
                 .map(|&o| {
                     let ob = &observations[o];
-                    recordings[ob.recording].camera.pixel_ray(ob.u_px, ob.v_px)
+                    (ob.recording, ob.u_px, ob.v_px)
                 })
                 .collect();
-            let sigmas: Vec<f64> = obs
-                .iter()
-                .map(|&o| {
-                    recordings[observations[o].recording]
-                        .camera
-                        .angular_sigma_rad(self.sigma_px)
-                })
-                .collect();
-            points_initial.push(match triangulate_rays(&rays, &sigmas) {
-                Ok(t) => t.point_world,
-                Err(_) => true_points[p] + systematic,
-            });
+            points_initial.push(
+                triangulate_recorded(&recordings, &views, self.sigma_px)
+                    .unwrap_or_else(|| true_points[p] + systematic),
+            );
         }
         // Check points: on the road edge, seen by every recording within 20 m.
         let mut check_points = Vec::new();
@@ -306,12 +304,12 @@ impl SyntheticBlockSpec {
                 let cam = &true_cameras[r];
                 if (cam.center_world - cp).norm() <= 20.0 {
                     let (u, v) = cam.project_world(&cp).expect("check point off centre");
+                    let (u_px, v_px) = self.observed_pixel(u, v, &mut rng);
                     check_observations.push(CheckObservation {
                         check_point: id,
                         recording: r,
-                        u_px: (u + self.pixel_noise_px * rng.next_gaussian())
-                            .rem_euclid(f64::from(width)),
-                        v_px: v + self.pixel_noise_px * rng.next_gaussian(),
+                        u_px,
+                        v_px,
                     });
                 }
             }
@@ -339,6 +337,42 @@ impl SyntheticBlockSpec {
             recorded_attitude_deg,
         }
     }
+}
+
+/// An aerial control point on tie point `p` at `true_world` surveyed with Gaussian noise of σ `noise_m` per
+/// coordinate (drawn from `rng` for x, y, z in turn), stated with the isotropic σ `sigma_m`.
+pub(crate) fn surveyed_control(
+    p: usize,
+    true_world: Vector3<f64>,
+    noise_m: f64,
+    sigma_m: f64,
+    rng: &mut SplitMix64,
+) -> ControlPoint {
+    let noise = Vector3::new(
+        rng.next_gaussian(),
+        rng.next_gaussian(),
+        rng.next_gaussian(),
+    ) * noise_m;
+    ControlPoint::isotropic(p, true_world + noise, sigma_m)
+}
+
+/// A tie point triangulated from its observations (recording, u_px, v_px) with the recorded poses of
+/// `recordings`, each ray weighted by `sigma_px` (the pipeline's initial tie points); `None` where that fails
+/// (too few rays, degenerate geometry).
+pub(crate) fn triangulate_recorded(
+    recordings: &[BlockRecording],
+    views: &[(usize, f64, f64)],
+    sigma_px: f64,
+) -> Option<Vector3<f64>> {
+    let rays: Vec<_> = views
+        .iter()
+        .map(|&(r, u, v)| recordings[r].camera.pixel_ray(u, v))
+        .collect();
+    let sigmas: Vec<f64> = views
+        .iter()
+        .map(|&(r, _, _)| recordings[r].camera.angular_sigma_rad(sigma_px))
+        .collect();
+    triangulate_rays(&rays, &sigmas).ok().map(|t| t.point_world)
 }
 
 /// Relative constraints of σ `sigma_m` between each of `n` recordings and the next, in order (a trajectory

@@ -21,6 +21,7 @@
 //! aerial heights with metre-level errors (thesis 3.5.1.1), larger than their a-priori σ says once the aerial
 //! orientations are a few centimetres off, and an offset the data cannot resolve must not fail a good campaign.
 
+use super::id_index::index_by_id;
 use crate::campaign::Recording;
 use crate::correspondence::AerialControlPoint;
 use crate::fsutil::atomic_write_with;
@@ -28,7 +29,6 @@ use crate::geometry::{triangulate_rays, PanoramaCamera};
 use crate::params::{describe, Params, StageId};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
-use std::collections::HashMap;
 use std::io::{self, Write};
 use std::ops::RangeInclusive;
 use std::path::Path;
@@ -233,11 +233,7 @@ pub fn verify_with_detail_levels(
             cam.angular_sigma_rad(config.pano_sigma_px * (1u64 << level) as f64)
         })
         .collect();
-    let index: HashMap<&str, usize> = recordings
-        .iter()
-        .enumerate()
-        .map(|(i, r)| (r.image_id.as_str(), i))
-        .collect();
+    let index = index_by_id(recordings, |r| r.image_id.as_str());
     let segment_of = segment_of_recordings(recordings, config);
     let n_segments = segment_of.last().map_or(0, |&s| s + 1);
     let mut points = Vec::new();

@@ -83,12 +83,7 @@ impl Factor {
                 let l2t = self.lower[start + a].transpose();
                 let diag_update = self.lower[start + a] * l2t;
                 self.diagonal[i2] -= diag_update;
-                let mut target = symbolic.column_positions(i2);
-                for (b, &i1) in rows.iter().enumerate().skip(a + 1) {
-                    let k = target
-                        .find(|&(_, row)| row == i1)
-                        .expect("the fill of column j lies in L's structure")
-                        .0;
+                for (b, k) in symbolic.merge_walk(j, a) {
                     let update = self.lower[start + b] * l2t;
                     self.lower[k] -= update;
                 }

@@ -44,12 +44,7 @@ impl SelectedInverse {
             for (a, &k) in rows.iter().enumerate() {
                 let l_kj = factor.lower(start + a);
                 acc[a] += z.diagonal[k] * l_kj;
-                let mut column_k = symbolic.column_positions(k);
-                for (b, &i) in rows.iter().enumerate().skip(a + 1) {
-                    let position = column_k
-                        .find(|&(_, row)| row == i)
-                        .expect("a column's structure is a clique of L's structure")
-                        .0;
+                for (b, position) in symbolic.merge_walk(j, a) {
                     let z_ik = &z.lower[position];
                     acc[b] += z_ik * l_kj;
                     acc[a] += z_ik.tr_mul(factor.lower(start + b));

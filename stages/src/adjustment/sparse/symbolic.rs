@@ -108,6 +108,22 @@ impl Symbolic {
             .map(move |(k, &row)| (start + k, row))
     }
 
+    /// For the row k = `column(j)[a]` of new column `j`: (b, storage position of the block
+    /// (`column(j)[b]`, k)) for every later row b > a of column `j`. Those rows lie in column k's structure
+    /// (the rows of a column are a clique of L's structure) and both are ascending: one merge walk finds
+    /// them.
+    pub fn merge_walk(&self, j: usize, a: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let rows = self.column(j);
+        let mut column_k = self.column_positions(rows[a]);
+        rows.iter().enumerate().skip(a + 1).map(move |(b, &i)| {
+            let position = column_k
+                .find(|&(_, row)| row == i)
+                .expect("a column's structure is a clique of L's structure")
+                .0;
+            (b, position)
+        })
+    }
+
     /// Strictly lower blocks of L.
     pub fn lower_blocks(&self) -> usize {
         self.columns.len()

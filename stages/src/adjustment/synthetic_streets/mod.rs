@@ -10,7 +10,8 @@ pub mod points;
 pub mod route;
 
 use super::problem::{Block, BlockRecording, ControlPoint, PanoObservation, RelativeConstraint};
-use crate::geometry::{triangulate_rays, PanoramaCamera};
+use super::synthetic_block::{surveyed_control, triangulate_recorded};
+use crate::geometry::PanoramaCamera;
 use crate::rng::{mix_seed, SplitMix64};
 use nalgebra::Vector3;
 use points::{crossing_points, observe, roadside_points, TiePoint};
@@ -179,12 +180,13 @@ impl StreetBlockSpec {
             .map(|j| {
                 let p = ((j * n_pts + n_pts / 2) / wanted).min(n_pts - 1);
                 let mut rng = SplitMix64::new(mix_seed(self.seed ^ 0xC0A7_0000, j as u64));
-                let noise = Vector3::new(
-                    rng.next_gaussian(),
-                    rng.next_gaussian(),
-                    rng.next_gaussian(),
-                ) * self.control_noise_m;
-                ControlPoint::isotropic(p, points[p].true_world + noise, self.control_sigma_m)
+                surveyed_control(
+                    p,
+                    points[p].true_world,
+                    self.control_noise_m,
+                    self.control_sigma_m,
+                    &mut rng,
+                )
             })
             .collect()
     }
@@ -203,15 +205,7 @@ fn initial_points(
         .zip(points)
         .with_min_len(1024)
         .map(|(obs, point)| {
-            let rays: Vec<_> = obs
-                .iter()
-                .map(|&(r, u, v)| recordings[r].camera.pixel_ray(u, v))
-                .collect();
-            let sigmas: Vec<f64> = obs
-                .iter()
-                .map(|&(r, _, _)| recordings[r].camera.angular_sigma_rad(sigma_px))
-                .collect();
-            triangulate_rays(&rays, &sigmas).map_or(point.true_world, |t| t.point_world)
+            triangulate_recorded(recordings, obs, sigma_px).unwrap_or(point.true_world)
         })
         .collect()
 }
