@@ -29,8 +29,11 @@
 //! with the fill of the sparse factor for street networks with crossings and repeated passes.
 
 pub mod adjust;
+pub mod adjust_inputs;
 pub mod aerial;
+pub mod block_build;
 pub mod block_point;
+pub mod block_recordings;
 pub mod campaign_checkpoints;
 pub mod config;
 pub mod control_consistency;
