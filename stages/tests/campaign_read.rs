@@ -164,6 +164,11 @@ fn key(
     )
 }
 
+/// `p`'s message contains `part` (the problem is shown when not).
+fn assert_mentions(p: &Problem, part: &str) {
+    assert!(p.message.contains(part), "{p}");
+}
+
 fn find<'a>(problems: &'a [Problem], file: &str, row: usize, field: &str) -> &'a Problem {
     problems
         .iter()
@@ -214,11 +219,7 @@ fn recordings_are_sorted_by_time_whatever_the_file_order() {
         keys(&problems),
         [3, 4, 5].map(|row| key("mm/recordings.csv", row, "time", Severity::Warning))
     );
-    assert!(
-        problems[0].message.contains("is before the time on row 2"),
-        "{}",
-        problems[0]
-    );
+    assert_mentions(&problems[0], "is before the time on row 2");
 }
 
 #[test]
@@ -597,39 +598,14 @@ fn more_broken_cases_toml_types_cross_file_ids_cell_counts_encoding() {
         key("control/observations.csv", 6, "point_id", Severity::Error),
     ];
     assert_eq!(keys(&problems), expected, "{problems:#?}");
-    assert!(
-        problems[0]
-            .message
-            .contains("is of type integer, not a string"),
-        "{}",
-        problems[0]
+    assert_mentions(&problems[0], "is of type integer, not a string");
+    assert_mentions(&problems[1], "has 14 cells but the header has 13 columns");
+    assert_mentions(&problems[2], "not valid UTF-8");
+    assert_mentions(
+        &problems[3],
+        "'n0' is also used on aerial/nadir/cameras.csv:2",
     );
-    assert!(
-        problems[1]
-            .message
-            .contains("has 14 cells but the header has 13 columns"),
-        "{}",
-        problems[1]
-    );
-    assert!(
-        problems[2].message.contains("not valid UTF-8"),
-        "{}",
-        problems[2]
-    );
-    assert!(
-        problems[3]
-            .message
-            .contains("'n0' is also used on aerial/nadir/cameras.csv:2"),
-        "{}",
-        problems[3]
-    );
-    assert!(
-        problems[6]
-            .message
-            .contains("'c1' in image 'pano_0' is also used on row 2"),
-        "{}",
-        problems[6]
-    );
+    assert_mentions(&problems[6], "'c1' in image 'pano_0' is also used on row 2");
     let ids: Vec<&str> = campaign
         .recordings
         .iter()

@@ -146,11 +146,11 @@ impl<F: FnOnce(&PyramidLayout) -> Vec<Region>> GreyRowSink for PartialBuild<F> {
     }
 
     fn row_u8(&mut self, row: &[u8]) -> io::Result<()> {
-        self.started()?.push_row_u8(row)
+        self.started()?.push_row(row)
     }
 
     fn row_u16(&mut self, row: &[u16]) -> io::Result<()> {
-        self.started()?.push_row_u16(row)
+        self.started()?.push_row(row)
     }
 }
 

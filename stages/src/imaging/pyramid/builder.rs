@@ -7,7 +7,7 @@
 //! temporary file.
 
 use super::layout::{PyramidLayout, SampleDepth, HEADER_LEN, TILE_HASH_LEN};
-use super::sample::{narrow_row, reduce_rows, widen_row, Sample};
+use super::sample::{reduce_rows, Sample};
 use rayon::prelude::*;
 use std::fs::{self, File, OpenOptions};
 use std::io;
@@ -313,25 +313,11 @@ impl<K: TileSink> DepthChain<K> {
         }
     }
 
-    /// Appends one full-width row of 8-bit samples.
-    pub(crate) fn push_row_u8(&mut self, row: &[u8]) -> io::Result<()> {
+    /// Appends one full-width row of samples of either depth.
+    pub(crate) fn push_row<T: Sample>(&mut self, row: &[T]) -> io::Result<()> {
         match &mut self.chain {
-            AnyChain::U8(c) => c.push_row(row),
-            AnyChain::U16(c) => {
-                widen_row(row, &mut self.scratch16);
-                c.push_row(&self.scratch16)
-            }
-        }
-    }
-
-    /// Appends one full-width row of 16-bit samples.
-    pub(crate) fn push_row_u16(&mut self, row: &[u16]) -> io::Result<()> {
-        match &mut self.chain {
-            AnyChain::U16(c) => c.push_row(row),
-            AnyChain::U8(c) => {
-                narrow_row(row, &mut self.scratch8);
-                c.push_row(&self.scratch8)
-            }
+            AnyChain::U8(c) => c.push_row(T::row_as_u8(row, &mut self.scratch8)),
+            AnyChain::U16(c) => c.push_row(T::row_as_u16(row, &mut self.scratch16)),
         }
     }
 
@@ -392,12 +378,12 @@ impl PyramidBuilder {
 
     /// Appends one full-width row of 8-bit samples.
     pub fn push_row_u8(&mut self, row: &[u8]) -> io::Result<()> {
-        self.chain.as_mut().expect("not finished").push_row_u8(row)
+        self.chain.as_mut().expect("not finished").push_row(row)
     }
 
     /// Appends one full-width row of 16-bit samples.
     pub fn push_row_u16(&mut self, row: &[u16]) -> io::Result<()> {
-        self.chain.as_mut().expect("not finished").push_row_u16(row)
+        self.chain.as_mut().expect("not finished").push_row(row)
     }
 
     /// Completes the file (all rows must have been pushed) and renames it into place.
