@@ -164,6 +164,15 @@ fn key(
     )
 }
 
+/// Writes `text` to `root/rel`, creating its folder.
+fn write_text(root: &Path, rel: &str, text: &str) {
+    let path = root.join(rel);
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).unwrap();
+    }
+    std::fs::write(path, text).unwrap();
+}
+
 /// `p`'s message contains `part` (the problem is shown when not).
 fn assert_mentions(p: &Problem, part: &str) {
     assert!(p.message.contains(part), "{p}");
@@ -281,7 +290,7 @@ fn broken_campaign_reports_every_problem_with_file_row_field() {
     std::fs::write(pano.join("trunc.jpg"), &bytes[..bytes.len() / 3]).unwrap();
 
     // campaign.toml without crs.
-    std::fs::write(root.join("campaign.toml"), "name = \"broken\"\n").unwrap();
+    write_text(root, "campaign.toml", "name = \"broken\"\n");
     let recordings = "\
 # exported by SomeTool
 # second comment
@@ -301,7 +310,7 @@ trunc.jpg,p10,155050,463000,2.5,90,2.5,2019-06-14T10:31:16Z,ann
 wide.png,p11,155055,463000,2.5,90,2.5,2019-06-14T10:31:17Z,ann
 p12.jpg,p12,155060,463000,2.5,90,2.5,2019-06-14T11:31:16.500+01:00,ann
 ";
-    std::fs::write(root.join("mm/recordings.csv"), recordings).unwrap();
+    write_text(root, "mm/recordings.csv", recordings);
 
     let nadir_dir = root.join("aerial/nadir");
     for name in ["n0.png", "n1.png", "n2.png", "n3.png", "n4.png", "n5.png"] {
@@ -315,19 +324,13 @@ n2,n2.png,155030,463000,300,0,0,0,-5,40,30,80,60\r\n\
 n3,n3.png,155030,463000,300,0,0,0,100,500,30,80,60\r\n\
 n4,n4.png,155030,463000,300,0,0,0,100,40,30,100,60\r\n\
 n5,n5.png,255030,463000,300,0,0,0,100,40,30,80,60\r\n";
-    std::fs::write(nadir_dir.join("cameras.csv"), nadir).unwrap();
+    write_text(root, "aerial/nadir/cameras.csv", nadir);
 
-    std::fs::create_dir_all(root.join("control")).unwrap();
-    std::fs::write(
-        root.join("control/checkpoints.csv"),
-        "point_id,x,y,z\nc1,155001,463005,0.5\nc2,155002,463005,\n",
-    )
-    .unwrap();
-    std::fs::write(
-        root.join("control/observations.csv"),
-        "point_id,image_id,u,v\nc1,p0,10,10\nc1,pX,10,10\nc1,p12,100,10\nc9,p0,5,5\n",
-    )
-    .unwrap();
+    let checkpoints = "point_id,x,y,z\nc1,155001,463005,0.5\nc2,155002,463005,\n";
+    write_text(root, "control/checkpoints.csv", checkpoints);
+    let observations =
+        "point_id,image_id,u,v\nc1,p0,10,10\nc1,pX,10,10\nc1,p12,100,10\nc9,p0,5,5\n";
+    write_text(root, "control/observations.csv", observations);
 
     use Severity::{Error, Warning};
     let read_expected = vec![
