@@ -301,6 +301,7 @@ pub(crate) struct DepthChain<K> {
 }
 
 impl<K: TileSink> DepthChain<K> {
+    /// The chain of `layout`'s tiles into `sink`.
     pub(crate) fn new(layout: PyramidLayout, sink: K) -> Self {
         let chain = match layout.depth {
             SampleDepth::U8 => AnyChain::U8(Chain::new(layout, sink)),
