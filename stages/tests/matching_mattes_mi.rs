@@ -141,7 +141,11 @@ fn mi_is_invariant_under_affine_intensity_remaps() {
             let mut moving = fixed.clone();
             moving.data.iter_mut().for_each(|v| *v = a * *v + b);
             let mi = mi_at(&fixed, &moving, samples, 3, [0.0, 0.0]);
-            assert_same_mi(mi, mi_ff, format_args!("a = {a}, b = {b}, samples {samples:?}"));
+            assert_same_mi(
+                mi,
+                mi_ff,
+                format_args!("a = {a}, b = {b}, samples {samples:?}"),
+            );
         }
     }
 }
@@ -395,7 +399,11 @@ fn integral_translations_match_the_definition() {
     for t in [[0, 0], [2, -1], [-7, 5], [12, 12], [-3, -11]] {
         let got = metric.evaluate(t[0] as f64, t[1] as f64).unwrap();
         let want = reference_mi_integral(&fixed, &moving_m, 50, t);
-        assert_same_mi(got, want, format_args!("shift {t:?} (got vs the definition's)"));
+        assert_same_mi(
+            got,
+            want,
+            format_args!("shift {t:?} (got vs the definition's)"),
+        );
     }
 }
 

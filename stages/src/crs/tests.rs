@@ -52,7 +52,12 @@ fn oblique_stereographic_guidance_note_example() {
     let to_map = HorizontalTransform::from_own_geographic(&rd);
     assert_takes(&to_map, (53.0, 6.0), (196_105.283, 557_057.739), 1e-3);
     let to_geographic = HorizontalTransform::to_own_geographic(&rd);
-    assert_takes(&to_geographic, (196_105.283, 557_057.739), (53.0, 6.0), 1e-8);
+    assert_takes(
+        &to_geographic,
+        (196_105.283, 557_057.739),
+        (53.0, 6.0),
+        1e-8,
+    );
 }
 
 /// `t` takes `from` to within `tol` of `to` in each coordinate.

@@ -88,7 +88,6 @@ impl TileSink for KeepSink {
     }
 }
 
-
 /// Receives the decoder's rows; sets up the chain once the size is known.
 struct PartialBuild<F> {
     path: PathBuf,
