@@ -214,15 +214,7 @@ pub fn sample_aerial_on_ortho_grid(
 
 /// Standard deviation of the grey values of `img`.
 pub fn grey_std(img: &GrayImage) -> f64 {
-    let n = img.data.len().max(1) as f64;
-    let mean = img.data.iter().map(|&g| g as f64).sum::<f64>() / n;
-    let var = img
-        .data
-        .iter()
-        .map(|&g| (g as f64 - mean).powi(2))
-        .sum::<f64>()
-        / n;
-    var.sqrt()
+    img.mean_std().1
 }
 
 /// Reusable per-thread buffers of one tie point's matching.
