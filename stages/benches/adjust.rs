@@ -3,11 +3,14 @@
 //! writes the problem (local frame, whitened) with the final cost to `$TMPDIR/adjust_bench_problem.json`
 //! (or the second argument) for the peer `benches/peers/adjust_scipy.py`.
 
+#[path = "peer_support/mod.rs"]
+mod peer_support;
+
 use nalgebra::Vector3;
+use peer_support::timed;
 use skytie_stages::adjustment::prepared::{Prepared, Rejected};
 use skytie_stages::adjustment::residuals::State;
 use skytie_stages::adjustment::{adjust, AdjustOptions, SyntheticBlockSpec};
-use std::time::Instant;
 
 fn main() {
     let args: Vec<String> = std::env::args()
@@ -27,14 +30,10 @@ fn main() {
         seed: 42,
         ..SyntheticBlockSpec::default()
     };
-    let t0 = Instant::now();
-    let synth = spec.generate();
-    let t_gen = t0.elapsed().as_secs_f64();
+    let (t_gen, synth) = timed(|| spec.generate());
     let b = &synth.block;
     let options = AdjustOptions::default();
-    let t1 = Instant::now();
-    let adj = adjust(b, &options).expect("adjustment");
-    let t_solve = t1.elapsed().as_secs_f64();
+    let (t_solve, adj) = timed(|| adjust(b, &options).expect("adjustment"));
     let max_err = adj
         .recordings
         .iter()

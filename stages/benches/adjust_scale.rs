@@ -12,13 +12,12 @@
 #[path = "peer_support/mod.rs"]
 mod peer_support;
 
-use peer_support::peak_rss_mib;
+use peer_support::{peak_rss_mib, timed};
 use skytie_stages::adjustment::layout::ReducedStructure;
 use skytie_stages::adjustment::prepared::{Prepared, Rejected};
 use skytie_stages::adjustment::residuals::State;
 use skytie_stages::adjustment::synthetic_streets::StreetBlockSpec;
 use skytie_stages::adjustment::{adjust, AdjustOptions, Block};
-use std::time::Instant;
 
 fn rms_xy(
     positions: impl Iterator<Item = nalgebra::Vector3<f64>>,
@@ -55,9 +54,7 @@ fn main() {
         seed: 42,
         ..StreetBlockSpec::default()
     };
-    let t0 = Instant::now();
-    let synth = spec.generate();
-    let t_gen = t0.elapsed().as_secs_f64();
+    let (t_gen, synth) = timed(|| spec.generate());
     let b = &synth.block;
     let options = AdjustOptions::default();
     let before = rms_xy(
@@ -68,9 +65,7 @@ fn main() {
         print_structure(b, &options);
         return;
     }
-    let t1 = Instant::now();
-    let adj = adjust(b, &options).expect("adjustment");
-    let t_adjust = t1.elapsed().as_secs_f64();
+    let (t_adjust, adj) = timed(|| adjust(b, &options).expect("adjustment"));
     let after = rms_xy(
         adj.recordings.iter().map(|r| r.position_world),
         &synth.true_centers_world,

@@ -13,16 +13,12 @@
 //! one frame of each kind of the real-size preset. Prints one row per file and decoder:
 //! `file  pixels  decoder  decode_s  ingest_s  ingest/decode`.
 
+#[path = "peer_support/mod.rs"]
+mod peer_support;
+
+use peer_support::timed;
 use skytie_stages::imaging::ingest::ingest;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
-
-/// Wall seconds of `f`, and its result.
-fn timed<T>(f: impl FnOnce() -> T) -> (f64, T) {
-    let s = Instant::now();
-    let r = f();
-    (s.elapsed().as_secs_f64(), r)
-}
 
 /// The `image` crate's decode of `path` with no allocation limit; returns the pixel count.
 fn decode_image_crate(path: &Path) -> Result<u64, String> {

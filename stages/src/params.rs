@@ -264,6 +264,38 @@ pub fn check_finite<T: RangeChecked>(field: &str, value: &T, out: &mut Vec<Viola
     }
 }
 
+/// Pushes a violation when `value` is not a finite number above `bound`, the value of the parameter
+/// `bound_field` (`unit` as in [`check_range`]; call it from a `check` block).
+pub fn check_above_field(
+    field: &str,
+    value: f64,
+    (bound_field, bound): (&str, f64),
+    unit: &str,
+    out: &mut Vec<Violation>,
+) {
+    if !(value.is_finite() && value > bound) {
+        let unit = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        };
+        out.push(Violation::new(
+            field,
+            format!("must be a finite number > {bound_field} ({bound}{unit}), got {value}"),
+        ));
+    }
+}
+
+/// The fields `p` violates, in order; `p` must not validate.
+#[cfg(test)]
+pub(crate) fn violated_fields<P: Params>(p: &P) -> Vec<String> {
+    p.validate()
+        .unwrap_err()
+        .into_iter()
+        .map(|v| v.field)
+        .collect()
+}
+
 /// Adds `prefix.` to the fields of a nested section's violations.
 pub fn prefixed(prefix: &str, violations: Vec<Violation>) -> impl Iterator<Item = Violation> + '_ {
     violations.into_iter().map(move |v| Violation {

@@ -80,3 +80,16 @@ impl SplitMix64 {
         true
     }
 }
+
+/// The successive states (after `seed`) of Knuth's MMIX linear congruential generator,
+/// `s ← 6364136223846793005·s + 1442695040888963407`: the data of the tests of image kernels.
+#[cfg(test)]
+pub(crate) fn mmix_states(seed: u64) -> impl Iterator<Item = u64> {
+    std::iter::successors(Some(seed), |s| {
+        Some(
+            s.wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407),
+        )
+    })
+    .skip(1)
+}

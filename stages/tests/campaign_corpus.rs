@@ -181,6 +181,22 @@ fn cell(rel: &'static str, row: usize, col: &'static str, value: &'static str) -
     move |r: &Path| set_cell(r, rel, row, col, value)
 }
 
+/// A case that sets the cell (file, row, column) `at` to `value` and expects one error, on that cell, whose
+/// message contains `message`.
+fn cell_case(
+    name: &'static str,
+    at: (&'static str, usize, &'static str),
+    value: &'static str,
+    message: &'static str,
+) -> Case {
+    let (rel, row, column) = at;
+    case(
+        name,
+        cell(rel, row, column, value),
+        vec![(rel, Some(row), Some(column), message)],
+    )
+}
+
 fn csv_cases() -> Vec<Case> {
     vec![
         case(
@@ -209,55 +225,49 @@ fn csv_cases() -> Vec<Case> {
             },
             vec![(CP, Some(1), Some("x"), "column appears twice")],
         ),
-        case(
+        cell_case(
             "x not a number",
-            cell(REC, 3, "x", "abc"),
-            vec![(REC, Some(3), Some("x"), "'abc' is not a number")],
+            (REC, 3, "x"),
+            "abc",
+            "'abc' is not a number",
         ),
-        case(
+        cell_case(
             "y NaN",
-            cell(REC, 3, "y", "NaN"),
-            vec![(REC, Some(3), Some("y"), "'NaN' is not a finite number")],
+            (REC, 3, "y"),
+            "NaN",
+            "'NaN' is not a finite number",
         ),
-        case(
+        cell_case(
             "z inf",
-            cell(REC, 4, "z", "inf"),
-            vec![(REC, Some(4), Some("z"), "'inf' is not a finite number")],
+            (REC, 4, "z"),
+            "inf",
+            "'inf' is not a finite number",
         ),
-        case(
-            "heading empty",
-            cell(REC, 5, "heading", ""),
-            vec![(REC, Some(5), Some("heading"), "is empty")],
-        ),
-        case(
+        cell_case("heading empty", (REC, 5, "heading"), "", "is empty"),
+        cell_case(
             "heading 720",
-            cell(REC, 5, "heading", "720"),
-            vec![(REC, Some(5), Some("heading"), "720° is outside -180°…360°")],
+            (REC, 5, "heading"),
+            "720",
+            "720° is outside -180°…360°",
         ),
-        case(
+        cell_case(
             "x 1e30",
-            cell(REC, 6, "x", "1e30"),
-            vec![(REC, Some(6), Some("x"), "is not a projected coordinate")],
+            (REC, 6, "x"),
+            "1e30",
+            "is not a projected coordinate",
         ),
-        case(
-            "z 1e30",
-            cell(REC, 6, "z", "1e30"),
-            vec![(REC, Some(6), Some("z"), "is not a height")],
-        ),
-        case(
+        cell_case("z 1e30", (REC, 6, "z"), "1e30", "is not a height"),
+        cell_case(
             "camera height 0",
-            cell(REC, 2, "camera_height", "0"),
-            vec![(REC, Some(2), Some("camera_height"), "is not above the road")],
+            (REC, 2, "camera_height"),
+            "0",
+            "is not above the road",
         ),
-        case(
+        cell_case(
             "time not ISO",
-            cell(REC, 7, "time", "yesterday"),
-            vec![(
-                REC,
-                Some(7),
-                Some("time"),
-                "'yesterday' is not an ISO 8601 time",
-            )],
+            (REC, 7, "time"),
+            "yesterday",
+            "'yesterday' is not an ISO 8601 time",
         ),
         case(
             "sigma 1e-30",
@@ -341,15 +351,11 @@ fn csv_cases() -> Vec<Case> {
             |r| std::fs::write(r.join(REC), "").unwrap(),
             vec![(REC, None, None, "is empty (no header row)")],
         ),
-        case(
+        cell_case(
             "50 km off",
-            cell(REC, 4, "x", "205010"),
-            vec![(
-                REC,
-                Some(4),
-                Some("x"),
-                "m from the middle of the campaign, while 95 % of the recordings lie within",
-            )],
+            (REC, 4, "x"),
+            "205010",
+            "m from the middle of the campaign, while 95 % of the recordings lie within",
         ),
         case(
             "jump away from both neighbours",
@@ -361,35 +367,35 @@ fn csv_cases() -> Vec<Case> {
                 "position jumps away from both neighbours",
             )],
         ),
-        case(
+        cell_case(
             "unknown point in observation",
-            cell(OBS, 2, "point_id", "c9"),
-            vec![(OBS, Some(2), Some("point_id"), "'c9' is not a usable point")],
+            (OBS, 2, "point_id"),
+            "c9",
+            "'c9' is not a usable point",
         ),
-        case(
+        cell_case(
             "unknown panorama in observation",
-            cell(OBS, 2, "image_id", "pano_9"),
-            vec![(
-                OBS,
-                Some(2),
-                Some("image_id"),
-                "'pano_9' is not a usable panorama",
-            )],
+            (OBS, 2, "image_id"),
+            "pano_9",
+            "'pano_9' is not a usable panorama",
         ),
-        case(
+        cell_case(
             "negative u",
-            cell(OBS, 3, "u", "-4"),
-            vec![(OBS, Some(3), Some("u"), "-4 px lies outside the panorama")],
+            (OBS, 3, "u"),
+            "-4",
+            "-4 px lies outside the panorama",
         ),
-        case(
+        cell_case(
             "u beyond the panorama",
-            cell(OBS, 3, "u", "64"),
-            vec![(OBS, Some(3), Some("u"), "u must be < 64")],
+            (OBS, 3, "u"),
+            "64",
+            "u must be < 64",
         ),
-        case(
+        cell_case(
             "v beyond the panorama",
-            cell(OBS, 4, "v", "33"),
-            vec![(OBS, Some(4), Some("v"), "v must be ≤ 32")],
+            (OBS, 4, "v"),
+            "33",
+            "v must be ≤ 32",
         ),
         case(
             "duplicate observation",
@@ -443,45 +449,31 @@ fn csv_cases() -> Vec<Case> {
                 "does not exist, so control/observations.csv cannot be used",
             )],
         ),
-        case(
+        cell_case(
             "focal 1e-9",
-            cell(NADIR, 2, "focal_px", "1e-9"),
-            vec![(NADIR, Some(2), Some("focal_px"), "field of view")],
+            (NADIR, 2, "focal_px"),
+            "1e-9",
+            "field of view",
         ),
-        case(
+        cell_case(
             "focal negative",
-            cell(NADIR, 2, "focal_px", "-5"),
-            vec![(
-                NADIR,
-                Some(2),
-                Some("focal_px"),
-                "is not a principal distance",
-            )],
+            (NADIR, 2, "focal_px"),
+            "-5",
+            "is not a principal distance",
         ),
-        case(
-            "focal 1e9",
-            cell(NADIR, 3, "focal_px", "1e9"),
-            vec![(NADIR, Some(3), Some("focal_px"), "field of view")],
-        ),
-        case(
-            "omega 95",
-            cell(NADIR, 2, "omega", "95"),
-            vec![(NADIR, Some(2), Some("omega"), "beyond ±90°")],
-        ),
-        case(
+        cell_case("focal 1e9", (NADIR, 3, "focal_px"), "1e9", "field of view"),
+        cell_case("omega 95", (NADIR, 2, "omega"), "95", "beyond ±90°"),
+        cell_case(
             "kappa 1000",
-            cell(NADIR, 2, "kappa", "1000"),
-            vec![(NADIR, Some(2), Some("kappa"), "1000° is outside")],
+            (NADIR, 2, "kappa"),
+            "1000",
+            "1000° is outside",
         ),
-        case(
+        cell_case(
             "width abc",
-            cell(NADIR, 2, "width", "abc"),
-            vec![(
-                NADIR,
-                Some(2),
-                Some("width"),
-                "is not a whole number of pixels",
-            )],
+            (NADIR, 2, "width"),
+            "abc",
+            "is not a whole number of pixels",
         ),
         case(
             "width 3",
@@ -501,15 +493,11 @@ fn csv_cases() -> Vec<Case> {
                 ),
             ],
         ),
-        case(
+        cell_case(
             "cx outside",
-            cell(NADIR, 3, "cx", "500"),
-            vec![(
-                NADIR,
-                Some(3),
-                Some("cx"),
-                "principal point 500 px lies outside",
-            )],
+            (NADIR, 3, "cx"),
+            "500",
+            "principal point 500 px lies outside",
         ),
         case(
             "sigma_px 1e-9",
@@ -519,20 +507,12 @@ fn csv_cases() -> Vec<Case> {
                 (NADIR, Some(3), Some("sigma_px"), "outside the plausible"),
             ],
         ),
-        case(
-            "aerial z 1e30",
-            cell(OBL, 2, "z", "1e30"),
-            vec![(OBL, Some(2), Some("z"), "is not a height")],
-        ),
-        case(
+        cell_case("aerial z 1e30", (OBL, 2, "z"), "1e30", "is not a height"),
+        cell_case(
             "aerial id used twice",
-            cell(OBL, 2, "image_id", "n0"),
-            vec![(
-                OBL,
-                Some(2),
-                Some("image_id"),
-                "'n0' is also used on aerial/nadir/cameras.csv:2",
-            )],
+            (OBL, 2, "image_id"),
+            "n0",
+            "'n0' is also used on aerial/nadir/cameras.csv:2",
         ),
         case(
             "cameras.csv missing",

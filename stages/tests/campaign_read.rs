@@ -164,6 +164,20 @@ fn key(
     )
 }
 
+/// Writes `text` to `root/rel`, creating its folder.
+fn write_text(root: &Path, rel: &str, text: &str) {
+    let path = root.join(rel);
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).unwrap();
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+/// `p`'s message contains `part` (the problem is shown when not).
+fn assert_mentions(p: &Problem, part: &str) {
+    assert!(p.message.contains(part), "{p}");
+}
+
 fn find<'a>(problems: &'a [Problem], file: &str, row: usize, field: &str) -> &'a Problem {
     problems
         .iter()
@@ -214,11 +228,7 @@ fn recordings_are_sorted_by_time_whatever_the_file_order() {
         keys(&problems),
         [3, 4, 5].map(|row| key("mm/recordings.csv", row, "time", Severity::Warning))
     );
-    assert!(
-        problems[0].message.contains("is before the time on row 2"),
-        "{}",
-        problems[0]
-    );
+    assert_mentions(&problems[0], "is before the time on row 2");
 }
 
 #[test]
@@ -280,7 +290,7 @@ fn broken_campaign_reports_every_problem_with_file_row_field() {
     std::fs::write(pano.join("trunc.jpg"), &bytes[..bytes.len() / 3]).unwrap();
 
     // campaign.toml without crs.
-    std::fs::write(root.join("campaign.toml"), "name = \"broken\"\n").unwrap();
+    write_text(root, "campaign.toml", "name = \"broken\"\n");
     let recordings = "\
 # exported by SomeTool
 # second comment
@@ -300,7 +310,7 @@ trunc.jpg,p10,155050,463000,2.5,90,2.5,2019-06-14T10:31:16Z,ann
 wide.png,p11,155055,463000,2.5,90,2.5,2019-06-14T10:31:17Z,ann
 p12.jpg,p12,155060,463000,2.5,90,2.5,2019-06-14T11:31:16.500+01:00,ann
 ";
-    std::fs::write(root.join("mm/recordings.csv"), recordings).unwrap();
+    write_text(root, "mm/recordings.csv", recordings);
 
     let nadir_dir = root.join("aerial/nadir");
     for name in ["n0.png", "n1.png", "n2.png", "n3.png", "n4.png", "n5.png"] {
@@ -314,19 +324,13 @@ n2,n2.png,155030,463000,300,0,0,0,-5,40,30,80,60\r\n\
 n3,n3.png,155030,463000,300,0,0,0,100,500,30,80,60\r\n\
 n4,n4.png,155030,463000,300,0,0,0,100,40,30,100,60\r\n\
 n5,n5.png,255030,463000,300,0,0,0,100,40,30,80,60\r\n";
-    std::fs::write(nadir_dir.join("cameras.csv"), nadir).unwrap();
+    write_text(root, "aerial/nadir/cameras.csv", nadir);
 
-    std::fs::create_dir_all(root.join("control")).unwrap();
-    std::fs::write(
-        root.join("control/checkpoints.csv"),
-        "point_id,x,y,z\nc1,155001,463005,0.5\nc2,155002,463005,\n",
-    )
-    .unwrap();
-    std::fs::write(
-        root.join("control/observations.csv"),
-        "point_id,image_id,u,v\nc1,p0,10,10\nc1,pX,10,10\nc1,p12,100,10\nc9,p0,5,5\n",
-    )
-    .unwrap();
+    let checkpoints = "point_id,x,y,z\nc1,155001,463005,0.5\nc2,155002,463005,\n";
+    write_text(root, "control/checkpoints.csv", checkpoints);
+    let observations =
+        "point_id,image_id,u,v\nc1,p0,10,10\nc1,pX,10,10\nc1,p12,100,10\nc9,p0,5,5\n";
+    write_text(root, "control/observations.csv", observations);
 
     use Severity::{Error, Warning};
     let read_expected = vec![
@@ -597,39 +601,14 @@ fn more_broken_cases_toml_types_cross_file_ids_cell_counts_encoding() {
         key("control/observations.csv", 6, "point_id", Severity::Error),
     ];
     assert_eq!(keys(&problems), expected, "{problems:#?}");
-    assert!(
-        problems[0]
-            .message
-            .contains("is of type integer, not a string"),
-        "{}",
-        problems[0]
+    assert_mentions(&problems[0], "is of type integer, not a string");
+    assert_mentions(&problems[1], "has 14 cells but the header has 13 columns");
+    assert_mentions(&problems[2], "not valid UTF-8");
+    assert_mentions(
+        &problems[3],
+        "'n0' is also used on aerial/nadir/cameras.csv:2",
     );
-    assert!(
-        problems[1]
-            .message
-            .contains("has 14 cells but the header has 13 columns"),
-        "{}",
-        problems[1]
-    );
-    assert!(
-        problems[2].message.contains("not valid UTF-8"),
-        "{}",
-        problems[2]
-    );
-    assert!(
-        problems[3]
-            .message
-            .contains("'n0' is also used on aerial/nadir/cameras.csv:2"),
-        "{}",
-        problems[3]
-    );
-    assert!(
-        problems[6]
-            .message
-            .contains("'c1' in image 'pano_0' is also used on row 2"),
-        "{}",
-        problems[6]
-    );
+    assert_mentions(&problems[6], "'c1' in image 'pano_0' is also used on row 2");
     let ids: Vec<&str> = campaign
         .recordings
         .iter()

@@ -16,18 +16,6 @@ fn texture(w: usize, h: usize) -> GrayImage {
     GrayImage::from_vec(w, h, data).unwrap()
 }
 
-fn mean_std(img: &GrayImage) -> (f64, f64) {
-    let n = img.data.len() as f64;
-    let m = img.data.iter().map(|&v| v as f64).sum::<f64>() / n;
-    let v = img
-        .data
-        .iter()
-        .map(|&x| (x as f64 - m).powi(2))
-        .sum::<f64>()
-        / n;
-    (m, v.sqrt())
-}
-
 #[test]
 fn constant_image_gives_b_mf_plus_one_minus_b_a_exactly() {
     let a = 0.3f32;
@@ -48,7 +36,7 @@ fn constant_image_gives_b_mf_plus_one_minus_b_a_exactly() {
 #[test]
 fn global_statistics_give_target_mean_and_std() {
     let img = texture(80, 60);
-    let (m, s) = mean_std(&img);
+    let (m, s) = img.mean_std();
     let p = WallisParams {
         target_mean: 0.45,
         target_std: 0.12,
@@ -59,7 +47,7 @@ fn global_statistics_give_target_mean_and_std() {
     let mi = GrayImage::filled(80, 60, m as f32);
     let si = GrayImage::filled(80, 60, s as f32);
     let out = wallis_apply(&img, &mi, &si, &p).unwrap();
-    let (mo, so) = mean_std(&out);
+    let (mo, so) = out.mean_std();
     assert!((mo - 0.45).abs() < 1e-3, "mean {mo}");
     assert!((so - 0.12).abs() < 1e-3, "std {so}");
 }

@@ -11,7 +11,8 @@ use skytie_stages::geometry::{opk_to_matrix, panorama_rotation};
 use skytie_stages::import::config::CampaignSection;
 use skytie_stages::import::context::ImportContext;
 use skytie_stages::import::export::{
-    export_metashape_xml, export_opk_list, export_pix4d, export_sbet_with_events, TrajectoryExport,
+    export_metashape_xml, export_opk_list, export_pix4d, export_sbet_with_events, ExportError,
+    TrajectoryExport,
 };
 use skytie_stages::import::{run_import, ImportConfig};
 use std::path::Path;
@@ -81,6 +82,30 @@ fn angle_between_deg(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
     c.clamp(-1.0, 1.0).acos().to_degrees()
 }
 
+/// The poses (position, world frame, m; rotation) of `orig` and `got` by `pose` within 1 mm and 0.0001° of each
+/// other; `what` names the row.
+fn assert_pose_close<T>(what: &str, orig: &T, got: &T, pose: fn(&T) -> ([f64; 3], Matrix3<f64>)) {
+    let ((o, ro), (g, rg)) = (pose(orig), pose(got));
+    let d = ((o[0] - g[0]).powi(2) + (o[1] - g[1]).powi(2) + (o[2] - g[2]).powi(2)).sqrt();
+    assert!(d <= 1e-3, "{what}: position off by {d} m");
+    let a = angle_between_deg(&ro, &rg);
+    assert!(a <= 1e-4, "{what}: rotation off by {a}°");
+}
+
+fn aerial_pose(a: &AerialImage) -> ([f64; 3], Matrix3<f64>) {
+    (
+        [a.x, a.y, a.z],
+        opk_to_matrix(a.omega_deg, a.phi_deg, a.kappa_deg),
+    )
+}
+
+fn panorama_pose(r: &Recording) -> ([f64; 3], Matrix3<f64>) {
+    (
+        [r.x, r.y, r.z],
+        panorama_rotation(r.yaw_deg, r.pitch_deg, r.roll_deg),
+    )
+}
+
 fn assert_aerial_equal(orig: &[AerialImage], got: &[AerialImage], what: &str) {
     assert_eq!(orig.len(), got.len(), "{what}: row count");
     for o in orig {
@@ -88,13 +113,7 @@ fn assert_aerial_equal(orig: &[AerialImage], got: &[AerialImage], what: &str) {
             .iter()
             .find(|g| g.image_id == o.image_id)
             .unwrap_or_else(|| panic!("{what}: {} missing", o.image_id));
-        let d = ((o.x - g.x).powi(2) + (o.y - g.y).powi(2) + (o.z - g.z).powi(2)).sqrt();
-        assert!(d <= 1e-3, "{what} {}: position off by {d} m", o.image_id);
-        let a = angle_between_deg(
-            &opk_to_matrix(o.omega_deg, o.phi_deg, o.kappa_deg),
-            &opk_to_matrix(g.omega_deg, g.phi_deg, g.kappa_deg),
-        );
-        assert!(a <= 1e-4, "{what} {}: rotation off by {a}°", o.image_id);
+        assert_pose_close(&format!("{what} {}", o.image_id), o, g, aerial_pose);
         for (name, x, y) in [
             ("focal", o.focal_px, g.focal_px),
             ("cx", o.cx_px, g.cx_px),
@@ -128,16 +147,20 @@ fn with_images(rows: &[AerialImage]) -> tempfile::TempDir {
     dir
 }
 
-fn context(geoid_separation_m: f64) -> ImportContext {
-    ImportContext::new(&CampaignSection {
+/// The campaign `t` in RD New + NAP, with a constant geoid separation or none.
+fn section(geoid_separation_m: Option<f64>) -> CampaignSection {
+    CampaignSection {
         name: "t".into(),
         crs: "EPSG:28992+5709".into(),
         geoid_grid: None,
-        geoid_separation_m: Some(geoid_separation_m),
+        geoid_separation_m,
         datum_grid: None,
         frame: Default::default(),
-    })
-    .unwrap()
+    }
+}
+
+fn context(geoid_separation_m: f64) -> ImportContext {
+    ImportContext::new(&section(Some(geoid_separation_m))).unwrap()
 }
 
 fn import(dir: &Path, config: &str) -> Campaign {
@@ -177,36 +200,37 @@ fn import_aerial(dir: &Path, kind: &str, format: &str, keys: &str) -> Campaign {
     )
 }
 
+/// `rows` exported by `export` (given the campaign context with a 43.25 m geoid separation, the export CRS
+/// EPSG:28992 and a scratch folder holding the rows' image files), then imported back as one `[[aerial]]`
+/// table of `kind` and `format` with the further `keys`.
+fn export_and_import(
+    rows: &[AerialImage],
+    export: impl FnOnce(&ImportContext, &str, &Path) -> Result<(), ExportError>,
+    kind: &str,
+    format: &str,
+    keys: &str,
+) -> Campaign {
+    let dir = with_images(rows);
+    export(&context(43.25), "EPSG:28992", dir.path()).unwrap();
+    import_aerial(dir.path(), kind, format, keys)
+}
+
 #[test]
 fn pix4d_round_trip() {
     let rows = four_aerials("n", false, false);
-    let dir = with_images(&rows);
-    export_pix4d(
-        &rows,
-        &context(43.25),
-        "EPSG:28992",
-        0.0046,
-        dir.path(),
-        "proj",
-    )
-    .unwrap();
-    let got = import_aerial(dir.path(), "nadir", "pix4d", "orientations = \"proj_calibrated_external_camera_parameters.txt\"\ninternals = \"proj_pix4d_calibrated_internal_camera_parameters.cam\"\nimages = \"images\"\ncrs = \"EPSG:28992+5709\"\nimage_width_px = 6000\nimage_height_px = 4000\n");
+    let export = |ctx: &ImportContext, crs: &str, dir: &Path| {
+        export_pix4d(&rows, ctx, crs, 0.0046, dir, "proj")
+    };
+    let got = export_and_import(&rows, export, "nadir", "pix4d", "orientations = \"proj_calibrated_external_camera_parameters.txt\"\ninternals = \"proj_pix4d_calibrated_internal_camera_parameters.cam\"\nimages = \"images\"\ncrs = \"EPSG:28992+5709\"\nimage_width_px = 6000\nimage_height_px = 4000\n");
     assert_aerial_equal(&rows, &got.nadir, "pix4d");
 }
 
 #[test]
 fn metashape_xml_round_trip_through_earth_centred_chunk() {
     let rows = four_aerials("o", true, true);
-    let dir = with_images(&rows);
-    export_metashape_xml(
+    let got = export_and_import(
         &rows,
-        &context(43.25),
-        "EPSG:28992",
-        &dir.path().join("cameras.xml"),
-    )
-    .unwrap();
-    let got = import_aerial(
-        dir.path(),
+        |ctx, crs, dir| export_metashape_xml(&rows, ctx, crs, &dir.join("cameras.xml")),
         "oblique",
         "metashape-xml",
         "orientations = \"cameras.xml\"\nimages = \"images\"\n",
@@ -219,17 +243,12 @@ fn metashape_opk_and_generic_lists_round_trip() {
     let rows = four_aerials("n", false, true);
     let camera = "[aerial.camera]\nfocal_px = 10000.5\ncx_px = 3000.25\ncy_px = 2001.75\nwidth_px = 6000\nheight_px = 4000\nk1 = -0.12\nk2 = 0.03\nk3 = 0.004\nk4 = -0.0005\np1 = 2e-4\np2 = -1e-4\nb1 = 0.8\nb2 = -0.3\n";
     // Metashape ω-φ-κ export.
-    let dir = with_images(&rows);
-    export_opk_list(
+    let got = export_and_import(
         &rows,
-        &context(43.25),
-        "EPSG:28992",
-        &OpkListFormat::metashape(),
-        &dir.path().join("opk.txt"),
-    )
-    .unwrap();
-    let got = import_aerial(
-        dir.path(),
+        |ctx, crs, dir| {
+            let format = OpkListFormat::metashape();
+            export_opk_list(&rows, ctx, crs, &format, &dir.join("opk.txt"))
+        },
         "nadir",
         "metashape-opk",
         &format!("orientations = \"opk.txt\"\nimages = \"images\"\n{camera}"),
@@ -237,18 +256,13 @@ fn metashape_opk_and_generic_lists_round_trip() {
     assert_aerial_equal(&rows, &got.nadir, "metashape-opk");
     // A classical AT list: semicolons, no header, gon, yaw-pitch-roll, columns by position.
     let layout = OpkListFormat::at_list();
-    let dir = with_images(&rows);
-    export_opk_list(
-        &rows,
-        &context(43.25),
-        "EPSG:28992",
-        &layout,
-        &dir.path().join("at.txt"),
-    )
-    .unwrap();
+    let export = |ctx: &ImportContext, crs: &str, dir: &Path| {
+        export_opk_list(&rows, ctx, crs, &layout, &dir.join("at.txt"))
+    };
     let layout_toml = "[aerial.layout]\ndelimiter = \"semicolon\"\nheader = false\nangle_unit = \"gon\"\nattitude = \"yaw-pitch-roll\"\n[aerial.layout.columns]\nimage = \"1\"\nx = \"2\"\ny = \"3\"\nz = \"4\"\nangles = [\"5\", \"6\", \"7\"]\n";
-    let got = import_aerial(
-        dir.path(),
+    let got = export_and_import(
+        &rows,
+        export,
         "nadir",
         "opk-list",
         &format!("orientations = \"at.txt\"\nimages = \"images\"\n{layout_toml}{camera}"),
@@ -260,13 +274,7 @@ fn assert_recordings_equal(orig: &[Recording], got: &[Recording]) {
     assert_eq!(orig.len(), got.len());
     for o in orig {
         let g = got.iter().find(|g| g.image_id == o.image_id).unwrap();
-        let d = ((o.x - g.x).powi(2) + (o.y - g.y).powi(2) + (o.z - g.z).powi(2)).sqrt();
-        assert!(d <= 1e-3, "{}: position off by {d} m", o.image_id);
-        let a = angle_between_deg(
-            &panorama_rotation(o.yaw_deg, o.pitch_deg, o.roll_deg),
-            &panorama_rotation(g.yaw_deg, g.pitch_deg, g.roll_deg),
-        );
-        assert!(a <= 1e-4, "{}: panorama rotation off by {a}°", o.image_id);
+        assert_pose_close(&format!("{} panorama", o.image_id), o, g, panorama_pose);
         let dh = (o.heading_deg - g.heading_deg + 180.0).rem_euclid(360.0) - 180.0;
         assert!(
             dh.abs() <= 1e-4,
@@ -287,14 +295,7 @@ fn sbet_round_trip(geoid_line: &str, geoid: Option<&GeoidGrid>) {
         &dir.path().join("panos"),
         recs.iter().map(|r| r.file.clone()),
     );
-    let mut section = CampaignSection {
-        name: "t".into(),
-        crs: "EPSG:28992+5709".into(),
-        geoid_grid: None,
-        geoid_separation_m: None,
-        datum_grid: None,
-        frame: Default::default(),
-    };
+    let mut section = section(None);
     if let Some(g) = geoid {
         std::fs::write(dir.path().join("geoid.gtx"), g.to_gtx_bytes()).unwrap();
         section.geoid_grid = Some(dir.path().join("geoid.gtx"));

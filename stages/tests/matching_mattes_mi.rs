@@ -5,7 +5,7 @@ use skytie_stages::estimators::one_plus_one::{minimize, OnePlusOneParams};
 use skytie_stages::estimators::SplitMix64;
 use skytie_stages::imaging::GrayImage;
 use skytie_stages::matching::mattes_mi::{
-    apply_mask, bspline3, register_translation, MattesMi, MiError,
+    apply_mask, bspline3, register_translation, MattesMi, MiError, MiRegistration,
 };
 use skytie_stages::params::Params;
 
@@ -71,6 +71,49 @@ fn es_params(seed: u64, max_iterations: usize) -> OnePlusOneParams {
     }
 }
 
+/// Mattes MI (50 bins) of `moving` against `fixed` at translation `t_px`, with `samples` drawn by `seed`.
+fn mi_at(
+    fixed: &GrayImage,
+    moving: &GrayImage,
+    samples: Option<usize>,
+    seed: u64,
+    t_px: [f64; 2],
+) -> f64 {
+    MattesMi::new(fixed, moving, 50, samples, seed)
+        .unwrap()
+        .evaluate(t_px[0], t_px[1])
+        .unwrap()
+}
+
+/// `got` equals the MI `want` to 1e-9; `what` names the case.
+fn assert_same_mi(got: f64, want: f64, what: std::fmt::Arguments) {
+    assert!((got - want).abs() < 1e-9, "{what}: {got} vs {want}");
+}
+
+/// The translation of `moving` against `fixed` registered by the (1+1)-ES (50 bins, every sample, from zero,
+/// at most `max_offset_px`, `es_params(es_seed, 300)`), and its distance from `d`, px.
+fn registered(
+    fixed: &GrayImage,
+    moving: &GrayImage,
+    max_offset_px: f64,
+    es_seed: u64,
+    d: [f64; 2],
+) -> (MiRegistration, f64) {
+    let reg = register_translation(
+        fixed,
+        moving,
+        50,
+        None,
+        [0.0, 0.0],
+        max_offset_px,
+        &es_params(es_seed, 300),
+    )
+    .unwrap();
+    let err =
+        ((reg.translation_px[0] - d[0]).powi(2) + (reg.translation_px[1] - d[1]).powi(2)).sqrt();
+    (reg, err)
+}
+
 #[test]
 fn bspline3_is_a_partition_of_unity() {
     let mut rng = SplitMix64::new(7);
@@ -92,21 +135,16 @@ fn mi_is_invariant_under_affine_intensity_remaps() {
     // Integer-valued pixels keep a·F + b exact in f32.
     let fixed = tex.render(64, [0.0, 0.0], |v| v.round());
     for samples in [None, Some(1500)] {
-        let mi_ff = MattesMi::new(&fixed, &fixed, 50, samples, 3)
-            .unwrap()
-            .evaluate(0.0, 0.0)
-            .unwrap();
+        let mi_ff = mi_at(&fixed, &fixed, samples, 3, [0.0, 0.0]);
         assert!(mi_ff > 1.0, "MI(F, F) = {mi_ff}");
         for (a, b) in [(2.0f32, 10.0f32), (-1.0, 255.0), (0.5, -3.0), (-3.0, 7.0)] {
             let mut moving = fixed.clone();
             moving.data.iter_mut().for_each(|v| *v = a * *v + b);
-            let mi = MattesMi::new(&fixed, &moving, 50, samples, 3)
-                .unwrap()
-                .evaluate(0.0, 0.0)
-                .unwrap();
-            assert!(
-                (mi - mi_ff).abs() < 1e-9,
-                "a = {a}, b = {b}, samples {samples:?}: {mi} vs {mi_ff}"
+            let mi = mi_at(&fixed, &moving, samples, 3, [0.0, 0.0]);
+            assert_same_mi(
+                mi,
+                mi_ff,
+                format_args!("a = {a}, b = {b}, samples {samples:?}"),
             );
         }
     }
@@ -124,16 +162,8 @@ fn mi_against_independent_noise_is_small_and_shrinks_with_more_samples() {
             .collect(),
     )
     .unwrap();
-    let mi_ff = MattesMi::new(&fixed, &fixed, 50, None, 0)
-        .unwrap()
-        .evaluate(0.0, 0.0)
-        .unwrap();
-    let mi_noise = |samples: Option<usize>| {
-        MattesMi::new(&fixed, &noise, 50, samples, 5)
-            .unwrap()
-            .evaluate(0.0, 0.0)
-            .unwrap()
-    };
+    let mi_ff = mi_at(&fixed, &fixed, None, 0, [0.0, 0.0]);
+    let mi_noise = |samples: Option<usize>| mi_at(&fixed, &noise, samples, 5, [0.0, 0.0]);
     let (few, many, all) = (mi_noise(Some(500)), mi_noise(Some(4000)), mi_noise(None));
     assert!(few > many && many > all, "{few} > {many} > {all}");
     assert!(all < 0.05 * mi_ff, "MI(F, noise) {all} vs MI(F, F) {mi_ff}");
@@ -147,18 +177,7 @@ fn es_recovers_a_translation_under_a_non_monotone_remap() {
     let d = [3.4, -2.1];
     let fixed = tex.render(96, [0.0, 0.0], |v| v);
     let moving = tex.render(96, d, |g| (g - 128.0).powi(2) / 128.0);
-    let reg = register_translation(
-        &fixed,
-        &moving,
-        50,
-        None,
-        [0.0, 0.0],
-        10.0,
-        &es_params(11, 300),
-    )
-    .unwrap();
-    let err =
-        ((reg.translation_px[0] - d[0]).powi(2) + (reg.translation_px[1] - d[1]).powi(2)).sqrt();
+    let (reg, err) = registered(&fixed, &moving, 10.0, 11, d);
     assert!(err < 0.1, "found {:?}, error {err} px", reg.translation_px);
     assert!(reg.mi > 0.5, "MI {}", reg.mi);
 }
@@ -174,18 +193,7 @@ fn mi_registration_recovers_a_subpixel_shift_of_a_gamma_changed_noisy_copy() {
             .data
             .iter_mut()
             .for_each(|v| *v += (4.0 * rng.next_gaussian()) as f32);
-        let reg = register_translation(
-            &fixed,
-            &moving,
-            50,
-            None,
-            [0.0, 0.0],
-            5.0,
-            &es_params(seed, 300),
-        )
-        .unwrap();
-        let err = ((reg.translation_px[0] - d[0]).powi(2) + (reg.translation_px[1] - d[1]).powi(2))
-            .sqrt();
+        let (reg, err) = registered(&fixed, &moving, 5.0, seed, d);
         assert!(err <= 0.2, "d = {d:?}: found {:?}", reg.translation_px);
     }
 }
@@ -207,18 +215,7 @@ fn masked_pixels_are_skipped_on_both_images() {
     let moving_m = apply_mask(&moving, &moving_valid).unwrap();
     let metric = MattesMi::new(&fixed_m, &moving_m, 50, None, 0).unwrap();
     assert_eq!(metric.sample_count(), 80 * 80 - 25 * 30);
-    let reg = register_translation(
-        &fixed_m,
-        &moving_m,
-        50,
-        None,
-        [0.0, 0.0],
-        6.0,
-        &es_params(2, 300),
-    )
-    .unwrap();
-    let err =
-        ((reg.translation_px[0] - d[0]).powi(2) + (reg.translation_px[1] - d[1]).powi(2)).sqrt();
+    let (reg, err) = registered(&fixed_m, &moving_m, 6.0, 2, d);
     assert!(err < 0.1, "found {:?}", reg.translation_px);
     // Garbage in the masked area must not matter: same MI whatever the masked pixels held.
     let mut moving_garbage = moving.clone();
@@ -227,14 +224,8 @@ fn masked_pixels_are_skipped_on_both_images() {
             *v = f32::NAN;
         }
     }
-    let a = MattesMi::new(&fixed_m, &moving_m, 50, None, 0)
-        .unwrap()
-        .evaluate(1.0, 2.0)
-        .unwrap();
-    let b = MattesMi::new(&fixed_m, &moving_garbage, 50, None, 0)
-        .unwrap()
-        .evaluate(1.0, 2.0)
-        .unwrap();
+    let a = mi_at(&fixed_m, &moving_m, None, 0, [1.0, 2.0]);
+    let b = mi_at(&fixed_m, &moving_garbage, None, 0, [1.0, 2.0]);
     assert_eq!(a, b);
 }
 
@@ -268,12 +259,7 @@ fn too_little_overlap_and_degenerate_inputs_are_errors() {
 fn sampled_metric_is_deterministic_for_a_seed() {
     let (tex, fixed) = Texture::with_image(10, 64);
     let moving = tex.render(64, [0.5, 0.5], |v| v);
-    let eval = |seed| {
-        MattesMi::new(&fixed, &moving, 50, Some(700), seed)
-            .unwrap()
-            .evaluate(0.3, 0.2)
-            .unwrap()
-    };
+    let eval = |seed| mi_at(&fixed, &moving, Some(700), seed, [0.3, 0.2]);
     assert_eq!(eval(1).to_bits(), eval(1).to_bits());
     assert_ne!(eval(1).to_bits(), eval(2).to_bits());
 }
@@ -413,9 +399,10 @@ fn integral_translations_match_the_definition() {
     for t in [[0, 0], [2, -1], [-7, 5], [12, 12], [-3, -11]] {
         let got = metric.evaluate(t[0] as f64, t[1] as f64).unwrap();
         let want = reference_mi_integral(&fixed, &moving_m, 50, t);
-        assert!(
-            (got - want).abs() < 1e-9,
-            "shift {t:?}: {got} vs the definition's {want}"
+        assert_same_mi(
+            got,
+            want,
+            format_args!("shift {t:?} (got vs the definition's)"),
         );
     }
 }

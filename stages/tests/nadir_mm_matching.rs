@@ -40,10 +40,15 @@ fn orthos(poses: &[Recording], panoramas: &[GrayImage]) -> Vec<OrthoImage> {
         .collect()
 }
 
+/// Width and height of the first of `panoramas` (all have that size), px.
+fn pano_px(panoramas: &[GrayImage]) -> (u32, u32) {
+    (panoramas[0].width as u32, panoramas[0].height as u32)
+}
+
 fn views<'a>(
     poses: &'a [Recording],
     orthos: &'a [OrthoImage],
-    pano: &GrayImage,
+    (pano_width_px, pano_height_px): (u32, u32),
 ) -> Vec<OrthoView<'a>> {
     poses
         .iter()
@@ -51,10 +56,31 @@ fn views<'a>(
         .map(|(recording, ortho)| OrthoView {
             recording,
             ortho,
-            pano_width_px: pano.width as u32,
-            pano_height_px: pano.height as u32,
+            pano_width_px,
+            pano_height_px,
         })
         .collect()
+}
+
+/// Recordings at `poses` (true or recorded), their whole-panorama orthos and the panoramas' size.
+struct Orthos {
+    poses: Vec<Recording>,
+    orthos: Vec<OrthoImage>,
+    pano_px: (u32, u32),
+}
+
+impl Orthos {
+    fn new(poses: Vec<Recording>, panoramas: &[GrayImage]) -> Self {
+        Self {
+            orthos: orthos(&poses, panoramas),
+            poses,
+            pano_px: pano_px(panoramas),
+        }
+    }
+
+    fn views(&self) -> Vec<OrthoView<'_>> {
+        views(&self.poses, &self.orthos, self.pano_px)
+    }
 }
 
 /// Every window along the trajectory: recording i with neighbours i+1 and i+2 (triples).
@@ -222,12 +248,9 @@ fn method_counts(windows: &[MmWindowMatch]) -> (usize, usize) {
 fn true_poses_rays_meet_and_tie_points_lie_on_the_road() {
     let f = fixture();
     let c = &f.campaign;
-    let poses = c.true_poses();
-    let o = orthos(&poses, &c.panoramas);
-    let v = views(&poses, &o, &c.panoramas[0]);
-    let windows = run_windows(&v, &MmMatchParams::default());
-    let pano = (c.panoramas[0].width as u32, c.panoramas[0].height as u32);
-    let (s, graded) = stats(&windows, &c.truth, &f.scene, pano);
+    let o = Orthos::new(c.true_poses(), &c.panoramas);
+    let windows = run_windows(&o.views(), &MmMatchParams::default());
+    let (s, graded) = stats(&windows, &c.truth, &f.scene, o.pano_px);
     print_stats("tiny, true poses", &s);
     // Measured (seed 7): see the report; the Tiny scene's vehicle mask leaves only a ring 5–9 m from each
     // camera, so there are few tie points.
@@ -266,7 +289,11 @@ fn true_poses_rays_meet_and_tie_points_lie_on_the_road() {
     // its ground point).
     for w in &windows {
         assert_eq!(w.ground_world.len(), w.tie_points.len());
-        let det = poses.iter().find(|r| r.image_id == w.recording_id).unwrap();
+        let det = o
+            .poses
+            .iter()
+            .find(|r| r.image_id == w.recording_id)
+            .unwrap();
         let cam = [det.x, det.y, det.z];
         for (g, tp) in w.ground_world.iter().zip(&w.tie_points) {
             assert!((g[2] - (det.z - det.camera_height_m)).abs() < 1e-9);
@@ -285,9 +312,8 @@ fn true_poses_rays_meet_and_tie_points_lie_on_the_road() {
 fn recorded_poses_give_tie_points_whose_true_rays_meet() {
     let f = fixture();
     let c = &f.campaign;
-    let o = orthos(&c.recorded, &c.panoramas);
-    let v = views(&c.recorded, &o, &c.panoramas[0]);
-    let windows = run_windows(&v, &MmMatchParams::default());
+    let o = Orthos::new(c.recorded.clone(), &c.panoramas);
+    let windows = run_windows(&o.views(), &MmMatchParams::default());
     let (pairs, kaze) = method_counts(&windows);
     for w in &windows {
         for p in &w.pairs {
@@ -303,8 +329,7 @@ fn recorded_poses_give_tie_points_whose_true_rays_meet() {
             );
         }
     }
-    let pano = (c.panoramas[0].width as u32, c.panoramas[0].height as u32);
-    let (s, _) = stats(&windows, &c.truth, &f.scene, pano);
+    let (s, _) = stats(&windows, &c.truth, &f.scene, o.pano_px);
     print_stats("tiny, recorded poses", &s);
     println!("tiny, recorded poses: pairs {pairs}, kaze {kaze}");
     // Every pair is reported, with a reason whenever KAZE was not used.
@@ -336,9 +361,8 @@ fn recorded_poses_give_tie_points_whose_true_rays_meet() {
 fn fallback_to_the_poses_when_kaze_cannot_work() {
     let f = fixture();
     let c = &f.campaign;
-    let poses = c.true_poses();
-    let o = orthos(&poses, &c.panoramas);
-    let v = views(&poses, &o, &c.panoramas[0]);
+    let o = Orthos::new(c.true_poses(), &c.panoramas);
+    let v = o.views();
     // (a) No KAZE keypoints at all: every pair falls back to the (here: true) poses and still matches.
     let p = MmMatchParams {
         kaze_threshold: 1e9,
@@ -357,8 +381,7 @@ fn fallback_to_the_poses_when_kaze_cannot_work() {
             }
         }
     }
-    let pano = (c.panoramas[0].width as u32, c.panoramas[0].height as u32);
-    let (s, _) = stats(&windows, &c.truth, &f.scene, pano);
+    let (s, _) = stats(&windows, &c.truth, &f.scene, o.pano_px);
     print_stats("tiny, forced fallback", &s);
     assert!(
         windows
@@ -376,7 +399,7 @@ fn fallback_to_the_poses_when_kaze_cannot_work() {
     );
 
     // (b) A blank neighbour: fallback, no corner can be located there, the other neighbour still works.
-    let mut blank = o[1].clone();
+    let mut blank = o.orthos[1].clone();
     blank.image.data.iter_mut().for_each(|x| *x = 0.5);
     let blank_view = OrthoView {
         ortho: &blank,
@@ -397,9 +420,8 @@ fn fallback_to_the_poses_when_kaze_cannot_work() {
 #[test]
 fn deterministic_for_any_thread_count() {
     let f = fixture();
-    let c = &f.campaign;
-    let o = orthos(&c.recorded, &c.panoramas);
-    let v = views(&c.recorded, &o, &c.panoramas[0]);
+    let o = Orthos::new(f.campaign.recorded.clone(), &f.campaign.panoramas);
+    let v = o.views();
     let p = MmMatchParams::default();
     let run = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
@@ -417,10 +439,9 @@ fn deterministic_for_any_thread_count() {
 
 #[test]
 fn invalid_parameters_and_empty_panorama_size_do_not_panic() {
-    let f = fixture();
-    let c = &f.campaign;
-    let o = orthos(&c.recorded[..2], &c.panoramas[..2]);
-    let v = views(&c.recorded[..2], &o, &c.panoramas[0]);
+    let c = &fixture().campaign;
+    let o = Orthos::new(c.recorded[..2].to_vec(), &c.panoramas[..2]);
+    let v = o.views();
     let bad = MmMatchParams {
         min_ncc: 3.0,
         ..MmMatchParams::default()
@@ -462,7 +483,7 @@ fn demo_report() {
         o.len(),
         t0.elapsed().as_secs_f64()
     );
-    let v = views(&poses, &o, &c.panoramas[0]);
+    let v = views(&poses, &o, pano_px(&c.panoramas));
     // SKYTIE_MM_PARAMS='min_inliers = 8' overrides parameters (TOML).
     let p: MmMatchParams =
         toml::from_str(&std::env::var("SKYTIE_MM_PARAMS").unwrap_or_default()).unwrap();
@@ -485,7 +506,7 @@ fn demo_report() {
         secs / windows.len() as f64,
         rayon::current_num_threads()
     );
-    let pano = (c.panoramas[0].width as u32, c.panoramas[0].height as u32);
+    let pano = pano_px(&c.panoramas);
     if let Some(scene) = scene_of(Path::new(&root)) {
         let (s, _) = stats(&windows, &c.truth, &scene, pano);
         print_stats(&format!("{root} (scene truth)"), &s);
@@ -569,10 +590,10 @@ fn diagnostics() {
             .collect();
         println!("kaze threshold {t}: keypoints {n:?}");
     }
-    let v = views(&poses, &o, &c.panoramas[0]);
+    let pano = pano_px(&c.panoramas);
+    let v = views(&poses, &o, pano);
     let p = MmMatchParams::default();
     let windows = run_windows(&v[..4.min(v.len())], &p);
-    let pano = (c.panoramas[0].width as u32, c.panoramas[0].height as u32);
     for w in &windows {
         println!(
             "window {}: corners {} pairs {:?}",
@@ -631,7 +652,7 @@ fn diagnostics_corners() {
     let c = load_campaign(Path::new(&root));
     let poses = c.true_poses();
     let o = orthos(&poses[..2], &c.panoramas[..2]);
-    let v = views(&poses[..2], &o, &c.panoramas[0]);
+    let v = views(&poses[..2], &o, pano_px(&c.panoramas));
     let p = MmMatchParams::default();
     let (pa, pb) = (PreparedOrtho::new(&o[0], &p), PreparedOrtho::new(&o[1], &p));
     let cs = corners::detect_corners(&v[0], &pa, &p);

@@ -137,12 +137,19 @@ fn refine(
 }
 
 /// Asserts that `after` keeps the matches of `before`, in order, except the one of tie point `dropped`.
-fn assert_exactly_dropped(
+/// `window` refined again from `initial` with `checked`: the check, counting its drops in `dropped_by`, drops
+/// exactly the tie point `dropped` of `before` and nothing else.
+fn assert_check_drops_exactly(
+    pair: &Pair,
+    window: &MmWindowMatch,
+    initial: Similarity2,
+    checked: &RefineParams,
     before: &AerialRefinement,
-    after: &AerialRefinement,
     dropped: &str,
-    what: &str,
-) {
+    dropped_by: fn(&AerialRefinement) -> usize,
+) -> AerialRefinement {
+    let after = refine_window(pair, window, &pair.aerial, initial, checked);
+    assert_eq!(dropped_by(&after), 1);
     let kept: Vec<&str> = after
         .matches
         .iter()
@@ -154,7 +161,8 @@ fn assert_exactly_dropped(
         .map(|m| m.tie_point_id.as_str())
         .filter(|id| *id != dropped)
         .collect();
-    assert_eq!(kept, expected, "{what}");
+    assert_eq!(kept, expected, "exactly {dropped} is dropped");
+    after
 }
 
 /// [`refine`] of any window over `pair`'s ortho image.
@@ -347,15 +355,26 @@ fn window_of_ids(pair: &Pair, ids: &[usize]) -> MmWindowMatch {
     w
 }
 
-#[test]
-fn the_view_check_drops_exactly_the_corner_whose_template_shows_content_at_another_position() {
-    let mut pair = make_pair(11, 0.01);
+/// The location of the tie point `id` in `r`, if located.
+fn match_of<'a>(r: &'a AerialRefinement, id: &str) -> Option<&'a AerialMatch> {
+    r.matches.iter().find(|m| m.tie_point_id == id)
+}
+
+/// The window of `pair` reduced to a 3 × 3 subgrid of its tie points (templates apart), and the transform of
+/// a recording off by (0.83, −0.61) aerial px.
+fn spread_window_off(pair: &Pair) -> (MmWindowMatch, Similarity2) {
     let ids: Vec<usize> = [1usize, 4, 7]
         .iter()
         .flat_map(|&j| [1usize, 4, 7].map(|i| j * 9 + i))
         .collect();
-    let window = window_of_ids(&pair, &ids);
     let off = Similarity2::new(1.0, 0.0, 0.83, -0.61).compose(&pair.truth);
+    (window_of_ids(pair, &ids), off)
+}
+
+#[test]
+fn the_view_check_drops_exactly_the_corner_whose_template_shows_content_at_another_position() {
+    let mut pair = make_pair(11, 0.01);
+    let (window, off) = spread_window_off(&pair);
     let checked = RefineParams {
         view_sigma_px: 0.25,
         ..params_at_peak_05()
@@ -389,38 +408,26 @@ fn the_view_check_drops_exactly_the_corner_whose_template_shows_content_at_anoth
         ..checked.clone()
     };
     let plain = refine_window(&pair, &window, &pair.aerial, off, &unchecked);
-    let wrong = plain
-        .matches
-        .iter()
-        .find(|m| m.tie_point_id == target)
-        .expect("without the check the perturbed corner is located");
+    let wrong =
+        match_of(&plain, &target).expect("without the check the perturbed corner is located");
     let t = true_aerial_px(&pair.ortho.georef, &pair.truth, g);
     let error_px = (wrong.observation.u_px - t.x).hypot(wrong.observation.v_px - t.y);
     assert!(
         error_px > 1.0,
         "the perturbed corner is located {error_px} px off"
     );
-    let r = refine_window(&pair, &window, &pair.aerial, off, &checked);
-    assert_eq!(r.view_inconsistent, 1);
-    assert_exactly_dropped(
-        &clean,
-        &r,
-        &target,
-        "exactly the perturbed corner is dropped",
-    );
+    // Exactly the perturbed corner is dropped.
+    assert_check_drops_exactly(&pair, &window, off, &checked, &clean, &target, |r| {
+        r.view_inconsistent
+    });
 }
 
 #[test]
 fn the_tie_point_consistency_drops_exactly_the_corner_whose_mm_point_is_off() {
     let pair = make_pair(11, 0.01);
-    let ids: Vec<usize> = [1usize, 4, 7]
-        .iter()
-        .flat_map(|&j| [1usize, 4, 7].map(|i| j * 9 + i))
-        .collect();
-    let mut window = window_of_ids(&pair, &ids);
     // The recording is off by (0.83, −0.61) aerial px: every corner's aerial location differs from its MM
     // point by that offset.
-    let off = Similarity2::new(1.0, 0.0, 0.83, -0.61).compose(&pair.truth);
+    let (mut window, off) = spread_window_off(&pair);
     let checked = RefineParams {
         point_sigma_px: 0.5,
         ..params_at_peak_05()
@@ -440,21 +447,13 @@ fn the_tie_point_consistency_drops_exactly_the_corner_whose_mm_point_is_off() {
         .position(|tp| tp.id == target)
         .unwrap();
     window.tie_points[k].point_world[0] += 0.25;
-    let r = refine_window(&pair, &window, &pair.aerial, off, &checked);
-    assert_eq!(r.point_inconsistent, 1);
-    assert_exactly_dropped(
-        &clean,
-        &r,
-        &target,
-        "exactly the inconsistent corner is dropped",
-    );
+    // Exactly the inconsistent corner is dropped.
+    let r = assert_check_drops_exactly(&pair, &window, off, &checked, &clean, &target, |r| {
+        r.point_inconsistent
+    });
     // The locations themselves do not change.
     for m in &r.matches {
-        let c = clean
-            .matches
-            .iter()
-            .find(|c| c.tie_point_id == m.tie_point_id)
-            .unwrap();
+        let c = match_of(&clean, &m.tie_point_id).unwrap();
         assert_eq!(m.observation, c.observation);
     }
 }

@@ -3,13 +3,17 @@
 //! points get XY from the orthophoto and Z from a planar DTM (or the MM height without one).
 
 use skytie_stages::campaign::orthophoto::RasterFile;
-use skytie_stages::correspondence::{HeightSource, MmTiePoint, PanoObservation};
+use skytie_stages::correspondence::{
+    AerialControlPoint, HeightSource, MmTiePoint, PanoObservation,
+};
 use skytie_stages::imaging::border::Border;
 use skytie_stages::imaging::georef::{GeoTransform, RasterHeader};
 use skytie_stages::imaging::pyramid::MemoryPyramid;
 use skytie_stages::imaging::sample::sample_bilinear;
 use skytie_stages::imaging::GrayImage;
-use skytie_stages::nadir::{MmWindowMatch, OrthoGeoref, OrthoImage, TransformOutcome};
+use skytie_stages::nadir::{
+    InitialTransform, MmWindowMatch, OrthoGeoref, OrthoImage, TransformOutcome,
+};
 use skytie_stages::orthophoto::{
     orthophoto_control, Dtm, DtmTile, OrthophotoInput, OrthophotoParams,
 };
@@ -40,6 +44,13 @@ fn texture(seed: u64, n: usize) -> GrayImage {
         }
     }
     img
+}
+
+/// The orthophoto texture `seed` with its tile and its pixels.
+fn textured_photo(seed: u64) -> (GrayImage, RasterFile, MemoryPyramid) {
+    let photo = texture(seed, PHOTO_PX);
+    let pixels = MemoryPyramid::from_gray(&photo);
+    (photo, photo_tile(), pixels)
 }
 
 fn photo_tile() -> RasterFile {
@@ -161,27 +172,48 @@ fn planar_dtm() -> Dtm {
     }
 }
 
+/// The orthophoto `tile` with `pixels`, stated accuracy 0.04 m, and the DTM `dtm` (stated accuracy 0.1 m).
+fn input<'a>(
+    tile: &'a RasterFile,
+    pixels: &'a MemoryPyramid,
+    dtm: Option<&'a Dtm>,
+) -> OrthophotoInput<'a> {
+    OrthophotoInput {
+        tile,
+        pixels,
+        sigma_m: 0.04,
+        dtm: dtm.map(|d| (d, 0.1)),
+    }
+}
+
+/// The initial transform of an accepted outcome; a rejected one fails the test.
+fn accepted(outcome: &TransformOutcome) -> &InitialTransform {
+    match outcome {
+        TransformOutcome::Accepted(t) => t,
+        other => panic!("rejected: {other:?}"),
+    }
+}
+
+/// Index in `w.tie_points` of the tie point that became `cp`.
+fn tie_point_index(w: &MmWindowMatch, cp: &AerialControlPoint) -> usize {
+    w.tie_points
+        .iter()
+        .position(|tp| tp.id == cp.tie_point_id)
+        .unwrap()
+}
+
 #[test]
 fn a_known_offset_is_recovered_and_control_points_take_xy_from_the_orthophoto_and_z_from_the_dtm() {
-    let photo = texture(7, PHOTO_PX);
-    let tile = photo_tile();
-    let pixels = MemoryPyramid::from_gray(&photo);
+    let (photo, tile, pixels) = textured_photo(7);
     let foot = [ORIGIN[0] + 31.7, ORIGIN[1] + 30.2, 1.8];
     let offset = [0.73, -1.21];
     let ortho = ortho_at(&photo, &tile.header.transform, foot, offset);
     let dtm = planar_dtm();
-    let input = OrthophotoInput {
-        tile: &tile,
-        pixels: &pixels,
-        sigma_m: 0.04,
-        dtm: Some((&dtm, 0.1)),
-    };
+    let input = input(&tile, &pixels, Some(&dtm));
     let p = OrthophotoParams::default();
     let w = window(foot);
     let out = orthophoto_control(&ortho, &w, &[], &input, &p).unwrap();
-    let TransformOutcome::Accepted(t) = &out.transform else {
-        panic!("rejected: {:?}", out.transform);
-    };
+    let t = accepted(&out.transform);
     let [ex, ey] = t.centre_offset_world_m;
     assert!(
         (ex - offset[0]).abs() < 0.03 && (ey - offset[1]).abs() < 0.03,
@@ -213,16 +245,9 @@ fn a_known_offset_is_recovered_and_control_points_take_xy_from_the_orthophoto_an
 
 #[test]
 fn without_a_dtm_the_height_is_the_mm_ground_and_a_far_offset_is_rejected() {
-    let photo = texture(11, PHOTO_PX);
-    let tile = photo_tile();
-    let pixels = MemoryPyramid::from_gray(&photo);
+    let (photo, tile, pixels) = textured_photo(11);
     let foot = [ORIGIN[0] + 30.0, ORIGIN[1] + 33.0, 1.8];
-    let input = OrthophotoInput {
-        tile: &tile,
-        pixels: &pixels,
-        sigma_m: 0.04,
-        dtm: None,
-    };
+    let input = input(&tile, &pixels, None);
     let p = OrthophotoParams::default();
     let ortho = ortho_at(&photo, &tile.header.transform, foot, [-0.4, 0.9]);
     let out = orthophoto_control(&ortho, &window(foot), &[], &input, &p).unwrap();
@@ -249,10 +274,8 @@ fn a_large_vehicle_mask_and_foreign_surroundings_still_give_control_points_withi
     // As in a street: the recording vehicle hides the middle of the ortho (6 × 4 m), and beyond 8.5 m from the
     // foot point the ortho shows something else than the orthophoto (façades smeared over the ground, tree
     // crowns in the orthophoto). The registration must rest on the ring of road between them.
-    let photo = texture(23, PHOTO_PX);
+    let (photo, tile, pixels) = textured_photo(23);
     let other = texture(99, 200);
-    let tile = photo_tile();
-    let pixels = MemoryPyramid::from_gray(&photo);
     let foot = [ORIGIN[0] + 32.3, ORIGIN[1] + 29.4, 1.8];
     let offset = [-0.92, 0.57];
     let mut ortho = ortho_at(&photo, &tile.header.transform, foot, offset);
@@ -269,17 +292,10 @@ fn a_large_vehicle_mask_and_foreign_surroundings_still_give_control_points_withi
         }
     }
     let dtm = planar_dtm();
-    let input = OrthophotoInput {
-        tile: &tile,
-        pixels: &pixels,
-        sigma_m: 0.04,
-        dtm: Some((&dtm, 0.1)),
-    };
+    let input = input(&tile, &pixels, Some(&dtm));
     let w = window(foot);
     let out = orthophoto_control(&ortho, &w, &[], &input, &OrthophotoParams::default()).unwrap();
-    let TransformOutcome::Accepted(t) = &out.transform else {
-        panic!("rejected: {:?}", out.transform);
-    };
+    let t = accepted(&out.transform);
     let [ex, ey] = t.centre_offset_world_m;
     assert!(
         (ex - offset[0]).hypot(ey - offset[1]) < 0.1,
@@ -287,11 +303,7 @@ fn a_large_vehicle_mask_and_foreign_surroundings_still_give_control_points_withi
     );
     assert!(out.control.points.len() >= 4, "{:?}", out.refinement);
     for cp in &out.control.points {
-        let k = w
-            .tie_points
-            .iter()
-            .position(|tp| tp.id == cp.tie_point_id)
-            .unwrap();
+        let k = tie_point_index(&w, cp);
         let g = w.ground_world[k];
         let [x, y, _] = cp.point_world.unwrap();
         let err = (x - g[0] - offset[0]).hypot(y - g[1] - offset[1]);
@@ -376,19 +388,10 @@ fn tie_points_half_hidden_by_tree_crowns_are_located_where_their_corrections_agr
         pixels,
     } = crowned_scene(31, foot, [0.64, 0.81], (1.1, 1.2));
     let dtm = planar_dtm();
-    let input = OrthophotoInput {
-        tile: &tile,
-        pixels: &pixels,
-        sigma_m: 0.04,
-        dtm: Some((&dtm, 0.1)),
-    };
+    let input = input(&tile, &pixels, Some(&dtm));
     let p = OrthophotoParams::default();
     let out = orthophoto_control(&ortho, &w, &[], &input, &p).unwrap();
-    assert!(
-        matches!(out.transform, TransformOutcome::Accepted(_)),
-        "{:?}",
-        out.transform
-    );
+    accepted(&out.transform);
     let weak = out
         .refinement
         .matches
@@ -398,11 +401,7 @@ fn tie_points_half_hidden_by_tree_crowns_are_located_where_their_corrections_agr
     assert!(weak >= 3, "{:?}", out.refinement);
     assert!(out.control.points.len() >= 4, "{:?}", out.refinement);
     for cp in &out.control.points {
-        let k = w
-            .tie_points
-            .iter()
-            .position(|tp| tp.id == cp.tie_point_id)
-            .unwrap();
+        let k = tie_point_index(&w, cp);
         let [x, y, _] = cp.point_world.unwrap();
         let err = (x - shown[k][0]).hypot(y - shown[k][1]);
         // A half-hidden template's peak is pulled by the crown: located within the corroboration radius
@@ -433,20 +432,11 @@ fn weak_peaks_that_disagree_give_no_control_points() {
     // entirely: any peak there is chance, scattered over the search window, and none may become control.
     let foot = [ORIGIN[0] + 31.1, ORIGIN[1] + 30.4, 1.8];
     let scene = crowned_scene(41, foot, [-0.5, 0.7], (3.0, 0.0));
-    let input = OrthophotoInput {
-        tile: &scene.tile,
-        pixels: &scene.pixels,
-        sigma_m: 0.04,
-        dtm: None,
-    };
+    let input = input(&scene.tile, &scene.pixels, None);
     let params = OrthophotoParams::default();
     let out = orthophoto_control(&scene.ortho, &scene.window, &[], &input, &params).unwrap();
     // The rest of the ortho still registers it; the hidden tie points give nothing.
-    assert!(
-        matches!(out.transform, TransformOutcome::Accepted(_)),
-        "{:?}",
-        out.transform
-    );
+    accepted(&out.transform);
     assert!(out.refinement.tried >= 4, "{:?}", out.refinement);
     assert!(
         out.control.points.is_empty(),

@@ -1,5 +1,6 @@
-//! Helpers shared by the peer-comparison benches (`phasecorr`, `ortho`, `mi`, `daisy_agast`) and `imaging`: the
-//! folder the identical inputs go to, thread CPU time, peak memory, median timers and a minimal `.npy` writer. Included with
+//! Helpers shared by the peer-comparison benches (`phasecorr`, `ortho`, `mi`, `daisy_agast`), `imaging`, the
+//! adjustment benches and `ingest_decode`: the folder the identical inputs go to, thread CPU time, peak memory,
+//! median and one-shot timers and a minimal `.npy` writer. Included with
 //! `#[path = "peer_support/mod.rs"] mod peer_support;` (not a bench target of its own).
 
 #![allow(dead_code)]
@@ -46,6 +47,13 @@ pub fn median_round_ms(reps: usize, mut round: impl FnMut()) -> f64 {
         .collect();
     t.sort_by(f64::total_cmp);
     t[t.len() / 2]
+}
+
+/// Wall seconds of `f`, and its result.
+pub fn timed<T>(f: impl FnOnce() -> T) -> (f64, T) {
+    let s = Instant::now();
+    let r = f();
+    (s.elapsed().as_secs_f64(), r)
 }
 
 /// Median over `reps` runs of the wall time of one call of `f`, ms.

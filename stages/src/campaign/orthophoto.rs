@@ -60,35 +60,73 @@ fn table_line(text: &str, name: &str) -> Option<usize> {
     text.lines().position(|l| l.trim() == header).map(|i| i + 1)
 }
 
-/// The `file`/`files` of table `name` as strings; problems for anything else.
-fn files(
-    table: &toml::Table,
-    name: &str,
+/// A key of `campaign.toml` (`field`, in the table on line `row` when known) and the hint its problems give.
+struct TomlKey {
     row: Option<usize>,
-    problems: &mut Vec<Problem>,
-) -> Vec<String> {
-    let field = format!("{name}.files");
-    let hint =
-        format!("write files = [\"{name}/tile.tif\", …] (paths relative to the campaign folder)");
+    field: String,
+    hint: String,
+}
+
+impl TomlKey {
+    /// An error in the key's value.
+    fn error(&self, message: impl Into<String>) -> Problem {
+        Problem::error(
+            TOML,
+            self.row,
+            Some(&self.field),
+            message,
+            self.hint.as_str(),
+        )
+    }
+
+    /// The key's value `value` is not of the `expected` type.
+    fn wrong_type(&self, value: &toml::Value, expected: &str) -> Problem {
+        self.error(format!("is of type {}, not {expected}", value.type_str()))
+    }
+
+    /// The key is absent.
+    fn missing(&self) -> Problem {
+        self.error("required key is missing")
+            .with_kind(ProblemKind::Missing)
+    }
+}
+
+/// The table `name` of `campaign.toml`, on line `row` when known.
+struct TomlTable<'a> {
+    table: &'a toml::Table,
+    name: &'a str,
+    row: Option<usize>,
+}
+
+impl TomlTable<'_> {
+    /// The table's key `key`, whose problems give `hint`.
+    fn key(&self, key: &str, hint: String) -> TomlKey {
+        TomlKey {
+            row: self.row,
+            field: format!("{}.{key}", self.name),
+            hint,
+        }
+    }
+}
+
+/// The `file`/`files` of `table` as strings; problems for anything else.
+fn files(table: &TomlTable, problems: &mut Vec<Problem>) -> Vec<String> {
+    let name = table.name;
+    let key = table.key(
+        "files",
+        format!("write files = [\"{name}/tile.tif\", …] (paths relative to the campaign folder)"),
+    );
+    let table = table.table;
     let value = table.get("files").or_else(|| table.get("file"));
     let list: Vec<&toml::Value> = match value {
         Some(toml::Value::Array(a)) => a.iter().collect(),
         Some(v @ toml::Value::String(_)) => vec![v],
         Some(other) => {
-            problems.push(Problem::error(
-                TOML,
-                row,
-                Some(&field),
-                format!("is of type {}, not a list of paths", other.type_str()),
-                hint,
-            ));
+            problems.push(key.wrong_type(other, "a list of paths"));
             return Vec::new();
         }
         None => {
-            problems.push(
-                Problem::error(TOML, row, Some(&field), "required key is missing", hint)
-                    .with_kind(ProblemKind::Missing),
-            );
+            problems.push(key.missing());
             return Vec::new();
         }
     };
@@ -96,61 +134,37 @@ fn files(
     for v in list {
         match v.as_str().map(str::trim).filter(|s| !s.is_empty()) {
             Some(s) => out.push(s.to_string()),
-            None => problems.push(Problem::error(
-                TOML,
-                row,
-                Some(&field),
-                format!("entry {v} is not a path"),
-                hint.clone(),
-            )),
+            None => problems.push(key.error(format!("entry {v} is not a path"))),
         }
     }
     out
 }
 
-/// `sigma_m` of table `name` (`default` when absent and allowed).
-fn sigma(
-    table: &toml::Table,
-    name: &str,
-    row: Option<usize>,
-    default: Option<f64>,
-    problems: &mut Vec<Problem>,
-) -> Option<f64> {
-    let field = format!("{name}.sigma_m");
-    let hint = format!("state the {name}'s accuracy as sigma_m = 0.05 (metres, 1σ)");
-    let v = match table.get("sigma_m") {
+/// `sigma_m` of `table` (`default` when absent and allowed).
+fn sigma(table: &TomlTable, default: Option<f64>, problems: &mut Vec<Problem>) -> Option<f64> {
+    let name = table.name;
+    let key = table.key(
+        "sigma_m",
+        format!("state the {name}'s accuracy as sigma_m = 0.05 (metres, 1σ)"),
+    );
+    let v = match table.table.get("sigma_m") {
         None => {
             if default.is_none() {
-                problems.push(
-                    Problem::error(TOML, row, Some(&field), "required key is missing", hint)
-                        .with_kind(ProblemKind::Missing),
-                );
+                problems.push(key.missing());
             }
             return default;
         }
         Some(toml::Value::Float(f)) => *f,
         Some(toml::Value::Integer(i)) => *i as f64,
         Some(other) => {
-            problems.push(Problem::error(
-                TOML,
-                row,
-                Some(&field),
-                format!("is of type {}, not a number", other.type_str()),
-                hint,
-            ));
+            problems.push(key.wrong_type(other, "a number"));
             return None;
         }
     };
     if v.is_finite() && v > 0.0 && v <= 100.0 {
         Some(v)
     } else {
-        problems.push(Problem::error(
-            TOML,
-            row,
-            Some(&field),
-            format!("is {v}; it must be in (0, 100] m"),
-            hint,
-        ));
+        problems.push(key.error(format!("is {v}; it must be in (0, 100] m")));
         None
     }
 }
@@ -229,17 +243,21 @@ fn read_table(
     let value = table.get(name)?;
     let row = table_line(text, name);
     let Some(t) = value.as_table() else {
-        problems.push(Problem::error(
-            TOML,
+        let key = TomlKey {
             row,
-            Some(name),
-            format!("is of type {}, not a table", value.type_str()),
-            format!("write it as a table: [{name}] with files = [...] and sigma_m = ..."),
-        ));
+            field: name.to_string(),
+            hint: format!("write it as a table: [{name}] with files = [...] and sigma_m = ..."),
+        };
+        problems.push(key.wrong_type(value, "a table"));
         return None;
     };
-    let files = files(t, name, row, problems);
-    let sigma_m = sigma(t, name, row, default_sigma, problems);
+    let t = TomlTable {
+        table: t,
+        name,
+        row,
+    };
+    let files = files(&t, problems);
+    let sigma_m = sigma(&t, default_sigma, problems);
     let tiles = headers(root, name, files, crs, problems);
     (!tiles.is_empty()).then_some(())?;
     Some((tiles, sigma_m?))

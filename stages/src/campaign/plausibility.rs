@@ -4,7 +4,7 @@
 //! rows sharing an image is right cannot be known); a lone jump between two drives is only a warning.
 
 use super::model::{CheckPoint, Recording};
-use super::problem::{Problem, ProblemKind};
+use super::problem::{Problem, ProblemKind, Severity};
 use super::unique::Sourced;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -124,12 +124,21 @@ fn step(rows: &[Sourced<Recording>], i: usize, j: usize) -> String {
     )
 }
 
+/// An implausible position (field `x`) on `row` of `file`.
+fn implausible_position(
+    file: &Path,
+    row: usize,
+    message: String,
+    hint: impl Into<String>,
+) -> Problem {
+    Problem::error(file, Some(row), Some("x"), message, hint).with_kind(ProblemKind::Implausible)
+}
+
 fn outlier(rows: &[Sourced<Recording>], i: usize) -> Problem {
     let r = &rows[i];
-    Problem::error(
+    implausible_position(
         &r.file,
-        Some(r.row),
-        Some("x"),
+        r.row,
         format!(
             "position jumps away from both neighbours ({}, {}; a vehicle drives < {MAX_SPEED_M_S} m/s) while they agree with each other",
             step(rows, i - 1, i),
@@ -137,36 +146,31 @@ fn outlier(rows: &[Sourced<Recording>], i: usize) -> Problem {
         ),
         "check x, y (and time) of this row: a typo, a position in another CRS or a failed GNSS fix",
     )
-    .with_kind(ProblemKind::Implausible)
 }
 
 fn lone_jump(rows: &[Sourced<Recording>], i: usize) -> Problem {
     let r = &rows[i];
-    Problem::warning(
-        &r.file,
-        Some(r.row),
-        Some("x"),
-        format!(
-            "position jumps {} (faster than {MAX_SPEED_M_S} m/s)",
-            step(rows, i - 1, i)
-        ),
-        "fine between two separate drives; otherwise check x, y and time of this row and the one before",
-    )
-    .with_kind(ProblemKind::Implausible)
+    let message = format!(
+        "position jumps {} (faster than {MAX_SPEED_M_S} m/s)",
+        step(rows, i - 1, i)
+    );
+    let hint = "fine between two separate drives; otherwise check x, y and time of this row and the one before";
+    Problem {
+        severity: Severity::Warning,
+        ..implausible_position(&r.file, r.row, message, hint)
+    }
 }
 
 fn far_away(file: &Path, row: usize, d: f64, e: &Extent, what: &str) -> Problem {
-    Problem::error(
+    implausible_position(
         file,
-        Some(row),
-        Some("x"),
+        row,
         format!(
             "lies {d:.0} m from the middle of the campaign, while 95 % of the recordings lie within {:.0} m of it",
             e.r95_m
         ),
         format!("check x and y of this row (a typo or another CRS?); {what} must lie in the campaign's area"),
     )
-    .with_kind(ProblemKind::Implausible)
 }
 
 /// Check points without those far outside the area of the recordings.

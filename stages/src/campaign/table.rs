@@ -7,7 +7,7 @@
 //! typed values, recording a [`Problem`] naming file, row and field for every bad cell (all of them, not
 //! just the first), so a caller can skip the row and still report everything at once.
 
-use super::problem::{Problem, ProblemKind};
+use super::problem::{Problem, ProblemKind, Severity};
 use super::unique::Sourced;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -38,22 +38,40 @@ pub(crate) fn read_table(
     required: &[&str],
     problems: &mut Vec<Problem>,
 ) -> Option<Table> {
-    let bytes = match std::fs::read(root.join(rel)) {
-        Ok(b) => b,
-        Err(e) => {
-            problems.push(
-                Problem::error(
-                    rel,
-                    None,
-                    None,
-                    format!("cannot be read ({e})"),
-                    "check that the file exists and is readable",
-                )
-                .with_kind(ProblemKind::Missing),
-            );
-            return None;
-        }
-    };
+    parse_table(root, rel, required, problems).unwrap_or_else(|fatal| {
+        problems.push(fatal);
+        None
+    })
+}
+
+/// A problem of `rel` that is about no one field: of line `row`, or of the whole file.
+fn line_problem(
+    rel: &Path,
+    row: Option<usize>,
+    kind: ProblemKind,
+    message: impl Into<String>,
+    hint: impl Into<String>,
+) -> Problem {
+    Problem::error(rel, row, None, message, hint).with_kind(kind)
+}
+
+/// [`read_table`], with the problem that ends the reading (the file cannot be read, is not valid CSV or has
+/// no header) as `Err`.
+fn parse_table(
+    root: &Path,
+    rel: &Path,
+    required: &[&str],
+    problems: &mut Vec<Problem>,
+) -> Result<Option<Table>, Problem> {
+    let bytes = std::fs::read(root.join(rel)).map_err(|e| {
+        line_problem(
+            rel,
+            None,
+            ProblemKind::Missing,
+            format!("cannot be read ({e})"),
+            "check that the file exists and is readable",
+        )
+    })?;
     let body = bytes
         .strip_prefix(b"\xEF\xBB\xBF".as_slice())
         .unwrap_or(&bytes);
@@ -90,17 +108,14 @@ pub(crate) fn read_table(
             Ok(true) => {}
             Err(e) => {
                 let row = e.position().map(|p| row_at(p.byte()));
-                problems.push(
-                    Problem::error(
-                        rel,
-                        row,
-                        None,
-                        format!("is not valid CSV ({e})"),
-                        "fix the quoting of this row",
-                    )
-                    .with_kind(ProblemKind::Syntax),
-                );
-                return None;
+                let message = format!("is not valid CSV ({e})");
+                return Err(line_problem(
+                    rel,
+                    row,
+                    ProblemKind::Syntax,
+                    message,
+                    "fix the quoting of this row",
+                ));
             }
         }
         let row = byte_record.position().map_or(0, |p| row_at(p.byte()));
@@ -109,30 +124,30 @@ pub(crate) fn read_table(
             .map(|c| std::str::from_utf8(c).map(str::to_string))
             .collect();
         let Ok(cells) = cells else {
-            problems.push(
-                Problem::error(
-                    rel,
-                    Some(row),
-                    None,
-                    "is not valid UTF-8",
-                    "save the file as UTF-8",
-                )
-                .with_kind(ProblemKind::Syntax),
-            );
-            header.as_ref()?;
+            let hint = "save the file as UTF-8";
+            problems.push(line_problem(
+                rel,
+                Some(row),
+                ProblemKind::Syntax,
+                "is not valid UTF-8",
+                hint,
+            ));
+            if header.is_none() {
+                return Ok(None);
+            }
             continue;
         };
         match &header {
             None => header = Some((row, cells)),
             Some((_, names)) => {
                 if cells.len() != names.len() {
-                    row_problems.push(Problem::error(
+                    row_problems.push(line_problem(
                         rel,
                         Some(row),
-                        None,
+                        ProblemKind::Syntax,
                         format!("has {} cells but the header has {} columns; row skipped", cells.len(), names.len()),
                         "give every row one cell per header column; quote values that contain commas",
-                    ).with_kind(ProblemKind::Syntax));
+                    ));
                     continue;
                 }
                 records.push(Record { row, fields: cells });
@@ -140,20 +155,12 @@ pub(crate) fn read_table(
         }
     }
     let Some((header_row, names)) = header else {
-        problems.push(
-            Problem::error(
-                rel,
-                None,
-                None,
-                "is empty (no header row)",
-                format!(
-                    "write a header row with the columns {}",
-                    required.join(", ")
-                ),
-            )
-            .with_kind(ProblemKind::Syntax),
+        let hint = format!(
+            "write a header row with the columns {}",
+            required.join(", ")
         );
-        return None;
+        let message = "is empty (no header row)";
+        return Err(line_problem(rel, None, ProblemKind::Syntax, message, hint));
     };
     let mut columns = HashMap::new();
     let mut usable = true;
@@ -195,11 +202,11 @@ pub(crate) fn read_table(
     if usable {
         problems.extend(row_problems);
     }
-    usable.then(|| Table {
+    Ok(usable.then(|| Table {
         file: rel.to_path_buf(),
         columns,
         records,
-    })
+    }))
 }
 
 /// `body` without comment lines (first byte `#`) and blank lines, outside quoted cells; plus, for every
@@ -290,15 +297,21 @@ impl Fields<'_> {
             .map(|&i| self.record.fields[i].as_str())
     }
 
+    /// The error `message` (with `hint`) in `column` of this row.
+    fn problem_at(
+        &self,
+        column: &str,
+        message: impl Into<String>,
+        hint: impl Into<String>,
+    ) -> Problem {
+        let row = Some(self.record.row);
+        Problem::error(&self.table.file, row, Some(column), message, hint)
+    }
+
     /// Reject the row because of `column`.
     pub fn error(&mut self, column: &str, message: impl Into<String>, hint: impl Into<String>) {
-        self.problems.push(Problem::error(
-            &self.table.file,
-            Some(self.record.row),
-            Some(column),
-            message,
-            hint,
-        ));
+        let problem = self.problem_at(column, message, hint);
+        self.problems.push(problem);
         self.ok = false;
     }
 
@@ -318,13 +331,11 @@ impl Fields<'_> {
 
     /// Keep the row but report something suspicious in `column`.
     pub fn warning(&mut self, column: &str, message: impl Into<String>, hint: impl Into<String>) {
-        self.problems.push(Problem::warning(
-            &self.table.file,
-            Some(self.record.row),
-            Some(column),
-            message,
-            hint,
-        ));
+        let problem = self.problem_at(column, message, hint);
+        self.problems.push(Problem {
+            severity: Severity::Warning,
+            ..problem
+        });
     }
 
     /// A required non-empty text cell (ids, file names).

@@ -18,6 +18,7 @@
 //! world coordinates are ≈ 10⁵ m). Deterministic for a given `seed`.
 
 use super::ransac::required_iterations;
+use crate::geometry::bounding_box;
 use crate::params::Params;
 use crate::rng::SplitMix64;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
@@ -222,14 +223,7 @@ pub fn fit_plane_mlesac(points: &[[f64; 3]], p: &PlaneFitParams) -> Option<Plane
             .is_none_or(|r| axis_angle_deg(n, r) <= p.max_angle_deg)
     };
     // Outlier density 1/ν, ν = bounding-box diagonal (PCL).
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for q in points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(q[k]);
-            hi[k] = hi[k].max(q[k]);
-        }
-    }
+    let (lo, hi) = bounding_box(points);
     let nu = Vector3::new(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]).norm();
     if !(nu > 0.0) {
         return None;

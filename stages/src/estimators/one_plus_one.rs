@@ -31,15 +31,8 @@ crate::params! {
         record_trace: bool = false;
     }
     check(p, v) {
-        if !(p.initial_radius.is_finite() && p.initial_radius > p.epsilon) {
-            v.push(crate::params::Violation::new(
-                "initial_radius",
-                format!(
-                    "must be a finite number > epsilon ({}), got {}",
-                    p.epsilon, p.initial_radius
-                ),
-            ));
-        }
+        let bound = ("epsilon", p.epsilon);
+        crate::params::check_above_field("initial_radius", p.initial_radius, bound, "", v);
     }
 }
 

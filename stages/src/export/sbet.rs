@@ -24,7 +24,7 @@ use crate::import::config::CampaignSection;
 use crate::import::context::ImportContext;
 use crate::import::convert::{Converter, Inverse};
 use crate::import::export::inverse;
-use crate::import::pose::{apply_lever_arm, body_to_ned, remove_lever_arm};
+use crate::import::pose::{body_to_ned, LeverArm};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::io;
@@ -95,8 +95,12 @@ impl Frames {
         let (roll, pitch) = (r.roll_rad.to_degrees(), r.pitch_rad.to_degrees());
         let heading = r.heading_rad.to_degrees();
         let r_bn = body_to_ned(roll, pitch, heading);
-        let lever = self.lever_arm_m;
-        let (plat, plon, ph) = apply_lever_arm(&self.ellipsoid, lat, lon, r.height_m, &r_bn, lever);
+        let lever = LeverArm {
+            ellipsoid: &self.ellipsoid,
+            body_to_ned: &r_bn,
+            lever_body_m: self.lever_arm_m,
+        };
+        let (plat, plon, ph) = lever.apply((lat, lon, r.height_m));
         let (x, y, z) = self
             .forward
             .position(plat, plon, ph)
@@ -108,7 +112,11 @@ impl Frames {
             .map_err(|e| e.to_string())?;
         let heading_new = heading + c.delta_yaw_deg;
         let r_bn_new = body_to_ned(roll, pitch, heading_new);
-        let (ilat, ilon, ih) = remove_lever_arm(&self.ellipsoid, qlat, qlon, qh, &r_bn_new, lever);
+        let lever_new = LeverArm {
+            body_to_ned: &r_bn_new,
+            ..lever
+        };
+        let (ilat, ilon, ih) = lever_new.remove((qlat, qlon, qh));
         let heading_rad = heading_new.to_radians();
         Ok(SbetRecord {
             lat_rad: ilat.to_radians(),

@@ -212,24 +212,39 @@ mod tests {
     use super::*;
     use crate::export::corrections::tests::fixture;
 
-    #[test]
-    fn keeps_the_input_columns_and_order_and_appends_the_new_ones() {
+    /// The fixture run's adjusted trajectory written from an input table of `head` (its first lines), one
+    /// `row` per fixture recording and `tail`: the run, the written file (in the returned folder) and the
+    /// write's counts.
+    fn adjusted_from(
+        head: &str,
+        row: impl Fn(&Recording) -> String,
+        tail: &str,
+    ) -> (AdjustmentRun, tempfile::TempDir, TrajectoryExportCounts) {
         let (recs, run) = fixture();
         let series = CorrectionSeries::from_run(&recs, &run).unwrap();
         let d = tempfile::tempdir().unwrap();
         let input = d.path().join("recordings.csv");
-        // Columns in an unusual order, a column skytie does not know, a comment, a rejected row (no time).
-        let mut text = String::from("# exported by the vendor\nfile,operator,image_id,x,y,z,time,heading,camera_height,sigma_z,yaw\n");
-        for r in &recs {
-            text.push_str(&format!(
-                "{}.jpg,\"Ann, B.\",{},{},{},{},2020-01-01T00:00:00Z,90,2.5,0.5,1.5\n",
-                r.image_id, r.image_id, r.x, r.y, r.z
-            ));
-        }
-        text.push_str("bad.jpg,x,bad,1,2,3,,90,2.5,,\n");
-        std::fs::write(&input, text).unwrap();
+        let text: String = recs.iter().map(row).collect();
+        std::fs::write(&input, format!("{head}{text}{tail}")).unwrap();
         let out = d.path().join("trajectory_adjusted.csv");
         let counts = write_adjusted_trajectory(&out, &input, &series, &run).unwrap();
+        (run, d, counts)
+    }
+
+    #[test]
+    fn keeps_the_input_columns_and_order_and_appends_the_new_ones() {
+        // Columns in an unusual order, a column skytie does not know, a comment, a rejected row (no time).
+        let (run, d, counts) = adjusted_from(
+            "# exported by the vendor\nfile,operator,image_id,x,y,z,time,heading,camera_height,sigma_z,yaw\n",
+            |r| {
+                format!(
+                    "{}.jpg,\"Ann, B.\",{},{},{},{},2020-01-01T00:00:00Z,90,2.5,0.5,1.5\n",
+                    r.image_id, r.image_id, r.x, r.y, r.z
+                )
+            },
+            "bad.jpg,x,bad,1,2,3,,90,2.5,,\n",
+        );
+        let out = d.path().join("trajectory_adjusted.csv");
         assert_eq!((counts.adjusted, counts.not_read), (4, 1));
         let mut rd = csv::Reader::from_path(&out).unwrap();
         let header: Vec<String> = rd.headers().unwrap().iter().map(str::to_string).collect();
@@ -259,18 +274,12 @@ mod tests {
 
     #[test]
     fn appended_names_never_collide_with_input_columns() {
-        let (recs, run) = fixture();
-        let series = CorrectionSeries::from_run(&recs, &run).unwrap();
-        let d = tempfile::tempdir().unwrap();
-        let input = d.path().join("recordings.csv");
-        let mut text = String::from("image_id,x,y,z,correction\n");
-        for r in &recs {
-            text.push_str(&format!("{},{},{},{},vendor\n", r.image_id, r.x, r.y, r.z));
-        }
-        std::fs::write(&input, text).unwrap();
-        let out = d.path().join("t.csv");
-        write_adjusted_trajectory(&out, &input, &series, &run).unwrap();
-        let first = std::fs::read_to_string(&out).unwrap();
+        let (_, d, _) = adjusted_from(
+            "image_id,x,y,z,correction\n",
+            |r| format!("{},{},{},{},vendor\n", r.image_id, r.x, r.y, r.z),
+            "",
+        );
+        let first = std::fs::read_to_string(d.path().join("trajectory_adjusted.csv")).unwrap();
         let header = first.lines().next().unwrap();
         assert!(header.starts_with("image_id,x,y,z,correction,sigma_x,sigma_y,sigma_z,yaw,"));
         assert!(header.ends_with(",skytie_correction"), "{header}");

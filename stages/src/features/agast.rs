@@ -267,14 +267,9 @@ mod tests {
     }
 
     fn random_image(w: usize, h: usize, seed: u64, levels: u64) -> GrayImage {
-        let mut s = seed;
-        let data = (0..w * h)
-            .map(|_| {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((s >> 33) % levels) as f32 / 255.0
-            })
+        let data = crate::rng::mmix_states(seed)
+            .take(w * h)
+            .map(|s| ((s >> 33) % levels) as f32 / 255.0)
             .collect();
         GrayImage::from_vec(w, h, data).unwrap()
     }

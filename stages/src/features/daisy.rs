@@ -364,12 +364,7 @@ mod tests {
             orientations: 100,
             normalization: DaisyNormalization::None,
         };
-        let fields: Vec<String> = bad
-            .validate()
-            .unwrap_err()
-            .into_iter()
-            .map(|e| e.field)
-            .collect();
+        let fields = crate::params::violated_fields(&bad);
         assert_eq!(fields, ["radius_px", "rings", "orientations"]);
     }
 }

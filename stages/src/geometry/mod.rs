@@ -9,6 +9,7 @@
 
 pub mod aerial_intersection;
 pub mod atan2_poly;
+pub mod bounds;
 pub mod closest_approach;
 pub mod distortion;
 pub mod frame;
@@ -27,6 +28,7 @@ pub mod trifocal;
 #[cfg(test)]
 mod tests;
 
+pub use bounds::bounding_box;
 pub use closest_approach::{closest_approach, ClosestApproach};
 pub use distortion::BrownDistortion;
 pub use frame::FrameCamera;

@@ -297,9 +297,18 @@ mod tests {
 
     #[test]
     fn mip_levels() {
-        assert_eq!(level_for(0.01, 0.03, 5), 1);
-        assert_eq!(level_for(0.01, 0.0401, 5), 2);
-        assert_eq!(level_for(0.01, 0.005, 5), 0);
-        assert_eq!(level_for(0.001, 1.0, 3), 3);
+        let cases = [
+            ((0.01, 0.03, 5), 1),
+            ((0.01, 0.0401, 5), 2),
+            ((0.01, 0.005, 5), 0),
+            ((0.001, 1.0, 3), 3),
+        ];
+        for ((a, b, levels), level) in cases {
+            assert_eq!(
+                level_for(a, b, levels),
+                level,
+                "level_for({a}, {b}, {levels})"
+            );
+        }
     }
 }

@@ -47,6 +47,19 @@ impl GrayImage {
     pub fn row(&self, row: usize) -> &[f32] {
         &self.data[row * self.width..(row + 1) * self.width]
     }
+
+    /// Mean and (population) standard deviation of the grey values (0, 0 for an empty image).
+    pub fn mean_std(&self) -> (f64, f64) {
+        let n = self.data.len().max(1) as f64;
+        let mean = self.data.iter().map(|&g| g as f64).sum::<f64>() / n;
+        let var = self
+            .data
+            .iter()
+            .map(|&g| (g as f64 - mean).powi(2))
+            .sum::<f64>()
+            / n;
+        (mean, var.sqrt())
+    }
 }
 
 /// Interleaved RGB `f32` image (linear values, nominally 0..1).

@@ -31,3 +31,14 @@ pub use image::{GrayImage, RgbImage};
 pub mod resample;
 pub mod wallis;
 pub mod window;
+
+/// Whether this CPU has AVX2, so that a test can compare an AVX2 path with the scalar one (it says so when
+/// not).
+#[cfg(all(test, target_arch = "x86_64"))]
+pub(crate) fn avx2_to_compare() -> bool {
+    let has = std::arch::is_x86_feature_detected!("avx2");
+    if !has {
+        eprintln!("no AVX2 on this CPU: nothing to compare");
+    }
+    has
+}

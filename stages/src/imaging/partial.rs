@@ -4,10 +4,9 @@
 //! ingestion writes ([`super::pyramid::PyramidBuilder`]: same decoder, same levels), so a window read from it
 //! equals the window a stage reads from the ingested pyramid.
 
-use super::pyramid::builder::{Chain, TileSink};
-use super::pyramid::layout::{PyramidLayout, SampleDepth, DEFAULT_TILE_SIDE};
+use super::pyramid::builder::{DepthChain, TileSink};
+use super::pyramid::layout::{PyramidLayout, DEFAULT_TILE_SIDE};
 use super::pyramid::reader::{PyramidError, PyramidHeader, TileId, TileSource};
-use super::pyramid::sample::{narrow_row, widen_row};
 use crate::imaging::decode::{decode_grey, limits, GreyInfo, GreyRowSink};
 use crate::imaging::io_error::ImageIoError;
 use std::collections::HashMap;
@@ -89,19 +88,21 @@ impl TileSink for KeepSink {
     }
 }
 
-enum PartialChain {
-    U8(Chain<u8, KeepSink>),
-    U16(Chain<u16, KeepSink>),
-}
-
 /// Receives the decoder's rows; sets up the chain once the size is known.
 struct PartialBuild<F> {
     path: PathBuf,
     regions: Option<F>,
-    chain: Option<PartialChain>,
+    chain: Option<DepthChain<KeepSink>>,
     reservation: Option<crate::imaging::budget::Reservation<'static>>,
-    scratch8: Vec<u8>,
-    scratch16: Vec<u16>,
+}
+
+impl<F> PartialBuild<F> {
+    /// The chain the decoder's rows go to, once it has said the image's size.
+    fn started(&mut self) -> io::Result<&mut DepthChain<KeepSink>> {
+        self.chain
+            .as_mut()
+            .ok_or_else(|| io::Error::other("internal: rows before the size"))
+    }
 }
 
 impl<F: FnOnce(&PyramidLayout) -> Vec<Region>> GreyRowSink for PartialBuild<F> {
@@ -139,33 +140,16 @@ impl<F: FnOnce(&PyramidLayout) -> Vec<Region>> GreyRowSink for PartialBuild<F> {
             kept,
             tiles: Mutex::new(HashMap::new()),
         };
-        self.chain = Some(match layout.depth {
-            SampleDepth::U8 => PartialChain::U8(Chain::new(layout, sink)),
-            SampleDepth::U16 => PartialChain::U16(Chain::new(layout, sink)),
-        });
+        self.chain = Some(DepthChain::new(layout, sink));
         Ok(())
     }
 
     fn row_u8(&mut self, row: &[u8]) -> io::Result<()> {
-        match self.chain.as_mut() {
-            Some(PartialChain::U8(c)) => c.push_row(row),
-            Some(PartialChain::U16(c)) => {
-                widen_row(row, &mut self.scratch16);
-                c.push_row(&self.scratch16)
-            }
-            None => Err(io::Error::other("internal: rows before the size")),
-        }
+        self.started()?.push_row(row)
     }
 
     fn row_u16(&mut self, row: &[u16]) -> io::Result<()> {
-        match self.chain.as_mut() {
-            Some(PartialChain::U16(c)) => c.push_row(row),
-            Some(PartialChain::U8(c)) => {
-                narrow_row(row, &mut self.scratch8);
-                c.push_row(&self.scratch8)
-            }
-            None => Err(io::Error::other("internal: rows before the size")),
-        }
+        self.started()?.push_row(row)
     }
 }
 
@@ -188,18 +172,12 @@ impl PartialPyramid {
             regions: Some(regions),
             chain: None,
             reservation: None,
-            scratch8: Vec::new(),
-            scratch16: Vec::new(),
         };
         decode_grey(path, &mut build)?;
         let fail =
             |e: io::Error| ImageIoError::new(path, format!("cannot complete its pyramid ({e})"));
         let (layout, white, sink) = match build.chain.take() {
-            Some(PartialChain::U8(c)) => {
-                let f = c.finish().map_err(fail)?;
-                (f.layout, f.white, f.sink)
-            }
-            Some(PartialChain::U16(c)) => {
+            Some(c) => {
                 let f = c.finish().map_err(fail)?;
                 (f.layout, f.white, f.sink)
             }

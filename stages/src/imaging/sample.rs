@@ -185,11 +185,7 @@ mod tests {
             f64::INFINITY,
             f64::NEG_INFINITY,
         ];
-        let mut state = 12345u64;
-        for _ in 0..10_000 {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
+        for state in crate::rng::mmix_states(12345).take(10_000) {
             values.push(((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 20_000.0);
         }
         for x in values {

@@ -65,29 +65,36 @@ pub fn import_control(
                         .file_stem()
                         .map(|s| s.to_string_lossy().into_owned())
                         .unwrap_or_else(|| r.image.clone());
-                    if !known.contains(r.point.as_str()) {
-                        m_report.problems.push(Problem::error(
-                            path,
-                            Some(r.line),
-                            Some(&layout.point),
+                    // (field, message, hint) of a measurement that is skipped.
+                    let skipped = if !known.contains(r.point.as_str()) {
+                        Some((
+                            &layout.point,
                             format!("point '{}' is not in the point list; skipped", r.point),
                             "measure only listed points",
-                        ));
+                        ))
                     } else if !panorama_ids.contains(&stem) {
-                        m_report.problems.push(Problem::error(
-                            path,
-                            Some(r.line),
-                            Some(&layout.image),
+                        Some((
+                            &layout.image,
                             format!("panorama '{}' was not imported; skipped", r.image),
                             "measure in imported panoramas",
-                        ));
+                        ))
                     } else {
-                        observations.push(Observation {
+                        None
+                    };
+                    match skipped {
+                        Some((field, message, hint)) => m_report.problems.push(Problem::error(
+                            path,
+                            Some(r.line),
+                            Some(field),
+                            message,
+                            hint,
+                        )),
+                        None => observations.push(Observation {
                             point_id: r.point,
                             image_id: stem,
                             u_px: r.u_px,
                             v_px: r.v_px,
-                        });
+                        }),
                     }
                 }
             }

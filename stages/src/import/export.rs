@@ -5,7 +5,7 @@
 
 use super::context::ImportContext;
 use super::convert::{ConvertError, Inverse};
-use super::pose::{body_to_ned, panorama_angles, panorama_matrix, remove_lever_arm};
+use super::pose::{body_to_ned, panorama_angles, panorama_matrix, LeverArm};
 use crate::campaign::{AerialImage, Recording};
 use crate::crs::{Crs, Ellipsoid, HeightKind};
 use crate::formats::camera_model::CameraModel;
@@ -246,8 +246,12 @@ pub fn export_sbet_with_events(
         )
         .0;
         let r_bn = body_to_ned(0.0, 0.0, heading_true);
-        let (ilat, ilon, ih) =
-            remove_lever_arm(&crs.ellipsoid, lat, lon, h, &r_bn, spec.lever_arm_m);
+        let lever = LeverArm {
+            ellipsoid: &crs.ellipsoid,
+            body_to_ned: &r_bn,
+            lever_body_m: spec.lever_arm_m,
+        };
+        let (ilat, ilon, ih) = lever.remove((lat, lon, h));
         let (w, sow) = unix_to_gps(r.time_s, spec.leap_seconds);
         if *week.get_or_insert(w) != w {
             return Err(ExportError::Setup(

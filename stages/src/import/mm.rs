@@ -8,9 +8,7 @@
 use super::config::{MmSource, North, PanoramaOrientation, TrajectoryFormat};
 use super::context::ImportContext;
 use super::panorama_row::{panorama_row, PanoramaPlacement};
-use super::pose::{
-    apply_lever_arm, body_to_ned, panorama_angles, panorama_matrix, panorama_to_enu,
-};
+use super::pose::{body_to_ned, panorama_angles, panorama_matrix, panorama_to_enu, LeverArm};
 use super::report::SourceReport;
 use crate::campaign::{format_time_iso, Problem, Recording};
 use crate::crs::{Crs, Ellipsoid, GridNorth, HorizontalTransform};
@@ -268,7 +266,12 @@ fn recording(
                 .map_err(|e| e.to_string())?
     };
     let r_bn = body_to_ned(s.roll_deg, s.pitch_deg, heading_true);
-    let (plat, plon, ph) = apply_lever_arm(&f.ellipsoid, lat, lon, s.h_m, &r_bn, src.lever_arm_m);
+    let lever = LeverArm {
+        ellipsoid: &f.ellipsoid,
+        body_to_ned: &r_bn,
+        lever_body_m: src.lever_arm_m,
+    };
+    let (plat, plon, ph) = lever.apply((lat, lon, s.h_m));
     let r_pano_enu = match pano_cols {
         None => panorama_to_enu(&r_bn, src.boresight_deg),
         Some((table, cols)) => {

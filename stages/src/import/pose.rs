@@ -54,41 +54,45 @@ pub fn panorama_matrix(yaw_deg: f64, pitch_deg: f64, roll_deg: f64) -> Matrix3<f
     panorama_rotation(yaw_deg, pitch_deg, roll_deg)
 }
 
-/// The geodetic position of a point `lever_body_m` (body frame) from the IMU at (lat, lon, h) with attitude
-/// `body_to_ned`, exact through earth-centred coordinates.
-pub fn apply_lever_arm(
-    ellipsoid: &Ellipsoid,
-    lat_deg: f64,
-    lon_deg: f64,
-    h_m: f64,
-    body_to_ned: &Matrix3<f64>,
-    lever_body_m: [f64; 3],
-) -> (f64, f64, f64) {
-    let lever = Vector3::from(lever_body_m);
-    if lever == Vector3::zeros() {
-        return (lat_deg, lon_deg, h_m);
-    }
-    let offset_ecef =
-        Ellipsoid::enu_to_ecef(lat_deg, lon_deg) * swap_xy_flip_z() * body_to_ned * lever;
-    ellipsoid.from_ecef(&(ellipsoid.to_ecef(lat_deg, lon_deg, h_m) + offset_ecef))
+/// A lever arm: the point `lever_body_m` (body frame) from the IMU, whose attitude is `body_to_ned`.
+/// Geodetic positions are (latitude °, longitude °, ellipsoidal height m) on `ellipsoid`.
+pub struct LeverArm<'a> {
+    pub ellipsoid: &'a Ellipsoid,
+    pub body_to_ned: &'a Matrix3<f64>,
+    pub lever_body_m: [f64; 3],
 }
 
-/// The IMU position whose lever arm ends at the panorama centre (the inverse of [`apply_lever_arm`], by
-/// fixed-point iteration: the attitude's ECEF axes depend on the IMU position, changing by < 1e-6 per m).
-pub fn remove_lever_arm(
-    ellipsoid: &Ellipsoid,
-    lat_deg: f64,
-    lon_deg: f64,
-    h_m: f64,
-    body_to_ned: &Matrix3<f64>,
-    lever_body_m: [f64; 3],
-) -> (f64, f64, f64) {
-    let target = ellipsoid.to_ecef(lat_deg, lon_deg, h_m);
-    let lever = Vector3::from(lever_body_m);
-    let mut imu = (lat_deg, lon_deg, h_m);
-    for _ in 0..5 {
-        let offset = Ellipsoid::enu_to_ecef(imu.0, imu.1) * swap_xy_flip_z() * body_to_ned * lever;
-        imu = ellipsoid.from_ecef(&(target - offset));
+impl LeverArm<'_> {
+    /// The lever arm in earth-centred axes at (lat, lon), m.
+    fn offset_ecef(&self, lat_deg: f64, lon_deg: f64) -> Vector3<f64> {
+        Ellipsoid::enu_to_ecef(lat_deg, lon_deg)
+            * swap_xy_flip_z()
+            * self.body_to_ned
+            * Vector3::from(self.lever_body_m)
     }
-    imu
+
+    /// The geodetic position of the lever arm's end for the IMU at `imu`, exact through earth-centred
+    /// coordinates.
+    pub fn apply(&self, imu: (f64, f64, f64)) -> (f64, f64, f64) {
+        if Vector3::from(self.lever_body_m) == Vector3::zeros() {
+            return imu;
+        }
+        let (lat_deg, lon_deg, h_m) = imu;
+        let offset_ecef = self.offset_ecef(lat_deg, lon_deg);
+        let e = self.ellipsoid;
+        e.from_ecef(&(e.to_ecef(lat_deg, lon_deg, h_m) + offset_ecef))
+    }
+
+    /// The IMU position whose lever arm ends at `end` (the inverse of [`LeverArm::apply`], by fixed-point
+    /// iteration: the attitude's ECEF axes depend on the IMU position, changing by < 1e-6 per m).
+    pub fn remove(&self, end: (f64, f64, f64)) -> (f64, f64, f64) {
+        let target = self.ellipsoid.to_ecef(end.0, end.1, end.2);
+        let mut imu = end;
+        for _ in 0..5 {
+            imu = self
+                .ellipsoid
+                .from_ecef(&(target - self.offset_ecef(imu.0, imu.1)));
+        }
+        imu
+    }
 }

@@ -890,11 +890,9 @@ mod tests {
 
     #[test]
     fn friendly_sizes() {
-        assert_eq!(fft_friendly_size(64), 64);
-        assert_eq!(fft_friendly_size(97), 100);
-        assert_eq!(fft_friendly_size(121), 125);
-        assert_eq!(fft_friendly_size(7), 8);
-        assert_eq!(fft_friendly_size(0), 1);
+        for (n, friendly) in [(64, 64), (97, 100), (121, 125), (7, 8), (0, 1)] {
+            assert_eq!(fft_friendly_size(n), friendly, "size {n}");
+        }
     }
 
     #[test]

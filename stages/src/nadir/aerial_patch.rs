@@ -271,6 +271,21 @@ impl AerialWindow {
         let (w, h) = self.window.full_size;
         u_px >= 0.0 && v_px >= 0.0 && u_px < w as f64 && v_px < h as f64
     }
+
+    /// The ortho pixel (u, v) of `ground_world` in `georef` and its full-resolution aerial location predicted by
+    /// `ortho_to_aerial`; `None` when that location lies outside the whole image.
+    pub fn predict(
+        &self,
+        georef: &OrthoGeoref,
+        ortho_to_aerial: &Similarity2,
+        ground_world: [f64; 3],
+    ) -> Option<((f64, f64), Vector2<f64>)> {
+        let g = ground_world;
+        let (u_o, v_o) = georef.world_to_pixel(&Vector3::new(g[0], g[1], g[2]));
+        let predicted = ortho_to_aerial.apply(&Vector2::new(u_o, v_o));
+        self.image_contains(predicted.x, predicted.y)
+            .then_some(((u_o, v_o), predicted))
+    }
 }
 
 #[cfg(test)]

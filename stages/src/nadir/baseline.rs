@@ -174,13 +174,10 @@ pub fn baseline_matches(
             || (GrayImage::filled(0, 0, 0.0), GrayImage::filled(0, 0, 0.0)),
             |(template, search), i| {
                 let g = window.ground_world[i];
-                let (u_o, v_o) = blurred
-                    .georef
-                    .world_to_pixel(&Vector3::new(g[0], g[1], g[2]));
-                let predicted = tf.apply(&Vector2::new(u_o, v_o));
-                if !aerial_window.image_contains(predicted.x, predicted.y) {
+                let Some(((u_o, v_o), predicted)) = aerial_window.predict(&blurred.georef, &tf, g)
+                else {
                     return (false, None);
-                }
+                };
                 // No isolated keypoint anywhere near: nothing to measure (saves the NCC).
                 let reach = p.search_px as f64 / 2.0 * tf.scale + snap_px;
                 if keypoint_tree.count_in_box([predicted.x, predicted.y], [reach, reach]) == 0 {

@@ -214,15 +214,7 @@ pub fn sample_aerial_on_ortho_grid(
 
 /// Standard deviation of the grey values of `img`.
 pub fn grey_std(img: &GrayImage) -> f64 {
-    let n = img.data.len().max(1) as f64;
-    let mean = img.data.iter().map(|&g| g as f64).sum::<f64>() / n;
-    let var = img
-        .data
-        .iter()
-        .map(|&g| (g as f64 - mean).powi(2))
-        .sum::<f64>()
-        / n;
-    var.sqrt()
+    img.mean_std().1
 }
 
 /// Reusable per-thread buffers of one tie point's matching.
@@ -436,13 +428,10 @@ pub fn refine_in_image(
         .into_par_iter()
         .map_init(new_buffers, |buf, i| {
             let g = window.ground_world[i];
-            let (u_o, v_o) = mm_ortho
-                .georef
-                .world_to_pixel(&Vector3::new(g[0], g[1], g[2]));
-            let predicted = tf.apply(&Vector2::new(u_o, v_o));
-            if !aerial_window.image_contains(predicted.x, predicted.y) {
+            let Some(((u_o, v_o), predicted)) = aerial_window.predict(&mm_ortho.georef, &tf, g)
+            else {
                 return Outcome::Outside;
-            }
+            };
             let Some(corner) = cut_template(mm_ortho, u_o, v_o, p, buf) else {
                 return Outcome::Rejected;
             };
@@ -757,24 +746,9 @@ fn consistent_shifts(matches: Vec<AerialMatch>, spread_px: f64) -> Vec<AerialMat
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::campaign::AerialKind;
 
     fn located(id: &str, shift: (f64, f64)) -> AerialMatch {
-        AerialMatch {
-            tie_point_id: id.into(),
-            observation: AerialObservation {
-                image_id: "a".into(),
-                kind: AerialKind::Nadir,
-                u_px: 1000.0 + shift.0,
-                v_px: 2000.0 + shift.1,
-                score: 0.9,
-                sigma_px: None,
-            },
-            predicted_u_px: 1000.0,
-            predicted_v_px: 2000.0,
-            level: 0,
-            view_disagreement_px: None,
-        }
+        AerialMatch::shifted(id, "a", (1000.0, 2000.0), shift, 0.9)
     }
 
     fn ids(v: &[AerialMatch]) -> Vec<&str> {

@@ -116,6 +116,35 @@ pub struct AerialMatch {
     pub view_disagreement_px: Option<f64>,
 }
 
+#[cfg(test)]
+impl AerialMatch {
+    /// A level-0 nadir match of the tie point `id` in `image_id`, predicted at `predicted_px` and located
+    /// `shift_px` from there with the peak `score`.
+    pub(crate) fn shifted(
+        id: &str,
+        image_id: &str,
+        predicted_px: (f64, f64),
+        shift_px: (f64, f64),
+        score: f64,
+    ) -> Self {
+        AerialMatch {
+            tie_point_id: id.into(),
+            observation: AerialObservation {
+                image_id: image_id.into(),
+                kind: crate::campaign::AerialKind::Nadir,
+                u_px: predicted_px.0 + shift_px.0,
+                v_px: predicted_px.1 + shift_px.1,
+                score,
+                sigma_px: None,
+            },
+            predicted_u_px: predicted_px.0,
+            predicted_v_px: predicted_px.1,
+            level: 0,
+            view_disagreement_px: None,
+        }
+    }
+}
+
 /// All refined correspondences of one (recording, aerial image).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AerialRefinement {

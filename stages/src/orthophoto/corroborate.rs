@@ -133,25 +133,9 @@ pub fn corroborated(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::campaign::AerialKind;
-    use crate::correspondence::AerialObservation;
 
     fn located(id: &str, shift: (f64, f64), peak: f64) -> AerialMatch {
-        AerialMatch {
-            tie_point_id: id.into(),
-            observation: AerialObservation {
-                image_id: "ortho".into(),
-                kind: AerialKind::Nadir,
-                u_px: 500.0 + shift.0,
-                v_px: 700.0 + shift.1,
-                score: peak,
-                sigma_px: None,
-            },
-            predicted_u_px: 500.0,
-            predicted_v_px: 700.0,
-            level: 0,
-            view_disagreement_px: None,
-        }
+        AerialMatch::shifted(id, "ortho", (500.0, 700.0), shift, peak)
     }
 
     fn ids(c: &Corroboration) -> Vec<&str> {

@@ -5,20 +5,7 @@
 use super::preset::{NadirPlan, ObliquePlan};
 use super::rng::{hash_str, Stream};
 use crate::campaign::AerialImage;
-use crate::geometry::{matrix_to_opk, rot_x, rot_z};
-
-/// Axis-aligned bounding box (min, max) of points.
-fn bbox(points: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
-    let mut lo = [f64::INFINITY; 2];
-    let mut hi = [f64::NEG_INFINITY; 2];
-    for p in points {
-        for k in 0..2 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (lo, hi)
-}
+use crate::geometry::{bounding_box, matrix_to_opk, rot_x, rot_z};
 
 /// Margin around the route that the nadir block covers in addition, m.
 const NADIR_MARGIN_M: f64 = 15.0;
@@ -37,7 +24,7 @@ pub fn plan_nadir(
     if route_points.is_empty() {
         return Vec::new();
     }
-    let (lo, hi) = bbox(route_points);
+    let (lo, hi) = bounding_box(route_points);
     let centre = [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0];
     let extent = [
         hi[0] - lo[0] + 2.0 * NADIR_MARGIN_M,

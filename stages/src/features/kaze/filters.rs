@@ -242,14 +242,9 @@ mod tests {
     use crate::imaging::gradient::scharr_kernels;
 
     fn image(w: usize, h: usize, seed: u64) -> GrayImage {
-        let mut state = seed;
-        let data = (0..w * h)
-            .map(|_| {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (state >> 40) as f32 / (1u64 << 24) as f32
-            })
+        let data = crate::rng::mmix_states(seed)
+            .take(w * h)
+            .map(|state| (state >> 40) as f32 / (1u64 << 24) as f32)
             .collect();
         GrayImage::from_vec(w, h, data).unwrap()
     }

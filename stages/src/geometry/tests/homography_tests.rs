@@ -12,19 +12,8 @@ pub(crate) fn truth() -> Homography {
 }
 
 fn pairs_for(h: &Homography, n: usize, seed: u64, offset: f64) -> Vec<PointPair> {
-    let mut rng = SplitMix64::new(seed);
-    (0..n)
-        .map(|_| {
-            let src = Vector2::new(
-                offset + 1000.0 * rng.next_f64(),
-                offset + 1000.0 * rng.next_f64(),
-            );
-            PointPair {
-                src,
-                dst: h.apply(&src).unwrap(),
-            }
-        })
-        .collect()
+    let map = |src: &Vector2<f64>| h.apply(src).unwrap();
+    super::pairs_of(map, n, seed, (offset, (1000.0, 1000.0)), None)
 }
 
 fn assert_h_close(a: &Homography, b: &Homography, tol: f64) {

@@ -1,7 +1,6 @@
 //! 2-D similarity: exact recovery, inverse/compose, Umeyama equivalence, normalisation invariance.
 
 use crate::geometry::{PointPair, Similarity2};
-use crate::rng::SplitMix64;
 use nalgebra::{Matrix2, Vector2};
 
 fn truth() -> Similarity2 {
@@ -9,18 +8,8 @@ fn truth() -> Similarity2 {
 }
 
 fn pairs_for(sim: &Similarity2, n: usize, seed: u64, offset: f64, noise: f64) -> Vec<PointPair> {
-    let mut rng = SplitMix64::new(seed);
-    (0..n)
-        .map(|_| {
-            let src = Vector2::new(
-                offset + 1000.0 * rng.next_f64(),
-                offset + 800.0 * rng.next_f64(),
-            );
-            let dst =
-                sim.apply(&src) + Vector2::new(rng.next_gaussian(), rng.next_gaussian()) * noise;
-            PointPair { src, dst }
-        })
-        .collect()
+    let map = |src: &Vector2<f64>| sim.apply(src);
+    super::pairs_of(map, n, seed, (offset, (1000.0, 800.0)), Some(noise))
 }
 
 fn assert_sim_close(a: &Similarity2, b: &Similarity2, rel: f64) {

@@ -254,14 +254,63 @@ struct ChunkLayout {
     channels: Channels,
 }
 
-/// One row of chunks decoded into full-width grey rows (`band8` or `band16`, `width × band_h`).
+/// One row of chunks decoded into full-width grey rows (`u8.rows` or `u16.rows`, `width × band_h`).
 struct Band {
-    band8: Vec<u8>,
-    band16: Vec<u16>,
-    pixel8: Vec<u8>,
-    pixel16: Vec<u16>,
-    grey8: Vec<u8>,
-    grey16: Vec<u16>,
+    u8: DepthBand<u8>,
+    u16: DepthBand<u16>,
+}
+
+/// The grey rows of a band at one sample depth, and the pixels and grey of the chunk row being placed.
+struct DepthBand<T> {
+    rows: Vec<T>,
+    pixel: Vec<T>,
+    grey: Vec<T>,
+}
+
+/// Where row `r` of a decoded chunk goes: its samples start at `start` (in every plane), it has `dw` pixels of
+/// `channels` (`n` samples each), and its first `w` grey values go to the band at `dst`.
+struct ChunkRow {
+    start: usize,
+    dw: usize,
+    n: usize,
+    channels: Channels,
+    dst: usize,
+    w: usize,
+}
+
+impl<T: Copy + Default> DepthBand<T> {
+    /// A band of `len` samples.
+    fn new(len: usize) -> Self {
+        Self {
+            rows: vec![T::default(); len],
+            pixel: Vec::new(),
+            grey: Vec::new(),
+        }
+    }
+
+    /// The grey of chunk row `at` of `decoded` (one sample vector, or one per plane, interleaved first) into
+    /// the band; `plane` gives a vector's samples of this depth, `grey_row` the grey of a row of pixels.
+    /// `None` where the chunk holds too few samples (or samples of another depth).
+    fn place_row(
+        &mut self,
+        decoded: &[Samples],
+        plane: fn(&Samples) -> Option<&[T]>,
+        grey_row: fn(&[T], Channels, &mut Vec<T>),
+        at: &ChunkRow,
+    ) -> Option<()> {
+        match decoded {
+            [one] if plane(one).is_some() => {
+                let src = plane(one)?.get(at.start..at.start + at.dw * at.n)?;
+                grey_row(src, at.channels, &mut self.grey);
+            }
+            planes => {
+                interleave(planes, plane, at.start, at.dw, &mut self.pixel)?;
+                grey_row(&self.pixel, at.channels, &mut self.grey);
+            }
+        }
+        self.rows[at.dst..at.dst + at.w].copy_from_slice(&self.grey[..at.w]);
+        Some(())
+    }
 }
 
 /// The decoded samples of chunk `index` (as the `tiff` crate returns them: `dw` pixels per row), or as
@@ -386,38 +435,25 @@ impl Band {
             )
         };
         for r in 0..dh {
-            let dst = r * s.width + x0;
-            let w = dw.min(s.width - x0);
-            match (s.depth, decoded, channels) {
+            let at = ChunkRow {
+                start: r * stride,
+                dw,
+                n,
+                channels,
+                dst: r * s.width + x0,
+                w: dw.min(s.width - x0),
+            };
+            let placed = match (s.depth, decoded, channels) {
                 // Grey samples go straight into the band.
-                (SampleDepth::U8, [Samples::U8(v)], Channels::Grey { extra: 0 }) => {
-                    let src = v.get(r * stride..r * stride + w).ok_or_else(short)?;
-                    self.band8[dst..dst + w].copy_from_slice(src);
-                    continue;
+                (SampleDepth::U8, [Samples::U8(v)], Channels::Grey { extra: 0 }) => v
+                    .get(at.start..at.start + at.w)
+                    .map(|src| self.u8.rows[at.dst..at.dst + at.w].copy_from_slice(src)),
+                (SampleDepth::U8, ..) => self.u8.place_row(decoded, Samples::u8, grey_row8, &at),
+                (SampleDepth::U16, ..) => {
+                    self.u16.place_row(decoded, Samples::u16, grey_row16, &at)
                 }
-                (SampleDepth::U8, [Samples::U8(v)], _) => {
-                    let src = v.get(r * stride..r * stride + dw * n).ok_or_else(short)?;
-                    grey_row8(src, channels, &mut self.grey8);
-                }
-                (SampleDepth::U8, planes, _) => {
-                    interleave(planes, Samples::u8, r * stride, dw, &mut self.pixel8)
-                        .ok_or_else(short)?;
-                    grey_row8(&self.pixel8, channels, &mut self.grey8);
-                }
-                (SampleDepth::U16, [Samples::U16(v)], _) => {
-                    let src = v.get(r * stride..r * stride + dw * n).ok_or_else(short)?;
-                    grey_row16(src, channels, &mut self.grey16);
-                }
-                (SampleDepth::U16, planes, _) => {
-                    interleave(planes, Samples::u16, r * stride, dw, &mut self.pixel16)
-                        .ok_or_else(short)?;
-                    grey_row16(&self.pixel16, channels, &mut self.grey16);
-                }
-            }
-            match s.depth {
-                SampleDepth::U8 => self.band8[dst..dst + w].copy_from_slice(&self.grey8[..w]),
-                SampleDepth::U16 => self.band16[dst..dst + w].copy_from_slice(&self.grey16[..w]),
-            }
+            };
+            placed.ok_or_else(short)?;
         }
         Ok(())
     }
@@ -464,34 +500,23 @@ pub fn decode(
         geotiff: GeoTiffTags::read(&mut dec),
     };
     sink.begin(&info).map_err(|e| sink_error(path, e))?;
+    let band_len = |depth: SampleDepth| {
+        if s.depth == depth {
+            s.width * s.chunk_h
+        } else {
+            0
+        }
+    };
     let mut band = Band {
-        band8: vec![
-            0;
-            if s.depth == SampleDepth::U8 {
-                s.width * s.chunk_h
-            } else {
-                0
-            }
-        ],
-        band16: vec![
-            0;
-            if s.depth == SampleDepth::U16 {
-                s.width * s.chunk_h
-            } else {
-                0
-            }
-        ],
-        pixel8: Vec::new(),
-        pixel16: Vec::new(),
-        grey8: Vec::new(),
-        grey16: Vec::new(),
+        u8: DepthBand::new(band_len(SampleDepth::U8)),
+        u16: DepthBand::new(band_len(SampleDepth::U16)),
     };
     for row in 0..s.chunks_down() {
         let band_h = band.read(path, &mut dec, &raw, &s, row)?;
         for r in 0..band_h {
             let result = match s.depth {
-                SampleDepth::U8 => sink.row_u8(&band.band8[r * s.width..(r + 1) * s.width]),
-                SampleDepth::U16 => sink.row_u16(&band.band16[r * s.width..(r + 1) * s.width]),
+                SampleDepth::U8 => sink.row_u8(&band.u8.rows[r * s.width..(r + 1) * s.width]),
+                SampleDepth::U16 => sink.row_u16(&band.u16.rows[r * s.width..(r + 1) * s.width]),
             };
             result.map_err(|e| sink_error(path, e))?;
         }

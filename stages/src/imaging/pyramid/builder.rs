@@ -7,7 +7,7 @@
 //! temporary file.
 
 use super::layout::{PyramidLayout, SampleDepth, HEADER_LEN, TILE_HASH_LEN};
-use super::sample::{narrow_row, reduce_rows, widen_row, Sample};
+use super::sample::{reduce_rows, Sample};
 use rayon::prelude::*;
 use std::fs::{self, File, OpenOptions};
 use std::io;
@@ -287,19 +287,55 @@ pub fn white_for(max: u16) -> u16 {
         .unwrap_or(u16::MAX)
 }
 
-enum AnyChain {
-    U8(Chain<u8, File>),
-    U16(Chain<u16, File>),
+enum AnyChain<K> {
+    U8(Chain<u8, K>),
+    U16(Chain<u16, K>),
+}
+
+/// A [`Chain`] at its layout's sample depth, taking rows of either depth.
+pub(crate) struct DepthChain<K> {
+    chain: AnyChain<K>,
+    /// u16 rows converted to u8 (or back) when the source's depth differs from the stored one.
+    scratch8: Vec<u8>,
+    scratch16: Vec<u16>,
+}
+
+impl<K: TileSink> DepthChain<K> {
+    /// The chain of `layout`'s tiles into `sink`.
+    pub(crate) fn new(layout: PyramidLayout, sink: K) -> Self {
+        let chain = match layout.depth {
+            SampleDepth::U8 => AnyChain::U8(Chain::new(layout, sink)),
+            SampleDepth::U16 => AnyChain::U16(Chain::new(layout, sink)),
+        };
+        Self {
+            chain,
+            scratch8: Vec::new(),
+            scratch16: Vec::new(),
+        }
+    }
+
+    /// Appends one full-width row of samples of either depth.
+    pub(crate) fn push_row<T: Sample>(&mut self, row: &[T]) -> io::Result<()> {
+        match &mut self.chain {
+            AnyChain::U8(c) => c.push_row(T::row_as_u8(row, &mut self.scratch8)),
+            AnyChain::U16(c) => c.push_row(T::row_as_u16(row, &mut self.scratch16)),
+        }
+    }
+
+    /// [`Chain::finish`].
+    pub(crate) fn finish(self) -> io::Result<Finished<K>> {
+        match self.chain {
+            AnyChain::U8(c) => c.finish(),
+            AnyChain::U16(c) => c.finish(),
+        }
+    }
 }
 
 /// Builds one pyramid file from rows pushed top to bottom; see the module documentation.
 pub struct PyramidBuilder {
-    chain: Option<AnyChain>,
+    chain: Option<DepthChain<File>>,
     tmp: PathBuf,
     dest: PathBuf,
-    /// u16 rows converted to u8 (or back) when the source's depth differs from the stored one.
-    scratch8: Vec<u8>,
-    scratch16: Vec<u16>,
 }
 
 impl PyramidBuilder {
@@ -334,39 +370,21 @@ impl PyramidBuilder {
             .truncate(true)
             .open(&tmp)?;
         file.set_len(layout.file_len())?;
-        let chain = match depth {
-            SampleDepth::U8 => AnyChain::U8(Chain::new(layout, file)),
-            SampleDepth::U16 => AnyChain::U16(Chain::new(layout, file)),
-        };
         Ok(Self {
-            chain: Some(chain),
+            chain: Some(DepthChain::new(layout, file)),
             tmp,
             dest: dest.to_path_buf(),
-            scratch8: Vec::new(),
-            scratch16: Vec::new(),
         })
     }
 
     /// Appends one full-width row of 8-bit samples.
     pub fn push_row_u8(&mut self, row: &[u8]) -> io::Result<()> {
-        match self.chain.as_mut().expect("not finished") {
-            AnyChain::U8(c) => c.push_row(row),
-            AnyChain::U16(c) => {
-                widen_row(row, &mut self.scratch16);
-                c.push_row(&self.scratch16)
-            }
-        }
+        self.chain.as_mut().expect("not finished").push_row(row)
     }
 
     /// Appends one full-width row of 16-bit samples.
     pub fn push_row_u16(&mut self, row: &[u16]) -> io::Result<()> {
-        match self.chain.as_mut().expect("not finished") {
-            AnyChain::U16(c) => c.push_row(row),
-            AnyChain::U8(c) => {
-                narrow_row(row, &mut self.scratch8);
-                c.push_row(&self.scratch8)
-            }
-        }
+        self.chain.as_mut().expect("not finished").push_row(row)
     }
 
     /// Completes the file (all rows must have been pushed) and renames it into place.
@@ -378,10 +396,7 @@ impl PyramidBuilder {
     /// checked against their hashes when read ([`super::TiledPyramid::open`]), so such a file is refused,
     /// never read as an image.
     pub fn finish(mut self) -> io::Result<PyramidSummary> {
-        let done = match self.chain.take().expect("not finished") {
-            AnyChain::U8(c) => c.finish()?,
-            AnyChain::U16(c) => c.finish()?,
-        };
+        let done = self.chain.take().expect("not finished").finish()?;
         let file = done.sink;
         file.write_all_at(&done.table, done.layout.hash_table_offset())?;
         file.write_all_at(&done.header, 0)?;
@@ -410,12 +425,17 @@ mod tests {
 
     #[test]
     fn white_is_the_smallest_all_ones_value_holding_the_maximum() {
-        assert_eq!(white_for(0), 255);
-        assert_eq!(white_for(255), 255);
-        assert_eq!(white_for(256), 511);
-        assert_eq!(white_for(4095), 4095);
-        assert_eq!(white_for(4096), 8191);
-        assert_eq!(white_for(65535), 65535);
+        let cases = [
+            (0, 255),
+            (255, 255),
+            (256, 511),
+            (4095, 4095),
+            (4096, 8191),
+            (65535, 65535),
+        ];
+        for (max, white) in cases {
+            assert_eq!(white_for(max), white, "white for the maximum {max}");
+        }
     }
 
     #[test]

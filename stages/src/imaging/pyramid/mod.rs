@@ -261,15 +261,21 @@ mod tests {
 
     #[test]
     fn level_rules() {
-        assert_eq!(nearest_level(0.025, 0.10, 8), 2);
-        assert_eq!(nearest_level(0.10, 0.10, 8), 0);
-        assert_eq!(nearest_level(0.0605, 0.10, 8), 1);
-        assert_eq!(nearest_level(0.00605, 0.10, 8), 4);
-        assert_eq!(nearest_level(0.2, 0.10, 8), 0);
-        assert_eq!(nearest_level(0.001, 10.0, 3), 2);
-        assert_eq!(footprint_level(1.0, 3.9, 8), 1);
-        assert_eq!(footprint_level(1.0, 4.0, 8), 2);
-        assert_eq!(footprint_level(1.0, 0.5, 8), 0);
-        assert_eq!(footprint_level(1.0, f64::NAN, 8), 0);
+        type Rule = fn(f64, f64, usize) -> usize;
+        let cases: [(Rule, &str, f64, f64, usize, usize); 10] = [
+            (nearest_level, "nearest_level", 0.025, 0.10, 8, 2),
+            (nearest_level, "nearest_level", 0.10, 0.10, 8, 0),
+            (nearest_level, "nearest_level", 0.0605, 0.10, 8, 1),
+            (nearest_level, "nearest_level", 0.00605, 0.10, 8, 4),
+            (nearest_level, "nearest_level", 0.2, 0.10, 8, 0),
+            (nearest_level, "nearest_level", 0.001, 10.0, 3, 2),
+            (footprint_level, "footprint_level", 1.0, 3.9, 8, 1),
+            (footprint_level, "footprint_level", 1.0, 4.0, 8, 2),
+            (footprint_level, "footprint_level", 1.0, 0.5, 8, 0),
+            (footprint_level, "footprint_level", 1.0, f64::NAN, 8, 0),
+        ];
+        for (rule, name, a, b, levels, level) in cases {
+            assert_eq!(rule(a, b, levels), level, "{name}({a}, {b}, {levels})");
+        }
     }
 }

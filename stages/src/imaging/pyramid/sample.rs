@@ -13,6 +13,10 @@ pub trait Sample: Copy + Default + PartialEq + Send + Sync + 'static {
     fn read_le(bytes: &[u8], index: usize) -> Self;
     /// As u16 (for the white level).
     fn as_u16(self) -> u16;
+    /// `row` as 8-bit samples: itself, or narrowed ([`narrow_row`]) into `scratch`.
+    fn row_as_u8<'a>(row: &'a [Self], scratch: &'a mut Vec<u8>) -> &'a [u8];
+    /// `row` as 16-bit samples: itself, or widened ([`widen_row`]) into `scratch`.
+    fn row_as_u16<'a>(row: &'a [Self], scratch: &'a mut Vec<u16>) -> &'a [u16];
 }
 
 impl Sample for u8 {
@@ -34,6 +38,15 @@ impl Sample for u8 {
 
     fn as_u16(self) -> u16 {
         u16::from(self)
+    }
+
+    fn row_as_u8<'a>(row: &'a [u8], _: &'a mut Vec<u8>) -> &'a [u8] {
+        row
+    }
+
+    fn row_as_u16<'a>(row: &'a [u8], scratch: &'a mut Vec<u16>) -> &'a [u16] {
+        widen_row(row, scratch);
+        scratch
     }
 }
 
@@ -59,6 +72,15 @@ impl Sample for u16 {
 
     fn as_u16(self) -> u16 {
         self
+    }
+
+    fn row_as_u8<'a>(row: &'a [u16], scratch: &'a mut Vec<u8>) -> &'a [u8] {
+        narrow_row(row, scratch);
+        scratch
+    }
+
+    fn row_as_u16<'a>(row: &'a [u16], _: &'a mut Vec<u16>) -> &'a [u16] {
+        row
     }
 }
 

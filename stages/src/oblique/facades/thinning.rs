@@ -15,6 +15,7 @@
 
 use super::params::ThinningSplit;
 use crate::estimators::SplitMix64;
+use crate::geometry::bounding_box;
 
 /// Indices (ascending) into `points` of the points kept: one per leaf box of at most
 /// `max_points_per_box` points and at most `max_box_m` along its longest dimension (module documentation).
@@ -40,14 +41,7 @@ pub fn box_grid_thin(
             continue;
         }
         let range = &mut order[start..end];
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for &i in range.iter() {
-            for a in 0..3 {
-                lo[a] = lo[a].min(points[i][a]);
-                hi[a] = hi[a].max(points[i][a]);
-            }
-        }
+        let (lo, hi) = bounding_box(range.iter().map(|&i| &points[i]));
         let axis = (0..3)
             .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])).then(b.cmp(&a)))
             .unwrap_or(0);

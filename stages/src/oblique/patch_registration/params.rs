@@ -70,14 +70,7 @@ crate::params! {
         seed: u64 = 0;
     }
     check(p, v) {
-        if !(p.es_initial_radius_m.is_finite() && p.es_initial_radius_m > p.es_epsilon_m) {
-            v.push(crate::params::Violation::new(
-                "es_initial_radius_m",
-                format!(
-                    "must be a finite number > es_epsilon_m ({} m), got {}",
-                    p.es_epsilon_m, p.es_initial_radius_m
-                ),
-            ));
-        }
+        let bound = ("es_epsilon_m", p.es_epsilon_m);
+        crate::params::check_above_field("es_initial_radius_m", p.es_initial_radius_m, bound, "m", v);
     }
 }

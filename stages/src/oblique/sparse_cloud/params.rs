@@ -71,7 +71,6 @@ impl SparseCloudParams {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::params::Params;
 
     #[test]
     fn right_side_yaws_mirror_the_left_ones() {
@@ -88,12 +87,7 @@ mod tests {
             max_range_m: f64::NAN,
             ..SparseCloudParams::default()
         };
-        let fields: Vec<String> = p
-            .validate()
-            .unwrap_err()
-            .into_iter()
-            .map(|e| e.field)
-            .collect();
+        let fields = crate::params::violated_fields(&p);
         assert_eq!(fields, ["view_width_px", "match_ratio", "max_range_m"]);
     }
 }
