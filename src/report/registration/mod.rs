@@ -29,7 +29,7 @@ use skytie_stages::campaign::{
 use skytie_stages::imaging::image::RgbImage;
 use skytie_stages::imaging::io::{dimensions, save_rgb};
 use std::collections::{BTreeMap, HashMap};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use truth::{true_point, ObliqueTruth, TruePanoObservation, Verdict};
 
@@ -119,14 +119,14 @@ struct CampaignViews {
 /// A drawn view: the aerial image shown and the verdict counts.
 type Drawn = Result<(String, ViewCounts), String>;
 
+/// The oblique grading rule's truth (when the campaign has one) and its notes.
+type ObliqueRule = (Option<ObliqueTruth>, Vec<String>);
+
 /// What the registration views of all pages of one report share, each computed once: the campaign, the
 /// oblique truth, and the views already drawn. The variants of a sweep mostly show the same correspondences
 /// (every oblique variant the same nadir ones), so a view is named after what it shows and drawn once.
 /// Values are computed outside the locks (a rayon worker may pick up another page meanwhile); when two pages
 /// compute the same value at once, both results are identical and the first is kept.
-/// The oblique grading rule's truth (when the campaign has one) and its notes.
-type ObliqueRule = (Option<ObliqueTruth>, Vec<String>);
-
 #[derive(Default)]
 pub struct SharedViews {
     campaign: Mutex<Option<Arc<Result<CampaignViews, String>>>>,
@@ -247,26 +247,8 @@ pub fn registration_section(
     };
     let points = parse_points(&corr);
     let has_oblique = points.keys().any(|(s, _)| s == "oblique");
-    let oblique = (has_oblique && !cv.truth.is_empty()).then(|| {
-        once(&shared.oblique, || {
-            match load_oblique_truth(&root, &cv.campaign, &cv.truth, &cv.pano_sizes) {
-                Ok(mut t) => {
-                    let mut notes = Vec::new();
-                    match load_scene(&root) {
-                        Ok(scene) => t.scene = scene,
-                        Err(e) => notes.push(format!(
-                            "oblique registration views graded without the scene: {e}"
-                        )),
-                    }
-                    (Some(t), notes)
-                }
-                Err(e) => (
-                    None,
-                    vec![format!("oblique registration views ungraded: {e}")],
-                ),
-            }
-        })
-    });
+    let oblique = (has_oblique && !cv.truth.is_empty())
+        .then(|| once(&shared.oblique, || oblique_rule(&root, cv)));
     if let Some(o) = &oblique {
         for n in &o.1 {
             b.note(page, n.clone());
@@ -280,7 +262,118 @@ pub fn registration_section(
         pano_sizes: &cv.pano_sizes,
         oblique_truth: oblique.as_ref().and_then(|o| o.0.as_ref()),
     };
-    let mut t = Table::new(
+    let mut t = views_table(prefix);
+    for source in ["nadir", "oblique"] {
+        for rec_id in most_controlled(&points, source, n_views) {
+            let Some(rec) = ctx.recording(rec_id) else {
+                continue;
+            };
+            let mine: Vec<&ControlPoint> = points
+                .iter()
+                .filter(|((s, _), p)| s == source && p.pano.iter().any(|o| o.image_id == rec_id))
+                .map(|(_, p)| p)
+                .collect();
+            // Named after what it shows, so pages showing the same correspondences share one file.
+            let shown = blake3::hash(format!("{source}|{rec_id}|{mine:?}").as_bytes());
+            let name = format!(
+                "registration-{source}-{}-{}.png",
+                slug(rec_id),
+                &shown.to_hex()[..12]
+            );
+            let (path, href) = b.figure_path(&name);
+            let made = drawn_once(b, &shared, &name, path, |path| {
+                if source == "nadir" {
+                    nadir_view(&ctx, rec, &mine, path)
+                } else {
+                    oblique_view(&ctx, rec, &mine, path)
+                }
+            });
+            show_view(b, page, &mut t, source, rec_id, &href, made);
+        }
+    }
+    if t.rows.is_empty() {
+        page.para("No control point has both panorama and aerial observations.");
+    } else {
+        b.table(page, t);
+    }
+    Ok(())
+}
+
+/// Adds view `made` of recording `rec_id` to `page` (figure and caption), to the recording's views and as a
+/// row of `t`; a view that could not be drawn becomes a note.
+fn show_view(
+    b: &mut Builder,
+    page: &mut Page,
+    t: &mut Table,
+    source: &str,
+    rec_id: &str,
+    href: &str,
+    made: Drawn,
+) {
+    match made {
+        Ok((aerial_id, c)) => {
+            let caption = format!(
+                "{rec_id} ({}) and {source} image {aerial_id}: {} correct (green), {} wrong (red), \
+                 {} non-matchable (blue), {} ungraded (yellow).",
+                if source == "nadir" {
+                    "MM ortho image, 3 cm, north up"
+                } else {
+                    "panorama crop"
+                },
+                c.correct,
+                c.wrong,
+                c.non_matchable,
+                c.ungraded
+            );
+            page.figure(
+                href,
+                &format!("{source} registration of {rec_id}"),
+                &caption,
+            );
+            b.recording_views
+                .entry(rec_id.to_string())
+                .or_default()
+                .push((href.to_string(), caption));
+            let n = c.correct + c.wrong + c.non_matchable + c.ungraded;
+            t.push(vec![
+                source.to_string(),
+                rec_id.to_string(),
+                aerial_id,
+                fmt_count(Some(n as f64)),
+                fmt_count(Some(c.correct as f64)),
+                fmt_count(Some(c.wrong as f64)),
+                fmt_count(Some(c.non_matchable as f64)),
+                fmt_count(Some(c.ungraded as f64)),
+            ]);
+        }
+        Err(e) => b.note(page, format!("{source} registration view of {rec_id}: {e}")),
+    }
+}
+
+/// The oblique grading rule of the campaign at `root`: its truth with the scene when it can be read, and the
+/// notes saying what is missing.
+fn oblique_rule(root: &Path, cv: &CampaignViews) -> ObliqueRule {
+    match load_oblique_truth(root, &cv.campaign, &cv.truth, &cv.pano_sizes) {
+        Ok(mut t) => {
+            let mut notes = Vec::new();
+            match load_scene(root) {
+                Ok(scene) => t.scene = scene,
+                Err(e) => notes.push(format!(
+                    "oblique registration views graded without the scene: {e}"
+                )),
+            }
+            (Some(t), notes)
+        }
+        Err(e) => (
+            None,
+            vec![format!("oblique registration views ungraded: {e}")],
+        ),
+    }
+}
+
+/// The table of the correspondences the views show, empty.
+fn views_table(prefix: &str) -> Table {
+    Table::new(
         &format!("{prefix}registration-views"),
         "Correspondences shown in the registration views",
         Origin::Skytie,
@@ -301,107 +394,52 @@ pub fn registration_section(
          oblique.* in metrics.json): rays within 0.15 m and the seen surface point (truth/scene.toml; else the \
          triangulated point) within 1.5 px; non-matchable = sky, hidden from the oblique camera or outside it. \
          Ungraded without truth.",
-    );
-    for source in ["nadir", "oblique"] {
-        // Recordings by number of control points of this source, most first.
-        let mut per_rec: BTreeMap<&str, usize> = BTreeMap::new();
-        for ((s, _), p) in &points {
-            if s != source || p.aerial.is_empty() {
-                continue;
-            }
-            for o in &p.pano {
-                *per_rec.entry(o.image_id.as_str()).or_default() += 1;
-            }
+    )
+}
+
+/// The `n` recordings with the most control points of `source` (ties: smallest id).
+fn most_controlled<'p>(points: &'p Points, source: &str, n: usize) -> Vec<&'p str> {
+    let mut per_rec: BTreeMap<&str, usize> = BTreeMap::new();
+    for ((s, _), p) in points {
+        if s != source || p.aerial.is_empty() {
+            continue;
         }
-        let mut ranked: Vec<(&str, usize)> = per_rec.into_iter().collect();
-        ranked.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(b.0)));
-        for (rec_id, _) in ranked.into_iter().take(n_views) {
-            let Some(rec) = ctx.recording(rec_id) else {
-                continue;
-            };
-            let mine: Vec<&ControlPoint> = points
-                .iter()
-                .filter(|((s, _), p)| s == source && p.pano.iter().any(|o| o.image_id == rec_id))
-                .map(|(_, p)| p)
-                .collect();
-            // Named after what it shows, so pages showing the same correspondences share one file.
-            let shown = blake3::hash(format!("{source}|{rec_id}|{mine:?}").as_bytes());
-            let name = format!(
-                "registration-{source}-{}-{}.png",
-                slug(rec_id),
-                &shown.to_hex()[..12]
-            );
-            let (path, href) = b.figure_path(&name);
-            let known = shared
-                .drawn
-                .lock()
-                .unwrap_or_else(|p| p.into_inner())
-                .get(&name)
-                .cloned();
-            let made = match known {
-                Some(d) => d,
-                None => {
-                    let d = if source == "nadir" {
-                        nadir_view(&ctx, rec, &mine, &path)
-                    } else {
-                        oblique_view(&ctx, rec, &mine, &path)
-                    };
-                    let mut drawn = shared.drawn.lock().unwrap_or_else(|p| p.into_inner());
-                    if !drawn.contains_key(&name) {
-                        drawn.insert(name.clone(), d.clone());
-                        if d.is_ok() {
-                            b.wrote_figure(path);
-                        }
-                    }
-                    d
-                }
-            };
-            match made {
-                Ok((aerial_id, c)) => {
-                    let caption = format!(
-                        "{rec_id} ({}) and {source} image {aerial_id}: {} correct (green), {} wrong (red), \
-                         {} non-matchable (blue), {} ungraded (yellow).",
-                        if source == "nadir" {
-                            "MM ortho image, 3 cm, north up"
-                        } else {
-                            "panorama crop"
-                        },
-                        c.correct,
-                        c.wrong,
-                        c.non_matchable,
-                        c.ungraded
-                    );
-                    page.figure(
-                        &href,
-                        &format!("{source} registration of {rec_id}"),
-                        &caption,
-                    );
-                    b.recording_views
-                        .entry(rec_id.to_string())
-                        .or_default()
-                        .push((href.clone(), caption));
-                    let n = c.correct + c.wrong + c.non_matchable + c.ungraded;
-                    t.push(vec![
-                        source.to_string(),
-                        rec_id.to_string(),
-                        aerial_id,
-                        fmt_count(Some(n as f64)),
-                        fmt_count(Some(c.correct as f64)),
-                        fmt_count(Some(c.wrong as f64)),
-                        fmt_count(Some(c.non_matchable as f64)),
-                        fmt_count(Some(c.ungraded as f64)),
-                    ]);
-                }
-                Err(e) => b.note(page, format!("{source} registration view of {rec_id}: {e}")),
-            }
+        for o in &p.pano {
+            *per_rec.entry(o.image_id.as_str()).or_default() += 1;
         }
     }
-    if t.rows.is_empty() {
-        page.para("No control point has both panorama and aerial observations.");
-    } else {
-        b.table(page, t);
+    let mut ranked: Vec<(&str, usize)> = per_rec.into_iter().collect();
+    ranked.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(b.0)));
+    ranked.into_iter().take(n).map(|(id, _)| id).collect()
+}
+
+/// The view named `name`: drawn by an earlier page of the report, or drawn now into `path` by `draw` (and
+/// counted as a figure the report wrote).
+fn drawn_once(
+    b: &mut Builder,
+    shared: &SharedViews,
+    name: &str,
+    path: PathBuf,
+    draw: impl FnOnce(&Path) -> Drawn,
+) -> Drawn {
+    let known = shared
+        .drawn
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .get(name)
+        .cloned();
+    if let Some(d) = known {
+        return d;
     }
-    Ok(())
+    let d = draw(&path);
+    let mut drawn = shared.drawn.lock().unwrap_or_else(|p| p.into_inner());
+    if !drawn.contains_key(name) {
+        drawn.insert(name.to_string(), d.clone());
+        if d.is_ok() {
+            b.wrote_figure(path);
+        }
+    }
+    d
 }
 
 /// The aerial image of `kind` observing most of `points` (ties: smallest id).
