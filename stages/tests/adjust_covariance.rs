@@ -60,6 +60,7 @@ fn two_priors_and_a_relative_constraint_give_the_analytic_sigma() {
             from: 0,
             to: 1,
             sigma_m: sigma_rel,
+            held: false,
         }],
         ..Block::default()
     };

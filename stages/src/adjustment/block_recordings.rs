@@ -146,6 +146,7 @@ pub(super) fn relative_constraints(
             from: i - 1,
             to: i,
             sigma_m,
+            held: false,
         })
         .collect()
 }

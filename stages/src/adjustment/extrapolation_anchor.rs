@@ -71,6 +71,7 @@ pub fn anchor_constraints(
         from: anchor,
         to,
         sigma_m: sigma_m * (anchor.abs_diff(to) as f64).powf(growth),
+        held: false,
     };
     let mut out = Vec::new();
     // Before the first: recordings first − 1, first − 2, … while each is linked to the next one.

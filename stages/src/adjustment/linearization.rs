@@ -182,7 +182,7 @@ fn add_relative_terms(
         let (a, b, sigma) = prep.relative[i];
         let r = prep.relative_residual(i, state);
         // IRLS: residual and Jacobian scaled by √ρ'(s) of the constraint's loss.
-        let w = prep.relative_loss.weight(r.norm_squared());
+        let w = prep.relative_loss_of(i).weight(r.norm_squared());
         let inv2 = w / (sigma * sigma);
         let mut block = Matrix4::zeros();
         for axis in 0..prep.position_axes() {

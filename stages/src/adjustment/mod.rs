@@ -50,6 +50,7 @@ pub mod linearization;
 pub mod parallel;
 pub mod prepared;
 pub mod problem;
+pub mod relative_bridge;
 pub mod relative_noise;
 pub mod relative_release;
 pub mod residuals;

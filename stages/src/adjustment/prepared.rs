@@ -89,6 +89,8 @@ pub struct Prepared {
     pub aerial: Vec<PreparedAerial>,
     /// (from, to, σ) with from ≠ to.
     pub relative: Vec<(usize, usize, f64)>,
+    /// Per relative constraint: held by least squares instead of `relative_loss`.
+    pub relative_held: Vec<bool>,
     /// Points with enough active observations to be determined.
     pub point_active: Vec<bool>,
     /// Active panorama observations by point and by recording.
@@ -272,6 +274,7 @@ impl Prepared {
             point_heights,
             aerial_cameras,
             aerial,
+            relative_held: block.relative_constraints.iter().map(|r| r.held).collect(),
             relative,
             point_active,
             layout,
@@ -356,6 +359,15 @@ impl Prepared {
         out
     }
 
+    /// The loss of relative constraint `i`: least squares when it is held, else `relative_loss`.
+    pub(super) fn relative_loss_of(&self, i: usize) -> RobustLoss {
+        if self.relative_held[i] {
+            RobustLoss::Squared
+        } else {
+            self.relative_loss
+        }
+    }
+
     /// Relative-constraint residual (whitened) of constraint `i`, per free axis.
     pub(super) fn relative_residual(&self, i: usize, state: &State) -> Vector3<f64> {
         let (a, b, sigma) = self.relative[i];
@@ -405,7 +417,7 @@ impl Prepared {
         total += self.prior_terms_sum(state);
         for i in 0..self.relative.len() {
             total += self
-                .relative_loss
+                .relative_loss_of(i)
                 .rho(self.relative_residual(i, state).norm_squared());
         }
         0.5 * total

@@ -100,6 +100,10 @@ pub struct RelativeConstraint {
     pub from: usize,
     pub to: usize,
     pub sigma_m: f64,
+    /// Held by least squares whatever [`AdjustOptions::relative_loss`] says: a step of a chain of
+    /// recordings without aerial evidence of their own, whose σ already covers what the chain's anchors
+    /// show ([`super::relative_bridge`]).
+    pub held: bool,
 }
 
 /// Everything the adjustment estimates from: recordings (initial poses and priors), initial tie-point

@@ -20,11 +20,12 @@
 //! (each observes a tie point that has a control point or aerial image observations) are tested at all: a
 //! recording without it (a bridged recording) is placed by tie points alone in that solution, whose
 //! chain of small errors and free yaw corrections can bend a stretch of them by decimetres while their
-//! covariance says centimetres; its constraints keep their σ, so it stays tied to its neighbours with the
-//! recorded shape. The adjustment proper then runs with these σ from the recorded trajectory (started from
+//! covariance says centimetres; its steps are tested together, as the chain from one anchor to the next
+//! ([`super::relative_bridge`]). The adjustment proper then runs with these σ from the recorded trajectory (started from
 //! the solution without relative constraints instead, it ends at the same result on demo seeds 1–3).
 
 use super::problem::{Block, RelativeConstraint};
+use super::relative_bridge::widen_bridges;
 use super::residuals::State;
 use nalgebra::{Matrix2, Matrix4, Vector2};
 
@@ -60,7 +61,7 @@ pub struct Evidence<'a> {
 /// `threshold` is the χ² (2 degrees of freedom) value above which a step is contradicted.
 pub fn release(block: &Block, evidence: &Evidence, threshold: f64) -> Release {
     let mut released = 0;
-    let constraints = block
+    let mut constraints: Vec<RelativeConstraint> = block
         .relative_constraints
         .iter()
         .zip(evidence.cross)
@@ -81,6 +82,7 @@ pub fn release(block: &Block, evidence: &Evidence, threshold: f64) -> Release {
             }
         })
         .collect();
+    released += widen_bridges(&mut constraints, evidence, threshold);
     Release {
         constraints,
         released,

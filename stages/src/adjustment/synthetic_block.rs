@@ -383,6 +383,7 @@ pub fn consecutive_constraints(n: usize, sigma_m: f64) -> Vec<RelativeConstraint
             from: i - 1,
             to: i,
             sigma_m,
+            held: false,
         })
         .collect()
 }

@@ -160,6 +160,7 @@ impl StreetBlockSpec {
                     from: r - 1,
                     to: r,
                     sigma_m,
+                    held: false,
                 })
                 .collect();
         }
