@@ -1095,11 +1095,9 @@ fn end_to_end_tiny_campaign_control_points_within_15_cm_of_truth() {
 #[ignore]
 fn demo_campaign_accuracy() {
     use skytie_stages::synth::{Preset, SynthOptions};
-    let Ok(dir) = std::env::var("SKYTIE_DEMO") else {
-        println!("set SKYTIE_DEMO to the demo campaign folder");
+    let Some(dir) = support::demo_campaign_dir() else {
         return;
     };
-    let dir = std::path::PathBuf::from(dir);
     let toml = std::fs::read_to_string(dir.join("campaign.toml")).unwrap();
     let seed: u64 = toml
         .split("seed")
