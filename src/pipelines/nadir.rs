@@ -28,7 +28,7 @@ use crate::nodes::nadir::transform::InitialTransformStage;
 use crate::nodes::nadir::transform_agreement::TransformAgreementStage;
 use crate::workflow::Workflow;
 use skytie_stages::adjustment::second_pass::RegistrationPasses;
-use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
+use skytie_stages::campaign::{AerialImage, AerialKind};
 use skytie_stages::crs::MapFrameSpec;
 use skytie_stages::nadir::aerial_overlap::NadirOverlap;
 use skytie_stages::nadir::baseline::BaselineParams;

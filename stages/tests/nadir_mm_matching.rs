@@ -498,7 +498,8 @@ fn demo_report() {
     }
     let corners: usize = windows.iter().map(|w| w.corners_detected).sum();
     println!(
-        "{root}: windows {}, pairs {pairs}, kaze {kaze}, fallback {}, corners {corners}, {:.3} s per window ({} threads)",
+        "{}: windows {}, pairs {pairs}, kaze {kaze}, fallback {}, corners {corners}, {:.3} s per window ({} threads)",
+        root.display(),
         windows.len(),
         pairs - kaze,
         secs / windows.len() as f64,
@@ -507,7 +508,7 @@ fn demo_report() {
     let pano = pano_px(&c.panoramas);
     if let Some(scene) = scene_of(&root) {
         let (s, _) = stats(&windows, &c.truth, &scene, pano);
-        print_stats(&format!("{root} (scene truth)"), &s);
+        print_stats(&format!("{} (scene truth)", root.display()), &s);
     }
     // Grading with the true poses only (rays meet), also for folders whose scene is unknown.
     let mut residuals = Vec::new();
