@@ -191,7 +191,10 @@ fn memory_remote_second_host_executes_nothing_and_gets_the_same_values() {
 fn a_corrupt_remote_entry_is_reported_deleted_and_recomputed() {
     let r = file_remote(&[1.0, 2.0, 3.0]);
     let (dag, h) = toy_with_folder(&r.items, 2.0, 1);
-    let a = exec(&Store::open_with_remote(&r.cache, Some(&r.url)).unwrap(), &dag);
+    let a = exec(
+        &Store::open_with_remote(&r.cache, Some(&r.url)).unwrap(),
+        &dag,
+    );
     assert_eq!(a.failed(), 0);
     // Damage one payload byte of the sum's remote entry.
     let sum_key = keys_of_stage(&a, "toy_sum");
@@ -229,16 +232,23 @@ fn a_corrupt_remote_entry_is_reported_deleted_and_recomputed() {
 fn a_damaged_generated_folder_on_the_remote_is_detected_and_recomputed() {
     let r = file_remote(&[1.0]);
     let (dag, _) = toy_with_folder(&r.items, 1.0, 7);
-    let a = exec(&Store::open_with_remote(&r.cache, Some(&r.url)).unwrap(), &dag);
+    let a = exec(
+        &Store::open_with_remote(&r.cache, Some(&r.url)).unwrap(),
+        &dag,
+    );
     let gen_key = keys_of_stage(&a, "toy_gen");
-    let file = r.remote
+    let file = r
+        .remote
         .join("dirs")
         .join(gen_key.to_string())
         .join("items/item_001.txt");
     assert!(file.is_file(), "the folder's files are on the remote");
     std::fs::write(&file, b"999\n").unwrap();
     let b_root = new_host(&r.cache);
-    let b = exec(&Store::open_with_remote(b_root, Some(&r.url)).unwrap(), &dag);
+    let b = exec(
+        &Store::open_with_remote(b_root, Some(&r.url)).unwrap(),
+        &dag,
+    );
     assert_eq!(b.executed_of("toy_gen"), 1, "{:?}", b.warnings);
     assert!(
         b.warnings
@@ -346,7 +356,8 @@ fn remote_gc_removes_exactly_the_unreachable_results() {
         "3 scale nodes, the sum and the folder node"
     );
     let old_gen = keys_of_stage(&first, "toy_gen");
-    assert!(r.remote
+    assert!(r
+        .remote
         .join("dirs")
         .join(format!("{old_gen}.manifest"))
         .is_file());
@@ -382,7 +393,8 @@ fn remote_gc_removes_exactly_the_unreachable_results() {
         keys(&second),
         "every result of the last run stays"
     );
-    assert!(!r.remote
+    assert!(!r
+        .remote
         .join("dirs")
         .join(format!("{old_gen}.manifest"))
         .exists());

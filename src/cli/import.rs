@@ -4,8 +4,8 @@
 //! `DIR/import_report.txt`. Exit code 0 = imported without skipped items, 1 = imported with skipped items,
 //! 2 = nothing imported (configuration or output folder unusable).
 
-use clap::Args;
 use crate::cli::common::exit_code;
+use clap::Args;
 use skytie_stages::import::{run_import, ImportConfig, ImportReport};
 use std::path::PathBuf;
 
