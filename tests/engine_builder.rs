@@ -5,7 +5,7 @@ mod support;
 
 use skytie::dag::{BuildError, DagBuilder, Handle, RawFile};
 use skytie::testing::toy::{ToyParse, ToyParseParams, ToyScale, ToyScaleParams};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use support::*;
 
 /// Adds the `toy_parse[a]` node reading `file`.
@@ -18,6 +18,15 @@ fn add_parse(b: &mut DagBuilder, file: &Path) -> Result<Handle<f64>, BuildError>
     )
 }
 
+/// A builder holding `toy_parse[a]` of the first of the toy items of `values` (written to `dir`), that node,
+/// and the items.
+fn builder_with_parse(dir: &Path, values: &[f64]) -> (DagBuilder, Handle<f64>, Vec<PathBuf>) {
+    let items = make_items(dir, values);
+    let mut b = DagBuilder::new();
+    let parse = add_parse(&mut b, &items[0]).unwrap();
+    (b, parse, items)
+}
+
 fn scale(factor: f64) -> ToyScaleParams {
     ToyScaleParams {
         factor,
@@ -28,9 +37,7 @@ fn scale(factor: f64) -> ToyScaleParams {
 #[test]
 fn equal_nodes_dedupe_and_variants_may_differ() {
     let dir = tempfile::tempdir().unwrap();
-    let items = make_items(dir.path(), &[1.0]);
-    let mut b = DagBuilder::new();
-    let parse = add_parse(&mut b, &items[0]).unwrap();
+    let (mut b, parse, _) = builder_with_parse(dir.path(), &[1.0]);
     let s1 = b.add(ToyScale, "a", scale(2.0), parse).unwrap();
     // Same identity, same key, same variant: the existing node.
     let again = b.add(ToyScale, "a", scale(2.0), parse).unwrap();
@@ -54,9 +61,7 @@ fn equal_nodes_dedupe_and_variants_may_differ() {
 #[test]
 fn same_identity_with_another_key_in_one_variant_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let items = make_items(dir.path(), &[1.0, 2.0]);
-    let mut b = DagBuilder::new();
-    let parse = add_parse(&mut b, &items[0]).unwrap();
+    let (mut b, parse, items) = builder_with_parse(dir.path(), &[1.0, 2.0]);
     b.add(ToyScale, "a", scale(2.0), parse).unwrap();
     let err = b.add(ToyScale, "a", scale(5.0), parse).unwrap_err();
     let m = &err.message;
@@ -81,9 +86,7 @@ fn same_identity_with_another_key_in_one_variant_is_refused() {
 #[test]
 fn a_shared_node_clashes_with_a_different_one_in_a_variant_that_uses_it() {
     let dir = tempfile::tempdir().unwrap();
-    let items = make_items(dir.path(), &[1.0]);
-    let mut b = DagBuilder::new();
-    let parse = add_parse(&mut b, &items[0]).unwrap();
+    let (mut b, parse, _) = builder_with_parse(dir.path(), &[1.0]);
     b.add(ToyScale, "a", scale(2.0), parse).unwrap();
     b.set_variant("exp1");
     // exp1 shares the default's node ...

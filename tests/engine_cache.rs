@@ -3,8 +3,9 @@
 
 mod support;
 
-use skytie::dag::{DagBuilder, Mode, NodeStatus};
+use skytie::dag::{DagBuilder, Mode, NodeStatus, Outcome};
 use skytie::testing::toy::{Faults, ToyScaleParams, ToySumParams, ToySummary};
+use std::path::{Path, PathBuf};
 use support::*;
 
 const VALUES: [f64; 4] = [1.0, 2.0, 3.0, 4.0];
@@ -12,6 +13,33 @@ const VALUES: [f64; 4] = [1.0, 2.0, 3.0, 4.0];
 /// The toy summary of `count` numbers adding up to `sum`.
 fn summary(sum: f64, count: u64) -> ToySummary {
     ToySummary { sum, count }
+}
+
+/// The default toy workflow but toy_scale's `factor` and `quantum`.
+fn scaling(factor: f64, quantum: f64) -> ToyConfig {
+    ToyConfig {
+        scale: ToyScaleParams {
+            factor,
+            quantum,
+            ..ToyScaleParams::default()
+        },
+        ..Default::default()
+    }
+}
+
+/// Runs the toy workflow and checks the nodes executed per stage (parse, scale, sum) and the sum; the outcome
+/// for further checks.
+fn run_checked(
+    cache: &Path,
+    items: &[PathBuf],
+    cfg: &ToyConfig,
+    executed_per_stage: (usize, usize, usize),
+    sum: f64,
+) -> Outcome {
+    let (o, h) = run_toy(cache, items, cfg);
+    assert_eq!(executed(&o), executed_per_stage);
+    assert_eq!(o.get(h).unwrap().sum, sum);
+    o
 }
 
 #[test]
@@ -36,35 +64,22 @@ fn changing_one_param_reruns_that_stage_and_its_dependents_only() {
     let mut cfg = ToyConfig::default();
     run_toy(&cache, &items, &cfg);
     cfg.scale.factor = 3.0;
-    let (o, h) = run_toy(&cache, &items, &cfg);
-    assert_eq!(executed(&o), (0, 4, 1));
+    let o = run_checked(&cache, &items, &cfg, (0, 4, 1), 30.0);
     assert_eq!(o.cached(), 4);
-    assert_eq!(o.get(h).unwrap().sum, 30.0);
     // Only the sum's param: only the sum.
     cfg.sum.offset = 1.5;
-    let (o, h) = run_toy(&cache, &items, &cfg);
-    assert_eq!(executed(&o), (0, 0, 1));
-    assert_eq!(o.get(h).unwrap().sum, 31.5);
+    run_checked(&cache, &items, &cfg, (0, 0, 1), 31.5);
 }
 
 #[test]
 fn early_cutoff_keeps_dependents_cached_when_output_is_identical() {
     let (_d, cache, items) = toy_workspace(&VALUES);
-    let mut cfg = ToyConfig {
-        scale: ToyScaleParams {
-            factor: 2.0,
-            quantum: 1.0,
-            faults: Faults::default(),
-        },
-        ..Default::default()
-    };
+    let mut cfg = scaling(2.0, 1.0);
     run_toy(&cache, &items, &cfg);
     // 2.001 * v rounds to the same integers: toy_scale re-runs, its outputs are identical, toy_sum is cached.
     cfg.scale.factor = 2.001;
-    let (o, h) = run_toy(&cache, &items, &cfg);
-    assert_eq!(executed(&o), (0, 4, 0));
+    let o = run_checked(&cache, &items, &cfg, (0, 4, 0), 20.0);
     assert_eq!(o.cached(), 5);
-    assert_eq!(o.get(h).unwrap().sum, 20.0);
 }
 
 #[test]
@@ -73,10 +88,8 @@ fn stage_version_bump_reruns_that_stage() {
     let mut cfg = ToyConfig::default();
     run_toy(&cache, &items, &cfg);
     cfg.scale_v2 = true;
-    let (o, h) = run_toy(&cache, &items, &cfg);
     // The twin computes the same values, so the sum is cut off early.
-    assert_eq!(executed(&o), (0, 4, 0));
-    assert_eq!(o.get(h).unwrap().sum, 20.0);
+    run_checked(&cache, &items, &cfg, (0, 4, 0), 20.0);
     let plan = run(
         &cache,
         &toy_dag(&items, &ToyConfig::default()).0,
@@ -239,24 +252,15 @@ fn failing_and_panicking_nodes_are_not_recorded_and_dependents_are_skipped() {
         );
         // Fix it: only the failed node and its dependent run.
         cfg.scale.faults = Faults::default();
-        let (o, h) = run_toy(&cache, &items, &cfg);
         // The fault params are part of the key, so all scale nodes re-run; their outputs are unchanged.
-        assert_eq!(executed(&o), (0, 4, 1));
-        assert_eq!(o.get(h).unwrap().sum, 20.0);
+        run_checked(&cache, &items, &cfg, (0, 4, 1), 20.0);
     }
 }
 
 #[test]
 fn results_are_identical_for_one_or_many_threads() {
     let (d, _, items) = toy_workspace(&VALUES);
-    let cfg = ToyConfig {
-        scale: ToyScaleParams {
-            factor: 0.1,
-            quantum: 0.0,
-            faults: Faults::default(),
-        },
-        ..Default::default()
-    };
+    let cfg = scaling(0.1, 0.0);
     let mut hashes = Vec::new();
     for threads in [1, 4] {
         let cache = d.path().join(format!("cache{threads}"));

@@ -74,6 +74,13 @@ impl Toy {
     fn metrics(&self, out: &Path) -> Value {
         serde_json::from_slice(&std::fs::read(out.join("metrics.json")).unwrap()).unwrap()
     }
+    /// `run`, which must succeed, and its metrics.
+    fn run_ok(&self) -> (Output, Value) {
+        let o = self.run();
+        assert!(o.status.success(), "{}", text(&o));
+        let m = self.metrics(&self.out());
+        (o, m)
+    }
 }
 
 fn text(o: &Output) -> String {
@@ -94,9 +101,7 @@ fn engine(m: &Value, field: &str) -> u64 {
 #[test]
 fn run_twice_then_plan_and_explain() {
     let t = Toy::new(4, "[toy_scale]\nfactor = 2.0\n");
-    let o = t.run();
-    assert!(o.status.success(), "{}", text(&o));
-    let m = t.metrics(&t.out());
+    let (o, m) = t.run_ok();
     assert_eq!(
         (
             engine(&m, "nodes_total"),
@@ -129,9 +134,7 @@ fn run_twice_then_plan_and_explain() {
     );
     assert_eq!(prov["outputs"]["toy_sum"]["status"], "executed");
 
-    let o = t.run();
-    assert!(o.status.success(), "{}", text(&o));
-    let m = t.metrics(&t.out());
+    let (_, m) = t.run_ok();
     assert_eq!(
         (engine(&m, "nodes_executed"), engine(&m, "nodes_cached")),
         (0, 9)
@@ -175,9 +178,7 @@ fn run_twice_then_plan_and_explain() {
 fn sweep_writes_per_variant_metrics_and_sweep_csv() {
     let sweep = "[[sweep.variant]]\nname = \"a\"\n\n[[sweep.variant]]\nname = \"b\"\n\"toy_sum.offset\" = 100.0\n";
     let t = Toy::new(3, sweep);
-    let o = t.run();
-    assert!(o.status.success(), "{}", text(&o));
-    let m = t.metrics(&t.out());
+    let (_, m) = t.run_ok();
     // 3 parse + 3 scale shared, one sum per variant.
     assert_eq!(
         (engine(&m, "nodes_total"), engine(&m, "nodes_executed")),
@@ -272,9 +273,8 @@ fn two_concurrent_runs_on_one_cache_are_both_correct() {
         assert_eq!(engine(&m, "nodes_failed"), 0);
     }
     // Afterwards the cache holds everything exactly once per key and a third run executes nothing.
-    let o = t.run();
-    assert!(o.status.success(), "{}", text(&o));
-    assert_eq!(engine(&t.metrics(&t.out()), "nodes_executed"), 0);
+    let (_, m) = t.run_ok();
+    assert_eq!(engine(&m, "nodes_executed"), 0);
 }
 
 #[test]
@@ -315,9 +315,7 @@ fn a_run_killed_mid_way_is_resumed_with_finished_nodes_reused() {
         !t.out().join("metrics.json").exists(),
         "the killed run must not have finished"
     );
-    let o = t.run();
-    assert!(o.status.success(), "{}", text(&o));
-    let m = t.metrics(&t.out());
+    let (_, m) = t.run_ok();
     assert_eq!(m["toy"]["sum"], 156.0);
     let cached = engine(&m, "nodes_cached");
     assert!(cached >= 3, "finished nodes are reused: {m}");

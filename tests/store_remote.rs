@@ -135,6 +135,30 @@ fn file_url(p: &Path) -> String {
     format!("file://{}", p.display())
 }
 
+/// A temporary folder holding a local-folder remote, the toy items of `values` and a cache path (not created).
+struct FileRemote {
+    tmp: tempfile::TempDir,
+    remote: PathBuf,
+    url: String,
+    items: Vec<PathBuf>,
+    cache: PathBuf,
+}
+
+fn file_remote(values: &[f64]) -> FileRemote {
+    let tmp = tempfile::tempdir().unwrap();
+    let remote = tmp.path().join("remote");
+    let url = file_url(&remote);
+    let items = make_items(tmp.path(), values);
+    let cache = tmp.path().join("cache");
+    FileRemote {
+        tmp,
+        remote,
+        url,
+        items,
+        cache,
+    }
+}
+
 #[test]
 fn memory_remote_second_host_executes_nothing_and_gets_the_same_values() {
     let tmp = tempfile::tempdir().unwrap();
@@ -165,24 +189,23 @@ fn memory_remote_second_host_executes_nothing_and_gets_the_same_values() {
 
 #[test]
 fn a_corrupt_remote_entry_is_reported_deleted_and_recomputed() {
-    let tmp = tempfile::tempdir().unwrap();
-    let remote = tmp.path().join("remote");
-    let url = file_url(&remote);
-    let items = make_items(tmp.path(), &[1.0, 2.0, 3.0]);
-    let (dag, h) = toy_with_folder(&items, 2.0, 1);
-    let cache = tmp.path().join("cache");
-    let a = exec(&Store::open_with_remote(&cache, Some(&url)).unwrap(), &dag);
+    let r = file_remote(&[1.0, 2.0, 3.0]);
+    let (dag, h) = toy_with_folder(&r.items, 2.0, 1);
+    let a = exec(
+        &Store::open_with_remote(&r.cache, Some(&r.url)).unwrap(),
+        &dag,
+    );
     assert_eq!(a.failed(), 0);
     // Damage one payload byte of the sum's remote entry.
     let sum_key = keys_of_stage(&a, "toy_sum");
-    let path = remote_entries(&remote)[&sum_key].clone();
+    let path = remote_entries(&r.remote)[&sum_key].clone();
     let mut bytes = std::fs::read(&path).unwrap();
     let last = bytes.len() - 1;
     bytes[last] ^= 0x20;
     std::fs::write(&path, &bytes).unwrap();
 
     let b = exec(
-        &Store::open_with_remote(new_host(&cache), Some(&url)).unwrap(),
+        &Store::open_with_remote(new_host(&r.cache), Some(&r.url)).unwrap(),
         &dag,
     );
     assert_eq!(b.executed(), 1, "only the damaged node is recomputed");
@@ -198,7 +221,7 @@ fn a_corrupt_remote_entry_is_reported_deleted_and_recomputed() {
     // The recomputed entry replaced the damaged one: a third host finds everything intact.
     assert_eq!(std::fs::read(&path).unwrap().len(), bytes.len());
     let c = exec(
-        &Store::open_with_remote(new_host(&cache), Some(&url)).unwrap(),
+        &Store::open_with_remote(new_host(&r.cache), Some(&r.url)).unwrap(),
         &dag,
     );
     assert_eq!(c.executed(), 0, "{:?}", c.warnings);
@@ -207,22 +230,25 @@ fn a_corrupt_remote_entry_is_reported_deleted_and_recomputed() {
 
 #[test]
 fn a_damaged_generated_folder_on_the_remote_is_detected_and_recomputed() {
-    let tmp = tempfile::tempdir().unwrap();
-    let remote = tmp.path().join("remote");
-    let url = file_url(&remote);
-    let items = make_items(tmp.path(), &[1.0]);
-    let (dag, _) = toy_with_folder(&items, 1.0, 7);
-    let cache = tmp.path().join("cache");
-    let a = exec(&Store::open_with_remote(&cache, Some(&url)).unwrap(), &dag);
+    let r = file_remote(&[1.0]);
+    let (dag, _) = toy_with_folder(&r.items, 1.0, 7);
+    let a = exec(
+        &Store::open_with_remote(&r.cache, Some(&r.url)).unwrap(),
+        &dag,
+    );
     let gen_key = keys_of_stage(&a, "toy_gen");
-    let file = remote
+    let file = r
+        .remote
         .join("dirs")
         .join(gen_key.to_string())
         .join("items/item_001.txt");
     assert!(file.is_file(), "the folder's files are on the remote");
     std::fs::write(&file, b"999\n").unwrap();
-    let b_root = new_host(&cache);
-    let b = exec(&Store::open_with_remote(b_root, Some(&url)).unwrap(), &dag);
+    let b_root = new_host(&r.cache);
+    let b = exec(
+        &Store::open_with_remote(b_root, Some(&r.url)).unwrap(),
+        &dag,
+    );
     assert_eq!(b.executed_of("toy_gen"), 1, "{:?}", b.warnings);
     assert!(
         b.warnings
@@ -245,18 +271,15 @@ fn a_damaged_generated_folder_on_the_remote_is_detected_and_recomputed() {
 
 #[test]
 fn verify_checks_the_remote_and_deletes_damaged_objects() {
-    let tmp = tempfile::tempdir().unwrap();
-    let remote = tmp.path().join("remote");
-    let url = file_url(&remote);
-    let items = make_items(tmp.path(), &[1.0, 2.0]);
-    let (dag, _) = toy_with_folder(&items, 1.0, 1);
-    let store = Store::open_with_remote(&tmp.path().join("a"), Some(&url)).unwrap();
+    let r = file_remote(&[1.0, 2.0]);
+    let (dag, _) = toy_with_folder(&r.items, 1.0, 1);
+    let store = Store::open_with_remote(&r.tmp.path().join("a"), Some(&r.url)).unwrap();
     exec(&store, &dag);
     let clean = store.verify_remote().unwrap().unwrap();
     assert_eq!(clean.entries_checked, dag.len() as u64);
     assert_eq!(clean.folders_checked, 1);
     assert!(clean.bad.is_empty(), "{:?}", clean.bad);
-    let entries = remote_entries(&remote);
+    let entries = remote_entries(&r.remote);
     let (key, path) = entries.iter().next().unwrap();
     let mut bytes = std::fs::read(path).unwrap();
     bytes[10] ^= 1; // inside the header's key
@@ -270,7 +293,7 @@ fn verify_checks_the_remote_and_deletes_damaged_objects() {
         "the damaged object is deleted from the remote"
     );
     // Without a remote there is nothing to check remotely.
-    assert!(Store::open(&tmp.path().join("a"))
+    assert!(Store::open(&r.tmp.path().join("a"))
         .unwrap()
         .verify_remote()
         .is_none());
@@ -318,16 +341,12 @@ fn concurrent_writers_of_one_key_are_harmless() {
 
 #[test]
 fn remote_gc_removes_exactly_the_unreachable_results() {
-    let tmp = tempfile::tempdir().unwrap();
-    let remote = tmp.path().join("remote");
-    let url = file_url(&remote);
-    let items = make_items(tmp.path(), &[1.0, 2.0, 3.0]);
-    let cache = tmp.path().join("cache");
-    let store = Store::open_with_remote(&cache, Some(&url)).unwrap();
-    let (dag1, _) = toy_with_folder(&items, 2.0, 1);
+    let r = file_remote(&[1.0, 2.0, 3.0]);
+    let store = Store::open_with_remote(&r.cache, Some(&r.url)).unwrap();
+    let (dag1, _) = toy_with_folder(&r.items, 2.0, 1);
     let first = exec(&store, &dag1);
     // New parameters: the scale and sum nodes and the generated folder get new keys; parse nodes stay.
-    let (dag2, _) = toy_with_folder(&items, 3.0, 2);
+    let (dag2, _) = toy_with_folder(&r.items, 3.0, 2);
     let second = exec(&store, &dag2);
     assert_eq!(second.executed_of("toy_parse"), 0);
     let superseded: Vec<NodeKey> = keys(&first).difference(&keys(&second)).copied().collect();
@@ -337,7 +356,8 @@ fn remote_gc_removes_exactly_the_unreachable_results() {
         "3 scale nodes, the sum and the folder node"
     );
     let old_gen = keys_of_stage(&first, "toy_gen");
-    assert!(remote
+    assert!(r
+        .remote
         .join("dirs")
         .join(format!("{old_gen}.manifest"))
         .is_file());
@@ -366,24 +386,25 @@ fn remote_gc_removes_exactly_the_unreachable_results() {
     assert_eq!(report.removed_folders, 1);
     assert_eq!(report.removed_records, superseded.len() as u64);
     assert_eq!(
-        remote_entries(&remote)
+        remote_entries(&r.remote)
             .keys()
             .copied()
             .collect::<BTreeSet<_>>(),
         keys(&second),
         "every result of the last run stays"
     );
-    assert!(!remote
+    assert!(!r
+        .remote
         .join("dirs")
         .join(format!("{old_gen}.manifest"))
         .exists());
     // (the folder backend may leave empty directories behind; no file of the folder stays)
-    let old_dir = remote.join("dirs").join(old_gen.to_string());
+    let old_dir = r.remote.join("dirs").join(old_gen.to_string());
     assert!(!old_dir.exists() || remote_files(&old_dir).is_empty());
     // A fresh host still gets everything of the last run from the remote.
     drop(store);
     let b = exec(
-        &Store::open_with_remote(new_host(&cache), Some(&url)).unwrap(),
+        &Store::open_with_remote(new_host(&r.cache), Some(&r.url)).unwrap(),
         &dag2,
     );
     assert_eq!(b.executed(), 0, "{:?}", b.warnings);

@@ -50,9 +50,8 @@ fn numbers(stdout: &str) -> Vec<f64> {
 #[test]
 fn ortho_shows_the_east_stripe_east_of_the_foot_point() {
     let dir = tempfile::tempdir().unwrap();
-    let camp = dir.path().join("camp");
     // Red stripe at azimuth 90° ± 4° on dark blue; camera 2.5 m above the ground.
-    stripe_campaign(&camp, 0.0);
+    let camp = stripe_campaign(dir.path(), 0.0);
     let out = dir.path().join("ortho.png");
     let ortho = |rotate_deg: &str| {
         let stdout = tool_ok(&[

@@ -162,8 +162,7 @@ fn mi_register_recovers_a_subpixel_shift_of_a_gamma_changed_copy() {
 #[test]
 fn perspective_renders_the_requested_azimuth_at_the_requested_width() {
     let dir = tempfile::tempdir().unwrap();
-    let camp = dir.path().join("camp");
-    stripe_campaign(&camp, 30.0);
+    let camp = stripe_campaign(dir.path(), 30.0);
     let out = dir.path().join("view.png");
     let view = |extra: &[&str]| {
         let mut args = vec![
@@ -251,8 +250,7 @@ fn bad_input_exits_2_naming_the_file() {
     assert_eq!(code, 2);
     assert!(err.contains(s(&missing)), "{err}");
 
-    let camp = dir.path().join("camp");
-    stripe_campaign(&camp, 0.0);
+    let camp = stripe_campaign(dir.path(), 0.0);
     let view = dir.path().join("v.png");
     let perspective_of = |recording: &str| {
         let (code, _, err) = tool(&[

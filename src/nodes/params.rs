@@ -1,6 +1,6 @@
 //! The bridge between the stages' declared parameters and the engine: every parameter struct declared with
 //! `skytie_stages::params!` (which does not know the engine) is a workflow table the engine can read and check,
-//! its range and cross-field violations becoming the engine's [`ParamError`]s.
+//! its range and cross-field violations being the engine's [`ParamError`]s (one type, shared through `skytie_util`).
 
 use crate::workflow::{ParamError, StageParams};
 use serde::de::DeserializeOwned;
@@ -9,12 +9,7 @@ use skytie_stages::params::Params;
 
 impl<P: Params + Serialize + DeserializeOwned> StageParams for P {
     fn validate(&self) -> Result<(), Vec<ParamError>> {
-        Params::validate(self).map_err(|violations| {
-            violations
-                .into_iter()
-                .map(|v| ParamError::new(v.field, v.message))
-                .collect()
-        })
+        Params::validate(self)
     }
 }
 

@@ -28,7 +28,7 @@ use crate::nodes::nadir::transform::InitialTransformStage;
 use crate::nodes::nadir::transform_agreement::TransformAgreementStage;
 use crate::workflow::Workflow;
 use skytie_stages::adjustment::second_pass::RegistrationPasses;
-use skytie_stages::campaign::{AerialImage, AerialKind, Recording};
+use skytie_stages::campaign::{AerialImage, AerialKind};
 use skytie_stages::crs::MapFrameSpec;
 use skytie_stages::nadir::aerial_overlap::NadirOverlap;
 use skytie_stages::nadir::baseline::BaselineParams;
@@ -485,30 +485,15 @@ pub fn add_second_pass(
             params,
             (report, nadir.control[ci].optional()),
         )?;
-        let window = b.add(
-            Shift::<MmWindowMatch>::new(),
-            &label,
-            SummaryParams::default(),
-            (rec.window, shift),
-        )?;
-        let row = b.add(
-            Shift::<Recording>::new(),
-            &label,
-            SummaryParams::default(),
-            (item.row, shift),
-        )?;
+        let window = Shift::add(b, &label, rec.window, shift)?;
+        let row = Shift::add(b, &label, item.row, shift)?;
         let mut pairs = Vec::new();
         for p in &rec.pairs {
             let pair_label = format!(
                 "{} pass 2",
                 pair_label(&item.recording.image_id, &p.aerial_id)
             );
-            let ortho = b.add(
-                Shift::<OrthoImage>::new(),
-                &pair_label,
-                SummaryParams::default(),
-                (p.ortho, shift),
-            )?;
+            let ortho = Shift::add(b, &pair_label, p.ortho, shift)?;
             let outcome = b.add(
                 InitialTransformStage,
                 &pair_label,

@@ -81,24 +81,6 @@ impl std::error::Error for WorkflowError {}
 /// A range-check failure reported by `StageParams::validate`.
 ///
 /// `field` is the dotted path of the parameter inside the stage table (`"threshold"`, `"patch.extent_m"`);
-/// `message` states the allowed range (`"must be in (0, 1]"`).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct ParamError {
-    pub field: String,
-    pub message: String,
-}
-
-impl ParamError {
-    pub fn new(field: impl Into<String>, message: impl Into<String>) -> Self {
-        ParamError {
-            field: field.into(),
-            message: message.into(),
-        }
-    }
-}
-
-impl fmt::Display for ParamError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}", self.field, self.message)
-    }
-}
+/// `message` states the allowed range (`"must be in (0, 1]"`). The same type as the photogrammetry crate's
+/// `Violation`, shared through `skytie_util` (the engine does not import that crate).
+pub use skytie_util::violation::Violation as ParamError;

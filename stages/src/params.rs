@@ -136,28 +136,8 @@ pub struct ParamSpec {
     pub section: Option<fn() -> Vec<ParamSpec>>,
 }
 
-/// A parameter value outside its allowed range: the dotted field path and a message stating the range.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Violation {
-    pub field: String,
-    pub message: String,
-}
-
-impl Violation {
-    pub fn new(field: impl Into<String>, message: impl Into<String>) -> Violation {
-        Violation {
-            field: field.into(),
-            message: message.into(),
-        }
-    }
-}
-
-/// `field: message`, e.g. `min_peak: must be in [0, 1), got 1.5`.
-impl fmt::Display for Violation {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}", self.field, self.message)
-    }
-}
+/// A parameter value outside its allowed range (shared with the engine, which calls it `ParamError`).
+pub use skytie_util::violation::Violation;
 
 /// Every violation as `field: message`, joined by `; ` (for error messages of a whole parameter set).
 pub fn describe(violations: &[Violation]) -> String {

@@ -167,12 +167,7 @@ fn checkpoints_csv_round_trip() {
     let dir = temp_dir("cp");
     let path = dir.join("checkpoints.csv");
     write_checkpoint_errors_csv(&path, &rows).unwrap();
-    let mut reader = csv::Reader::from_path(&path).unwrap();
-    assert_eq!(
-        reader.headers().unwrap().iter().collect::<Vec<_>>(),
-        CHECKPOINTS_CSV_HEADER
-    );
-    let records: Vec<csv::StringRecord> = reader.records().map(|x| x.unwrap()).collect();
+    let records = support::csv_records(&path, &CHECKPOINTS_CSV_HEADER);
     assert_eq!(records.len(), c.checkpoints.len());
     for (rec, row) in records.iter().zip(&rows) {
         assert_eq!(&rec[0], row.point_id);

@@ -42,12 +42,18 @@ fn assert_shift(s: &PhaseShift, want: (f64, f64), tol_px: f64) {
     );
 }
 
+/// A 128 × 128 crop of the periodic texture of `seed`, the same crop circularly shifted by `shift` px, and their
+/// unwindowed phase correlation.
+fn circular_pair(seed: u64, shift: (f64, f64)) -> (GrayImage, GrayImage, PhaseShift) {
+    let tex = Texture::new(128, 32, seed);
+    let (f1, f2) = shifted_pair(&tex, 128, (0.0, 0.0), shift);
+    let s = phase_correlate(&f1, &f2, &unwindowed()).unwrap();
+    (f1, f2, s)
+}
+
 #[test]
 fn integer_circular_shift_gives_exact_peak() {
-    let tex = Texture::new(128, 32, 1);
-    let (f1, f2) = shifted_pair(&tex, 128, (0.0, 0.0), (5.0, -3.0));
-    let p = unwindowed();
-    let s = phase_correlate(&f1, &f2, &p).unwrap();
+    let (f1, f2, s) = circular_pair(1, (5.0, -3.0));
     assert_shift(&s, (5.0, -3.0), 1e-6);
     assert!(s.peak > 0.2, "{s:?}");
     // Windowed: the taper cuts the circularly wrapped seam differently in both images, so only the integer
@@ -59,10 +65,7 @@ fn integer_circular_shift_gives_exact_peak() {
 
 #[test]
 fn circular_fourier_shift_is_recovered() {
-    let tex = Texture::new(128, 32, 2);
-    let (f1, f2) = shifted_pair(&tex, 128, (0.0, 0.0), (2.3, -1.7));
-    let p = unwindowed();
-    let s = phase_correlate(&f1, &f2, &p).unwrap();
+    let (f1, f2, s) = circular_pair(2, (2.3, -1.7));
     assert_shift(&s, (2.3, -1.7), 0.02);
     // Plain quadratic on the unweighted spectrum (thesis' fit): the bound of 0.15 px.
     let p = PhaseCorrelationParams {

@@ -270,10 +270,8 @@ fn es_minimises_a_quadratic_by_the_epsilon_rule_with_a_reproducible_trace() {
     let x0 = [c[0] + 0.6, c[1] + 0.8];
     let f = |x: &[f64]| Some((x[0] - c[0]).powi(2) + (x[1] - c[1]).powi(2));
     let p = OnePlusOneParams {
-        max_iterations: 5000,
-        seed: 42,
         record_trace: true,
-        ..OnePlusOneParams::default()
+        ..es_params(42, 5000)
     };
     let r1 = minimize(f, &x0, &[1.0, 1.0], &p).unwrap();
     assert!(r1.converged, "stopped after {} iterations", r1.iterations);
@@ -284,28 +282,14 @@ fn es_minimises_a_quadratic_by_the_epsilon_rule_with_a_reproducible_trace() {
     assert_eq!(r1, r2, "rerun must give an identical trace");
     assert_eq!(r1.trace.len(), r1.iterations);
     // 100 iterations are not enough from 1 unit away.
-    let short = minimize(
-        f,
-        &x0,
-        &[1.0, 1.0],
-        &OnePlusOneParams {
-            max_iterations: 100,
-            seed: 42,
-            ..OnePlusOneParams::default()
-        },
-    )
-    .unwrap();
+    let short = minimize(f, &x0, &[1.0, 1.0], &es_params(42, 100)).unwrap();
     assert!(!short.converged);
     assert_eq!(short.iterations, 100);
 }
 
 #[test]
 fn es_treats_invalid_children_as_failures_and_rejects_bad_input() {
-    let p = OnePlusOneParams {
-        max_iterations: 2000,
-        seed: 1,
-        ..OnePlusOneParams::default()
-    };
+    let p = es_params(1, 2000);
     // Minimum of (x − 2)² constrained to x ≤ 1.5 (None beyond): converges to the boundary.
     let f = |x: &[f64]| (x[0] <= 1.5).then(|| (x[0] - 2.0).powi(2));
     let r = minimize(f, &[0.0], &[1.0], &p).unwrap();

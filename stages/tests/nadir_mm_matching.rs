@@ -25,7 +25,7 @@ use skytie_stages::synth::{Preset, SynthOptions};
 use std::collections::HashMap;
 use std::path::Path;
 use std::time::Instant;
-use support::tiny::{fixture, load_campaign, true_rays, TrueRays};
+use support::tiny::{fixture, load_demo_campaign, true_rays, TrueRays};
 
 /// An observation is correct when the true scene point re-projects within this many panorama pixels.
 const CORRECT_TOL_PX: f64 = 1.5;
@@ -465,11 +465,9 @@ fn invalid_parameters_and_empty_panorama_size_do_not_panic() {
 #[test]
 #[ignore]
 fn demo_report() {
-    let Ok(root) = std::env::var("SKYTIE_DEMO") else {
-        println!("SKYTIE_DEMO not set; nothing to do");
+    let Some((root, c)) = load_demo_campaign() else {
         return;
     };
-    let c = load_campaign(Path::new(&root));
     // SKYTIE_TRUE_POSES=1 runs the matching on the true poses instead of the recorded ones.
     let poses = if std::env::var("SKYTIE_TRUE_POSES").is_ok_and(|v| v == "1") {
         c.true_poses()
@@ -500,16 +498,17 @@ fn demo_report() {
     }
     let corners: usize = windows.iter().map(|w| w.corners_detected).sum();
     println!(
-        "{root}: windows {}, pairs {pairs}, kaze {kaze}, fallback {}, corners {corners}, {:.3} s per window ({} threads)",
+        "{}: windows {}, pairs {pairs}, kaze {kaze}, fallback {}, corners {corners}, {:.3} s per window ({} threads)",
+        root.display(),
         windows.len(),
         pairs - kaze,
         secs / windows.len() as f64,
         rayon::current_num_threads()
     );
     let pano = pano_px(&c.panoramas);
-    if let Some(scene) = scene_of(Path::new(&root)) {
+    if let Some(scene) = scene_of(&root) {
         let (s, _) = stats(&windows, &c.truth, &scene, pano);
-        print_stats(&format!("{root} (scene truth)"), &s);
+        print_stats(&format!("{} (scene truth)", root.display()), &s);
     }
     // Grading with the true poses only (rays meet), also for folders whose scene is unknown.
     let mut residuals = Vec::new();
@@ -566,12 +565,10 @@ fn scene_of(root: &Path) -> Option<Scene> {
 #[test]
 #[ignore]
 fn diagnostics() {
-    let Ok(root) = std::env::var("SKYTIE_DEMO") else {
+    let Some((root, c)) = load_demo_campaign() else {
         return;
     };
-    let root = Path::new(&root);
-    let c = load_campaign(root);
-    let scene = scene_of(root).expect("a synthetic campaign");
+    let scene = scene_of(&root).expect("a synthetic campaign");
     let poses = c.true_poses();
     let o = orthos(&poses, &c.panoramas);
     for t in [1e-3f32, 3e-4, 1e-4, 3e-5, 1e-5] {
@@ -646,10 +643,9 @@ fn diagnostics_corners() {
     use skytie_stages::nadir::mm_matching::{
         corners, pair_transform, prepared::PreparedOrtho, template,
     };
-    let Ok(root) = std::env::var("SKYTIE_DEMO") else {
+    let Some((_, c)) = load_demo_campaign() else {
         return;
     };
-    let c = load_campaign(Path::new(&root));
     let poses = c.true_poses();
     let o = orthos(&poses[..2], &c.panoramas[..2]);
     let v = views(&poses[..2], &o, pano_px(&c.panoramas));

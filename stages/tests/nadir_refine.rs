@@ -600,16 +600,9 @@ fn control_points_from_exact_observations_are_exact() {
 /// if they were Cartesian it misses by the map scale and the earth's curvature (centimetres).
 #[test]
 fn control_points_in_the_campaign_frame_are_free_of_map_scale_and_curvature() {
-    use skytie_stages::crs::{CoordinateFrame, MapFrame, MapFrameSpec};
     // Near Utrecht: RD New's scale factor there is ≈ 0.99991.
     let truth_map = Vector3::new(136_400.0, 455_300.0, 2.0);
-    let (spec, note) = MapFrameSpec::for_campaign(
-        CoordinateFrame::Projected,
-        "EPSG:28992",
-        Some([truth_map.x, truth_map.y, truth_map.z]),
-    );
-    assert!(note.is_none(), "{note:?}");
-    let frame = MapFrame::from_spec(&spec).unwrap();
+    let frame = support::projected_map_frame("EPSG:28992", truth_map);
     let rows: Vec<AerialImage> = [(-400.0, -150.0), (-400.0, 150.0), (-250.0, 0.0)]
         .into_iter()
         .enumerate()
@@ -1095,11 +1088,9 @@ fn end_to_end_tiny_campaign_control_points_within_15_cm_of_truth() {
 #[ignore]
 fn demo_campaign_accuracy() {
     use skytie_stages::synth::{Preset, SynthOptions};
-    let Ok(dir) = std::env::var("SKYTIE_DEMO") else {
-        println!("set SKYTIE_DEMO to the demo campaign folder");
+    let Some(dir) = support::demo_campaign_dir() else {
         return;
     };
-    let dir = std::path::PathBuf::from(dir);
     let toml = std::fs::read_to_string(dir.join("campaign.toml")).unwrap();
     let seed: u64 = toml
         .split("seed")

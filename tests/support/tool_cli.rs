@@ -5,7 +5,7 @@
 use skytie_stages::imaging::io::save_rgb;
 use skytie_stages::imaging::{GrayImage, RgbImage};
 use skytie_stages::synth::test_texture::band_limited_noise;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// Exit code, stdout, stderr of `skytie tool ARGS…`.
@@ -66,9 +66,10 @@ pub fn bright_rectangle(background: f32) -> GrayImage {
     img
 }
 
-/// A one-recording campaign whose 360×180 panorama is dark blue except for a red stripe at azimuth 90° ± 4°
-/// (east; equirectangular columns u = W·(A + 180°)/360°).
-pub fn stripe_campaign(root: &Path, heading_deg: f64) {
+/// A one-recording campaign in `dir/camp` (returned) whose 360×180 panorama is dark blue except for a red
+/// stripe at azimuth 90° ± 4° (east; equirectangular columns u = W·(A + 180°)/360°).
+pub fn stripe_campaign(dir: &Path, heading_deg: f64) -> PathBuf {
+    let root = dir.join("camp");
     std::fs::create_dir_all(root.join("mm/panoramas")).unwrap();
     std::fs::write(
         root.join("mm/recordings.csv"),
@@ -85,4 +86,5 @@ pub fn stripe_campaign(root: &Path, heading_deg: f64) {
         }
     }
     save_rgb(&root.join("mm/panoramas/r1.png"), &pano, 95).unwrap();
+    root
 }

@@ -5,7 +5,7 @@
 //! equal the first pass's and every node below them is found in the cache.
 
 use crate::codec::Artifact;
-use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage};
+use crate::dag::{BuildError, DagBuilder, Handle, InputsOf, NodeCtx, Optional, RunResult, Stage};
 use crate::nodes::adjust::adjustment::{AdjustReport, Verdict};
 use crate::nodes::campaign::summary::SummaryParams;
 use skytie_stages::adjustment::second_pass::{
@@ -52,6 +52,18 @@ impl<T> Shift<T> {
     /// The stage that translates a `T`.
     pub const fn new() -> Self {
         Self(PhantomData)
+    }
+}
+
+impl<T: Shiftable + Artifact> Shift<T> {
+    /// Adds the node that translates `input` by `shift` (item `label`).
+    pub fn add(
+        b: &mut DagBuilder,
+        label: &str,
+        input: Handle<T>,
+        shift: Handle<PassShift>,
+    ) -> Result<Handle<T>, BuildError> {
+        b.add(Self::new(), label, SummaryParams::default(), (input, shift))
     }
 }
 

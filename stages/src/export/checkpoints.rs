@@ -135,8 +135,7 @@ pub fn write_checkpoint_errors_csv(path: &Path, rows: &[CheckPointRow]) -> io::R
             None => vec![String::new(); 6],
         }
     };
-    atomic_write_with(path, |w| {
-        writeln!(w, "{}", CHECKPOINTS_CSV_HEADER.join(","))?;
+    write_csv(path, &CHECKPOINTS_CSV_HEADER, |w| {
         for r in rows {
             let mut cells = vec![quote(&r.point_id)];
             cells.extend(errors(&r.before));
@@ -149,6 +148,17 @@ pub fn write_checkpoint_errors_csv(path: &Path, rows: &[CheckPointRow]) -> io::R
             writeln!(w, "{}", cells.join(","))?;
         }
         Ok(())
+    })
+}
+
+/// Writes a CSV file atomically: the `header` row, then the rows `rows` writes.
+pub(crate) fn write_csv<F>(path: &Path, header: &[&str], rows: F) -> io::Result<()>
+where
+    F: FnOnce(&mut io::BufWriter<&mut std::fs::File>) -> io::Result<()>,
+{
+    atomic_write_with(path, |w| {
+        writeln!(w, "{}", header.join(","))?;
+        rows(w)
     })
 }
 

@@ -7,10 +7,9 @@
 //! `dyaw_deg` (adjusted − recorded yaw), `sigma_e_m, sigma_n_m, sigma_u_m, sigma_yaw_deg`. Apply as
 //! `corrected = recorded + Δ`. Floats in shortest round-trip form; deterministic.
 
-use super::checkpoints::quote;
+use super::checkpoints::{quote, write_csv};
 use super::corrections::CorrectionSeries;
 use crate::campaign::time::format_time_iso;
-use crate::fsutil::atomic_write_with;
 use std::io::{self, Write};
 use std::path::Path;
 
@@ -36,8 +35,7 @@ pub const CORRECTIONS_CSV_HEADER: [&str; 13] = [
 
 /// Writes `corrections.csv` atomically.
 pub fn write_corrections_csv(path: &Path, series: &CorrectionSeries) -> io::Result<()> {
-    atomic_write_with(path, |w| {
-        writeln!(w, "{}", CORRECTIONS_CSV_HEADER.join(","))?;
+    write_csv(path, &CORRECTIONS_CSV_HEADER, |w| {
         for (id, c) in series.rows(CORRECTION_STEP_S) {
             let time = format_time_iso(c.time_s).unwrap_or_default();
             let [de, dn, du] = c.delta_enu_m;

@@ -7,10 +7,9 @@
 //! observations). Rows are in the order given (the pipeline passes them sorted by recording), observations of a
 //! point in the order panorama first, then aerial; floats in shortest round-trip form.
 
-use super::checkpoints::quote;
+use super::checkpoints::{quote, write_csv};
 use crate::campaign::AerialKind;
 use crate::correspondence::AerialControlPoint;
-use crate::fsutil::atomic_write_with;
 use std::io::{self, Write};
 use std::path::Path;
 
@@ -30,8 +29,7 @@ pub fn write_correspondences_csv(
     path: &Path,
     groups: &[(&str, &[AerialControlPoint])],
 ) -> io::Result<()> {
-    atomic_write_with(path, |w| {
-        writeln!(w, "{}", CORRESPONDENCES_CSV_HEADER.join(","))?;
+    write_csv(path, &CORRESPONDENCES_CSV_HEADER, |w| {
         for (source, points) in groups {
             for p in *points {
                 let id = quote(&p.tie_point_id);

@@ -142,30 +142,37 @@ mod tests {
         c.kept.iter().map(|m| m.tie_point_id.as_str()).collect()
     }
 
+    /// Weak peaks at the agreed correction are kept and stray ones dropped; without enough agreement the weak
+    /// ones are dropped and the strong ones kept. Per case: the matches, the ids kept, (weak kept, weak dropped).
     #[test]
-    fn weak_peaks_at_the_agreed_correction_are_kept_and_stray_ones_dropped() {
-        let m = vec![
-            located("weak_a", (2.1, -0.4), 0.55),
-            located("strong", (2.3, -0.5), 0.9),
-            located("weak_b", (1.8, -0.2), 0.62),
-            located("stray", (-7.0, 5.0), 0.58),
-            located("weak_c", (2.4, -0.6), 0.51),
+    fn weak_peaks_are_kept_where_enough_peaks_agree_strong_ones_always() {
+        let cases = [
+            (
+                vec![
+                    located("weak_a", (2.1, -0.4), 0.55),
+                    located("strong", (2.3, -0.5), 0.9),
+                    located("weak_b", (1.8, -0.2), 0.62),
+                    located("stray", (-7.0, 5.0), 0.58),
+                    located("weak_c", (2.4, -0.6), 0.51),
+                ],
+                vec!["weak_a", "strong", "weak_b", "weak_c"],
+                (3, 1),
+            ),
+            (
+                vec![
+                    located("weak_a", (2.0, 0.0), 0.6),
+                    located("strong", (9.0, 3.0), 0.8),
+                    located("weak_b", (-4.0, 6.0), 0.6),
+                ],
+                vec!["strong"],
+                (0, 2),
+            ),
         ];
-        let c = corroborated(m, &[], 0.75, 1.0, 3, 1.0);
-        assert_eq!(ids(&c), ["weak_a", "strong", "weak_b", "weak_c"]);
-        assert_eq!((c.weak_kept, c.weak_dropped), (3, 1));
-    }
-
-    #[test]
-    fn weak_peaks_without_enough_agreement_are_dropped_strong_ones_kept() {
-        let m = vec![
-            located("weak_a", (2.0, 0.0), 0.6),
-            located("strong", (9.0, 3.0), 0.8),
-            located("weak_b", (-4.0, 6.0), 0.6),
-        ];
-        let c = corroborated(m, &[], 0.75, 1.0, 3, 1.0);
-        assert_eq!(ids(&c), ["strong"]);
-        assert_eq!((c.weak_kept, c.weak_dropped), (0, 2));
+        for (m, kept, weak) in cases {
+            let c = corroborated(m, &[], 0.75, 1.0, 3, 1.0);
+            assert_eq!(ids(&c), kept);
+            assert_eq!((c.weak_kept, c.weak_dropped), weak);
+        }
     }
 
     #[test]

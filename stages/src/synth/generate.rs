@@ -221,24 +221,18 @@ fn write_error_free(
     for rel in ["mm/recordings.csv", "truth/recordings.csv"] {
         write(rel, &|p| cw::write_recordings_csv(p, &truth.recordings))?;
     }
-    write("aerial/nadir/cameras.csv", &|p| {
-        cw::write_aerial_cameras_csv(p, &truth.nadir)
-    })?;
-    write("aerial/oblique/cameras.csv", &|p| {
-        cw::write_aerial_cameras_csv(p, &truth.oblique)
-    })?;
-    let controls = || plan.areas.iter().map(|a| &a.control);
-    let checkpoints: Vec<_> = controls()
-        .flat_map(|c| c.checkpoints.iter().cloned())
-        .collect();
+    for (rel, frames) in [
+        ("aerial/nadir/cameras.csv", &truth.nadir),
+        ("aerial/oblique/cameras.csv", &truth.oblique),
+    ] {
+        write(rel, &|p| cw::write_aerial_cameras_csv(p, frames))?;
+    }
+    let control = plan.control();
     write("control/checkpoints.csv", &|p| {
-        cw::write_checkpoints_csv(p, &checkpoints)
+        cw::write_checkpoints_csv(p, &control.checkpoints)
     })?;
-    let observations: Vec<_> = controls()
-        .flat_map(|c| c.observations.iter().cloned())
-        .collect();
     write("control/observations.csv", &|p| {
-        cw::write_observations_csv(p, &observations)
+        cw::write_observations_csv(p, &control.observations)
     })?;
     let none = Profile::none();
     let readme = readme(name, plan.seed, &none, &none.apply(plan.seed, &truth));

@@ -57,6 +57,22 @@ impl CampaignPlan {
         }
     }
 
+    /// The check points and observations of all areas, in area order.
+    pub fn control(&self) -> ControlSet {
+        ControlSet {
+            checkpoints: self
+                .areas
+                .iter()
+                .flat_map(|a| a.control.checkpoints.iter().cloned())
+                .collect(),
+            observations: self
+                .areas
+                .iter()
+                .flat_map(|a| a.control.observations.iter().cloned())
+                .collect(),
+        }
+    }
+
     /// Recorded (erroneous) poses of all areas, in the order of the truth.
     pub fn recorded(&self) -> &[Recording] {
         &self.applied.tables.recordings

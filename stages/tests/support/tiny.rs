@@ -13,7 +13,7 @@ use skytie_stages::synth::generate::plan_campaign;
 use skytie_stages::synth::scene::Scene;
 use skytie_stages::synth::{generate, Preset, SynthOptions};
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// The seed of the shared Tiny campaign.
@@ -43,6 +43,13 @@ impl Campaign {
 pub struct Fixture {
     pub campaign: Campaign,
     pub scene: Scene,
+}
+
+/// The demo campaign `SKYTIE_DEMO` names (`demo_campaign_dir`), loaded, and its folder.
+pub fn load_demo_campaign() -> Option<(PathBuf, Campaign)> {
+    let root = super::demo_campaign_dir()?;
+    let campaign = load_campaign(&root);
+    Some((root, campaign))
 }
 
 /// Reads `mm/recordings.csv`, `truth/recordings.csv` and the panoramas of a campaign folder; panics on any

@@ -45,15 +45,19 @@ fn truth() -> Tables {
     }
 }
 
+/// `value` of each recording of `out` minus that of the same recording of `t`.
+fn differences<T>(out: &Tables, t: &Tables, value: impl Fn(&Recording, &Recording) -> T) -> Vec<T> {
+    out.recordings
+        .iter()
+        .zip(&t.recordings)
+        .map(|(r, t)| value(r, t))
+        .collect()
+}
+
 fn errors(p: &Profile, seed: u64) -> (Tables, Vec<[f64; 2]>) {
     let t = truth();
     let out = p.apply(seed, &t).tables;
-    let e = out
-        .recordings
-        .iter()
-        .zip(&t.recordings)
-        .map(|(r, t)| [r.x - t.x, r.y - t.y])
-        .collect();
+    let e = differences(&out, &t, |r, t| [r.x - t.x, r.y - t.y]);
     (out, e)
 }
 
@@ -172,12 +176,7 @@ fn ins_biases_yaw_and_heading_per_route_and_adds_pitch_roll_noise() {
             }
         }
     }
-    let dp: Vec<f64> = out
-        .recordings
-        .iter()
-        .zip(&t.recordings)
-        .map(|(r, t)| r.pitch_deg - t.pitch_deg)
-        .collect();
+    let dp = differences(&out, &t, |r, t| r.pitch_deg - t.pitch_deg);
     let rms = (dp.iter().map(|v| v * v).sum::<f64>() / dp.len() as f64).sqrt();
     assert!(rms > 0.01 && rms < 0.04, "pitch noise {rms}°");
     // With the random walk the heading error wanders but stays near the bias.
@@ -196,12 +195,7 @@ fn vertical_adds_a_height_bias_per_route_and_a_camera_height_error() {
     p.params.vertical.camera_height_sigma_m = 0.0;
     let t = truth();
     let out = p.apply(2, &t).tables;
-    let dz: Vec<f64> = out
-        .recordings
-        .iter()
-        .zip(&t.recordings)
-        .map(|(r, t)| r.z - t.z)
-        .collect();
+    let dz = differences(&out, &t, |r, t| r.z - t.z);
     assert!((0.1..=0.3).contains(&dz[0].abs()) && (0.1..=0.3).contains(&dz[45].abs()));
     assert!(dz[..41].iter().all(|d| *d == dz[0]) && dz[41..].iter().all(|d| *d == dz[45]));
     let dh = out.recordings[7].camera_height_m - t.recordings[7].camera_height_m;
