@@ -56,12 +56,7 @@ fn two_priors_and_a_relative_constraint_give_the_analytic_sigma() {
             recording(0.0, Some(sigma), Some(sigma)),
             recording(5.0, Some(sigma), Some(sigma)),
         ],
-        relative_constraints: vec![RelativeConstraint {
-            from: 0,
-            to: 1,
-            sigma_m: sigma_rel,
-            held: false,
-        }],
+        relative_constraints: vec![RelativeConstraint::new(0, 1, sigma_rel)],
         ..Block::default()
     };
     let adj = adjust(&block, &AdjustOptions::default()).unwrap();

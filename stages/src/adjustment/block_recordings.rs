@@ -142,11 +142,6 @@ pub(super) fn relative_constraints(
             let (a, b) = (&recordings[i - 1], &recordings[i]);
             (a.x - b.x).hypot(a.y - b.y) <= config.relative_max_gap_m
         })
-        .map(|i| RelativeConstraint {
-            from: i - 1,
-            to: i,
-            sigma_m,
-            held: false,
-        })
+        .map(|i| RelativeConstraint::new(i - 1, i, sigma_m))
         .collect()
 }

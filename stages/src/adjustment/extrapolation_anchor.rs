@@ -67,11 +67,12 @@ pub fn anchor_constraints(
         return Vec::new();
     };
     let linked = |i: usize| linked_to_previous.get(i).copied().unwrap_or(false);
-    let constraint = |anchor: usize, to: usize| RelativeConstraint {
-        from: anchor,
-        to,
-        sigma_m: sigma_m * (anchor.abs_diff(to) as f64).powf(growth),
-        held: false,
+    let constraint = |anchor: usize, to: usize| {
+        RelativeConstraint::new(
+            anchor,
+            to,
+            sigma_m * (anchor.abs_diff(to) as f64).powf(growth),
+        )
     };
     let mut out = Vec::new();
     // Before the first: recordings first − 1, first − 2, … while each is linked to the next one.

@@ -9,6 +9,7 @@
 
 use super::parallel::{chunks, split_at_ends};
 use super::prepared::Prepared;
+use super::problem::RelativeConstraint;
 use super::residuals::{CameraJacobian2, State};
 use nalgebra::{Matrix3, Matrix4, SMatrix, Vector2, Vector3, Vector4};
 use rayon::prelude::*;
@@ -179,7 +180,12 @@ fn add_relative_terms(
 ) -> Vec<Matrix4<f64>> {
     let mut camera_off = Vec::with_capacity(prep.relative.len());
     for i in 0..prep.relative.len() {
-        let (a, b, sigma) = prep.relative[i];
+        let RelativeConstraint {
+            from: a,
+            to: b,
+            sigma_m: sigma,
+            ..
+        } = prep.relative[i];
         let r = prep.relative_residual(i, state);
         // IRLS: residual and Jacobian scaled by √ρ'(s) of the constraint's loss.
         let w = prep.relative_loss_of(i).weight(r.norm_squared());

@@ -11,7 +11,7 @@ use super::aerial::FixedFrameCamera;
 use super::error::AdjustError;
 use super::layout::{ObservationLayout, ReducedStructure};
 use super::parallel::ordered_sum;
-use super::problem::{AdjustOptions, Block};
+use super::problem::{AdjustOptions, Block, RelativeConstraint};
 use super::residuals::{observed_angles_rad, pano_residual, Parameterization, State};
 use super::robust::RobustLoss;
 use nalgebra::{Matrix3, Vector3};
@@ -87,10 +87,8 @@ pub struct Prepared {
     /// Fixed aerial cameras in the local frame.
     pub aerial_cameras: Vec<FixedFrameCamera>,
     pub aerial: Vec<PreparedAerial>,
-    /// (from, to, σ) with from ≠ to.
-    pub relative: Vec<(usize, usize, f64)>,
-    /// Per relative constraint: held by least squares instead of `relative_loss`.
-    pub relative_held: Vec<bool>,
+    /// The relative constraints (from ≠ to).
+    pub relative: Vec<RelativeConstraint>,
     /// Points with enough active observations to be determined.
     pub point_active: Vec<bool>,
     /// Active panorama observations by point and by recording.
@@ -234,12 +232,8 @@ impl Prepared {
                 .map(|(i, o)| (i, o.point)),
             |i| pano[i].recording,
         );
-        let relative: Vec<(usize, usize, f64)> = block
-            .relative_constraints
-            .iter()
-            .map(|r| (r.from, r.to, r.sigma_m))
-            .collect();
-        let pairs: Vec<(usize, usize)> = relative.iter().map(|&(a, b, _)| (a, b)).collect();
+        let relative = block.relative_constraints.clone();
+        let pairs: Vec<(usize, usize)> = relative.iter().map(|r| (r.from, r.to)).collect();
         let structure = ReducedStructure::new(&layout, &pairs);
         Ok(Self {
             parameterization: Parameterization::from_options(options),
@@ -274,7 +268,6 @@ impl Prepared {
             point_heights,
             aerial_cameras,
             aerial,
-            relative_held: block.relative_constraints.iter().map(|r| r.held).collect(),
             relative,
             point_active,
             layout,
@@ -361,7 +354,7 @@ impl Prepared {
 
     /// The loss of relative constraint `i`: least squares when it is held, else `relative_loss`.
     pub(super) fn relative_loss_of(&self, i: usize) -> RobustLoss {
-        if self.relative_held[i] {
+        if self.relative[i].held {
             RobustLoss::Squared
         } else {
             self.relative_loss
@@ -370,7 +363,12 @@ impl Prepared {
 
     /// Relative-constraint residual (whitened) of constraint `i`, per free axis.
     pub(super) fn relative_residual(&self, i: usize, state: &State) -> Vector3<f64> {
-        let (a, b, sigma) = self.relative[i];
+        let RelativeConstraint {
+            from: a,
+            to: b,
+            sigma_m: sigma,
+            ..
+        } = self.relative[i];
         let kept = self.recorded_local[b] - self.recorded_local[a];
         let mut r = (state.centers_local[b] - state.centers_local[a] - kept) / sigma;
         if self.horizontal_only {

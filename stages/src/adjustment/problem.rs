@@ -106,6 +106,18 @@ pub struct RelativeConstraint {
     pub held: bool,
 }
 
+impl RelativeConstraint {
+    /// A constraint between recordings `from` and `to` with σ `sigma_m` per axis, under the relative loss.
+    pub fn new(from: usize, to: usize, sigma_m: f64) -> Self {
+        Self {
+            from,
+            to,
+            sigma_m,
+            held: false,
+        }
+    }
+}
+
 /// Everything the adjustment estimates from: recordings (initial poses and priors), initial tie-point
 /// coordinates and the observations.
 #[derive(Clone, Debug, Default)]

@@ -188,12 +188,7 @@ mod tests {
     use super::*;
 
     fn rc(from: usize, to: usize) -> RelativeConstraint {
-        RelativeConstraint {
-            from,
-            to,
-            sigma_m: 0.02,
-            held: false,
-        }
+        RelativeConstraint::new(from, to, 0.02)
     }
 
     #[test]

@@ -192,7 +192,7 @@ fn reduced_row(
         }
     }
     for &k in structure.relative_by_row.row(r) {
-        let (a, b, _) = prep.relative[k];
+        let (a, b) = (prep.relative[k].from, prep.relative[k].to);
         let col = cols
             .binary_search(&a.min(b))
             .expect("constrained recordings are in the row");

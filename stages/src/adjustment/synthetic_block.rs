@@ -379,11 +379,6 @@ pub(crate) fn triangulate_recorded(
 /// without gaps).
 pub fn consecutive_constraints(n: usize, sigma_m: f64) -> Vec<RelativeConstraint> {
     (1..n)
-        .map(|i| RelativeConstraint {
-            from: i - 1,
-            to: i,
-            sigma_m,
-            held: false,
-        })
+        .map(|i| RelativeConstraint::new(i - 1, i, sigma_m))
         .collect()
 }

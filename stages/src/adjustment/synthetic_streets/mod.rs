@@ -156,12 +156,7 @@ impl StreetBlockSpec {
         if let Some(sigma_m) = self.relative_sigma_m {
             block.relative_constraints = (1..n)
                 .filter(|&r| (true_centers[r] - true_centers[r - 1]).norm() <= 2.0 * self.spacing_m)
-                .map(|r| RelativeConstraint {
-                    from: r - 1,
-                    to: r,
-                    sigma_m,
-                    held: false,
-                })
+                .map(|r| RelativeConstraint::new(r - 1, r, sigma_m))
                 .collect();
         }
         StreetBlock {
