@@ -20,7 +20,7 @@
 //! (each observes a tie point that has a control point or aerial image observations) are tested at all: a
 //! recording without it (a bridged recording) is placed by tie points alone in that solution, whose
 //! chain of small errors and free yaw corrections can bend a stretch of them by decimetres while their
-//! covariance says centimetres; its steps are tested together, as the chain from one anchor to the next
+//! covariance says centimetres; its steps take the σ of the tested steps next to its stretch
 //! ([`super::relative_bridge`]). The adjustment proper then runs with these σ from the recorded trajectory (started from
 //! the solution without relative constraints instead, it ends at the same result on demo seeds 1–3).
 
@@ -82,7 +82,7 @@ pub fn release(block: &Block, evidence: &Evidence, threshold: f64) -> Release {
             }
         })
         .collect();
-    released += widen_bridges(&mut constraints, evidence, threshold);
+    released += widen_bridges(&mut constraints, evidence.aerial);
     Release {
         constraints,
         released,
