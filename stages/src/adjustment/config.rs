@@ -134,6 +134,8 @@ crate::params! {
         /// (2 degrees of freedom, against σ² plus the solution's own variance of the step) above this value
         /// gets the σ at which the statistic equals its expectation (`adjustment::relative_release`). A
         /// smooth drift (a GNSS outage) does not show in the second differences the σ is estimated from.
+        /// The steps of a stretch of recordings without aerial evidence of their own take the largest σ of
+        /// the tested steps at its ends and are held by least squares (`adjustment::relative_bridge`).
         /// Absent = every constraint keeps its σ.
         relative_release_threshold: Option<f64> = None, above 0.0;
         /// Observe each recording's height as the campaign DTM's height under its recorded position plus
