@@ -35,9 +35,10 @@ struct Chain {
 /// its anchors and holds them by least squares (module documentation). Returns how many constraints were
 /// widened.
 pub fn widen_bridges(constraints: &mut [RelativeConstraint], aerial: &[bool]) -> usize {
+    let tested = tested_sigma2(constraints, aerial);
     let mut widened = 0;
     for chain in chains(constraints, aerial) {
-        let local = tested_sigma2_at(constraints, aerial, chain.anchors);
+        let local = tested[chain.anchors.0].max(tested[chain.anchors.1]);
         for &k in &chain.constraints {
             let rc = &mut constraints[k];
             if local > rc.sigma_m * rc.sigma_m {
@@ -50,23 +51,18 @@ pub fn widen_bridges(constraints: &mut [RelativeConstraint], aerial: &[bool]) ->
     widened
 }
 
-/// The largest σ² among the tested constraints (both ends with aerial evidence) at either anchor, after the
-/// release: how fast the trajectory's error changes per step next to the chain, m².
-fn tested_sigma2_at(
-    constraints: &[RelativeConstraint],
-    aerial: &[bool],
-    anchors: (usize, usize),
-) -> f64 {
-    constraints
-        .iter()
-        .filter(|rc| aerial[rc.from] && aerial[rc.to])
-        .filter(|rc| {
-            [rc.from, rc.to]
-                .iter()
-                .any(|&r| r == anchors.0 || r == anchors.1)
-        })
-        .map(|rc| rc.sigma_m * rc.sigma_m)
-        .fold(0.0, f64::max)
+/// Per recording, the largest σ² among its tested constraints (both ends with aerial evidence) after the
+/// release, 0 without any: how fast the trajectory's error changes per step there, m².
+fn tested_sigma2(constraints: &[RelativeConstraint], aerial: &[bool]) -> Vec<f64> {
+    let mut out = vec![0.0_f64; aerial.len()];
+    for rc in constraints {
+        if aerial.get(rc.from) == Some(&true) && aerial.get(rc.to) == Some(&true) {
+            let s2 = rc.sigma_m * rc.sigma_m;
+            out[rc.from] = out[rc.from].max(s2);
+            out[rc.to] = out[rc.to].max(s2);
+        }
+    }
+    out
 }
 
 /// The simple chains of bridged recordings (`!aerial`) between two distinct anchors, each once.
