@@ -16,7 +16,7 @@ use super::covariance::{recording_covariances, recording_covariances_with_pairs}
 use super::error::AdjustError;
 use super::prepared::{Prepared, Rejected};
 use super::problem::{AdjustOptions, Block};
-use super::relative_release::{release, Evidence};
+use super::relative_release::{self, release, Evidence};
 use super::residuals::{pano_residual, State};
 use super::solver::{solve, SolveReport, Termination};
 use nalgebra::Vector3;
@@ -303,8 +303,9 @@ fn release_contradicted(
     Some((free, out.released))
 }
 
-/// Whether each recording observes, with an active observation, a tie point that has active aerial evidence
-/// (a control point or aerial image observations).
+/// Whether each recording has aerial evidence of its own for the release
+/// ([`relative_release::with_aerial_evidence`]) among the active observations of `prep`: the tie points with
+/// an active control point or active aerial image observations that it observes.
 fn aerial_evidence(prep: &Prepared) -> Vec<bool> {
     let mut anchored = vec![false; prep.point_active.len()];
     for c in prep.control.iter().filter(|c| c.active) {
@@ -313,11 +314,13 @@ fn aerial_evidence(prep: &Prepared) -> Vec<bool> {
     for o in prep.aerial.iter().filter(|o| o.active) {
         anchored[o.point] = true;
     }
-    let mut out = vec![false; prep.recorded_local.len()];
-    for o in prep.pano.iter().filter(|o| o.active && anchored[o.point]) {
-        out[o.recording] = true;
-    }
-    out
+    relative_release::with_aerial_evidence(
+        prep.recorded_local.len(),
+        prep.pano
+            .iter()
+            .filter(|o| o.active && anchored[o.point])
+            .map(|o| (o.recording, o.point)),
+    )
 }
 
 /// An observation that may be rejected.

@@ -134,9 +134,11 @@ crate::params! {
         /// (2 degrees of freedom, against σ² plus the solution's own variance of the step) above this value
         /// gets the σ at which the statistic equals its expectation (`adjustment::relative_release`). A
         /// smooth drift (a GNSS outage) does not show in the second differences the σ is estimated from.
-        /// The steps of a stretch of recordings without aerial evidence of their own take the largest σ of
-        /// the tested steps at its ends and are held by least squares (`adjustment::relative_bridge`).
-        /// Absent = every constraint keeps its σ.
+        /// Only steps between recordings with aerial evidence of their own (at least two tie points with
+        /// aerial evidence each) are tested. The steps of a stretch of recordings without it take the
+        /// largest σ of the tested steps at its ends, and are then held by least squares
+        /// (`adjustment::relative_bridge`). Absent = every constraint keeps its σ; `default.toml` sets 9.21
+        /// (the 99 % quantile).
         relative_release_threshold: Option<f64> = None, above 0.0;
         /// Observe each recording's height as the campaign DTM's height under its recorded position plus
         /// its `camera_height`, with σ = √(the DTM's stated σ² + `camera_height_sigma_m`²), beside the

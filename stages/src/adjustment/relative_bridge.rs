@@ -11,9 +11,12 @@
 //! A drift changes slowly along the trajectory, so the steps next to the stretch say how much its own steps
 //! are off: for a path of constraints from an anchor `a` through bridged recordings only to a second anchor
 //! `b`, every step of the path takes at least the largest σ of the tested steps at `a` and `b` after the
-//! release (unchanged where none of them was released), and the path is held by least squares instead of
-//! the robust loss. Equal weights along the path put the bridged recordings on the straight interpolation of
-//! the anchors' corrections where their own tie points say nothing else.
+//! release, and the widened path is held by least squares instead of the robust loss. Equal weights along the
+//! path put the bridged recordings on the straight interpolation of the anchors' corrections where their own
+//! tie points say nothing else. A path whose anchors' tested steps were not released is left as it is (σ and
+//! robust loss): nothing says that it drifted, and holding its recorded shape by least squares against its
+//! own tie points moved stretches next to wrong aerial evidence by metres on rendered campaigns
+//! (measured in docs/evaluation.md).
 //!
 //! The path keeps that σ even when the anchors' corrections differ by more than it allows: widening it
 //! further to cover the whole difference lets the bridged recordings' own tie points, which are few and
@@ -32,8 +35,8 @@ struct Chain {
 }
 
 /// Gives the constraints of every chain of bridged recordings in `constraints` the σ of the tested steps at
-/// its anchors and holds them by least squares (module documentation). Returns how many constraints were
-/// widened.
+/// its anchors and holds the widened ones by least squares (module documentation). Returns how many
+/// constraints were widened.
 pub fn widen_bridges(constraints: &mut [RelativeConstraint], aerial: &[bool]) -> usize {
     let tested = tested_sigma2(constraints, aerial);
     let mut widened = 0;
@@ -43,9 +46,9 @@ pub fn widen_bridges(constraints: &mut [RelativeConstraint], aerial: &[bool]) ->
             let rc = &mut constraints[k];
             if local > rc.sigma_m * rc.sigma_m {
                 rc.sigma_m = local.sqrt();
+                rc.held = true;
                 widened += 1;
             }
-            rc.held = true;
         }
     }
     widened
@@ -169,6 +172,24 @@ mod tests {
         assert_eq!(found.len(), 1);
         assert_eq!(found[0].constraints, vec![1, 2, 3, 4]);
         assert_eq!(found[0].anchors, (1, 5));
+    }
+
+    #[test]
+    fn a_chain_is_widened_and_held_only_next_to_a_released_step() {
+        // 0 1 [2 3 4] 5 6, nothing released: the chain keeps its σ and the robust loss.
+        let aerial = [true, true, false, false, false, true, true];
+        let mut constraints: Vec<_> = (0..6).map(|i| rc(i, i + 1)).collect();
+        let before = constraints.clone();
+        assert_eq!(widen_bridges(&mut constraints, &aerial), 0);
+        assert_eq!(constraints, before);
+        // Step 0→1 released to σ 0.3 m: the chain from anchor 1 takes it and is held.
+        constraints[0].sigma_m = 0.3;
+        assert_eq!(widen_bridges(&mut constraints, &aerial), 4);
+        for k in 1..5 {
+            assert_eq!(constraints[k].sigma_m, 0.3);
+            assert!(constraints[k].held);
+        }
+        assert!(!constraints[5].held && constraints[5].sigma_m == 0.02);
     }
 
     #[test]

@@ -17,7 +17,8 @@
 //! σ becomes `√(σ² + s²)` with the added variance `s²` at which `T` equals its expectation 2 (a variance
 //! component of this one step). Every other constraint keeps its σ — a step the solution determines poorly
 //! has a large `Q` and is not released. Only steps between two recordings with aerial evidence of their own
-//! (each observes a tie point that has a control point or aerial image observations) are tested at all: a
+//! (each observes at least two tie points that have a control point or aerial image observations, so that a
+//! wrong one shows against the other) are tested at all: a
 //! recording without it (a bridged recording) is placed by tie points alone in that solution, whose
 //! chain of small errors and free yaw corrections can bend a stretch of them by decimetres while their
 //! covariance says centimetres; its steps take the σ of the tested steps next to its stretch
@@ -46,8 +47,8 @@ pub struct Evidence<'a> {
     pub state: &'a State,
     /// The recorded trajectory (the initial state of the block).
     pub recorded: &'a State,
-    /// Whether each recording has aerial evidence of its own in that solution (it observes a tie point with
-    /// a control point or aerial image observations).
+    /// Whether each recording has aerial evidence of its own in that solution (it observes at least two tie
+    /// points with a control point or aerial image observations).
     pub aerial: &'a [bool],
     /// A-priori covariance blocks over (x, y, z, ψ) per recording.
     pub covariance: &'a [Matrix4<f64>],
@@ -55,6 +56,34 @@ pub struct Evidence<'a> {
     pub cross: &'a [Option<Matrix4<f64>>],
     /// Factor from a-priori to a-posteriori variance (σ̂0² when above 1, else 1).
     pub variance_scale: f64,
+}
+
+/// Distinct tie points with aerial evidence that a recording must observe to have aerial evidence of its own:
+/// one such point cannot be checked against anything, and a wrong correspondence there (one panorama ray to
+/// one aerial ray) moves the recording in the solution without relative constraints while its covariance
+/// stays small, so a step next to it would be released on that alone (measured in docs/evaluation.md: a
+/// recording at the start of a trajectory placed 0.66 m off with a stated σ of 0.08 m). With two, a wrong one
+/// contradicts the other in that solution.
+pub const MIN_ANCHORED_POINTS: usize = 2;
+
+/// Per recording (`recordings` of them), whether it observes at least [`MIN_ANCHORED_POINTS`] distinct tie
+/// points with aerial evidence; `observed` lists (recording, tie point) for each observation of such a point
+/// (repeats count once).
+pub fn with_aerial_evidence(
+    recordings: usize,
+    observed: impl IntoIterator<Item = (usize, usize)>,
+) -> Vec<bool> {
+    let mut pairs: Vec<(usize, usize)> = observed
+        .into_iter()
+        .filter(|&(r, _)| r < recordings)
+        .collect();
+    pairs.sort_unstable();
+    pairs.dedup();
+    let mut count = vec![0_usize; recordings];
+    for (recording, _) in pairs {
+        count[recording] += 1;
+    }
+    count.iter().map(|&n| n >= MIN_ANCHORED_POINTS).collect()
 }
 
 /// The relative constraints of `block` with the contradicted ones widened (module documentation);
@@ -144,6 +173,15 @@ pub fn added_variance(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_recording_needs_two_distinct_anchored_points_for_aerial_evidence() {
+        // Recording 0: points 4 and 7; recording 1: point 4 twice; recording 2: nothing.
+        let observed = [(0, 4), (1, 4), (0, 7), (1, 4)];
+        assert_eq!(with_aerial_evidence(3, observed), vec![true, false, false]);
+        // An observation of a recording outside the block is ignored.
+        assert_eq!(with_aerial_evidence(1, [(5, 1), (5, 2)]), vec![false]);
+    }
 
     #[test]
     fn a_step_within_its_uncertainty_is_kept() {
