@@ -18,8 +18,8 @@
 //! component of this one step). Every other constraint keeps its σ — a step the solution determines poorly
 //! has a large `Q` and is not released. Only steps between two recordings with aerial evidence of their own
 //! (each observes at least two tie points that have a control point or aerial image observations, so that a
-//! wrong one shows against the other) are tested at all: a
-//! recording without it (a bridged recording) is placed by tie points alone in that solution, whose
+//! wrong one shows against the other; [`MIN_ANCHORED_POINTS`]) are tested at all: a recording without it (a
+//! bridged recording) is placed by tie points alone in that solution, whose
 //! chain of small errors and free yaw corrections can bend a stretch of them by decimetres while their
 //! covariance says centimetres; its steps take the σ of the tested steps next to its stretch
 //! ([`super::relative_bridge`]). The adjustment proper then runs with these σ from the recorded trajectory (started from
