@@ -23,6 +23,39 @@ pub fn mix_seed(seed: u64, index: u64) -> u64 {
     mix64(seed ^ mix64(index.wrapping_add(GOLDEN_GAMMA)))
 }
 
+/// FNV-1a offset basis and prime (64 bit).
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+const FNV_PRIME: u64 = 0x0000_0100_0000_01b3;
+
+/// FNV-1a of `bytes`, continued from `hash`.
+fn fnv1a(hash: u64, bytes: impl IntoIterator<Item = u8>) -> u64 {
+    bytes
+        .into_iter()
+        .fold(hash, |h, b| (h ^ u64::from(b)).wrapping_mul(FNV_PRIME))
+}
+
+/// A stable 64-bit hash (FNV-1a) of a name: the same on every platform, run and Rust version (unlike
+/// `DefaultHasher`), for deriving per-item seeds from item ids.
+pub fn stable_hash(text: &str) -> u64 {
+    fnv1a(FNV_OFFSET, text.bytes())
+}
+
+/// [`stable_hash`] of several names, each followed by the byte 0xff (so `["ab", "c"]` and `["a", "bc"]` differ).
+pub fn stable_hash_parts(parts: &[&str]) -> u64 {
+    parts.iter().fold(FNV_OFFSET, |h, part| {
+        fnv1a(h, part.bytes().chain(std::iter::once(0xff)))
+    })
+}
+
+/// The seed of one pair of named items (a recording and an image, two recordings) in a computation seeded
+/// with `seed`: derived from the seed and both names only, so it does not depend on the order of work.
+pub fn pair_seed(seed: u64, first: &str, second: &str) -> u64 {
+    mix_seed(
+        seed,
+        stable_hash(first) ^ stable_hash(second).rotate_left(29),
+    )
+}
+
 impl SplitMix64 {
     /// A generator with the given seed.
     pub fn new(seed: u64) -> Self {
@@ -92,4 +125,22 @@ pub(crate) fn mmix_states(seed: u64) -> impl Iterator<Item = u64> {
         )
     })
     .skip(1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stable_hashes_are_fnv1a_and_parts_are_separated() {
+        // The FNV-1a 64-bit test vectors.
+        assert_eq!(stable_hash(""), 0xcbf2_9ce4_8422_2325);
+        assert_eq!(stable_hash("a"), 0xaf63_dc4c_8601_ec8c);
+        assert_ne!(
+            stable_hash_parts(&["ab", "c"]),
+            stable_hash_parts(&["a", "bc"])
+        );
+        assert_eq!(pair_seed(7, "x", "y"), pair_seed(7, "x", "y"));
+        assert_ne!(pair_seed(7, "x", "y"), pair_seed(7, "y", "x"));
+    }
 }

@@ -22,10 +22,11 @@
 
 use super::aerial_patch::{aerial_ground_similarity, extract_patch, level_of_scale, AerialPatch};
 use super::ortho::{OrthoGeoref, OrthoImage};
+use super::ortho_mask::{fill_masked, near_mask};
 use super::registration::{InitialTransform, TransformOutcome};
 use super::translation_consensus::{consensus_doubt, translation_consensus};
 use crate::campaign::{AerialImage, Recording};
-use crate::estimators::{mix_seed, ransac_filtered, RansacParams};
+use crate::estimators::{ransac_filtered, RansacParams};
 use crate::features::kaze::{detect_and_describe, Features, KazeParams};
 use crate::geometry::{intersect_ray_plane, FrameCamera, Plane, PointPair, Similarity2};
 use crate::imaging::pyramid::{PyramidError, TileSource};
@@ -33,6 +34,7 @@ use crate::imaging::wallis::{wallis_filter, WallisParams};
 use crate::imaging::GrayImage;
 use crate::matching::descriptor_match::match_windowed;
 use crate::params::{describe, Params, StageId};
+use crate::rng::pair_seed;
 use nalgebra::{Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
@@ -157,21 +159,6 @@ impl TransformParams {
     }
 }
 
-/// 64-bit FNV-1a of a string (a stable, platform-independent label hash for per-pair seeds).
-fn fnv1a64(text: &str) -> u64 {
-    text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    })
-}
-
-/// The RANSAC seed of one (recording, aerial image) pair: derived from the stage seed and both ids only.
-pub fn pair_seed(seed: u64, recording_id: &str, aerial_id: &str) -> u64 {
-    mix_seed(
-        seed,
-        fnv1a64(recording_id) ^ fnv1a64(aerial_id).rotate_left(29),
-    )
-}
-
 /// The similarity ortho px → full aerial px implied by the recorded pose (ortho plane projected through the
 /// aerial camera), fitted by least squares to the footprint's corners and centre. `None` if the footprint does
 /// not project in front of the camera.
@@ -214,60 +201,6 @@ pub fn centre_offset_world(
 /// Wraps an angle difference into [−180°, 180°).
 fn wrap_deg(a: f64) -> f64 {
     (a + 180.0).rem_euclid(360.0) - 180.0
-}
-
-/// A copy of the ortho image with masked pixels replaced by the mean of the valid ones (so the Wallis filter and
-/// the detector see no artificial edge at the mask border).
-pub(crate) fn fill_masked(ortho: &OrthoImage) -> GrayImage {
-    let mut img = ortho.image.clone();
-    let (mut sum, mut n) = (0.0f64, 0usize);
-    for (&g, &ok) in img.data.iter().zip(&ortho.valid) {
-        if ok != 0 {
-            sum += f64::from(g);
-            n += 1;
-        }
-    }
-    let fill = if n > 0 { (sum / n as f64) as f32 } else { 0.0 };
-    for (g, &ok) in img.data.iter_mut().zip(&ortho.valid) {
-        if ok == 0 {
-            *g = fill;
-        }
-    }
-    img
-}
-
-/// True if a masked pixel (valid = 0) lies within `radius_px` of the continuous pixel (u, v).
-pub(crate) fn near_mask(
-    valid: &[u8],
-    width: usize,
-    height: usize,
-    u: f64,
-    v: f64,
-    radius_px: f64,
-) -> bool {
-    if width == 0 || height == 0 {
-        return false;
-    }
-    let r2 = radius_px * radius_px;
-    let clamp = |x: f64, n: usize| x.clamp(0.0, n as f64 - 1.0) as usize;
-    let (c0, c1) = (
-        clamp((u - radius_px - 0.5).floor(), width),
-        clamp((u + radius_px - 0.5).ceil(), width),
-    );
-    let (r0, r1) = (
-        clamp((v - radius_px - 0.5).floor(), height),
-        clamp((v + radius_px - 0.5).ceil(), height),
-    );
-    for row in r0..=r1 {
-        let dv = row as f64 + 0.5 - v;
-        for col in c0..=c1 {
-            let du = col as f64 + 0.5 - u;
-            if du * du + dv * dv <= r2 && valid[row * width + col] == 0 {
-                return true;
-            }
-        }
-    }
-    false
 }
 
 /// The KAZE features of the Wallis-filtered image with threshold `threshold`; `Err` names what failed.

@@ -10,6 +10,7 @@ pub mod grading;
 pub mod initial_transform;
 pub mod mm_matching;
 pub mod ortho;
+pub mod ortho_mask;
 pub mod parallax_check;
 pub mod refine;
 pub mod registration;

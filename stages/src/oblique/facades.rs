@@ -42,19 +42,12 @@ use crate::geometry::local_frame::LocalOrigin;
 use crate::geometry::FrameCamera;
 use crate::oblique::types::{FacadePlane, FacadeStats, SparseCloud, StreetSide, TripletFacades};
 use crate::params::{Params, StageId};
-use crate::rng::mix_seed;
+use crate::rng::{mix_seed, stable_hash};
 use nalgebra::Vector3;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
 pub const STAGE: StageId = StageId::new("facades", "4");
-
-/// FNV-1a hash of a string: a stable item id for seeding (independent of platform and run).
-fn stable_hash(s: &str) -> u64 {
-    s.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    })
-}
 
 fn to_array(v: &Vector3<f64>) -> [f64; 3] {
     [v.x, v.y, v.z]

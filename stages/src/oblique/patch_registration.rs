@@ -47,6 +47,7 @@ use crate::oblique::types::{
     SparsePoint, TripletFacades,
 };
 use crate::params::StageId;
+use crate::rng::stable_hash_parts;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use search::{mi_search, ncc_search, Found};
@@ -54,18 +55,6 @@ use search::{mi_search, ncc_search, Found};
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
 pub const STAGE: StageId = StageId::new("patches", "8");
-
-/// Stable 64-bit FNV-1a hash of the strings (separated), for per-item seeds.
-fn stable_hash(parts: &[&str]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for part in parts {
-        for b in part.bytes().chain(std::iter::once(0xff)) {
-            h ^= u64::from(b);
-            h = h.wrapping_mul(0x0100_0000_01b3);
-        }
-    }
-    h
-}
 
 /// One patch centre offered to the registration.
 struct Candidate<'a> {
@@ -132,7 +121,7 @@ impl Context<'_> {
     fn seed(&self, point_id: &str, level: &str) -> u64 {
         mix_seed(
             self.p.seed,
-            stable_hash(&[point_id, self.oblique_id, level]),
+            stable_hash_parts(&[point_id, self.oblique_id, level]),
         )
     }
 

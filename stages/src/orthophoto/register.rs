@@ -16,8 +16,9 @@ use crate::imaging::georef::GeoTransform;
 use crate::imaging::pyramid::{PyramidError, TileSource};
 use crate::nadir::aerial_patch::AerialWindow;
 use crate::nadir::initial_transform::{
-    fill_masked, near_mask, rejected, wallis_kaze, Rejection, TransformParams, WindowedQuery,
+    rejected, wallis_kaze, Rejection, TransformParams, WindowedQuery,
 };
+use crate::nadir::ortho_mask::{fill_masked, near_mask};
 use crate::nadir::translation_consensus::{consensus_doubt, translation_consensus};
 use crate::nadir::{InitialTransform, OrthoGeoref, OrthoImage, TransformOutcome};
 use nalgebra::Vector2;

@@ -27,10 +27,10 @@ pub use params::MmMatchParams;
 
 use crate::campaign::Recording;
 use crate::correspondence::PanoObservation;
-use crate::estimators::mix_seed;
 use crate::geometry::PanoramaCamera;
 use crate::nadir::{MmWindowMatch, OrthoImage, PairMethod, PairReport, ViewGround};
 use crate::params::{describe, Params, StageId};
+use crate::rng::pair_seed;
 use prepared::PreparedOrtho;
 use rayon::prelude::*;
 
@@ -45,21 +45,6 @@ pub struct OrthoView<'a> {
     pub ortho: &'a OrthoImage,
     pub pano_width_px: u32,
     pub pano_height_px: u32,
-}
-
-/// FNV-1a of a string (stable across platforms and Rust versions, unlike `DefaultHasher`).
-fn stable_hash(s: &str) -> u64 {
-    s.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-    })
-}
-
-/// RANSAC seed of the pair (detecting, neighbour).
-fn pair_seed(seed: u64, from_id: &str, to_id: &str) -> u64 {
-    mix_seed(
-        seed,
-        stable_hash(from_id) ^ stable_hash(to_id).rotate_left(29),
-    )
 }
 
 /// A window whose parameters are invalid: no tie points, every pair reported with the reason.

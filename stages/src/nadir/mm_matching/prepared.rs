@@ -6,6 +6,7 @@ use super::params::MmMatchParams;
 use super::template::ValidIndex;
 use crate::features::kaze::{detect_and_describe, Features, KazeParams};
 use crate::imaging::GrayImage;
+use crate::nadir::ortho_mask::fill_masked;
 use crate::nadir::OrthoImage;
 
 /// An ortho image with what every pair needs of it, computed once per window.
@@ -26,33 +27,6 @@ pub fn kaze_params(p: &MmMatchParams) -> KazeParams {
         upright: true,
         extended: false,
         ..KazeParams::default()
-    }
-}
-
-/// `ortho.image` with masked (and non-finite) pixels replaced by the mean of the valid pixels.
-pub fn fill_masked(ortho: &OrthoImage) -> GrayImage {
-    let img = &ortho.image;
-    let n = img.data.len();
-    let is_valid =
-        |i: usize| ortho.valid.get(i).is_some_and(|&v| v != 0) && img.data[i].is_finite();
-    let (mut sum, mut count) = (0.0f64, 0usize);
-    for i in 0..n {
-        if is_valid(i) {
-            sum += img.data[i] as f64;
-            count += 1;
-        }
-    }
-    let mean = if count > 0 {
-        (sum / count as f64) as f32
-    } else {
-        0.0
-    };
-    GrayImage {
-        width: img.width,
-        height: img.height,
-        data: (0..n)
-            .map(|i| if is_valid(i) { img.data[i] } else { mean })
-            .collect(),
     }
 }
 
