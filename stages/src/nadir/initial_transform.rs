@@ -39,7 +39,7 @@ use nalgebra::{Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("transform", "4");
+pub const STAGE: StageId = StageId::new("transform", "5");
 
 crate::params! {
     /// Parameters of the initial MM→aerial transform (thesis 3.4.5.2). Intensities are 0..1.
