@@ -23,8 +23,9 @@ use skytie_stages::imaging::GrayImage;
 use skytie_stages::nadir::aerial_overlap::{foot_point_world, overlapping_nadir};
 use skytie_stages::nadir::aerial_patch::ortho_params_for_aerial;
 use skytie_stages::nadir::initial_transform::{
-    centre_offset_world, initial_transform, reuse_neighbour, TransformParams,
+    centre_offset_world, initial_transform, TransformParams,
 };
+use skytie_stages::nadir::neighbour_transform::reuse_neighbour;
 use skytie_stages::nadir::refine::RefineParams;
 use skytie_stages::nadir::transform_agreement::check_agreement;
 use skytie_stages::nadir::{

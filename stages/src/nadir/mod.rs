@@ -9,6 +9,7 @@ pub mod footprint_index;
 pub mod grading;
 pub mod initial_transform;
 pub mod mm_matching;
+pub mod neighbour_transform;
 pub mod ortho;
 pub mod ortho_mask;
 pub mod parallax_check;
