@@ -130,13 +130,12 @@ pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, Adju
     let rejected_pano = flagged(&rejected.pano);
     let rejected_control = flagged(&rejected.control);
     let rejected_aerial = flagged(&rejected.aerial);
-    let priors = block
-        .recordings
-        .iter()
-        .map(|r| {
-            usize::from(r.prior_sigma_xy_m.is_some()) * 2
-                + usize::from(r.prior_sigma_z_m.is_some() && !options.horizontal_only)
-                + usize::from(r.height_observation.is_some() && !options.horizontal_only)
+    let priors = (0..prep.recorded_local.len())
+        .map(|c| {
+            prep.prior_terms(c, &state)
+                .iter()
+                .filter(|t| t.2 > 0.0)
+                .count()
         })
         .sum();
     Ok(Adjustment {

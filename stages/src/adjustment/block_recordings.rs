@@ -3,8 +3,9 @@
 //! consecutive recordings (thesis 3.4.2).
 
 use super::adjust_inputs::AdjustInputs;
-use super::config::AdjustConfig;
+use super::config::{AdjustConfig, TrajectoryError};
 use super::error::AdjustError;
+use super::gauss_markov;
 use super::height_observation::{HeightObservations, HeightSource};
 use super::problem::{BlockRecording, RelativeConstraint};
 use crate::campaign::Recording;
@@ -131,7 +132,8 @@ pub(super) fn resolve_recording(
         })
 }
 
-/// Consecutive recordings at most `relative_max_gap_m` apart keep their recorded difference (thesis 3.4.2).
+/// Consecutive recordings at most `relative_max_gap_m` apart keep their recorded difference (thesis 3.4.2),
+/// or, with `trajectory_error = "gauss_markov"`, the Gauss–Markov step between their corrections.
 pub(super) fn relative_constraints(
     recordings: &[Recording],
     config: &AdjustConfig,
@@ -142,6 +144,20 @@ pub(super) fn relative_constraints(
             let (a, b) = (&recordings[i - 1], &recordings[i]);
             (a.x - b.x).hypot(a.y - b.y) <= config.relative_max_gap_m
         })
-        .map(|i| RelativeConstraint::new(i - 1, i, sigma_m))
+        .map(|i| {
+            let constraint = RelativeConstraint::new(i - 1, i, sigma_m);
+            match config.trajectory_error {
+                TrajectoryError::RandomWalk => constraint,
+                TrajectoryError::GaussMarkov => {
+                    let (from_xy, from_z) = prior_sigmas_m(&recordings[i - 1], config);
+                    let (to_xy, to_z) = prior_sigmas_m(&recordings[i], config);
+                    RelativeConstraint {
+                        carry_xy: gauss_markov::carry(sigma_m, from_xy, to_xy),
+                        carry_z: gauss_markov::carry(sigma_m, from_z, to_z),
+                        ..constraint
+                    }
+                }
+            }
+        })
         .collect()
 }

@@ -61,6 +61,20 @@ pub enum ControlWeighting {
     Covariance,
 }
 
+/// How the recorded trajectory's error is modelled between consecutive recordings ([`super::gauss_markov`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum TrajectoryError {
+    /// Every recording has its own position prior, and consecutive recordings differ by a random-walk step
+    /// of `relative_sigma_m` (thesis 3.4.2).
+    #[default]
+    RandomWalk,
+    /// A first-order Gauss–Markov error: each step carries the share of the previous recording's correction
+    /// that the prior σ and `relative_sigma_m` imply, and stands for the next recording's prior; only the
+    /// first recording of each chain has a prior of its own.
+    GaussMarkov,
+}
+
 /// Loss on the observations (panorama, aerial, control); priors and relative constraints stay quadratic.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
@@ -119,6 +133,10 @@ crate::params! {
         /// consecutive recordings); absent = estimated from the recorded trajectory itself (cross-track second
         /// differences, `adjustment::relative_noise`).
         relative_sigma_m: Option<f64> = None, unit "m", above 0.0;
+        /// The trajectory error model of the relative constraints: `random_walk` (independent priors and
+        /// random-walk steps) or `gauss_markov` (correlated errors: a correction carries along the chain and
+        /// the priors count once per chain, `adjustment::gauss_markov`).
+        trajectory_error: TrajectoryError = TrajectoryError::RandomWalk;
         /// Robust loss on the relative constraints: `none`, `huber` or `cauchy`. A step between consecutive
         /// recordings that differs from the recorded one by more than `relative_loss_scale` σ (a jump when
         /// GNSS is re-acquired, drift during an outage, an error turning with the vehicle) is released so that

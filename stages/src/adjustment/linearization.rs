@@ -187,16 +187,18 @@ fn add_relative_terms(
             ..
         } = prep.relative[i];
         let r = prep.relative_residual(i, state);
+        let carry = prep.relative_carry(i);
         // IRLS: residual and Jacobian scaled by √ρ'(s) of the constraint's loss.
         let w = prep.relative_loss_of(i).weight(r.norm_squared());
         let inv2 = w / (sigma * sigma);
         let mut block = Matrix4::zeros();
         for axis in 0..prep.position_axes() {
-            camera_diag[a][(axis, axis)] += inv2;
+            // J_a = −carry·I/σ, J_b = I/σ (carry 1: the random walk).
+            let phi = carry[axis];
+            camera_diag[a][(axis, axis)] += phi * phi * inv2;
             camera_diag[b][(axis, axis)] += inv2;
-            block[(axis, axis)] = -inv2;
-            // J_a = −I/σ, J_b = I/σ.
-            camera_rhs[a][axis] += w * r[axis] / sigma;
+            block[(axis, axis)] = -phi * inv2;
+            camera_rhs[a][axis] += phi * w * r[axis] / sigma;
             camera_rhs[b][axis] -= w * r[axis] / sigma;
         }
         camera_off.push(block);

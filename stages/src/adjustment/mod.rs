@@ -10,6 +10,8 @@
 //! by point and recording, structure of the reduced camera matrix), [`prepared`] (one solve's setup and
 //! cost), [`linearization`] (normal-equation blocks), [`schur`] (the reduced camera system), [`solver`]
 //! (Levenberg–Marquardt), [`relative_noise`] (the trajectory's relative accuracy from its own second differences),
+//! [`gauss_markov`] (the trajectory error as a Gauss–Markov process: how much of a correction the next
+//! recording shares),
 //! [`covariance`] (posterior σ per recording), [`adjust`](mod@adjust) (solve, reject by
 //! normalised residuals, re-solve), [`evaluate`] (check-point triangulation and RMSE), [`id_index`] (rows
 //! by their string id), [`synthetic_block`]
@@ -42,6 +44,7 @@ pub mod error;
 pub mod evaluate;
 pub mod extrapolation_anchor;
 pub mod from_correspondences;
+pub mod gauss_markov;
 pub mod height_observation;
 pub mod id_index;
 pub mod in_frame;
@@ -70,7 +73,7 @@ pub mod weak_control_sigma;
 pub mod weighting;
 
 pub use adjust::{adjust, AdjustedRecording, Adjustment, ObservationCounts, RoundReport};
-pub use config::{AdjustConfig, ControlWeighting, Dimensions, LossKind, Sources};
+pub use config::{AdjustConfig, ControlWeighting, Dimensions, LossKind, Sources, TrajectoryError};
 pub use error::AdjustError;
 pub use evaluate::{
     evaluate_checkpoints, CheckObservation, CheckPointError, CheckPointEvaluation, RmseSummary,

@@ -77,6 +77,9 @@ pub struct Prepared {
     pub recorded_local: Vec<Vector3<f64>>,
     pub prior_sigma_xy_m: Vec<Option<f64>>,
     pub prior_sigma_z_m: Vec<Option<f64>>,
+    /// Per recording: whether a Gauss–Markov relative constraint leads into it in X/Y and in Z, which then
+    /// stands for its position prior on those axes ([`RelativeConstraint::is_gauss_markov`]).
+    pub prior_in_chain: Vec<[bool; 2]>,
     /// Observed heights of the recordings' centres: (Z in the local frame, σ in metres).
     pub height_observations: Vec<Option<(f64, f64)>>,
     pub yaw_prior_sigma_rad: Option<f64>,
@@ -233,6 +236,11 @@ impl Prepared {
             |i| pano[i].recording,
         );
         let relative = block.relative_constraints.clone();
+        let mut prior_in_chain = vec![[false; 2]; n_rec];
+        for rc in &relative {
+            prior_in_chain[rc.to][0] |= rc.carry_xy < 1.0;
+            prior_in_chain[rc.to][1] |= rc.carry_z < 1.0;
+        }
         let pairs: Vec<(usize, usize)> = relative.iter().map(|r| (r.from, r.to)).collect();
         let structure = ReducedStructure::new(&layout, &pairs);
         Ok(Self {
@@ -248,6 +256,7 @@ impl Prepared {
                 .map(|r| r.prior_sigma_xy_m)
                 .collect(),
             prior_sigma_z_m: block.recordings.iter().map(|r| r.prior_sigma_z_m).collect(),
+            prior_in_chain,
             height_observations: block
                 .recordings
                 .iter()
@@ -333,16 +342,18 @@ impl Prepared {
     }
 
     /// Whitened prior residuals of recording `c`: (axis, residual, 1/σ) for each prior axis, then its height
-    /// observation (axis 2); unused entries have 1/σ = 0.
+    /// observation (axis 2); unused entries have 1/σ = 0. An axis whose prior a Gauss–Markov chain carries
+    /// has none here.
     pub(super) fn prior_terms(&self, c: usize, state: &State) -> [(usize, f64, f64); 4] {
         let d = state.centers_local[c] - self.recorded_local[c];
         let mut out = [(0, 0.0, 0.0); 4];
-        if let Some(s) = self.prior_sigma_xy_m[c] {
+        let [chain_xy, chain_z] = self.prior_in_chain[c];
+        if let Some(s) = self.prior_sigma_xy_m[c].filter(|_| !chain_xy) {
             out[0] = (0, d.x / s, 1.0 / s);
             out[1] = (1, d.y / s, 1.0 / s);
         }
         if !self.horizontal_only {
-            if let Some(s) = self.prior_sigma_z_m[c] {
+            if let Some(s) = self.prior_sigma_z_m[c].filter(|_| !chain_z) {
                 out[2] = (2, d.z / s, 1.0 / s);
             }
             if let Some((z_local, s)) = self.height_observations[c] {
@@ -361,20 +372,30 @@ impl Prepared {
         }
     }
 
-    /// Relative-constraint residual (whitened) of constraint `i`, per free axis.
+    /// Relative-constraint residual (whitened) of constraint `i`, per free axis:
+    /// `(c_to − carry ∘ c_from) / σ` with `c` the correction of a centre.
     pub(super) fn relative_residual(&self, i: usize, state: &State) -> Vector3<f64> {
-        let RelativeConstraint {
-            from: a,
-            to: b,
-            sigma_m: sigma,
-            ..
-        } = self.relative[i];
-        let kept = self.recorded_local[b] - self.recorded_local[a];
-        let mut r = (state.centers_local[b] - state.centers_local[a] - kept) / sigma;
+        let rc = &self.relative[i];
+        let (a, b, sigma) = (rc.from, rc.to, rc.sigma_m);
+        let mut r = if rc.is_gauss_markov() {
+            let carry = self.relative_carry(i);
+            let ca = state.centers_local[a] - self.recorded_local[a];
+            let cb = state.centers_local[b] - self.recorded_local[b];
+            (cb - ca.component_mul(&carry)) / sigma
+        } else {
+            let kept = self.recorded_local[b] - self.recorded_local[a];
+            (state.centers_local[b] - state.centers_local[a] - kept) / sigma
+        };
         if self.horizontal_only {
             r.z = 0.0;
         }
         r
+    }
+
+    /// The carry of relative constraint `i` per axis (x, y, z).
+    pub(super) fn relative_carry(&self, i: usize) -> Vector3<f64> {
+        let rc = &self.relative[i];
+        Vector3::new(rc.carry_xy, rc.carry_xy, rc.carry_z)
     }
 
     /// The cost ½·Σρ at `state`; +∞ if some observation is geometrically degenerate there.

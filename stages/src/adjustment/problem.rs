@@ -93,13 +93,21 @@ pub struct AerialImageObservation {
     pub sigma_px: f64,
 }
 
-/// A relative constraint between two recordings (thesis 3.4.2: the trajectory's high relative accuracy):
-/// the difference of their recorded positions is kept with standard deviation `sigma_m` per axis.
+/// A relative constraint between two recordings (thesis 3.4.2: the trajectory's high relative accuracy).
+///
+/// With `c = adjusted − recorded` the correction of a recording's centre, the constraint keeps
+/// `c_to − carry ∘ c_from` at zero with standard deviation `sigma_m` per axis. A carry of 1 keeps the recorded
+/// difference of the two positions (the error is a random walk); a carry below 1 is the step of a first-order
+/// Gauss–Markov error, which also stands for `to`'s position prior ([`super::trajectory_error`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RelativeConstraint {
     pub from: usize,
     pub to: usize,
     pub sigma_m: f64,
+    /// Fraction of `from`'s correction expected at `to` in X and Y, in [0, 1].
+    pub carry_xy: f64,
+    /// Fraction of `from`'s correction expected at `to` in Z, in [0, 1].
+    pub carry_z: f64,
     /// Held by least squares whatever [`AdjustOptions::relative_loss`] says: a step of a chain of
     /// recordings without aerial evidence of their own, whose σ already covers what the chain's anchors
     /// show ([`super::relative_bridge`]).
@@ -113,8 +121,16 @@ impl RelativeConstraint {
             from,
             to,
             sigma_m,
+            carry_xy: 1.0,
+            carry_z: 1.0,
             held: false,
         }
+    }
+
+    /// Whether the constraint is a Gauss–Markov step (some carry below 1): it then replaces `to`'s position
+    /// prior on the axes where it is.
+    pub fn is_gauss_markov(&self) -> bool {
+        self.carry_xy < 1.0 || self.carry_z < 1.0
     }
 }
 
@@ -396,6 +412,11 @@ impl Block {
                 Some("from and to are the same recording".to_string())
             } else if !positive_finite(rc.sigma_m) {
                 Some(format!("sigma_m = {} must be finite and > 0", rc.sigma_m))
+            } else if !(0.0..=1.0).contains(&rc.carry_xy) || !(0.0..=1.0).contains(&rc.carry_z) {
+                Some(format!(
+                    "carry_xy = {} and carry_z = {} must lie in [0, 1]",
+                    rc.carry_xy, rc.carry_z
+                ))
             } else {
                 None
             };

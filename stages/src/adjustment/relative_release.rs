@@ -118,7 +118,8 @@ pub fn release(block: &Block, evidence: &Evidence, threshold: f64) -> Release {
     }
 }
 
-/// The solution's horizontal change of the constraint's step and its covariance, m and m².
+/// The solution's horizontal change of the constraint's step (`c_to − carry·c_from`, with `c` the correction of
+/// a centre) and its covariance, m and m².
 fn step_change(
     rc: &RelativeConstraint,
     cross: Option<&Matrix4<f64>>,
@@ -126,11 +127,22 @@ fn step_change(
 ) -> (Vector2<f64>, Matrix2<f64>) {
     let correction =
         |c: usize| evidence.state.centers_local[c] - evidence.recorded.centers_local[c];
-    let d = correction(rc.to) - correction(rc.from);
+    let phi = rc.carry_xy;
     let horizontal = |m: &Matrix4<f64>| m.fixed_view::<2, 2>(0, 0).into_owned();
-    let mut q = horizontal(&evidence.covariance[rc.to]) + horizontal(&evidence.covariance[rc.from]);
+    let (d, mut q) = if phi == 1.0 {
+        (
+            correction(rc.to) - correction(rc.from),
+            horizontal(&evidence.covariance[rc.to]) + horizontal(&evidence.covariance[rc.from]),
+        )
+    } else {
+        (
+            correction(rc.to) - correction(rc.from) * phi,
+            horizontal(&evidence.covariance[rc.to])
+                + horizontal(&evidence.covariance[rc.from]) * (phi * phi),
+        )
+    };
     if let Some(c) = cross {
-        let c = horizontal(c);
+        let c = horizontal(c) * phi;
         q -= c + c.transpose();
     }
     (Vector2::new(d.x, d.y), q * evidence.variance_scale)
