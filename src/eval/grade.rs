@@ -34,7 +34,7 @@ pub const SEGMENT_OFF_M: f64 = 0.3;
 pub const SEGMENT_GOOD_M: f64 = 0.2;
 
 /// Every metric, in table order.
-pub const METRICS: [MetricDef; 16] = [
+pub const METRICS: [MetricDef; 17] = [
     MetricDef {
         key: "nadir_inlier",
         title: "nadir inlier",
@@ -126,6 +126,12 @@ pub const METRICS: [MetricDef; 16] = [
         floor: 0.001,
     },
     MetricDef {
+        key: "verify_off_passed",
+        title: "off passed",
+        better: Better::Lower,
+        floor: 0.001,
+    },
+    MetricDef {
         key: "verify_false",
         title: "false flags",
         better: Better::Lower,
@@ -153,8 +159,9 @@ fn checkpoint_max_after(out: &Path) -> Result<Option<f64>, String> {
         .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v)))))
 }
 
-/// Per verification segment: (true mean horizontal offset of its recordings, flagged as failed).
-fn segment_truth(out: &Path, campaign: &Path) -> Result<Vec<(f64, bool)>, String> {
+/// Per verification segment: (true mean horizontal offset of its recordings, its status: `pass`, `fail` or
+/// `insufficient`).
+fn segment_truth(out: &Path, campaign: &Path) -> Result<Vec<(f64, String)>, String> {
     let Some(v) = read_csv_opt(&out.join("verification.csv"))? else {
         return Ok(Vec::new());
     };
@@ -190,7 +197,7 @@ fn segment_truth(out: &Path, campaign: &Path) -> Result<Vec<(f64, bool)>, String
             }
         }
         if n > 0.0 {
-            out_rows.push(((dx / n).hypot(dy / n), v.text(row, "status") == "fail"));
+            out_rows.push(((dx / n).hypot(dy / n), v.text(row, "status").to_string()));
         }
     }
     Ok(out_rows)
@@ -250,20 +257,23 @@ pub fn grade_cell(out: &Path) -> Result<CellMetrics, String> {
     })?;
     if campaign.join("truth/recordings.csv").is_file() {
         let segments = segment_truth(out, &campaign)?;
-        let off: Vec<bool> = segments
+        let off: Vec<&str> = segments
             .iter()
             .filter(|(d, _)| *d > SEGMENT_OFF_M)
-            .map(|(_, f)| *f)
+            .map(|(_, status)| status.as_str())
             .collect();
         put("segments_off", Some(off.len() as f64));
         if !off.is_empty() {
-            let flagged = off.iter().filter(|f| **f).count();
-            put("verify_detected", Some(flagged as f64 / off.len() as f64));
+            let share = |status: &str| {
+                off.iter().filter(|s| **s == status).count() as f64 / off.len() as f64
+            };
+            put("verify_detected", Some(share("fail")));
+            put("verify_off_passed", Some(share("pass")));
         }
         if !segments.is_empty() {
             let false_flags = segments
                 .iter()
-                .filter(|(d, f)| *f && *d < SEGMENT_GOOD_M)
+                .filter(|(d, status)| status == "fail" && *d < SEGMENT_GOOD_M)
                 .count();
             put("verify_false", Some(false_flags as f64));
         }
