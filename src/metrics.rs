@@ -12,6 +12,7 @@
 
 use crate::dag::{NodeReport, NodeStatus};
 use serde_json::{json, Map, Value};
+use skytie_util::csv_out::quote;
 use std::collections::BTreeMap;
 use std::io;
 use std::path::Path;
@@ -213,11 +214,11 @@ pub fn sweep_csv(rows: &[(String, Value)]) -> String {
     let mut out = String::from("variant");
     for c in &columns {
         out.push(',');
-        out.push_str(&csv_field(c));
+        out.push_str(&quote(c));
     }
     out.push('\n');
     for (name, m) in &leaves {
-        out.push_str(&csv_field(name));
+        out.push_str(&quote(name));
         for c in &columns {
             out.push(',');
             if let Some(v) = m.get(c) {
@@ -227,14 +228,6 @@ pub fn sweep_csv(rows: &[(String, Value)]) -> String {
         out.push('\n');
     }
     out
-}
-
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
 }
 
 /// Write pretty JSON atomically.

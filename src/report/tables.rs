@@ -6,6 +6,7 @@
 //! ones — with a line saying so; its CSV and Markdown files always hold every row.
 
 use super::html::escape;
+use skytie_util::csv_out::quote;
 use std::fmt::Write as _;
 
 /// Most rows a table shows in the HTML page; every row stays in its CSV and Markdown files.
@@ -107,7 +108,7 @@ impl Table {
     pub fn to_csv(&self) -> String {
         let mut s = String::new();
         for row in std::iter::once(&self.header).chain(&self.rows) {
-            let cells: Vec<String> = row.iter().map(|c| csv_field(c)).collect();
+            let cells: Vec<String> = row.iter().map(|c| quote(c)).collect();
             s.push_str(&cells.join(","));
             s.push('\n');
         }
@@ -170,14 +171,6 @@ impl Table {
             let _ = writeln!(s, "<p class=\"note\">{}</p>", escape(&self.note));
         }
         s
-    }
-}
-
-fn csv_field(c: &str) -> String {
-    if c.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", c.replace('"', "\"\""))
-    } else {
-        c.to_string()
     }
 }
 

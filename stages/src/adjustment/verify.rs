@@ -24,11 +24,11 @@
 use super::id_index::index_by_id;
 use crate::campaign::Recording;
 use crate::correspondence::AerialControlPoint;
-use crate::fsutil::atomic_write_with;
 use crate::geometry::{triangulate_rays, PanoramaCamera};
 use crate::params::{describe, Params, StageId};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
+use skytie_util::csv_out::{quote, write_csv};
 use std::io::{self, Write};
 use std::ops::RangeInclusive;
 use std::path::Path;
@@ -473,8 +473,7 @@ pub const VERIFICATION_CSV_HEADER: [&str; 19] = [
 /// `verification.csv`: one row per segment (metres; floats in shortest round-trip form), then a row
 /// `segment = all` with the overall statistics. Written atomically.
 pub fn write_verification_csv(path: &Path, v: &Verification) -> io::Result<()> {
-    atomic_write_with(path, |w| {
-        writeln!(w, "{}", VERIFICATION_CSV_HEADER.join(","))?;
+    write_csv(path, &VERIFICATION_CSV_HEADER, |w| {
         for s in v.segments.iter().chain(std::iter::once(&v.overall)) {
             let label = if std::ptr::eq(s, &v.overall) {
                 "all".to_string()
@@ -498,8 +497,8 @@ pub fn write_verification_csv(path: &Path, v: &Verification) -> io::Result<()> {
             writeln!(
                 w,
                 "{label},{},{},{},{},{},{},{},{}",
-                csv_text(&s.first_image_id),
-                csv_text(&s.last_image_id),
+                quote(&s.first_image_id),
+                quote(&s.last_image_id),
                 s.recordings,
                 s.points,
                 nums.join(","),
@@ -510,14 +509,6 @@ pub fn write_verification_csv(path: &Path, v: &Verification) -> io::Result<()> {
         }
         Ok(())
     })
-}
-
-fn csv_text(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) || s.starts_with('#') {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
 }
 
 /// A short fixed-width table for stdout (Table 5-13 layout per segment, centimetres).

@@ -11,6 +11,7 @@ use super::read_recordings::RECORDING_COLUMNS;
 use super::time::format_time_iso;
 use crate::crs::CoordinateFrame;
 use crate::fsutil::atomic_write_with;
+use skytie_util::csv_out::quote;
 use std::collections::BTreeMap;
 use std::io::{self, Write};
 use std::path::Path;
@@ -129,7 +130,7 @@ fn write_recording_rows(path: &Path, rows: &[(&Recording, Option<[f64; 3]>)]) ->
         let mut cells: Vec<String> = Vec::with_capacity(header.len());
         for ((r, sigma), time) in rows.iter().zip(&times) {
             cells.clear();
-            cells.extend([text(&r.image_id), text(&r.file), text(time)]);
+            cells.extend([quote(&r.image_id), quote(&r.file), quote(time)]);
             cells.extend([r.x, r.y, r.z, r.heading_deg, r.camera_height_m].map(num));
             if has_sigma_xy {
                 cells.push(opt(r.sigma_xy_m));
@@ -183,7 +184,7 @@ pub fn write_aerial_cameras_csv(path: &Path, rows: &[AerialImage]) -> io::Result
         let mut cells: Vec<String> = Vec::with_capacity(header.len());
         for a in rows {
             cells.clear();
-            cells.extend([text(&a.image_id), text(&a.file)]);
+            cells.extend([quote(&a.image_id), quote(&a.file)]);
             cells.extend(
                 [
                     a.x,
@@ -228,7 +229,7 @@ pub fn write_checkpoints_csv(path: &Path, rows: &[CheckPoint]) -> io::Result<()>
     atomic_write_with(path, |w| {
         write_line(w, header.iter().map(|h| h.to_string()))?;
         for c in rows {
-            let mut cells = vec![text(&c.point_id), num(c.x), num(c.y), num(c.z)];
+            let mut cells = vec![quote(&c.point_id), num(c.x), num(c.y), num(c.z)];
             if has_sigma_xy {
                 cells.push(opt(c.sigma_xy_m));
             }
@@ -254,8 +255,8 @@ pub fn write_observations_csv(path: &Path, rows: &[Observation]) -> io::Result<(
             write_line(
                 w,
                 [
-                    text(&o.point_id),
-                    text(&o.image_id),
+                    quote(&o.point_id),
+                    quote(&o.image_id),
                     num(o.u_px),
                     num(o.v_px),
                 ]
@@ -390,19 +391,6 @@ fn opt(v: Option<f64>) -> String {
     v.map(num).unwrap_or_default()
 }
 
-/// A text cell, quoted (RFC 4180) when needed.
-fn text(s: &str) -> String {
-    let needs_quotes = s.starts_with('#')
-        || s.starts_with(' ')
-        || s.ends_with(' ')
-        || s.contains([',', '"', '\n', '\r']);
-    if needs_quotes {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
-
 fn write_line<W: Write>(w: &mut W, cells: impl Iterator<Item = String>) -> io::Result<()> {
     for (i, c) in cells.enumerate() {
         if i > 0 {
@@ -416,14 +404,6 @@ fn write_line<W: Write>(w: &mut W, cells: impl Iterator<Item = String>) -> io::R
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn text_cells_are_quoted_only_when_needed() {
-        assert_eq!(text("pano_001"), "pano_001");
-        assert_eq!(text("a,b"), "\"a,b\"");
-        assert_eq!(text("say \"hi\""), "\"say \"\"hi\"\"\"");
-        assert_eq!(text("#1"), "\"#1\"");
-    }
 
     #[test]
     fn floats_round_trip_exactly() {

@@ -4,8 +4,8 @@
 
 use crate::adjustment::campaign_checkpoints::CheckPointComparison;
 use crate::adjustment::CheckPointError;
-use crate::fsutil::atomic_write_with;
 use serde::{Deserialize, Serialize};
+use skytie_util::csv_out::{quote, write_csv};
 use std::collections::HashMap;
 use std::io::{self, Write};
 use std::path::Path;
@@ -149,24 +149,4 @@ pub fn write_checkpoint_errors_csv(path: &Path, rows: &[CheckPointRow]) -> io::R
         }
         Ok(())
     })
-}
-
-/// Writes a CSV file atomically: the `header` row, then the rows `rows` writes.
-pub(crate) fn write_csv<F>(path: &Path, header: &[&str], rows: F) -> io::Result<()>
-where
-    F: FnOnce(&mut io::BufWriter<&mut std::fs::File>) -> io::Result<()>,
-{
-    atomic_write_with(path, |w| {
-        writeln!(w, "{}", header.join(","))?;
-        rows(w)
-    })
-}
-
-/// A CSV cell: quoted when it holds a separator, a quote, a line break, or starts with `#` or a space.
-pub(crate) fn quote(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) || s.starts_with('#') || s.starts_with(' ') {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
 }

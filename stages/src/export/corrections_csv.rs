@@ -7,9 +7,9 @@
 //! `dyaw_deg` (adjusted − recorded yaw), `sigma_e_m, sigma_n_m, sigma_u_m, sigma_yaw_deg`. Apply as
 //! `corrected = recorded + Δ`. Floats in shortest round-trip form; deterministic.
 
-use super::checkpoints::{quote, write_csv};
 use super::corrections::CorrectionSeries;
 use crate::campaign::time::format_time_iso;
+use skytie_util::csv_out::{quote, write_csv};
 use std::io::{self, Write};
 use std::path::Path;
 

@@ -7,9 +7,9 @@
 //! observations). Rows are in the order given (the pipeline passes them sorted by recording), observations of a
 //! point in the order panorama first, then aerial; floats in shortest round-trip form.
 
-use super::checkpoints::{quote, write_csv};
 use crate::campaign::AerialKind;
 use crate::correspondence::AerialControlPoint;
+use skytie_util::csv_out::{quote, write_csv};
 use std::io::{self, Write};
 use std::path::Path;
 

@@ -16,11 +16,11 @@
 //! Only points with an aerial triangulation (seen in ≥ 2 aerial images) are control; the others are counted
 //! in [`GcpExport::skipped_single_aerial`]. Labels are `<source>_<point id>` with white space replaced by `_`.
 
-use super::checkpoints::quote;
 use crate::adjustment::AdjustmentRun;
 use crate::campaign::{AerialKind, Campaign};
 use crate::correspondence::AerialControlPoint;
 use crate::fsutil::atomic_write_with;
+use skytie_util::csv_out::quote;
 use std::collections::HashMap;
 use std::io::{self, Write};
 use std::path::Path;

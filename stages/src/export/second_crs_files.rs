@@ -14,7 +14,6 @@
 //! Values in metres keep the campaign's scale: the two projections' scale factors differ by ~10⁻⁴, well
 //! below the precision of a correction.
 
-use super::checkpoints::quote;
 use super::corrections::CorrectionSeries;
 use super::corrections_csv::write_corrections_csv;
 use super::gcp::{collect, GcpExport};
@@ -24,6 +23,7 @@ use crate::campaign::Campaign;
 use crate::correspondence::AerialControlPoint;
 use crate::crs::second_crs::{turn, turn_sigma, SecondCrs};
 use crate::fsutil::atomic_write_with;
+use skytie_util::csv_out::quote;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
