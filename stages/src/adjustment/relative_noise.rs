@@ -155,20 +155,10 @@ mod tests {
         path
     }
 
-    /// Deterministic N(0, 1) draws (Box–Muller on a fixed linear congruential sequence).
+    /// Deterministic N(0, 1) draws.
     fn normals(n: usize) -> Vec<f64> {
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut uniform = || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-        };
-        (0..n)
-            .map(|_| {
-                (-2.0 * uniform().ln()).sqrt() * (2.0 * std::f64::consts::PI * uniform()).cos()
-            })
-            .collect()
+        let mut rng = crate::rng::SplitMix64::new(0x2545_f491_4f6c_dd1d);
+        (0..n).map(|_| rng.next_gaussian()).collect()
     }
 
     #[test]
