@@ -1,4 +1,5 @@
-//! Recordings beyond the first or last recording with control, tied to that recording's correction.
+//! Recordings beyond the first or last recording with control (a control point or aerial image observations of
+//! a tie point it observes), tied to that recording's correction.
 //!
 //! A stretch of trajectory before the first or after the last recording that observes control has no
 //! correction of its own: the adjustment carries one into it through the panorama tie points and the relative
@@ -23,8 +24,8 @@ use super::problem::{Block, RelativeConstraint};
 use super::tie_point_heights::controlled_recordings;
 use crate::campaign::Recording;
 
-/// The anchor constraints of `block` (its control points already chosen): a recording has control when it
-/// observes a control point; consecutive `recordings` (the block's, in time order) are linked when at most
+/// The anchor constraints of `block` (its control points and aerial observations already chosen): a recording
+/// has control when it observes a control point or a tie point observed in an aerial image; consecutive `recordings` (the block's, in time order) are linked when at most
 /// `relative_max_gap_m` apart; σ from `relative_sigma_m` and `extrapolation_anchor_growth`.
 pub fn tail_anchors(
     block: &Block,

@@ -62,11 +62,17 @@ pub fn tie_point_heights(
         .collect()
 }
 
-/// Per recording of `block`, whether it observes one of the block's control points.
+/// Per recording of `block`, whether it observes a tie point with aerial evidence: a control point, or an
+/// observation in an aerial image (the bundle's aerial observations, `aerial_observations = true`).
 pub fn controlled_recordings(block: &Block) -> Vec<bool> {
     let mut is_control = vec![false; block.points_initial_world.len()];
-    for c in &block.control_points {
-        if let Some(flag) = is_control.get_mut(c.point) {
+    let anchored = block
+        .control_points
+        .iter()
+        .map(|c| c.point)
+        .chain(block.aerial_observations.iter().map(|o| o.point));
+    for point in anchored {
+        if let Some(flag) = is_control.get_mut(point) {
             *flag = true;
         }
     }
@@ -128,6 +134,41 @@ mod tests {
             covariance_m2: [[0.0; 3]; 3],
             max_angle_deg: 10.0,
         }
+    }
+
+    #[test]
+    fn control_points_and_aerial_image_observations_both_control_a_recording() {
+        use crate::adjustment::problem::{AerialImageObservation, ControlPoint, PanoObservation};
+        use nalgebra::Vector3;
+        let pano = |recording, point| PanoObservation {
+            recording,
+            point,
+            u_px: 10.0,
+            v_px: 10.0,
+            sigma_px: 0.5,
+        };
+        let recordings = crate::adjustment::SyntheticBlockSpec {
+            recordings: 3,
+            ..Default::default()
+        }
+        .generate()
+        .block
+        .recordings;
+        let block = Block {
+            recordings,
+            points_initial_world: vec![Vector3::zeros(); 3],
+            pano_observations: vec![pano(0, 0), pano(1, 1), pano(2, 2)],
+            control_points: vec![ControlPoint::isotropic(0, Vector3::zeros(), 0.1)],
+            aerial_observations: vec![AerialImageObservation {
+                camera: 0,
+                point: 1,
+                u_px: 5.0,
+                v_px: 5.0,
+                sigma_px: 0.5,
+            }],
+            ..Block::default()
+        };
+        assert_eq!(controlled_recordings(&block), [true, true, false]);
     }
 
     #[test]
