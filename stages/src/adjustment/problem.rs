@@ -98,7 +98,7 @@ pub struct AerialImageObservation {
 /// With `c = adjusted − recorded` the correction of a recording's centre, the constraint keeps
 /// `c_to − carry ∘ c_from` at zero with standard deviation `sigma_m` per axis. A carry of 1 keeps the recorded
 /// difference of the two positions (the error is a random walk); a carry below 1 is the step of a first-order
-/// Gauss–Markov error, which also stands for `to`'s position prior ([`super::trajectory_error`]).
+/// Gauss–Markov error, which also stands for `to`'s position prior ([`super::gauss_markov`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RelativeConstraint {
     pub from: usize,
