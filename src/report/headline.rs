@@ -295,10 +295,24 @@ impl Headline {
         self.support[3]
     }
 
+    /// A delivered correction of which no segment passes the verification of the adjusted trajectory (a street
+    /// with little aerial evidence, or evidence that disagrees with itself).
+    pub fn unverified(&self) -> bool {
+        self.verification_after
+            .as_ref()
+            .is_some_and(|v| !v.segments.is_empty() && v.count("pass") == 0)
+    }
+
     /// The headline as short lines of plain text (terminal summary; the report shows the same numbers).
     pub fn lines(&self) -> Vec<String> {
         let mut out = Vec::new();
         out.push(match &self.status {
+            Status::Corrected if self.unverified() => {
+                "RESULT: trajectory corrected, but not verified: no segment of the adjusted trajectory passes \
+                 the verification (its aerial control is too sparse or disagrees; see the σ after and the \
+                 segments below)"
+                    .to_string()
+            }
             Status::Corrected => "RESULT: trajectory corrected".to_string(),
             Status::NotAdjusted => "RESULT: not adjusted (verification only)".to_string(),
             Status::NotCorrected(why) => format!("WARNING: NOT CORRECTED: {why}"),
@@ -436,6 +450,40 @@ mod tests {
         assert!(text.contains("2 of 3 recordings corrected"), "{text}");
         assert!(text.contains("1 not corrected"), "{text}");
         assert!(text.contains("Check points after: 0.050 m"), "{text}");
+        assert!(!h.unverified());
+        assert_eq!(h.lines()[0], "RESULT: trajectory corrected");
+    }
+
+    #[test]
+    fn a_correction_without_a_verified_segment_says_so() {
+        let c = corrections(&[
+            ("recording", 0.3, 0.0, 0.4, "controlled"),
+            ("recording", 0.2, 0.0, 0.4, "bridged"),
+        ]);
+        let v = CsvTable::from_cells(
+            &[
+                "segment",
+                "first_image_id",
+                "last_image_id",
+                "points",
+                "mean_x",
+                "mean_y",
+                "status",
+            ],
+            &[
+                &["0", "a", "b", "1", "0.3", "0.4", "insufficient"],
+                &["1", "c", "d", "0", "", "", "insufficient"],
+                &["all", "a", "d", "1", "0.3", "0.4", "insufficient"],
+            ],
+        );
+        let h = Headline::from_parts(&metrics(0.84, 0.77), Some(&c), None, Some(&v));
+        assert_eq!(h.status, Status::Corrected);
+        assert!(h.unverified());
+        assert!(
+            h.lines()[0].starts_with("RESULT: trajectory corrected, but not verified"),
+            "{:?}",
+            h.lines()
+        );
     }
 
     #[test]

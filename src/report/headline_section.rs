@@ -95,7 +95,7 @@ pub fn headline_section(
             return Ok(());
         }
     };
-    let warn = matches!(h.status, Status::NotCorrected(_) | Status::Worse(_));
+    let warn = matches!(h.status, Status::NotCorrected(_) | Status::Worse(_)) || h.unverified();
     let mut lines = h.lines().into_iter();
     let status = lines.next().unwrap_or_default();
     let mut html = format!(
