@@ -406,6 +406,22 @@ mod tests {
         }
     }
 
+    /// A `verification_adjusted.csv` with the given rows (segment, first, last, points, mean x, mean y, status).
+    fn verification(rows: &[&[&str]]) -> CsvTable {
+        CsvTable::from_cells(
+            &[
+                "segment",
+                "first_image_id",
+                "last_image_id",
+                "points",
+                "mean_x",
+                "mean_y",
+                "status",
+            ],
+            rows,
+        )
+    }
+
     fn metrics(before: f64, after: f64) -> Value {
         serde_json::json!({
             "campaign": {"recordings": 3},
@@ -422,22 +438,11 @@ mod tests {
             ("recording", 0.3, 0.4, 0.04, "bridged"),
             ("recording", 0.0, 0.0, 2.0, "uncorrected"),
         ]);
-        let v = CsvTable::from_cells(
-            &[
-                "segment",
-                "first_image_id",
-                "last_image_id",
-                "points",
-                "mean_x",
-                "mean_y",
-                "status",
-            ],
-            &[
-                &["0", "a", "b", "5", "0.03", "0.04", "pass"],
-                &["1", "c", "d", "1", "0.3", "0.4", "insufficient"],
-                &["all", "a", "d", "6", "0.06", "0.08", "pass"],
-            ],
-        );
+        let v = verification(&[
+            &["0", "a", "b", "5", "0.03", "0.04", "pass"],
+            &["1", "c", "d", "1", "0.3", "0.4", "insufficient"],
+            &["all", "a", "d", "6", "0.06", "0.08", "pass"],
+        ]);
         let h = Headline::from_parts(&metrics(0.8, 0.05), Some(&c), None, Some(&v));
         assert_eq!(h.status, Status::Corrected);
         assert_eq!(h.support, [1, 1, 0, 1]);
@@ -460,22 +465,11 @@ mod tests {
             ("recording", 0.3, 0.0, 0.4, "controlled"),
             ("recording", 0.2, 0.0, 0.4, "bridged"),
         ]);
-        let v = CsvTable::from_cells(
-            &[
-                "segment",
-                "first_image_id",
-                "last_image_id",
-                "points",
-                "mean_x",
-                "mean_y",
-                "status",
-            ],
-            &[
-                &["0", "a", "b", "1", "0.3", "0.4", "insufficient"],
-                &["1", "c", "d", "0", "", "", "insufficient"],
-                &["all", "a", "d", "1", "0.3", "0.4", "insufficient"],
-            ],
-        );
+        let v = verification(&[
+            &["0", "a", "b", "1", "0.3", "0.4", "insufficient"],
+            &["1", "c", "d", "0", "", "", "insufficient"],
+            &["all", "a", "d", "1", "0.3", "0.4", "insufficient"],
+        ]);
         let h = Headline::from_parts(&metrics(0.84, 0.77), Some(&c), None, Some(&v));
         assert_eq!(h.status, Status::Corrected);
         assert!(h.unverified());
