@@ -2,13 +2,19 @@
 //! together on neighbouring recordings — strong, and agreeing with itself — is caught against the control of
 //! the other recordings nearby (`[adjust] control_consistency_window`), and a stretch beyond the last
 //! recording with control keeps that recording's correction instead of drifting with a noisy tie-point chain
-//! (`[adjust] extrapolation_anchor`), while staying flagged as extrapolated.
+//! (`[adjust] extrapolation_anchor`), while staying flagged as extrapolated. The first check works the same
+//! when the control points' aerial pixels go into the bundle (`aerial_observations`).
 
 mod common_adjust;
 
-use common_adjust::{runs_without_and_with, weak_prior_campaign, RELATIVE_SIGMA_M};
+use common_adjust::{
+    relative_config_with, runs_without_and_with, weak_prior_campaign, RELATIVE_SIGMA_M,
+};
+use nalgebra::Vector3;
 use skytie_stages::adjustment::control_consistency::tolerance_m;
+use skytie_stages::adjustment::run;
 use skytie_stages::export::{recording_support, Support};
+use skytie_stages::geometry::FrameCamera;
 
 #[test]
 fn control_wrong_together_on_neighbouring_recordings_is_not_used() {
@@ -52,6 +58,72 @@ fn control_wrong_together_on_neighbouring_recordings_is_not_used() {
         plain.build.control_as_gcp - wrong.len()
     );
     assert_eq!(plain.build.inconsistent_control_dropped, 0);
+}
+
+#[test]
+fn wrong_aerial_pixels_in_the_bundle_are_caught_like_wrong_ground_control() {
+    let mut c = weak_prior_campaign(30, 0.05, 0.0, 5);
+    // The same wrong content as above, but as aerial pixels: every aerial pixel of a point seen only from
+    // recordings 19–22 is where the point 0.5 m east of its true place would be.
+    let wrong: Vec<usize> = (0..c.control.len())
+        .filter(|&k| {
+            c.control_observed_from(k)
+                .iter()
+                .all(|r| (19..=22).contains(r))
+        })
+        .collect();
+    assert!(wrong.len() >= 2, "{wrong:?}");
+    for &k in &wrong {
+        let p = c.control[k].point_world.as_mut().expect("triangulated");
+        p[0] += 0.5;
+        let moved = Vector3::from(*p);
+        for o in &mut c.control[k].aerial {
+            let image = c
+                .nadir
+                .iter()
+                .find(|n| n.image_id == o.image_id)
+                .expect("nadir");
+            let (u, v) = FrameCamera::from_aerial(image)
+                .project_world(&moved)
+                .expect("in view");
+            (o.u_px, o.v_px) = (u, v);
+        }
+    }
+    let (unchecked, checked) = {
+        let in_bundle = relative_config_with(|config| config.aerial_observations = true);
+        let mut with_check = in_bundle.clone();
+        with_check.control_consistency_window = Some(20);
+        let inputs = c.adjust_inputs();
+        (
+            run(&inputs, &in_bundle).unwrap(),
+            run(&inputs, &with_check).unwrap(),
+        )
+    };
+    assert!(unchecked.build.aerial_observations > 0);
+    let (before, after) = (
+        c.horizontal_errors_m(&unchecked),
+        c.horizontal_errors_m(&checked),
+    );
+    let worst = |e: &[f64]| e[19..=22].iter().copied().fold(0.0, f64::max);
+    println!(
+        "aerial pixels, recordings 19–22: worst error {:.3} m unchecked, {:.3} m checked",
+        worst(&before),
+        worst(&after),
+    );
+    assert!(worst(&before) > 0.1, "{before:?}");
+    assert!(after.iter().all(|&e| e < 0.01), "{after:?}");
+    // Exactly the wrong points' aerial observations left the bundle.
+    assert_eq!(checked.build.inconsistent_control_dropped, wrong.len());
+    let wrong_pixels: usize = wrong.iter().map(|&k| c.control[k].aerial.len()).sum();
+    assert_eq!(
+        checked.build.aerial_observations,
+        unchecked.build.aerial_observations - wrong_pixels
+    );
+    assert_eq!(
+        checked.build.control_as_aerial_observations,
+        unchecked.build.control_as_aerial_observations - wrong.len()
+    );
+    assert_eq!(unchecked.build.inconsistent_control_dropped, 0);
 }
 
 #[test]

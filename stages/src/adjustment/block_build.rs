@@ -6,7 +6,9 @@
 
 pub use super::block_point::{BlockPoint, PointKind};
 use super::config::{AdjustConfig, ControlWeighting};
-use super::control_consistency::select_control;
+use super::control_screen::{
+    aerial_observation_evidence, screen_control, EvidenceSource, SourcedEvidence,
+};
 use super::error::AdjustError;
 use super::extrapolation_anchor::tail_anchors;
 use super::height_observation::HeightObservations;
@@ -14,7 +16,7 @@ use super::problem::{AdjustOptions, AerialImageObservation, Block, ControlPoint,
 use super::relative_noise::RelativeSigma;
 use super::tie_point_heights::{controlled_recordings, tie_point_heights};
 use super::weak_control::ControlEvidence;
-use super::weak_control_sigma::{self, WeakSigmaEstimate};
+use super::weak_control_sigma::WeakSigmaEstimate;
 use crate::campaign::{AerialImage, AerialKind};
 use crate::correspondence::{AerialControlPoint, MmTiePoint};
 use crate::geometry::{triangulate_rays, FrameCamera};
@@ -124,7 +126,7 @@ pub fn build_block(
     }
 
     // Per control point of the block: the correction it implies, its recordings and whether it is weak.
-    let mut evidence: Vec<ControlEvidence> = Vec::new();
+    let mut evidence: Vec<SourcedEvidence> = Vec::new();
     for cp in inputs.control {
         if let Some(e) = asm.add_control_point(cp, inputs, config, &resolve, sigma_px)? {
             evidence.push(e);
@@ -135,7 +137,14 @@ pub fn build_block(
         inputs.recordings,
         config.relative_max_gap_m,
     );
-    asm.screen_control(&evidence, config, relative_sigma.sigma_m);
+    screen_control(
+        &mut asm.block,
+        &mut asm.points,
+        &evidence,
+        config,
+        relative_sigma.sigma_m,
+        &mut asm.counts,
+    );
     let Assembly {
         mut block,
         points,
@@ -207,7 +216,7 @@ impl<'a> Assembly<'a> {
         config: &AdjustConfig,
         resolve: &impl Fn(&str, &str) -> Result<usize, AdjustError>,
         sigma_px: &[f64],
-    ) -> Result<Option<ControlEvidence>, AdjustError> {
+    ) -> Result<Option<SourcedEvidence>, AdjustError> {
         self.counts.control_points += 1;
         let owner = format!("aerial control point '{}'", cp.tie_point_id);
         // Resolve the aerial images (in order of first use, so the numbering is deterministic).
@@ -255,6 +264,7 @@ impl<'a> Assembly<'a> {
             .aerial
             .extend(aerial.iter().map(|&(camera, u, v, _)| (camera, u, v)));
         if config.aerial_observations && cp.map.is_none() {
+            let first = self.block.aerial_observations.len();
             add_aerial_observations(
                 &mut self.block,
                 &self.cameras.rows,
@@ -262,6 +272,16 @@ impl<'a> Assembly<'a> {
                 &aerial,
                 &mut self.counts,
             );
+            let rows = &self.cameras.rows;
+            return Ok(aerial_observation_evidence(
+                &self.block,
+                |camera| FrameCamera::from_aerial(rows[camera]),
+                p,
+                cp.point_world,
+                first..self.block.aerial_observations.len(),
+                self.points[p].recordings(),
+                recording_spread(&self.block, &self.points[p].pano, sigma_px),
+            ));
         } else if let Some(xyz) = cp
             .point_world
             .filter(|_| cp.aerial.len() >= 2 || cp.map.is_some())
@@ -274,98 +294,22 @@ impl<'a> Assembly<'a> {
             });
             self.counts.control_as_gcp += 1;
             let initial = self.block.points_initial_world[p];
-            let mut recordings: Vec<usize> = self.points[p].pano.iter().map(|o| o.0).collect();
-            recordings.sort_unstable();
-            recordings.dedup();
-            return Ok(Some(ControlEvidence {
-                correction_m: nalgebra::Vector2::new(xyz[0] - initial.x, xyz[1] - initial.y),
-                recordings,
-                weak: cp
-                    .map
-                    .as_ref()
-                    .is_some_and(|m| m.score < config.weak_control_below),
-                spread: recording_spread(&self.block, &self.points[p].pano, sigma_px),
+            return Ok(Some(SourcedEvidence {
+                evidence: ControlEvidence {
+                    correction_m: nalgebra::Vector2::new(xyz[0] - initial.x, xyz[1] - initial.y),
+                    recordings: self.points[p].recordings(),
+                    weak: cp
+                        .map
+                        .as_ref()
+                        .is_some_and(|m| m.score < config.weak_control_below),
+                    spread: recording_spread(&self.block, &self.points[p].pano, sigma_px),
+                },
+                source: EvidenceSource::Ground(self.block.control_points.len() - 1),
             }));
         } else {
             self.counts.control_unused += 1;
         }
         Ok(None)
-    }
-
-    /// Screens the ground control: drops what [`select_control`] rejects (weak and inconsistent control)
-    /// and, with `weak_control_sigma_estimated`, raises the σ of weak control to the spread the consistent
-    /// control shows.
-    fn screen_control(
-        &mut self,
-        evidence: &[ControlEvidence],
-        config: &AdjustConfig,
-        relative_sigma_m: f64,
-    ) {
-        let selection = select_control(
-            evidence,
-            self.block.recordings.len(),
-            config,
-            relative_sigma_m,
-        );
-        self.counts.weak_control_dropped = selection.weak;
-        self.counts.inconsistent_control_dropped = selection.inconsistent;
-        if config.weak_control_sigma_estimated {
-            let estimate = weak_control_sigma::estimate(evidence, &selection.keep);
-            if let Some(sigma_m) = estimate.sigma_m {
-                let given: Vec<Matrix3<f64>> = self
-                    .block
-                    .control_points
-                    .iter()
-                    .map(|c| c.covariance_m2)
-                    .collect();
-                let raised = weak_control_sigma::weak_covariances(
-                    evidence,
-                    &selection.keep,
-                    &given,
-                    sigma_m,
-                );
-                for (c, cov) in self.block.control_points.iter_mut().zip(raised) {
-                    c.covariance_m2 = cov;
-                }
-            }
-            self.counts.weak_control_sigma = Some(estimate);
-        }
-        if selection.keep.contains(&false) {
-            drop_control(
-                &mut self.block,
-                &mut self.points,
-                &selection.keep,
-                &mut self.counts,
-            );
-        }
-    }
-}
-
-/// Removes the control points `keep` rejects (parallel to the block's control points); a point left without
-/// control becomes a tie point again.
-fn drop_control(
-    block: &mut Block,
-    points: &mut [BlockPoint],
-    keep: &[bool],
-    counts: &mut BuildCounts,
-) {
-    let mut kept = Vec::with_capacity(block.control_points.len());
-    for (c, k) in block.control_points.iter().zip(keep) {
-        if *k {
-            kept.push(*c);
-        } else {
-            counts.control_as_gcp -= 1;
-        }
-    }
-    block.control_points = kept;
-    let mut still_control = vec![false; points.len()];
-    for c in &block.control_points {
-        still_control[c.point] = true;
-    }
-    for (p, point) in points.iter_mut().enumerate() {
-        if point.kind == PointKind::Control && !still_control[p] && point.aerial.is_empty() {
-            point.kind = PointKind::Tie;
-        }
     }
 }
 

@@ -25,3 +25,13 @@ pub struct BlockPoint {
     /// (aerial image index, u, v) aerial pixels (all aerial observations of the point, used or not).
     pub aerial: Vec<(usize, f64, f64)>,
 }
+
+impl BlockPoint {
+    /// The recordings that observe the point in their panoramas, ascending, each once.
+    pub fn recordings(&self) -> Vec<usize> {
+        let mut recordings: Vec<usize> = self.pano.iter().map(|o| o.0).collect();
+        recordings.sort_unstable();
+        recordings.dedup();
+        recordings
+    }
+}

@@ -188,7 +188,8 @@ crate::params! {
         /// correction differs from their median correction by more than the 99.9 % bound of its own scatter
         /// about a common correction (2.63 × the relative σ for a point of one recording, wider along the rays
         /// of a point whose triangulation the recordings' errors move farther) is not used as control
-        /// (counted in `build.inconsistent_control_dropped`); absent = no check.
+        /// (counted in `build.inconsistent_control_dropped`; with `aerial_observations` its aerial pixels
+        /// leave the bundle, `adjustment::control_screen`); absent = no check.
         control_consistency_window: Option<usize> = None, min 1;
         /// Measure the σ of weak orthophoto control (peak below `weak_control_below`) against the strong
         /// control of the same recordings and weight the weak points with it
