@@ -211,6 +211,11 @@ crate::params! {
         estimate_yaw: bool = false;
         /// σ of the zero prior on each yaw correction.
         yaw_prior_sigma_deg: f64 = 1.0, unit "deg", above 0.0;
+        /// σ of the change of the yaw correction between two recordings linked by a relative constraint
+        /// (with `estimate_yaw` and `relative_constraints`; least squares): an inertial unit's heading error
+        /// is a bias that wanders slowly, so neighbouring recordings share their yaw evidence instead of
+        /// each estimating its own from its few rays; absent = each recording's yaw is independent.
+        yaw_relative_sigma_deg: Option<f64> = None, unit "deg", above 0.0;
         /// Largest number of Levenberg–Marquardt iterations per solve.
         max_iterations: usize = 100, min 1;
         /// Registration passes (nadir chain): with 2, the recordings that found no aerial control are searched
@@ -251,6 +256,7 @@ impl AdjustConfig {
             horizontal_only: self.dimensions == Dimensions::Horizontal,
             estimate_yaw: self.estimate_yaw,
             yaw_prior_sigma_deg: self.estimate_yaw.then_some(self.yaw_prior_sigma_deg),
+            yaw_relative_sigma_deg: self.yaw_relative_sigma_deg.filter(|_| self.estimate_yaw),
             weighting: self.weighting(),
             loss: robust_loss(self.loss, self.loss_scale),
             relative_loss: robust_loss(self.relative_loss, self.relative_loss_scale),

@@ -162,7 +162,7 @@ fn camera_blocks(
                         b[axis] -= inv_sigma * r;
                     }
                 }
-                if let Some(s) = prep.yaw_prior_sigma_rad {
+                if let Some(s) = prep.yaw_prior_of(c) {
                     d[(3, 3)] += 1.0 / (s * s);
                     b[3] -= state.yaw_correction_rad[c] / (s * s);
                 }
@@ -200,6 +200,18 @@ fn add_relative_terms(
             block[(axis, axis)] = -phi * inv2;
             camera_rhs[a][axis] += phi * w * r[axis] / sigma;
             camera_rhs[b][axis] -= w * r[axis] / sigma;
+        }
+        if let (Some(r), Some(s)) = (
+            prep.relative_yaw_residual(i, state),
+            prep.yaw_relative_sigma_rad,
+        ) {
+            // Least squares: J_a = −1/σ_ψ, J_b = 1/σ_ψ.
+            let inv2 = 1.0 / (s * s);
+            camera_diag[a][(3, 3)] += inv2;
+            camera_diag[b][(3, 3)] += inv2;
+            block[(3, 3)] = -inv2;
+            camera_rhs[a][3] += r / s;
+            camera_rhs[b][3] -= r / s;
         }
         camera_off.push(block);
     }

@@ -83,6 +83,11 @@ pub struct Prepared {
     /// Observed heights of the recordings' centres: (Z in the local frame, σ in metres).
     pub height_observations: Vec<Option<(f64, f64)>>,
     pub yaw_prior_sigma_rad: Option<f64>,
+    /// σ of the change of the yaw correction along each relative constraint, radians (with `estimate_yaw`).
+    pub yaw_relative_sigma_rad: Option<f64>,
+    /// Per recording: whether a relative constraint with a yaw term leads into it, which then stands for its
+    /// yaw prior (the prior counts once per chain, not once per recording of a shared bias).
+    pub yaw_prior_in_chain: Vec<bool>,
     pub pano: Vec<PreparedPano>,
     pub control: Vec<PreparedControl>,
     /// Observed tie-point heights (inactive for undetermined points and horizontal-only solves).
@@ -241,6 +246,16 @@ impl Prepared {
             prior_in_chain[rc.to][0] |= rc.carry_xy < 1.0;
             prior_in_chain[rc.to][1] |= rc.carry_z < 1.0;
         }
+        let yaw_relative_sigma_rad = options
+            .estimate_yaw
+            .then_some(options.yaw_relative_sigma_deg.map(f64::to_radians))
+            .flatten();
+        let mut yaw_prior_in_chain = vec![false; n_rec];
+        if yaw_relative_sigma_rad.is_some() {
+            for rc in &relative {
+                yaw_prior_in_chain[rc.to] = true;
+            }
+        }
         let pairs: Vec<(usize, usize)> = relative.iter().map(|r| (r.from, r.to)).collect();
         let structure = ReducedStructure::new(&layout, &pairs);
         Ok(Self {
@@ -272,6 +287,8 @@ impl Prepared {
                 .estimate_yaw
                 .then_some(options.yaw_prior_sigma_deg.map(f64::to_radians))
                 .flatten(),
+            yaw_relative_sigma_rad,
+            yaw_prior_in_chain,
             pano,
             control,
             point_heights,
@@ -392,6 +409,21 @@ impl Prepared {
         r
     }
 
+    /// σ of recording `c`'s zero yaw prior, radians; `None` without a prior or when a relative yaw term
+    /// leads into `c` ([`Self::yaw_prior_in_chain`]).
+    pub(super) fn yaw_prior_of(&self, c: usize) -> Option<f64> {
+        self.yaw_prior_sigma_rad
+            .filter(|_| !self.yaw_prior_in_chain[c])
+    }
+
+    /// Whitened change of the yaw correction along relative constraint `i`, `(ψ_to − ψ_from) / σ_ψ`; `None`
+    /// without [`Self::yaw_relative_sigma_rad`].
+    pub(super) fn relative_yaw_residual(&self, i: usize, state: &State) -> Option<f64> {
+        let s = self.yaw_relative_sigma_rad?;
+        let rc = &self.relative[i];
+        Some((state.yaw_correction_rad[rc.to] - state.yaw_correction_rad[rc.from]) / s)
+    }
+
     /// The carry of relative constraint `i` per axis (x, y, z).
     pub(super) fn relative_carry(&self, i: usize) -> Vector3<f64> {
         let rc = &self.relative[i];
@@ -442,15 +474,20 @@ impl Prepared {
         0.5 * total
     }
 
-    /// Σ‖r‖² of the priors and yaw priors (never robustified).
+    /// Σ‖r‖² of the priors, yaw priors and relative yaw terms (never robustified).
     fn prior_terms_sum(&self, state: &State) -> f64 {
         let mut total = 0.0;
         for c in 0..self.recorded_local.len() {
             for (_, r, _) in self.prior_terms(c, state) {
                 total += r * r;
             }
-            if let Some(s) = self.yaw_prior_sigma_rad {
+            if let Some(s) = self.yaw_prior_of(c) {
                 total += (state.yaw_correction_rad[c] / s).powi(2);
+            }
+        }
+        for i in 0..self.relative.len() {
+            if let Some(r) = self.relative_yaw_residual(i, state) {
+                total += r * r;
             }
         }
         total
@@ -502,11 +539,14 @@ impl Prepared {
                 .iter()
                 .filter(|t| t.2 > 0.0)
                 .count();
-            if self.yaw_prior_sigma_rad.is_some() {
+            if self.yaw_prior_of(c).is_some() {
                 count += 1;
             }
         }
         count += self.relative.len() * self.position_axes();
+        if self.yaw_relative_sigma_rad.is_some() {
+            count += self.relative.len();
+        }
         (total, count)
     }
 }

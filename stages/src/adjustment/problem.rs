@@ -185,6 +185,9 @@ pub struct AdjustOptions {
     pub estimate_yaw: bool,
     /// σ of a zero prior on each yaw correction, degrees (`None` = no prior).
     pub yaw_prior_sigma_deg: Option<f64>,
+    /// σ of the change of the yaw correction along each relative constraint, degrees (least squares; `None`
+    /// = no such term). Used only with `estimate_yaw`.
+    pub yaw_relative_sigma_deg: Option<f64>,
     /// Residual weighting of panorama observations (thesis 5.7 methods 1–4).
     pub weighting: ResidualWeighting,
     /// Loss on panorama and control-point residuals (IRLS inside LM).
@@ -209,6 +212,7 @@ impl Default for AdjustOptions {
             horizontal_only: false,
             estimate_yaw: false,
             yaw_prior_sigma_deg: None,
+            yaw_relative_sigma_deg: None,
             weighting: ResidualWeighting::default(),
             loss: RobustLoss::Squared,
             relative_loss: RobustLoss::Squared,
@@ -434,6 +438,11 @@ impl AdjustOptions {
         optional_positive(
             "yaw_prior_sigma_deg",
             self.yaw_prior_sigma_deg,
+            "must be finite and > 0, or absent",
+        )?;
+        optional_positive(
+            "yaw_relative_sigma_deg",
+            self.yaw_relative_sigma_deg,
             "must be finite and > 0, or absent",
         )?;
         optional_positive(
