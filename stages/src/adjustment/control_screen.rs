@@ -7,8 +7,8 @@
 //! aerial images (two or more), or else its single aerial ray intersected with the horizontal plane at the
 //! height the panorama rays give it — a nadir ray is steep, so that height barely moves the position.
 
-use super::block_build::BuildCounts;
 use super::block_point::{BlockPoint, PointKind};
+use super::build_counts::BuildCounts;
 use super::config::AdjustConfig;
 use super::control_consistency::select_control;
 use super::problem::Block;

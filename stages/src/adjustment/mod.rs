@@ -21,8 +21,8 @@
 //! model), [`weak_control`] (weak orthophoto control checked against the strong control along the trajectory),
 //! [`weak_control_sigma`] (weak control weighted by its σ measured against the strong control),
 //! [`control_consistency`] (every control point checked against the neighbouring recordings' control),
-//! [`control_screen`] (the evidence of ground control and of aerial pixels in the bundle, and what the checks
-//! reject taken out of the block),
+//! [`build_counts`] (what went into a block, for `metrics.json`), [`control_screen`] (the evidence of
+//! ground control and of aerial pixels in the bundle, and what the checks reject taken out of the block),
 //! [`extrapolation_anchor`] (recordings beyond the outermost control tied to its correction),
 //! [`second_pass`] (the shifted inputs of a second registration pass around the adjusted trajectory),
 //! [`verify`] (thesis Table 5-13 verification per trajectory
@@ -38,6 +38,7 @@ pub mod aerial;
 pub mod block_build;
 pub mod block_point;
 pub mod block_recordings;
+pub mod build_counts;
 pub mod campaign_checkpoints;
 pub mod config;
 pub mod control_consistency;

@@ -13,8 +13,8 @@
 //! `Δ(t) = (1 − w)·Δᵢ + w·Δⱼ`, `σ(t)² = ((1 − w)·σᵢ + w·σⱼ)² + q·(t − tᵢ)·(tⱼ − t)/(tⱼ − tᵢ)` (the σ term
 //! assumes the two ends fully correlated, the conservative case). Outside the span: `σ(t)² = σ_end² +
 //! q·|t − t_end|`. Two recordings the adjustment did not link (a gap, or separate groups) are still
-//! interpolated, but flagged [`SampleKind::Gap`]. Yaw uses the same model with `yaw_prior_sigma_deg` when
-//! yaw is estimated, and is exactly 0 otherwise.
+//! interpolated, but flagged [`SampleKind::Gap`]. Yaw uses the same model with `yaw_relative_sigma_deg` (or,
+//! without it, `yaw_prior_sigma_deg`) when yaw is estimated, and is exactly 0 otherwise.
 
 use crate::adjustment::AdjustmentRun;
 use crate::campaign::Recording;
@@ -149,7 +149,8 @@ impl CorrectionSeries {
             recordings: out,
             q_position_m2_per_s: run.relative_sigma.sigma_m * run.relative_sigma.sigma_m / step,
             q_yaw_deg2_per_s: if c.estimate_yaw {
-                c.yaw_prior_sigma_deg * c.yaw_prior_sigma_deg / step
+                let per_step = c.yaw_relative_sigma_deg.unwrap_or(c.yaw_prior_sigma_deg);
+                per_step * per_step / step
             } else {
                 0.0
             },
