@@ -13,14 +13,15 @@ use common_adjust::{
 use nalgebra::Vector3;
 use skytie_stages::adjustment::control_consistency::tolerance_m;
 use skytie_stages::adjustment::run;
+use skytie_stages::adjustment::synthetic_campaign::SyntheticCampaign;
 use skytie_stages::export::{recording_support, Support};
 use skytie_stages::geometry::FrameCamera;
 
-#[test]
-fn control_wrong_together_on_neighbouring_recordings_is_not_used() {
+/// The weak-prior campaign with every control point seen only from recordings 19–22 moved 0.5 m east (its
+/// `point_world`): strong, and consistent with the others of its stretch — a template matched at a wrong place
+/// by several recordings. Returns the campaign and the moved points.
+fn wrong_together_at_19_to_22() -> (SyntheticCampaign, Vec<usize>) {
     let mut c = weak_prior_campaign(30, 0.05, 0.0, 5);
-    // Every control point seen only from recordings 19–22 is moved 0.5 m east: strong, and consistent with
-    // the others of its stretch — a template matched at a wrong place by several recordings.
     let wrong: Vec<usize> = (0..c.control.len())
         .filter(|&k| {
             c.control_observed_from(k)
@@ -33,6 +34,12 @@ fn control_wrong_together_on_neighbouring_recordings_is_not_used() {
         let p = c.control[k].point_world.as_mut().expect("triangulated");
         p[0] += 0.5;
     }
+    (c, wrong)
+}
+
+#[test]
+fn control_wrong_together_on_neighbouring_recordings_is_not_used() {
+    let (c, wrong) = wrong_together_at_19_to_22();
     let (plain, checked) = runs_without_and_with(&c.adjust_inputs(), |config| {
         config.control_consistency_window = Some(20)
     });
@@ -62,21 +69,11 @@ fn control_wrong_together_on_neighbouring_recordings_is_not_used() {
 
 #[test]
 fn wrong_aerial_pixels_in_the_bundle_are_caught_like_wrong_ground_control() {
-    let mut c = weak_prior_campaign(30, 0.05, 0.0, 5);
-    // The same wrong content as above, but as aerial pixels: every aerial pixel of a point seen only from
-    // recordings 19–22 is where the point 0.5 m east of its true place would be.
-    let wrong: Vec<usize> = (0..c.control.len())
-        .filter(|&k| {
-            c.control_observed_from(k)
-                .iter()
-                .all(|r| (19..=22).contains(r))
-        })
-        .collect();
-    assert!(wrong.len() >= 2, "{wrong:?}");
+    // The same wrong content as above, but as aerial pixels: every aerial pixel of a moved point is where the
+    // point 0.5 m east of its true place would be.
+    let (mut c, wrong) = wrong_together_at_19_to_22();
     for &k in &wrong {
-        let p = c.control[k].point_world.as_mut().expect("triangulated");
-        p[0] += 0.5;
-        let moved = Vector3::from(*p);
+        let moved = Vector3::from(c.control[k].point_world.expect("triangulated"));
         for o in &mut c.control[k].aerial {
             let image = c
                 .nadir
