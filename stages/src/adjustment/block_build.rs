@@ -239,6 +239,11 @@ impl<'a> Assembly<'a> {
                 &aerial,
                 &mut self.counts,
             );
+            // Only the consistency check reads the evidence of aerial pixels (weak control is orthophoto
+            // control): its triangulations are not spent without it.
+            if config.control_consistency_window.is_none() {
+                return Ok(None);
+            }
             let rows = &self.cameras.rows;
             return Ok(aerial_observation_evidence(
                 &self.block,
