@@ -3,6 +3,8 @@
 //! control covers only the first half of the street. Estimated independently, each recording's yaw comes from
 //! its own few noisy rays, and the second half keeps its recorded heading within the prior; tied along the
 //! chain, the recordings share their evidence and the second half takes the first half's correction.
+//! A chain keeps the tie only when its common correction is significant (`yaw_tie_significance`): the same
+//! street without a heading error falls back to per-recording yaw priors.
 
 mod common_adjust;
 
@@ -17,6 +19,12 @@ const WALK_STEP_DEG: f64 = 0.005;
 /// A block whose recorded yaws are the true ones minus a common bias plus a random walk, with control only on
 /// points seen from recordings 0–19 and pixel noise of 0.5 px.
 fn biased_heading_block(seed: u64) -> SyntheticBlock {
+    heading_block(seed, BIAS_DEG, WALK_STEP_DEG)
+}
+
+/// [`biased_heading_block`] with a heading error of `bias_deg` plus a random walk of `walk_step_deg` per
+/// recording.
+fn heading_block(seed: u64, bias_deg: f64, walk_step_deg: f64) -> SyntheticBlock {
     let spec = SyntheticBlockSpec {
         pixel_noise_px: 0.5,
         sigma_px: 0.5,
@@ -31,8 +39,8 @@ fn biased_heading_block(seed: u64) -> SyntheticBlock {
     let mut rng = SplitMix64::new(seed ^ 0x5eed);
     let mut walk = 0.0;
     for (i, r) in synth.block.recordings.iter_mut().enumerate() {
-        walk += WALK_STEP_DEG * rng.next_gaussian();
-        let error = BIAS_DEG + walk;
+        walk += walk_step_deg * rng.next_gaussian();
+        let error = bias_deg + walk;
         let [yaw, pitch, roll] = synth.recorded_attitude_deg[i];
         let cam = &r.camera;
         r.camera = PanoramaCamera::new(
@@ -119,5 +127,58 @@ fn a_shared_heading_bias_is_estimated_along_the_chain() {
             .recordings
             .iter()
             .all(|r| r.sigma_yaw_a_priori_deg > 0.0 && r.sigma_yaw_a_priori_deg < 0.3));
+    }
+}
+
+/// The options of the default workflow's yaw model: per-recording priors of 0.3°, tied by 0.02° per step, the
+/// tie kept only for a common correction of at least `k` σ.
+fn tied_options(k: f64) -> AdjustOptions {
+    AdjustOptions {
+        estimate_yaw: true,
+        yaw_prior_sigma_deg: Some(0.3),
+        yaw_relative_sigma_deg: Some(0.02),
+        yaw_tie_significance: k,
+        ..AdjustOptions::default()
+    }
+}
+
+#[test]
+fn a_chain_keeps_its_yaw_tie_only_when_its_common_correction_is_significant() {
+    for seed in [21u64, 22, 23] {
+        // A 0.3° bias: the tie is kept and the solve is the always-tied one.
+        let biased = biased_heading_block(seed);
+        let tested = adjust(&biased.block, &tied_options(2.0)).unwrap();
+        let always = adjust(&biased.block, &tied_options(0.0)).unwrap();
+        assert_eq!(tested.yaw_chains.len(), 1, "seed {seed}");
+        let chain = &tested.yaw_chains[0];
+        assert!(chain.tied, "seed {seed}: {chain:?}");
+        assert_eq!(chain.recordings.len(), biased.block.recordings.len());
+        assert!(
+            (chain.correction_rad.to_degrees() - BIAS_DEG).abs()
+                < 3.0 * chain.sigma_rad.to_degrees(),
+            "seed {seed}: common correction {:.3}° ± {:.3}° for a bias of {BIAS_DEG}°",
+            chain.correction_rad.to_degrees(),
+            chain.sigma_rad.to_degrees()
+        );
+        assert_eq!(tested.recordings, always.recordings, "seed {seed}");
+
+        // No heading error: the common correction is noise, the chain is untied and the solve is the one with
+        // independent yaw priors.
+        let unbiased = heading_block(seed, 0.0, 0.0);
+        let tested = adjust(&unbiased.block, &tied_options(2.0)).unwrap();
+        let chain = &tested.yaw_chains[0];
+        println!(
+            "seed {seed}: unbiased common correction {:.4}° ± {:.4}°",
+            chain.correction_rad.to_degrees(),
+            chain.sigma_rad.to_degrees()
+        );
+        assert!(!chain.tied, "seed {seed}: {chain:?}");
+        let independent = AdjustOptions {
+            yaw_relative_sigma_deg: None,
+            ..tied_options(2.0)
+        };
+        let free = adjust(&unbiased.block, &independent).unwrap();
+        assert_eq!(tested.recordings, free.recordings, "seed {seed}");
+        assert!(free.yaw_chains.is_empty());
     }
 }

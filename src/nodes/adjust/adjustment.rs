@@ -107,9 +107,30 @@ impl AdjustReport {
             })),
             "off_control_sigma": self.off_control_sigma,
             "trajectory": recording_metrics(r),
+            "yaw_chains": (!r.yaw_chains.is_empty()).then(|| yaw_chain_metrics(r)),
             "verdict": self.verdict().label(),
         }})
     }
+}
+
+/// Per chain of recordings linked by yaw terms: its first and last recording, how many, the common yaw
+/// correction with its σ, and whether the evidence supported it (`tied`; otherwise each recording kept its own
+/// yaw prior, `adjustment::yaw_support`).
+fn yaw_chain_metrics(r: &AdjustmentRun) -> serde_json::Value {
+    let id = |i: usize| r.recordings.get(i).map(|rec| rec.image_id.as_str());
+    r.yaw_chains
+        .iter()
+        .map(|c| {
+            serde_json::json!({
+                "first": c.recordings.first().and_then(|&i| id(i)),
+                "last": c.recordings.last().and_then(|&i| id(i)),
+                "recordings": c.recordings.len(),
+                "correction_deg": c.correction_rad.to_degrees(),
+                "sigma_deg": c.sigma_rad.to_degrees(),
+                "tied": c.tied,
+            })
+        })
+        .collect()
 }
 
 /// The `build` counts; the height observations are under their own key, and the counts of the control checks

@@ -19,6 +19,7 @@ use super::problem::{AdjustOptions, Block};
 use super::relative_release::{self, release, Evidence};
 use super::residuals::{pano_residual, State};
 use super::solver::{solve, SolveReport, Termination};
+use super::yaw_support;
 use nalgebra::Vector3;
 
 /// One adjusted recording.
@@ -89,6 +90,9 @@ pub struct Adjustment {
     /// Relative constraints whose σ was widened because the evidence contradicts their step
     /// ([`AdjustOptions::relative_release_threshold`]; 0 without).
     pub released_relative: usize,
+    /// With relative yaw terms: each chain's common yaw correction from the tied solve and whether it kept
+    /// its tie ([`yaw_support`]); empty without.
+    pub yaw_chains: Vec<yaw_support::ChainYaw>,
 }
 
 /// Adjusts `block` with `options`.
@@ -110,8 +114,37 @@ pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, Adju
         }
         None => block,
     };
-    let (prep, rejected, rounds) = solve_with_rejection(block, options, &mut state)?;
-    let cov = recording_covariances(&prep, &state)?;
+    let initial = state.clone();
+    let (mut prep, mut rejected, mut rounds) = solve_with_rejection(block, options, &mut state)?;
+    let mut cov = recording_covariances(&prep, &state)?;
+    let mut yaw_chains = Vec::new();
+    let untied_block;
+    let block = if yaw_support::applies(options) {
+        let chains = yaw_support::yaw_chains(block.recordings.len(), &block.relative_constraints);
+        let scale = cov.variance_factor.map_or(1.0, posterior_scale);
+        yaw_chains =
+            yaw_support::chain_yaws(&chains, &state.yaw_correction_rad, &cov.a_priori, scale);
+        for chain in &mut yaw_chains {
+            chain.tied = chain.is_significant(options.yaw_tie_significance);
+        }
+        let weak: Vec<&yaw_support::ChainYaw> = yaw_chains.iter().filter(|y| !y.tied).collect();
+        match yaw_support::untied(&block.relative_constraints, &weak) {
+            Some(relative_constraints) => {
+                untied_block = Block {
+                    relative_constraints,
+                    ..block.clone()
+                };
+                state = initial;
+                (prep, rejected, rounds) =
+                    solve_with_rejection(&untied_block, options, &mut state)?;
+                cov = recording_covariances(&prep, &state)?;
+                &untied_block
+            }
+            None => block,
+        }
+    } else {
+        block
+    };
     let recordings = (0..block.recordings.len())
         .map(|c| {
             let m = &cov.a_priori[c];
@@ -176,6 +209,7 @@ pub fn adjust(block: &Block, options: &AdjustOptions) -> Result<Adjustment, Adju
         rejected_aerial,
         rounds,
         released_relative,
+        yaw_chains,
     })
 }
 

@@ -216,6 +216,10 @@ crate::params! {
         /// is a bias that wanders slowly, so neighbouring recordings share their yaw evidence instead of
         /// each estimating its own from its few rays; absent = each recording's yaw is independent.
         yaw_relative_sigma_deg: Option<f64> = None, unit "deg", above 0.0;
+        /// With `yaw_relative_sigma_deg`: a chain of recordings keeps its yaw tie only when its common yaw
+        /// correction is at least this many times its σ (`adjustment::yaw_support`); otherwise each of its
+        /// recordings keeps its own yaw prior, as without the tie. 0 = always tied.
+        yaw_tie_significance: f64 = 2.0, min 0.0, max 10.0;
         /// Largest number of Levenberg–Marquardt iterations per solve.
         max_iterations: usize = 100, min 1;
         /// Registration passes (nadir chain): with 2, the recordings that found no aerial control are searched
@@ -257,6 +261,7 @@ impl AdjustConfig {
             estimate_yaw: self.estimate_yaw,
             yaw_prior_sigma_deg: self.estimate_yaw.then_some(self.yaw_prior_sigma_deg),
             yaw_relative_sigma_deg: self.yaw_relative_sigma_deg.filter(|_| self.estimate_yaw),
+            yaw_tie_significance: self.yaw_tie_significance,
             weighting: self.weighting(),
             loss: robust_loss(self.loss, self.loss_scale),
             relative_loss: robust_loss(self.relative_loss, self.relative_loss_scale),

@@ -11,6 +11,7 @@ use super::config::AdjustConfig;
 use super::error::AdjustError;
 use super::in_frame::{adjustment_to_map, block_to_local};
 use super::relative_noise::RelativeSigma;
+use super::yaw_support::ChainYaw;
 use crate::crs::MapFrame;
 use crate::params::StageId;
 use serde::{Deserialize, Serialize};
@@ -21,7 +22,7 @@ pub use super::block_build::{
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("adjust", "15");
+pub const STAGE: StageId = StageId::new("adjust", "16");
 
 /// One adjusted recording.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -75,6 +76,9 @@ pub struct AdjustmentRun {
     /// The σ of the relative constraints between consecutive recordings (used by them when they are on, and
     /// by the corrections' interpolation between recordings always).
     pub relative_sigma: RelativeSigma,
+    /// With relative yaw terms: each chain's common yaw correction and whether the evidence supported it
+    /// ([`super::yaw_support`]).
+    pub yaw_chains: Vec<ChainYaw>,
 }
 
 /// Builds and adjusts one configuration, taking the campaign's coordinates as a Cartesian frame.
@@ -154,5 +158,6 @@ pub fn run_in_frame(
             released: adj.released_relative,
             ..build.relative_sigma
         },
+        yaw_chains: adj.yaw_chains,
     })
 }

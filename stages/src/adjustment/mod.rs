@@ -11,7 +11,7 @@
 //! cost), [`linearization`] (normal-equation blocks), [`schur`] (the reduced camera system), [`solver`]
 //! (Levenberg–Marquardt), [`relative_noise`] (the trajectory's relative accuracy from its own second differences),
 //! [`gauss_markov`] (the trajectory error as a Gauss–Markov process: how much of a correction the next
-//! recording shares),
+//! recording shares), [`yaw_support`] (whether the evidence supports one heading correction per chain),
 //! [`covariance`] (posterior σ per recording), [`adjust`](mod@adjust) (solve, reject by
 //! normalised residuals, re-solve), [`evaluate`] (check-point triangulation and RMSE), [`id_index`] (rows
 //! by their string id), [`synthetic_block`]
@@ -75,6 +75,7 @@ pub mod verify;
 pub mod weak_control;
 pub mod weak_control_sigma;
 pub mod weighting;
+pub mod yaw_support;
 
 pub use adjust::{adjust, AdjustedRecording, Adjustment, ObservationCounts, RoundReport};
 pub use config::{AdjustConfig, ControlWeighting, Dimensions, LossKind, Sources, TrajectoryError};

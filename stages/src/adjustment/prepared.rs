@@ -252,7 +252,7 @@ impl Prepared {
             .flatten();
         let mut yaw_prior_in_chain = vec![false; n_rec];
         if yaw_relative_sigma_rad.is_some() {
-            for rc in &relative {
+            for rc in relative.iter().filter(|rc| rc.ties_yaw) {
                 yaw_prior_in_chain[rc.to] = true;
             }
         }
@@ -417,10 +417,14 @@ impl Prepared {
     }
 
     /// Whitened change of the yaw correction along relative constraint `i`, `(ψ_to − ψ_from) / σ_ψ`; `None`
-    /// without [`Self::yaw_relative_sigma_rad`].
+    /// without [`Self::yaw_relative_sigma_rad`] or when the constraint does not tie the yaw
+    /// ([`RelativeConstraint::ties_yaw`]).
     pub(super) fn relative_yaw_residual(&self, i: usize, state: &State) -> Option<f64> {
         let s = self.yaw_relative_sigma_rad?;
         let rc = &self.relative[i];
+        if !rc.ties_yaw {
+            return None;
+        }
         Some((state.yaw_correction_rad[rc.to] - state.yaw_correction_rad[rc.from]) / s)
     }
 
@@ -545,7 +549,7 @@ impl Prepared {
         }
         count += self.relative.len() * self.position_axes();
         if self.yaw_relative_sigma_rad.is_some() {
-            count += self.relative.len();
+            count += self.relative.iter().filter(|rc| rc.ties_yaw).count();
         }
         (total, count)
     }

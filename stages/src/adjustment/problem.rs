@@ -112,6 +112,10 @@ pub struct RelativeConstraint {
     /// recordings without aerial evidence of their own, whose σ already covers what the chain's anchors
     /// show ([`super::relative_bridge`]).
     pub held: bool,
+    /// Whether the constraint also ties the yaw corrections of `from` and `to` when
+    /// [`AdjustOptions::yaw_relative_sigma_deg`] is given; a chain whose common yaw correction the evidence
+    /// does not support is untied ([`super::yaw_support`]).
+    pub ties_yaw: bool,
 }
 
 impl RelativeConstraint {
@@ -124,6 +128,7 @@ impl RelativeConstraint {
             carry_xy: 1.0,
             carry_z: 1.0,
             held: false,
+            ties_yaw: true,
         }
     }
 
@@ -188,6 +193,10 @@ pub struct AdjustOptions {
     /// σ of the change of the yaw correction along each relative constraint, degrees (least squares; `None`
     /// = no such term). Used only with `estimate_yaw`.
     pub yaw_relative_sigma_deg: Option<f64>,
+    /// k of the significance test of a chain's common yaw correction, `|ψ̄| ≥ k·σ_ψ̄`, with relative yaw
+    /// terms: a chain that fails it is solved with per-recording yaw priors ([`super::yaw_support`]); 0 keeps
+    /// every chain tied.
+    pub yaw_tie_significance: f64,
     /// Residual weighting of panorama observations (thesis 5.7 methods 1–4).
     pub weighting: ResidualWeighting,
     /// Loss on panorama and control-point residuals (IRLS inside LM).
@@ -213,6 +222,7 @@ impl Default for AdjustOptions {
             estimate_yaw: false,
             yaw_prior_sigma_deg: None,
             yaw_relative_sigma_deg: None,
+            yaw_tie_significance: 0.0,
             weighting: ResidualWeighting::default(),
             loss: RobustLoss::Squared,
             relative_loss: RobustLoss::Squared,
@@ -445,6 +455,13 @@ impl AdjustOptions {
             self.yaw_relative_sigma_deg,
             "must be finite and > 0, or absent",
         )?;
+        if !(self.yaw_tie_significance.is_finite() && self.yaw_tie_significance >= 0.0) {
+            return Err(AdjustError::InvalidOption {
+                field: "yaw_tie_significance",
+                value: self.yaw_tie_significance,
+                hint: "must be finite and ≥ 0 (0 keeps every chain's yaw tied)",
+            });
+        }
         optional_positive(
             "relative_release_threshold",
             self.relative_release_threshold,

@@ -54,5 +54,6 @@ pub fn run(
         rejection_rounds: 0,
         build: Default::default(),
         relative_sigma: Default::default(),
+        yaw_chains: Vec::new(),
     }
 }

@@ -307,6 +307,7 @@ impl OutputsSpec {
             rejection_rounds: 0,
             build: Default::default(),
             relative_sigma: Default::default(),
+            yaw_chains: Vec::new(),
         };
         SyntheticOutputs {
             spec: *self,
