@@ -321,3 +321,40 @@ fn a_run_killed_mid_way_is_resumed_with_finished_nodes_reused() {
     assert!(cached >= 3, "finished nodes are reused: {m}");
     assert_eq!(engine(&m, "nodes_executed") + cached, 25);
 }
+
+#[test]
+fn a_relative_cache_path_is_reused_from_another_working_folder() {
+    // A generated campaign (`synth:`) records its folder in the cache; given as `--cache cache` from one
+    // folder and as `--cache ../cache` from a sub-folder, the cache is the same and nothing runs again.
+    let t = Toy::new(0, "");
+    std::fs::write(
+        t.wf(),
+        "name = \"toytest\"\npipeline = \"toy\"\ncampaign = \"synth:tiny\"\n\
+         stages = [\"toy_gen\", \"toy_parse\", \"toy_scale\", \"toy_sum\"]\n[toy_gen]\ncount = 3\n",
+    )
+    .unwrap();
+    let sub = t.dir.path().join("sub");
+    std::fs::create_dir_all(&sub).unwrap();
+    let run_from = |cwd: &Path, cache: &str, out: &str| {
+        let o = t
+            .cmd(&[
+                "run",
+                &t.wf().display().to_string(),
+                "--cache",
+                cache,
+                "--out",
+                out,
+                "--quiet",
+            ])
+            .current_dir(cwd)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", text(&o));
+        t.metrics(&cwd.join(out))
+    };
+    let first = run_from(t.dir.path(), "cache", "out1");
+    assert_eq!(engine(&first, "nodes_cached"), 0, "{first}");
+    let again = run_from(&sub, "../cache", "out2");
+    assert_eq!(engine(&again, "nodes_executed"), 0, "{again}");
+    assert_eq!(first["toy"]["sum"], again["toy"]["sum"]);
+}

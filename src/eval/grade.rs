@@ -255,6 +255,14 @@ pub fn grade_cell(out: &Path) -> Result<CellMetrics, String> {
             out.display()
         )
     })?;
+    if !campaign.is_dir() {
+        return Err(format!(
+            "{}: the campaign folder {} named by provenance.json is gone (its cache was moved or cleaned); \
+             run the cell again",
+            out.display(),
+            campaign.display()
+        ));
+    }
     if campaign.join("truth/recordings.csv").is_file() {
         let segments = segment_truth(out, &campaign)?;
         let off: Vec<&str> = segments

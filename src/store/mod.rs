@@ -104,10 +104,15 @@ impl Store {
 
     /// Opens the store at `root` as the local cache in front of the remote at `remote_url` (see [`remote`]
     /// for the URL forms); `None` is [`Store::open`].
+    /// A relative `root` is taken from the current folder and kept absolute: the paths of generated folders
+    /// recorded in results (a rendered campaign's folder, `provenance.json`) then name the same folder from
+    /// any working folder, and a run started elsewhere reuses them instead of regenerating them.
     pub fn open_with_remote(root: &Path, remote_url: Option<&str>) -> Result<Store, StoreError> {
         let remote = remote_url.map(Remote::open).transpose()?;
+        let root =
+            std::path::absolute(root).map_err(StoreError::io("locate cache folder", root))?;
         let store = Store {
-            root: root.to_path_buf(),
+            root: root.clone(),
             objects: root.join("objects"),
             records: root.join("records"),
             runs: root.join("runs"),
