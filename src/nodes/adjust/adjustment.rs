@@ -151,6 +151,9 @@ fn build_metrics(r: &AdjustmentRun) -> serde_json::Value {
         if !r.config.extrapolation_anchor {
             m.remove("extrapolation_anchors");
         }
+        if r.config.chain_end_min_aerial_observations <= 1 {
+            m.remove("chain_end_evidence_dropped");
+        }
         if !r.config.weak_control_sigma_estimated {
             m.remove("weak_control_sigma");
         }

@@ -6,6 +6,7 @@
 
 pub use super::block_point::{BlockPoint, PointKind};
 pub use super::build_counts::BuildCounts;
+use super::chain_end_evidence::drop_lone_chain_end_evidence;
 use super::config::{AdjustConfig, ControlWeighting};
 use super::control_screen::{
     aerial_observation_evidence, screen_control, EvidenceSource, SourcedEvidence,
@@ -114,7 +115,7 @@ pub fn build_block(
     );
     let Assembly {
         mut block,
-        points,
+        mut points,
         point_index,
         cameras,
         mut counts,
@@ -141,6 +142,12 @@ pub fn build_block(
             relative_constraints(inputs.recordings, config, relative_sigma.sigma_m);
         counts.relative_constraints = block.relative_constraints.len();
     }
+    drop_lone_chain_end_evidence(
+        &mut block,
+        &mut points,
+        config.chain_end_min_aerial_observations,
+        &mut counts,
+    );
     if config.extrapolation_anchor {
         let anchors = tail_anchors(&block, inputs.recordings, config, relative_sigma.sigma_m);
         counts.extrapolation_anchors = anchors.len();

@@ -29,6 +29,9 @@ pub struct BuildCounts {
     /// Control points not used because their correction disagrees with the control of the neighbouring
     /// recordings (`control_consistency_window`).
     pub inconsistent_control_dropped: usize,
+    /// Aerial points left out because they alone anchored a chain end with too few aerial observations
+    /// (`chain_end_min_aerial_observations`).
+    pub chain_end_evidence_dropped: usize,
     /// Recordings beyond the first or last recording with control tied to it (`extrapolation_anchor`).
     pub extrapolation_anchors: usize,
     /// Tie points whose height was observed from the terrain model (`dtm_tie_heights`).

@@ -207,6 +207,12 @@ crate::params! {
         /// How the σ of `extrapolation_anchor` grows with the number of recordings k from the anchor: σ_rel ×
         /// k^this (0.5: like k consecutive relative constraints; 0: the same σ at every distance).
         extrapolation_anchor_growth: f64 = 0.5, min 0.0, max 2.0;
+        /// Leave out the aerial evidence that alone anchors the end of a chain of recordings when it has fewer
+        /// aerial observations than this (ground control counts as 2; `adjustment::chain_end_evidence`): at a
+        /// chain end nothing checks it, and the recordings up to the next evidence would follow it whatever it
+        /// says. They follow the chain's other evidence instead (counted in `build.chain_end_evidence_dropped`;
+        /// with `relative_constraints`). 1 = no check.
+        chain_end_min_aerial_observations: usize = 1, min 1, max 10;
         /// Estimate a yaw correction per recording.
         estimate_yaw: bool = false;
         /// σ of the zero prior on each yaw correction.

@@ -23,6 +23,7 @@
 //! [`control_consistency`] (every control point checked against the neighbouring recordings' control),
 //! [`build_counts`] (what went into a block, for `metrics.json`), [`control_screen`] (the evidence of
 //! ground control and of aerial pixels in the bundle, and what the checks reject taken out of the block),
+//! [`chain_end_evidence`] (a chain end's lone aerial evidence left out when nothing can check it),
 //! [`extrapolation_anchor`] (recordings beyond the outermost control tied to its correction),
 //! [`second_pass`] (the shifted inputs of a second registration pass around the adjusted trajectory),
 //! [`verify`] (thesis Table 5-13 verification per trajectory
@@ -40,6 +41,7 @@ pub mod block_point;
 pub mod block_recordings;
 pub mod build_counts;
 pub mod campaign_checkpoints;
+pub mod chain_end_evidence;
 pub mod config;
 pub mod control_consistency;
 pub mod control_screen;
