@@ -48,9 +48,7 @@ fn chains(n: usize, constraints: &[RelativeConstraint]) -> Vec<(usize, usize)> {
     let mut start = 0;
     for i in 1..=n {
         if i == n || !linked_to_previous[i] {
-            if n > 0 {
-                out.push((start, i - 1));
-            }
+            out.push((start, i - 1));
             start = i;
         }
     }
@@ -244,5 +242,6 @@ mod tests {
         );
         assert_eq!(chains(6, &linked(6, Some(2))), [(0, 2), (3, 5)]);
         assert_eq!(chains(3, &[]), [(0, 0), (1, 1), (2, 2)]);
+        assert!(chains(0, &[]).is_empty());
     }
 }
