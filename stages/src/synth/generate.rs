@@ -37,7 +37,7 @@ use std::time::Instant;
 
 /// The identity of the generator stage (the rendered campaign with an error profile applied) in cache keys;
 /// bump the version whenever its output for the same inputs and parameters changes.
-pub const STAGE: StageId = StageId::new("synth", "3");
+pub const STAGE: StageId = StageId::new("synth", "4");
 
 /// The identity of the render stage (the error-free campaign of a [`RenderIdentity`]); bump the version
 /// whenever the generator renders differently (scenes, presets, cameras, looks).

@@ -62,7 +62,7 @@ pub const COMPONENTS: [(Component, &str, &str); 8] = [
     (
         Component::Outage,
         "outage",
-        "GNSS outage: error rising to 1.5-2 m and back, turning with the vehicle, random walk",
+        "GNSS outage: error rising to 1.5-2 m and back, growing in a direction that turns with the vehicle, random walk",
     ),
     (
         Component::Ins,
