@@ -114,7 +114,11 @@ impl Outage {
             .collect();
         let want = g.iter().copied().fold(0.0, f64::max);
         let got = drift.iter().map(|d| d[0].hypot(d[1])).fold(0.0, f64::max);
-        let scale = if got > 1e-12 { self.peak_m * want / got } else { 0.0 };
+        let scale = if got > 1e-12 {
+            self.peak_m * want / got
+        } else {
+            0.0
+        };
         for d in &mut drift {
             d[0] *= scale;
             d[1] *= scale;

@@ -127,12 +127,24 @@ fn outage_rises_to_its_peak_and_back_and_its_growth_turns_with_the_vehicle() {
     // 0 at both ends, the largest size equal to the peak.
     assert!(size(e[0]) < 1e-9 && size(e[40]) < 1e-9);
     let largest = e[..41].iter().map(|&v| size(v)).fold(0.0, f64::max);
-    assert!((largest - o.peak_m).abs() < 1e-9, "{largest} against {}", o.peak_m);
+    assert!(
+        (largest - o.peak_m).abs() < 1e-9,
+        "{largest} against {}",
+        o.peak_m
+    );
     // Near each end the error points about where it grows: `relative_azimuth_deg` from the local driving
     // direction (east before the bend, south after it; the other filter's solution pulls it by a few degrees),
     // so its direction turns with the bend over the outage.
-    assert!(angle_off(az(e[1]), 90.0 + o.relative_azimuth_deg) < 10.0, "{}", az(e[1]));
-    assert!(angle_off(az(e[39]), 180.0 + o.relative_azimuth_deg) < 10.0, "{}", az(e[39]));
+    assert!(
+        angle_off(az(e[1]), 90.0 + o.relative_azimuth_deg) < 10.0,
+        "{}",
+        az(e[1])
+    );
+    assert!(
+        angle_off(az(e[39]), 180.0 + o.relative_azimuth_deg) < 10.0,
+        "{}",
+        az(e[39])
+    );
     let turn = (az(e[39]) - az(e[1])).rem_euclid(360.0);
     assert!((70.0..=90.0).contains(&turn), "turned by {turn}°");
     // Continuous through the bend: no step between consecutive recordings larger than the rate allows
@@ -148,9 +160,15 @@ fn outage_rises_to_its_peak_and_back_and_its_growth_turns_with_the_vehicle() {
     assert_eq!((o1.start_m, o1.length_m), (0.0, 45.0));
     for (i, err) in e.iter().enumerate().skip(41) {
         let along = routes.along_m[i];
-        assert!((size(*err) - o1.drift_m(along)).abs() < 1e-9, "recording {i}");
+        assert!(
+            (size(*err) - o1.drift_m(along)).abs() < 1e-9,
+            "recording {i}"
+        );
         if o1.drift_m(along) > 1e-6 {
-            assert!(angle_off(az(*err), o1.relative_azimuth_deg) < 1e-6, "recording {i}");
+            assert!(
+                angle_off(az(*err), o1.relative_azimuth_deg) < 1e-6,
+                "recording {i}"
+            );
         }
     }
     assert!(e[41..].iter().any(|&v| size(v) > 0.1));
