@@ -3,6 +3,10 @@
 //! `x y z px py image [extras]`, `#` comments, pixel centres on integers), Metashape's reference CSV
 //! (`nxyzXYZ`) and projection list. The fixture lines are the documentation's own examples.
 
+use skytie_stages::adjustment::relative_noise::RelativeSigma;
+use skytie_stages::adjustment::{
+    AdjustConfig, AdjustmentRun, BlockPoint, BuildCounts, ObservationCounts, PointKind, RunPoint,
+};
 use skytie_stages::campaign::{AerialImage, AerialKind, Campaign, Recording};
 use skytie_stages::correspondence::{AerialControlPoint, AerialObservation, PanoObservation};
 use skytie_stages::export::{opensfm_projection, write_ground_control};
@@ -192,4 +196,92 @@ fn an_unknown_crs_skips_gcp_list_with_a_reason() {
     assert!(d.path().join("control_points.csv").exists());
     assert_eq!(opensfm_projection("epsg:25832").unwrap(), "EPSG:25832");
     assert!(opensfm_projection("+proj=utm +zone=32 +ellps=GRS80").is_ok());
+}
+
+/// An adjustment that used control point `used` and kept `left_out` as a mere tie point (its checks left the
+/// control out), both determined.
+fn run_with(used: &str, left_out: &str) -> AdjustmentRun {
+    let point = |id: &str, kind: PointKind, at: [f64; 3]| RunPoint {
+        point: BlockPoint {
+            id: id.into(),
+            kind,
+            pano: Vec::new(),
+            aerial: Vec::new(),
+        },
+        position_world: at,
+        determined: true,
+    };
+    AdjustmentRun {
+        config: AdjustConfig::default(),
+        recordings: Vec::new(),
+        points: vec![
+            point(used, PointKind::Control, [85000.225, 445000.5, 1.25]),
+            point(left_out, PointKind::Tie, [85002.0, 445001.0, 1.0]),
+        ],
+        aerial_images: Vec::new(),
+        iterations: 0,
+        termination: String::new(),
+        observations: ObservationCounts::default(),
+        rejected: ObservationCounts::default(),
+        rejected_total: 0,
+        final_cost: 0.0,
+        variance_factor: None,
+        redundancy: 0,
+        rejection_rounds: 0,
+        build: BuildCounts::default(),
+        relative_sigma: RelativeSigma::default(),
+        yaw_chains: Vec::new(),
+    }
+}
+
+#[test]
+fn control_the_adjustment_left_out_is_listed_but_not_handed_to_other_tools() {
+    let mut pts = control();
+    let mut wrong = pts[0].clone();
+    wrong.tie_point_id = "t 9".into();
+    wrong.point_world = Some([85001.0, 445000.0, 1.0]);
+    pts.push(wrong);
+    let d = tempfile::tempdir().unwrap();
+    let c = campaign("EPSG:28992");
+    let run = run_with("t 1", "t 9");
+    let e = write_ground_control(d.path(), &c, &[("nadir", &pts)], Some(&run)).unwrap();
+    assert_eq!(
+        (e.points, e.observations, e.left_out_by_adjustment),
+        (1, 4, 1)
+    );
+    let text = std::fs::read_to_string(d.path().join("gcp_list.txt")).unwrap();
+    let (_, lines) = read_gcp_list(&text).unwrap();
+    assert!(lines.iter().all(|l| l.6 == ["nadir_t_1"]), "{text}");
+    let reference = std::fs::read_to_string(d.path().join("metashape_reference.csv")).unwrap();
+    assert!(!reference.contains("t_9"), "{reference}");
+    let projections = std::fs::read_to_string(d.path().join("metashape_projections.csv")).unwrap();
+    assert!(!projections.contains("t_9"), "{projections}");
+
+    let mut r = csv::Reader::from_path(d.path().join("control_points.csv")).unwrap();
+    let h = r.headers().unwrap().clone();
+    let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+    let col = |name: &str| h.iter().position(|x| x == name).unwrap();
+    let row = |label: &str| rows.iter().find(|r| &r[0] == label).unwrap();
+    assert_eq!(rows.len(), 2);
+    assert_eq!(&row("nadir_t_1")[col("status")], "used");
+    let rx: f64 = row("nadir_t_1")[col("residual_x")].parse().unwrap();
+    assert!((rx - 0.1).abs() < 1e-9, "{rx}");
+    // The left-out point keeps its residual: how far the adjustment put it from its aerial triangulation.
+    assert_eq!(&row("nadir_t_9")[col("status")], "left_out");
+    let rx: f64 = row("nadir_t_9")[col("residual_x")].parse().unwrap();
+    assert!((rx - 1.0).abs() < 1e-9, "{rx}");
+}
+
+#[test]
+fn without_an_adjustment_every_control_point_is_handed_on_as_not_adjusted() {
+    let d = tempfile::tempdir().unwrap();
+    let pts = control();
+    let e =
+        write_ground_control(d.path(), &campaign("EPSG:28992"), &[("nadir", &pts)], None).unwrap();
+    assert_eq!(e.left_out_by_adjustment, 0);
+    let mut r = csv::Reader::from_path(d.path().join("control_points.csv")).unwrap();
+    let h = r.headers().unwrap().clone();
+    let status = h.iter().position(|x| x == "status").unwrap();
+    let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+    assert!(rows.iter().all(|r| &r[status] == "not_adjusted"));
 }

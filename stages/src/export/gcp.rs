@@ -10,26 +10,34 @@
 //!   their accuracies) and `metashape_projections.csv` (label, camera label = file name without extension,
 //!   file, u, v in Metashape's pixel convention, which is the campaign's: top-left image corner at (0, 0)).
 //! - `control_points.csv`: the plain list — label, source, point id, x, y, z, σ per axis, the numbers of
-//!   aerial and panorama observations and the adjusted point minus the aerial triangulation (empty when the
-//!   adjustment did not use the point).
+//!   aerial and panorama observations, the adjusted point minus the aerial triangulation (empty when the
+//!   adjustment did not determine the point) and the point's `status` ([`ControlStatus`]).
 //!
 //! Only points with an aerial triangulation (seen in ≥ 2 aerial images) are control; the others are counted
-//! in [`GcpExport::skipped_single_aerial`]. Labels are `<source>_<point id>` with white space replaced by `_`.
+//! in [`GcpExport::skipped_single_aerial`]. Control that the adjustment left out (its checks found it
+//! inconsistent with the neighbouring recordings' control, or too weak) is not handed to other tools: it is
+//! listed in `control_points.csv` with status `left_out` and counted in [`GcpExport::left_out_by_adjustment`],
+//! and kept out of `gcp_list.txt` and the Metashape files. Labels are `<source>_<point id>` with white space replaced by `_`.
 
 use crate::adjustment::AdjustmentRun;
+use crate::adjustment::PointKind;
 use crate::campaign::{AerialKind, Campaign};
 use crate::correspondence::AerialControlPoint;
 use crate::fsutil::atomic_write_with;
 use skytie_util::csv_out::quote;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::io::{self, Write};
 use std::path::Path;
 
 /// What [`write_ground_control`] wrote.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct GcpExport {
+    /// Control points in the tools' files (`gcp_list.txt`, the Metashape files).
     pub points: usize,
+    /// Their image observations.
     pub observations: usize,
+    /// Control points the adjustment left out: listed in `control_points.csv` only.
+    pub left_out_by_adjustment: usize,
     pub skipped_single_aerial: usize,
     /// Observations left out because their image is not in the campaign.
     pub skipped_unknown_image: usize,
@@ -38,6 +46,55 @@ pub struct GcpExport {
     pub gcp_list_skipped_names: usize,
     /// Why `gcp_list.txt` was not written (its projection line needs a known CRS).
     pub gcp_list_skipped: Option<String>,
+}
+
+/// What the adjustment made of a control point (`status` in `control_points.csv`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ControlStatus {
+    /// The adjustment used it as aerial control.
+    Used,
+    /// The adjustment left it out (its checks of the control), or did not include it.
+    LeftOut,
+    /// No adjustment to judge it (written without a run).
+    NotAdjusted,
+}
+
+impl ControlStatus {
+    /// The word written to `control_points.csv`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Used => "used",
+            Self::LeftOut => "left_out",
+            Self::NotAdjusted => "not_adjusted",
+        }
+    }
+}
+
+/// The ids of the points `run` used as aerial control (the others, also those it kept as mere tie points, were
+/// left out).
+fn used_as_control(run: &AdjustmentRun) -> HashSet<&str> {
+    run.points
+        .iter()
+        .filter(|p| p.point.kind != PointKind::Tie)
+        .map(|p| p.point.id.as_str())
+        .collect()
+}
+
+/// The status of every point of `gcps` under `run` (parallel to `gcps`).
+pub(crate) fn statuses(gcps: &[Gcp<'_>], run: Option<&AdjustmentRun>) -> Vec<ControlStatus> {
+    let Some(run) = run else {
+        return vec![ControlStatus::NotAdjusted; gcps.len()];
+    };
+    let used = used_as_control(run);
+    gcps.iter()
+        .map(|g| {
+            if used.contains(g.point.tie_point_id.as_str()) {
+                ControlStatus::Used
+            } else {
+                ControlStatus::LeftOut
+            }
+        })
+        .collect()
 }
 
 /// One control point ready for the writers.
@@ -150,20 +207,30 @@ pub fn write_ground_control(
     std::fs::create_dir_all(dir)?;
     let mut out = GcpExport::default();
     let gcps = collect(campaign, groups, &mut out);
+    let status = statuses(&gcps, run);
+    let delivered: Vec<&Gcp<'_>> = gcps
+        .iter()
+        .zip(&status)
+        .filter(|(_, &s)| s != ControlStatus::LeftOut)
+        .map(|(g, _)| g)
+        .collect();
+    out.left_out_by_adjustment = gcps.len() - delivered.len();
+    out.points = delivered.len();
+    out.observations = delivered.iter().map(|g| g.observations.len()).sum();
     match opensfm_projection(&campaign.crs) {
         Ok(projection) => {
             out.gcp_list_skipped_names =
-                write_gcp_list(&dir.join("gcp_list.txt"), &projection, &gcps)?
+                write_gcp_list(&dir.join("gcp_list.txt"), &projection, &delivered)?
         }
         Err(why) => out.gcp_list_skipped = Some(why),
     }
-    write_metashape(dir, &gcps)?;
-    write_point_list(&dir.join("control_points.csv"), &gcps, run)?;
+    write_metashape(dir, &delivered)?;
+    write_point_list(&dir.join("control_points.csv"), &gcps, &status, run)?;
     Ok(out)
 }
 
 /// Returns the number of observations left out for a file name with white space.
-fn write_gcp_list(path: &Path, projection: &str, gcps: &[Gcp<'_>]) -> io::Result<usize> {
+fn write_gcp_list(path: &Path, projection: &str, gcps: &[&Gcp<'_>]) -> io::Result<usize> {
     let mut skipped = 0;
     atomic_write_with(path, |w| {
         skipped = 0;
@@ -188,7 +255,7 @@ fn file_stem(file: &str) -> &str {
     name.rsplit_once('.').map_or(name, |(stem, _)| stem)
 }
 
-fn write_metashape(dir: &Path, gcps: &[Gcp<'_>]) -> io::Result<()> {
+fn write_metashape(dir: &Path, gcps: &[&Gcp<'_>]) -> io::Result<()> {
     atomic_write_with(&dir.join("metashape_reference.csv"), |w| {
         writeln!(w, "label,x,y,z,sigma_x,sigma_y,sigma_z")?;
         for g in gcps {
@@ -214,7 +281,12 @@ fn write_metashape(dir: &Path, gcps: &[Gcp<'_>]) -> io::Result<()> {
     })
 }
 
-fn write_point_list(path: &Path, gcps: &[Gcp<'_>], run: Option<&AdjustmentRun>) -> io::Result<()> {
+fn write_point_list(
+    path: &Path,
+    gcps: &[Gcp<'_>],
+    status: &[ControlStatus],
+    run: Option<&AdjustmentRun>,
+) -> io::Result<()> {
     let adjusted: HashMap<&str, [f64; 3]> = run
         .map(|r| {
             r.points
@@ -228,9 +300,9 @@ fn write_point_list(path: &Path, gcps: &[Gcp<'_>], run: Option<&AdjustmentRun>) 
         writeln!(
             w,
             "label,source,point_id,x,y,z,sigma_x,sigma_y,sigma_z,aerial_observations,panorama_observations,\
-             residual_x,residual_y,residual_z"
+             residual_x,residual_y,residual_z,status"
         )?;
-        for g in gcps {
+        for (g, status) in gcps.iter().zip(status) {
             let ([x, y, z], [sx, sy, sz]) = (g.xyz, g.sigma);
             let residual = adjusted
                 .get(g.point.tie_point_id.as_str())
@@ -238,12 +310,13 @@ fn write_point_list(path: &Path, gcps: &[Gcp<'_>], run: Option<&AdjustmentRun>) 
                 .unwrap_or_else(|| ",,".to_string());
             writeln!(
                 w,
-                "{},{},{},{x},{y},{z},{sx},{sy},{sz},{},{},{residual}",
+                "{},{},{},{x},{y},{z},{sx},{sy},{sz},{},{},{residual},{}",
                 quote(&g.label),
                 g.source,
                 quote(&g.point.tie_point_id),
                 g.point.aerial.len(),
-                g.point.mm.len()
+                g.point.mm.len(),
+                status.as_str()
             )?;
         }
         Ok(())

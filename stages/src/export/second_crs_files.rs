@@ -9,14 +9,15 @@
 //! - `corrections.csv` — the correction series with the columns of the campaign's `corrections.csv`, east and
 //!   north turned into the CRS's axes (its grid axes, or true east/north for a geographic CRS);
 //! - `control_points.csv` — a first line as above, then `label, source, point_id`, the aerial-triangulated
-//!   position in the CRS and its σ along the CRS's axes.
+//!   position in the CRS and its σ along the CRS's axes, for the control the adjustment used (as in
+//!   `ground_control/`'s files for other tools).
 //!
 //! Values in metres keep the campaign's scale: the two projections' scale factors differ by ~10⁻⁴, well
 //! below the precision of a correction.
 
 use super::corrections::CorrectionSeries;
 use super::corrections_csv::write_corrections_csv;
-use super::gcp::{collect, GcpExport};
+use super::gcp::{collect, statuses, ControlStatus, GcpExport};
 use crate::adjustment::AdjustmentRun;
 use crate::campaign::time::format_time_iso;
 use crate::campaign::Campaign;
@@ -149,8 +150,13 @@ fn turned_series(second: &SecondCrs, x: &SecondCrsRun<'_>) -> io::Result<Correct
 
 fn write_control_points(path: &Path, second: &SecondCrs, x: &SecondCrsRun<'_>) -> io::Result<()> {
     let gcps = collect(x.campaign, x.control, &mut GcpExport::default());
+    let status = statuses(&gcps, Some(x.run));
     let mut rows = Vec::with_capacity(gcps.len());
-    for g in &gcps {
+    for (g, _) in gcps
+        .iter()
+        .zip(&status)
+        .filter(|(_, &s)| s == ControlStatus::Used)
+    {
         let fail = |e: String| invalid(format!("control point '{}': {e}", g.label));
         let p = second.point(g.xyz).map_err(fail)?;
         let t = second.turn_deg(g.xyz[0], g.xyz[1]).map_err(fail)?;
