@@ -198,9 +198,9 @@ fn an_unknown_crs_skips_gcp_list_with_a_reason() {
     assert!(opensfm_projection("+proj=utm +zone=32 +ellps=GRS80").is_ok());
 }
 
-/// An adjustment that used control point `used` and kept `left_out` as a mere tie point (its checks left the
-/// control out), both determined.
-fn run_with(used: &str, left_out: &str) -> AdjustmentRun {
+/// An adjustment that used control point `used`, kept `left_out` as a mere tie point (its checks left the
+/// control out) and rejected an aerial observation of `rejected`, all determined.
+fn run_with(used: &str, left_out: &str, rejected: &str) -> AdjustmentRun {
     let point = |id: &str, kind: PointKind, at: [f64; 3]| RunPoint {
         point: BlockPoint {
             id: id.into(),
@@ -210,6 +210,7 @@ fn run_with(used: &str, left_out: &str) -> AdjustmentRun {
         },
         position_world: at,
         determined: true,
+        control_rejected: false,
     };
     AdjustmentRun {
         config: AdjustConfig::default(),
@@ -217,6 +218,10 @@ fn run_with(used: &str, left_out: &str) -> AdjustmentRun {
         points: vec![
             point(used, PointKind::Control, [85000.225, 445000.5, 1.25]),
             point(left_out, PointKind::Tie, [85002.0, 445001.0, 1.0]),
+            RunPoint {
+                control_rejected: true,
+                ..point(rejected, PointKind::Control, [85003.0, 445000.0, 1.0])
+            },
         ],
         aerial_images: Vec::new(),
         iterations: 0,
@@ -237,33 +242,45 @@ fn run_with(used: &str, left_out: &str) -> AdjustmentRun {
 #[test]
 fn control_the_adjustment_left_out_is_listed_but_not_handed_to_other_tools() {
     let mut pts = control();
-    let mut wrong = pts[0].clone();
-    wrong.tie_point_id = "t 9".into();
-    wrong.point_world = Some([85001.0, 445000.0, 1.0]);
-    pts.push(wrong);
+    for (id, at) in [
+        ("t 9", [85001.0, 445000.0, 1.0]),
+        ("t 8", [85001.0, 445000.0, 1.0]),
+    ] {
+        let mut wrong = pts[0].clone();
+        wrong.tie_point_id = id.into();
+        wrong.point_world = Some(at);
+        pts.push(wrong);
+    }
     let d = tempfile::tempdir().unwrap();
     let c = campaign("EPSG:28992");
-    let run = run_with("t 1", "t 9");
+    let run = run_with("t 1", "t 9", "t 8");
     let e = write_ground_control(d.path(), &c, &[("nadir", &pts)], Some(&run)).unwrap();
     assert_eq!(
         (e.points, e.observations, e.left_out_by_adjustment),
-        (1, 4, 1)
+        (1, 4, 2)
     );
     let text = std::fs::read_to_string(d.path().join("gcp_list.txt")).unwrap();
     let (_, lines) = read_gcp_list(&text).unwrap();
     assert!(lines.iter().all(|l| l.6 == ["nadir_t_1"]), "{text}");
     let reference = std::fs::read_to_string(d.path().join("metashape_reference.csv")).unwrap();
-    assert!(!reference.contains("t_9"), "{reference}");
+    assert!(
+        !reference.contains("t_9") && !reference.contains("t_8"),
+        "{reference}"
+    );
     let projections = std::fs::read_to_string(d.path().join("metashape_projections.csv")).unwrap();
-    assert!(!projections.contains("t_9"), "{projections}");
+    assert!(
+        !projections.contains("t_9") && !projections.contains("t_8"),
+        "{projections}"
+    );
 
     let mut r = csv::Reader::from_path(d.path().join("control_points.csv")).unwrap();
     let h = r.headers().unwrap().clone();
     let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
     let col = |name: &str| h.iter().position(|x| x == name).unwrap();
     let row = |label: &str| rows.iter().find(|r| &r[0] == label).unwrap();
-    assert_eq!(rows.len(), 2);
+    assert_eq!(rows.len(), 3);
     assert_eq!(&row("nadir_t_1")[col("status")], "used");
+    assert_eq!(&row("nadir_t_8")[col("status")], "rejected");
     let rx: f64 = row("nadir_t_1")[col("residual_x")].parse().unwrap();
     assert!((rx - 0.1).abs() < 1e-9, "{rx}");
     // The left-out point keeps its residual: how far the adjustment put it from its aerial triangulation.

@@ -22,7 +22,7 @@ pub use super::block_build::{
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("adjust", "16");
+pub const STAGE: StageId = StageId::new("adjust", "17");
 
 /// One adjusted recording.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -49,6 +49,10 @@ pub struct RunPoint {
     pub position_world: [f64; 3],
     /// Determined in the final solve (≥ 2 rays or a control point).
     pub determined: bool,
+    /// The adjustment rejected one of the point's aerial observations or its ground control as a gross
+    /// error (its control is then not to be trusted).
+    #[serde(default)]
+    pub control_rejected: bool,
 }
 
 /// Everything the adjust node reports (metrics: iterations, observations, rejected, cost).
@@ -128,6 +132,13 @@ pub fn run_in_frame(
             }
         })
         .collect();
+    let mut control_rejected = vec![false; build.points.len()];
+    for &i in &adj.rejected_aerial {
+        control_rejected[build.block.aerial_observations[i].point] = true;
+    }
+    for &i in &adj.rejected_control {
+        control_rejected[build.block.control_points[i].point] = true;
+    }
     let points = build
         .points
         .into_iter()
@@ -136,6 +147,7 @@ pub fn run_in_frame(
             point,
             position_world: adj.points_world[i].into(),
             determined: adj.point_determined[i],
+            control_rejected: control_rejected[i],
         })
         .collect();
     let rejected_total = adj.rejected.pano + adj.rejected.control + adj.rejected.aerial;

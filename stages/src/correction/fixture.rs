@@ -29,6 +29,7 @@ pub fn point(kind: PointKind, recs: &[usize]) -> RunPoint {
         },
         position_world: [0.0; 3],
         determined: true,
+        control_rejected: false,
     }
 }
 

@@ -14,10 +14,11 @@
 //!   adjustment did not determine the point) and the point's `status` ([`ControlStatus`]).
 //!
 //! Only points with an aerial triangulation (seen in ≥ 2 aerial images) are control; the others are counted
-//! in [`GcpExport::skipped_single_aerial`]. Control that the adjustment left out (its checks found it
-//! inconsistent with the neighbouring recordings' control, or too weak) is not handed to other tools: it is
-//! listed in `control_points.csv` with status `left_out` and counted in [`GcpExport::left_out_by_adjustment`],
-//! and kept out of `gcp_list.txt` and the Metashape files. Labels are `<source>_<point id>` with white space replaced by `_`.
+//! in [`GcpExport::skipped_single_aerial`]. Control that the adjustment did not use — its gross-error test
+//! rejected an aerial observation of it, or its checks left it out as inconsistent with the neighbouring
+//! recordings' control or too weak — is not handed to other tools: it is listed in `control_points.csv` with
+//! status `rejected` or `left_out`, counted in [`GcpExport::left_out_by_adjustment`], and kept out of
+//! `gcp_list.txt` and the Metashape files. Labels are `<source>_<point id>` with white space replaced by `_`.
 
 use crate::adjustment::AdjustmentRun;
 use crate::adjustment::PointKind;
@@ -25,7 +26,7 @@ use crate::campaign::{AerialKind, Campaign};
 use crate::correspondence::AerialControlPoint;
 use crate::fsutil::atomic_write_with;
 use skytie_util::csv_out::quote;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 use std::io::{self, Write};
 use std::path::Path;
 
@@ -36,7 +37,7 @@ pub struct GcpExport {
     pub points: usize,
     /// Their image observations.
     pub observations: usize,
-    /// Control points the adjustment left out: listed in `control_points.csv` only.
+    /// Control points the adjustment left out or rejected: listed in `control_points.csv` only.
     pub left_out_by_adjustment: usize,
     pub skipped_single_aerial: usize,
     /// Observations left out because their image is not in the campaign.
@@ -53,6 +54,8 @@ pub struct GcpExport {
 pub enum ControlStatus {
     /// The adjustment used it as aerial control.
     Used,
+    /// The adjustment's gross-error test rejected one of its aerial observations (or its ground control).
+    Rejected,
     /// The adjustment left it out (its checks of the control), or did not include it.
     LeftOut,
     /// No adjustment to judge it (written without a run).
@@ -64,20 +67,11 @@ impl ControlStatus {
     pub fn as_str(self) -> &'static str {
         match self {
             Self::Used => "used",
+            Self::Rejected => "rejected",
             Self::LeftOut => "left_out",
             Self::NotAdjusted => "not_adjusted",
         }
     }
-}
-
-/// The ids of the points `run` used as aerial control (the others, also those it kept as mere tie points, were
-/// left out).
-fn used_as_control(run: &AdjustmentRun) -> HashSet<&str> {
-    run.points
-        .iter()
-        .filter(|p| p.point.kind != PointKind::Tie)
-        .map(|p| p.point.id.as_str())
-        .collect()
 }
 
 /// The status of every point of `gcps` under `run` (parallel to `gcps`).
@@ -85,14 +79,26 @@ pub(crate) fn statuses(gcps: &[Gcp<'_>], run: Option<&AdjustmentRun>) -> Vec<Con
     let Some(run) = run else {
         return vec![ControlStatus::NotAdjusted; gcps.len()];
     };
-    let used = used_as_control(run);
+    let in_run: HashMap<&str, ControlStatus> = run
+        .points
+        .iter()
+        .map(|p| {
+            let status = if p.point.kind == PointKind::Tie {
+                ControlStatus::LeftOut
+            } else if p.control_rejected {
+                ControlStatus::Rejected
+            } else {
+                ControlStatus::Used
+            };
+            (p.point.id.as_str(), status)
+        })
+        .collect();
     gcps.iter()
         .map(|g| {
-            if used.contains(g.point.tie_point_id.as_str()) {
-                ControlStatus::Used
-            } else {
-                ControlStatus::LeftOut
-            }
+            in_run
+                .get(g.point.tie_point_id.as_str())
+                .copied()
+                .unwrap_or(ControlStatus::LeftOut)
         })
         .collect()
 }
@@ -211,7 +217,7 @@ pub fn write_ground_control(
     let delivered: Vec<&Gcp<'_>> = gcps
         .iter()
         .zip(&status)
-        .filter(|(_, &s)| s != ControlStatus::LeftOut)
+        .filter(|(_, &s)| matches!(s, ControlStatus::Used | ControlStatus::NotAdjusted))
         .map(|(g, _)| g)
         .collect();
     out.left_out_by_adjustment = gcps.len() - delivered.len();

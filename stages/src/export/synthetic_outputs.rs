@@ -245,6 +245,7 @@ impl OutputsSpec {
                 },
                 position_world: p.into(),
                 determined: true,
+                control_rejected: false,
             });
         }
         let mut checkpoints = Vec::new();
