@@ -66,9 +66,9 @@ impl Outage {
     /// `relative_azimuth_deg` from the driving direction. Integrated forward from the outage's start (error
     /// 0 there) and backward from its end (error 0 there, too), the two solutions agree on a straight route and
     /// differ past a bend; they are blended with weights inversely proportional to each one's error variance
-    /// (see [`backward_weight`]), as a two-filter smoother does. The result is scaled so that its largest size equals the largest
-    /// `peak · sin²(π t)` at these recordings: on a straight route it is exactly `peak · sin²(π t)` pointing
-    /// `relative_azimuth_deg` from the driving direction.
+    /// (the backward one weighs `t² / (t² + (1 − t)²)`), as a two-filter smoother does. The result is scaled
+    /// so that its largest size equals the largest `peak · sin²(π t)` at these recordings: on a straight route
+    /// it is exactly `peak · sin²(π t)` pointing `relative_azimuth_deg` from the driving direction.
     pub fn drift_world_m(&self, along_m: &[f64], heading_deg: &[f64]) -> Vec<[f64; 2]> {
         let n = along_m.len().min(heading_deg.len());
         if n == 0 {
@@ -214,8 +214,8 @@ impl OutageParams {
                  start, 1 at its end) on a straight route, growing in a direction {:.1}° clockwise from the \
                  driving direction (so the direction of growth turns with the vehicle; the error is that \
                  rate integrated forward from the start and backward from the end, blended with weights \
-                 t² / (t² + (1 − t)²) for the backward one and scaled to the peak), plus a random walk with N(0, {:.3} m) steps per recording and axis, tapered by \
-                 sin(π t);",
+                 t² / (t² + (1 − t)²) for the backward one and scaled to the peak), plus a random walk \
+                 with N(0, {:.3} m) steps per recording and axis, tapered by sin(π t);",
                 o.start_m,
                 o.start_m + o.length_m,
                 o.peak_m,
