@@ -88,7 +88,7 @@ pub fn write_exports(dir: &Path, x: &ExportInputs<'_>) -> Vec<String> {
         let path = dir.join("correspondences.csv");
         p.note(
             "correspondences.csv",
-            write_correspondences_csv(&path, &groups),
+            write_correspondences_csv(&path, &groups, x.report.map(|r| &r.run)),
         );
     }
     for (file, v) in [

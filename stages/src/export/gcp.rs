@@ -20,8 +20,8 @@
 //! status `rejected` or `left_out`, counted in [`GcpExport::left_out_by_adjustment`], and kept out of
 //! `gcp_list.txt` and the Metashape files. Labels are `<source>_<point id>` with white space replaced by `_`.
 
+use super::control_status::{ControlStatus, ControlStatuses};
 use crate::adjustment::AdjustmentRun;
-use crate::adjustment::PointKind;
 use crate::campaign::{AerialKind, Campaign};
 use crate::correspondence::AerialControlPoint;
 use crate::fsutil::atomic_write_with;
@@ -47,60 +47,6 @@ pub struct GcpExport {
     pub gcp_list_skipped_names: usize,
     /// Why `gcp_list.txt` was not written (its projection line needs a known CRS).
     pub gcp_list_skipped: Option<String>,
-}
-
-/// What the adjustment made of a control point (`status` in `control_points.csv`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ControlStatus {
-    /// The adjustment used it as aerial control.
-    Used,
-    /// The adjustment's gross-error test rejected one of its aerial observations (or its ground control).
-    Rejected,
-    /// The adjustment left it out (its checks of the control), or did not include it.
-    LeftOut,
-    /// No adjustment to judge it (written without a run).
-    NotAdjusted,
-}
-
-impl ControlStatus {
-    /// The word written to `control_points.csv`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Self::Used => "used",
-            Self::Rejected => "rejected",
-            Self::LeftOut => "left_out",
-            Self::NotAdjusted => "not_adjusted",
-        }
-    }
-}
-
-/// The status of every point of `gcps` under `run` (parallel to `gcps`).
-pub(crate) fn statuses(gcps: &[Gcp<'_>], run: Option<&AdjustmentRun>) -> Vec<ControlStatus> {
-    let Some(run) = run else {
-        return vec![ControlStatus::NotAdjusted; gcps.len()];
-    };
-    let in_run: HashMap<&str, ControlStatus> = run
-        .points
-        .iter()
-        .map(|p| {
-            let status = if p.point.kind == PointKind::Tie {
-                ControlStatus::LeftOut
-            } else if p.control_rejected {
-                ControlStatus::Rejected
-            } else {
-                ControlStatus::Used
-            };
-            (p.point.id.as_str(), status)
-        })
-        .collect();
-    gcps.iter()
-        .map(|g| {
-            in_run
-                .get(g.point.tie_point_id.as_str())
-                .copied()
-                .unwrap_or(ControlStatus::LeftOut)
-        })
-        .collect()
 }
 
 /// One control point ready for the writers.
@@ -213,11 +159,15 @@ pub fn write_ground_control(
     std::fs::create_dir_all(dir)?;
     let mut out = GcpExport::default();
     let gcps = collect(campaign, groups, &mut out);
-    let status = statuses(&gcps, run);
+    let statuses = ControlStatuses::of(run);
+    let status: Vec<ControlStatus> = gcps
+        .iter()
+        .map(|g| statuses.get(&g.point.tie_point_id))
+        .collect();
     let delivered: Vec<&Gcp<'_>> = gcps
         .iter()
         .zip(&status)
-        .filter(|(_, &s)| matches!(s, ControlStatus::Used | ControlStatus::NotAdjusted))
+        .filter(|(_, s)| s.delivered())
         .map(|(g, _)| g)
         .collect();
     out.left_out_by_adjustment = gcps.len() - delivered.len();

@@ -4,7 +4,8 @@
 //! [`corrections_csv`] `corrections.csv` (the correction time series of [`corrections`], each value with what
 //! supports it, [`crate::correction::support`]), [`geojson`] `trajectory.geojson` (QGIS), [`ply`] `tie_points.ply`
 //! (CloudCompare), [`checkpoints`] `checkpoints.csv` (per-point errors before/after), [`correspondences`]
-//! `correspondences.csv` (every control point's observations), [`gcp`] ground control for OpenSfM /
+//! `correspondences.csv` (every control point's observations), [`control_status`] what the adjustment made of
+//! each control point, [`gcp`] ground control for OpenSfM /
 //! OpenDroneMap, Metashape and as a plain list, [`gpkg`] `skytie.gpkg` (GeoPackage layers for GIS), [`colmap`] a COLMAP text
 //! model (`cameras.txt`, `images.txt`, `points3D.txt`) with COLMAP's EQUIRECTANGULAR model for the panoramas;
 //! [`second_crs_files`]: the adjusted trajectory, corrections and control points also in a second CRS
@@ -14,6 +15,7 @@
 
 pub mod checkpoints;
 pub mod colmap;
+pub mod control_status;
 pub mod corrections;
 pub mod corrections_csv;
 pub mod correspondences;
@@ -31,6 +33,7 @@ pub use checkpoints::{
     checkpoint_rows, write_checkpoint_errors_csv, CheckPointRow, CHECKPOINTS_CSV_HEADER,
 };
 pub use colmap::{write_colmap_model, ColmapExport};
+pub use control_status::{ControlStatus, ControlStatuses};
 pub use corrections::{Correction, CorrectionSeries, SampleKind};
 pub use corrections_csv::{write_corrections_csv, CORRECTIONS_CSV_HEADER, CORRECTION_STEP_S};
 pub use correspondences::{write_correspondences_csv, CORRESPONDENCES_CSV_HEADER};

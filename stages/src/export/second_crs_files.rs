@@ -15,9 +15,10 @@
 //! Values in metres keep the campaign's scale: the two projections' scale factors differ by ~10⁻⁴, well
 //! below the precision of a correction.
 
+use super::control_status::ControlStatuses;
 use super::corrections::CorrectionSeries;
 use super::corrections_csv::write_corrections_csv;
-use super::gcp::{collect, statuses, ControlStatus, GcpExport};
+use super::gcp::{collect, GcpExport};
 use crate::adjustment::AdjustmentRun;
 use crate::campaign::time::format_time_iso;
 use crate::campaign::Campaign;
@@ -150,12 +151,11 @@ fn turned_series(second: &SecondCrs, x: &SecondCrsRun<'_>) -> io::Result<Correct
 
 fn write_control_points(path: &Path, second: &SecondCrs, x: &SecondCrsRun<'_>) -> io::Result<()> {
     let gcps = collect(x.campaign, x.control, &mut GcpExport::default());
-    let status = statuses(&gcps, Some(x.run));
+    let statuses = ControlStatuses::of(Some(x.run));
     let mut rows = Vec::with_capacity(gcps.len());
-    for (g, _) in gcps
+    for g in gcps
         .iter()
-        .zip(&status)
-        .filter(|(_, &s)| s == ControlStatus::Used)
+        .filter(|g| statuses.get(&g.point.tie_point_id).delivered())
     {
         let fail = |e: String| invalid(format!("control point '{}': {e}", g.label));
         let p = second.point(g.xyz).map_err(fail)?;

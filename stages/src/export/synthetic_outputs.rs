@@ -399,7 +399,7 @@ pub fn write_outputs(s: &SyntheticOutputs, campaign: &Path, out: &Path) -> io::R
     );
     let groups: [(&str, &[AerialControlPoint]); 2] = [("nadir", &s.control), ("oblique", &[])];
     timed("correspondences.csv", &mut || {
-        write_correspondences_csv(&out.join("correspondences.csv"), &groups)
+        write_correspondences_csv(&out.join("correspondences.csv"), &groups, Some(&s.run))
     })?;
     timed("verification.csv", &mut || {
         write_verification_csv(&out.join("verification.csv"), &v)

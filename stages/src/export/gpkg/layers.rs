@@ -19,6 +19,7 @@ use crate::campaign::{CheckPoint, Recording};
 use crate::correction::support::recording_support;
 use crate::correspondence::AerialControlPoint;
 use crate::export::checkpoints::CheckPointRow;
+use crate::export::control_status::ControlStatuses;
 use crate::export::corrections::CorrectionSeries;
 use crate::positions::positions_by;
 use std::collections::HashMap;
@@ -207,9 +208,11 @@ fn control_layer(x: &RunLayers<'_>) -> Layer {
             ("residual_x_m", FieldType::Real),
             ("residual_y_m", FieldType::Real),
             ("residual_z_m", FieldType::Real),
+            ("status", FieldType::Text),
         ]),
         features: Vec::new(),
     };
+    let statuses = ControlStatuses::of(Some(x.run));
     for &(source, points) in x.control {
         for p in points {
             let Some(xyz) = p.point_world else {
@@ -227,6 +230,7 @@ fn control_layer(x: &RunLayers<'_>) -> Layer {
             values.extend(sigma.map(opt));
             values.extend([int(p.aerial.len()), int(p.mm.len())]);
             values.extend(res.map(opt));
+            values.push(text(statuses.get(&p.tie_point_id).as_str()));
             l.features.push((Geometry::PointZ(xyz), values));
         }
     }
