@@ -149,7 +149,8 @@ pub(crate) fn collect<'a>(
 }
 
 /// Writes the files of the module doc into `dir` (created when missing). `groups` are (source label,
-/// control points); `run` (optional) gives the residuals of `control_points.csv`.
+/// control points); `run` (optional) gives each point's status — only used control goes into the tools'
+/// files — and the residuals of `control_points.csv`.
 pub fn write_ground_control(
     dir: &Path,
     campaign: &Campaign,
