@@ -77,48 +77,29 @@ impl<'a> ControlStatuses<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::adjustment::relative_noise::RelativeSigma;
-    use crate::adjustment::{AdjustConfig, BlockPoint, BuildCounts, ObservationCounts, RunPoint};
+    use crate::adjustment::AdjustConfig;
+    use crate::correction::fixture;
 
-    fn point(id: &str, kind: PointKind, control_rejected: bool) -> RunPoint {
-        RunPoint {
-            point: BlockPoint {
-                id: id.into(),
-                kind,
-                pano: Vec::new(),
-                aerial: Vec::new(),
-            },
-            position_world: [0.0; 3],
-            determined: true,
-            control_rejected,
-        }
+    /// A determined point `id` of `kind`, its control rejected or not.
+    fn point(id: &str, kind: PointKind, control_rejected: bool) -> crate::adjustment::RunPoint {
+        let mut p = fixture::point(kind, &[0]);
+        p.point.id = id.into();
+        p.control_rejected = control_rejected;
+        p
     }
 
     #[test]
     fn each_point_gets_what_the_adjustment_made_of_it() {
-        let run = AdjustmentRun {
-            config: AdjustConfig::default(),
-            recordings: Vec::new(),
-            points: vec![
+        let run = fixture::run(
+            AdjustConfig::default(),
+            Vec::new(),
+            vec![
                 point("used", PointKind::Control, false),
                 point("single", PointKind::SingleAerial, false),
                 point("rejected", PointKind::Control, true),
                 point("left out", PointKind::Tie, false),
             ],
-            aerial_images: Vec::new(),
-            iterations: 0,
-            termination: String::new(),
-            observations: ObservationCounts::default(),
-            rejected: ObservationCounts::default(),
-            rejected_total: 0,
-            final_cost: 0.0,
-            variance_factor: None,
-            redundancy: 0,
-            rejection_rounds: 0,
-            build: BuildCounts::default(),
-            relative_sigma: RelativeSigma::default(),
-            yaw_chains: Vec::new(),
-        };
+        );
         let s = ControlStatuses::of(Some(&run));
         assert_eq!(s.get("used"), ControlStatus::Used);
         assert_eq!(s.get("single"), ControlStatus::Used);
