@@ -273,6 +273,42 @@ fn refinement_handles_larger_offsets_within_the_margin() {
 }
 
 #[test]
+fn corners_beside_the_mask_are_located_with_a_template_moved_off_centre() {
+    let pair = make_pair(11, 0.01);
+    let off = Similarity2::new(1.002, 0.003, 0.83, -0.61);
+    let initial = off.compose(&pair.truth);
+    let centred = params_at_peak_05();
+    let r0 = refine(&pair, &pair.aerial, initial, &centred);
+    assert!(r0.unusable_templates > 0, "some centred templates touch the masked block");
+    assert_eq!(
+        r0.tried,
+        r0.matches.len() + r0.unusable_templates + r0.beyond_search + r0.weak_peaks
+    );
+    let moved = RefineParams {
+        template_offset_px: 8,
+        ..params_at_peak_05()
+    };
+    moved.validate().unwrap();
+    let r = refine(&pair, &pair.aerial, initial, &moved);
+    println!(
+        "located {} centred, {} with offsets; unusable {} → {}",
+        r0.matches.len(),
+        r.matches.len(),
+        r0.unusable_templates,
+        r.unusable_templates
+    );
+    assert!(r.unusable_templates < r0.unusable_templates);
+    assert!(r.matches.len() > r0.matches.len());
+    // Every corner located centred is located identically; the corners added are as accurate.
+    for m in &r0.matches {
+        assert_eq!(match_of(&r, &m.tie_point_id), Some(m));
+    }
+    let (rms, max) = errors_px(&pair, &r);
+    assert!(rms < 0.1, "rms {rms}");
+    assert!(max < 0.25, "max {max}");
+}
+
+#[test]
 fn unrelated_aerial_content_gives_weak_peaks_that_are_rejected() {
     let pair = make_pair(3, 0.0);
     let other = make_pair(99, 0.0);
@@ -520,14 +556,7 @@ fn refinement_at(
     level: usize,
 ) -> AerialRefinement {
     AerialRefinement {
-        recording_id: "rec".into(),
-        aerial_id: row.image_id.clone(),
         tried: obs.len(),
-        parallax_rejected: 0,
-        shift_inconsistent: 0,
-        view_inconsistent: 0,
-        point_inconsistent: 0,
-        unconfirmed: 0,
         matches: obs
             .iter()
             .map(|(id, (u, v))| AerialMatch {
@@ -546,6 +575,7 @@ fn refinement_at(
                 view_disagreement_px: None,
             })
             .collect(),
+        ..AerialRefinement::empty("rec", &row.image_id)
     }
 }
 

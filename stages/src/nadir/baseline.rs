@@ -42,7 +42,7 @@ use nalgebra::{Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("baseline", "7");
+pub const STAGE: StageId = StageId::new("baseline", "8");
 
 crate::params! {
     /// Parameters of [`baseline_matches`]; thesis 2.2.3 values as defaults.

@@ -5,7 +5,8 @@
 //! of thesis 3.4.5.2. For every tie point:
 //! 1. ground point → MM ortho pixel (`OrthoGeoref::world_to_pixel`) → predicted aerial pixel (the transform);
 //! 2. MM template: `template_px²` ortho pixels around the corner; skipped if it leaves the ortho image, touches a
-//!    pixel masked by the vehicle, or is nearly flat (phase correlation of a flat patch is noise);
+//!    pixel masked by the vehicle, or is nearly flat (phase correlation of a flat patch is noise) — unless a
+//!    template moved off centre by up to `template_offset_px` is usable (the corner stays inside it);
 //!    It is also compared with the neighbouring recordings' views of the same corner (`parallax_check`): a
 //!    template showing content at another height than the corner (a kerb) is left out;
 //! 3. aerial window: the aerial image is **resampled onto the MM ortho grid** (bicubic, through the transform)
@@ -53,7 +54,7 @@ use nalgebra::{Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("refine", "11");
+pub const STAGE: StageId = StageId::new("refine", "12");
 
 /// Taper applied before the Fourier transform (serialisable mirror of [`WindowKind`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -92,6 +93,12 @@ crate::params! {
         min_peak: f64 = 0.75, min 0.0, below 1.0;
         /// Smallest standard deviation of the template grey values (0..1 scale); flatter templates are skipped.
         min_template_std: f64 = 0.01, min 0.0;
+        /// When the template centred on the corner touches a pixel masked by the vehicle or leaves the ortho
+        /// image, it may be moved off centre by up to this much per axis (at most a quarter of `template_px`;
+        /// nearest usable position first) so that it lies on valid pixels; the corner stays inside it and
+        /// moves with the shift found. Corners next to the vehicle (lane lines beside the car) are then located
+        /// instead of skipped. 0 = centred only (the thesis).
+        template_offset_px: usize = 0, unit "px", max 128;
         /// Parallax check (`nadir::parallax_check`): a corner is not located when a neighbouring recording that
         /// saw it shows more than this share of the template's structure differently. 1 = no check.
         max_parallax_share: f64 = 0.25, min 0.0, max 1.0;
@@ -239,8 +246,8 @@ fn new_buffers() -> Buffers {
 enum Outcome {
     /// Predicted outside the aerial image: not tried.
     Outside,
-    /// Tried but not located (template unusable, window outside, weak peak, shift too large).
-    Rejected,
+    /// Tried but not located: why.
+    NotLocated(Miss),
     /// Tried, but left out before phase correlation: a neighbouring view shows the template's structure
     /// differently (parallax check).
     Parallax,
@@ -249,33 +256,66 @@ enum Outcome {
     Located(AerialMatch),
 }
 
+/// Why a tried tie point was not located in the aerial image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Miss {
+    /// The template leaves the ortho image, touches a masked pixel or is nearly flat.
+    Template,
+    /// The search window leaves the aerial image.
+    Window,
+    /// The content found lies beyond the search margin.
+    Margin,
+    /// The correlation peak is below `min_peak`.
+    Peak,
+}
+
 /// Cut the template around the corner at ortho pixel (`u_o`, `v_o`) into `buf.template` (step 2 of the module
-/// documentation); its top-left pixel, or nothing when it leaves the ortho image, touches a masked pixel or is
-/// nearly flat.
+/// documentation); its top-left pixel, or nothing when the template is unusable at every offset of `offsets`
+/// ([`template_offsets`]) from the centred position (it leaves the ortho image, touches a masked pixel or is
+/// nearly flat). Offsets are tried in order, so the result is the centred template whenever that one is usable.
 fn cut_template(
     ortho: &OrthoImage,
-    u_o: f64,
-    v_o: f64,
+    (u_o, v_o): (f64, f64),
+    offsets: &[(isize, isize)],
     p: &RefineParams,
     buf: &mut Buffers,
 ) -> Option<(f64, f64)> {
     let half = p.template_px as f64 / 2.0;
-    let x0 = (u_o - half).round();
-    let y0 = (v_o - half).round();
-    (cut_ortho_template(
-        ortho,
-        x0 as isize,
-        y0 as isize,
-        p.template_px,
-        &mut buf.template,
-    ) && grey_std(&buf.template) >= p.min_template_std)
-        .then_some((x0, y0))
+    let x0 = (u_o - half).round() as isize;
+    let y0 = (v_o - half).round() as isize;
+    offsets.iter().find_map(|&(ox, oy)| {
+        let (x, y) = (x0 + ox, y0 + oy);
+        (cut_ortho_template(ortho, x, y, p.template_px, &mut buf.template)
+            && grey_std(&buf.template) >= p.min_template_std)
+            .then_some((x as f64, y as f64))
+    })
+}
+
+/// Template offsets (x, y) of `p.template_offset_px` at most per axis (and at most a quarter of the template, so
+/// the corner stays well inside the taper), nearest first (by Chebyshev ring, then Euclidean distance, then a fixed order), in
+/// steps of a quarter of that reach (at least 1 px); (0, 0) first.
+fn template_offsets(p: &RefineParams) -> Vec<(isize, isize)> {
+    let reach = p.template_offset_px.min(p.template_px / 4) as isize;
+    let step = (reach / 4).max(1);
+    let mut offsets: Vec<(isize, isize)> = (-reach..=reach)
+        .step_by(step as usize)
+        .flat_map(|ox| {
+            (-reach..=reach)
+                .step_by(step as usize)
+                .map(move |oy| (ox, oy))
+        })
+        .collect();
+    if !offsets.contains(&(0, 0)) {
+        offsets.push((0, 0));
+    }
+    offsets.sort_by_key(|&(ox, oy)| (ox.abs().max(oy.abs()), ox * ox + oy * oy, oy, ox));
+    offsets
 }
 
 /// Phase-correlation location of `template`, whose top-left pixel lies at (`x0`, `y0`) on the ortho grid
 /// (continuous), in `aerial`, which `tf` maps from ortho pixels (steps 3–5); `search` is scratch. Returns the
-/// shift of the template centre (ortho px) and the peak, or nothing when the window leaves the aerial image,
-/// the shift exceeds the margin or the peak is weak.
+/// shift of the template centre (ortho px) and the peak, or why not: the window leaves the aerial image, the
+/// shift exceeds the margin or the peak is weak.
 fn search_template(
     aerial: &GrayImage,
     tf: &Similarity2,
@@ -284,7 +324,7 @@ fn search_template(
     p: &RefineParams,
     phase: &PhaseCorrelationParams,
     search: &mut GrayImage,
-) -> Option<(f64, f64, f64)> {
+) -> Result<(f64, f64, f64), Miss> {
     let half = p.template_px as f64 / 2.0;
     let margin = p.search_margin_px as f64;
     let side = p.template_px + 2 * p.search_margin_px;
@@ -302,9 +342,9 @@ fn search_template(
             side,
             search,
         ) {
-            return None;
+            return Err(Miss::Window);
         }
-        let loc = locate_template(template, search, phase).ok()?;
+        let loc = locate_template(template, search, phase).map_err(|_| Miss::Peak)?;
         // Template centre in ortho-grid coordinates, and where it was found.
         let step_x = (x0 - margin + dx + loc.u_px) - (x0 + half) - dx;
         let step_y = (y0 - margin + dy + loc.v_px) - (y0 + half) - dy;
@@ -312,13 +352,17 @@ fn search_template(
         dy += step_y;
         peak = loc.peak;
         if !(dx.abs() <= margin && dy.abs() <= margin) {
-            return None;
+            return Err(Miss::Margin);
         }
         if step_x.hypot(step_y) < 0.02 {
             break;
         }
     }
-    (peak >= p.min_peak).then_some((dx, dy, peak))
+    if peak >= p.min_peak {
+        Ok((dx, dy, peak))
+    } else {
+        Err(Miss::Peak)
+    }
 }
 
 /// The neighbour among `neighbours` that saw the corner of `view`, with that view's pixel in its ortho image.
@@ -423,6 +467,7 @@ pub fn refine_in_image(
     let aerial_img = &aerial_window.window.image;
     let tf_window = aerial_window.ortho_to_window;
     let phase = p.phase_params();
+    let offsets = template_offsets(p);
     let n = window.tie_points.len().min(window.ground_world.len());
     let outcomes: Vec<Outcome> = (0..n)
         .into_par_iter()
@@ -432,8 +477,8 @@ pub fn refine_in_image(
             else {
                 return Outcome::Outside;
             };
-            let Some(corner) = cut_template(mm_ortho, u_o, v_o, p, buf) else {
-                return Outcome::Rejected;
+            let Some(corner) = cut_template(mm_ortho, (u_o, v_o), &offsets, p, buf) else {
+                return Outcome::NotLocated(Miss::Template);
             };
             if p.max_parallax_share < 1.0 {
                 let views = window.neighbour_ground_world.get(i).map_or(&[][..], |v| v);
@@ -450,7 +495,7 @@ pub fn refine_in_image(
                     }
                 }
             }
-            let Some((dx, dy, peak)) = search_template(
+            let found = search_template(
                 aerial_img,
                 &tf_window,
                 &buf.template,
@@ -458,8 +503,10 @@ pub fn refine_in_image(
                 p,
                 &phase,
                 &mut buf.search,
-            ) else {
-                return Outcome::Rejected;
+            );
+            let (dx, dy, peak) = match found {
+                Ok(f) => f,
+                Err(miss) => return Outcome::NotLocated(miss),
             };
             let views = window.neighbour_ground_world.get(i).map_or(&[][..], |v| v);
             let disagreement = (p.view_sigma_px > 0.0)
@@ -498,7 +545,14 @@ pub fn refine_in_image(
     for o in outcomes {
         match o {
             Outcome::Outside => {}
-            Outcome::Rejected => result.tried += 1,
+            Outcome::NotLocated(miss) => {
+                result.tried += 1;
+                match miss {
+                    Miss::Template => result.unusable_templates += 1,
+                    Miss::Window | Miss::Margin => result.beyond_search += 1,
+                    Miss::Peak => result.weak_peaks += 1,
+                }
+            }
             Outcome::Parallax => {
                 result.tried += 1;
                 result.parallax_rejected += 1;
@@ -580,7 +634,7 @@ fn view_disagreement_px(
     let (x0, y0) = found.template_origin;
     let mut worst: Option<f64> = None;
     let mut compare = |buf: &mut Buffers, origin: (f64, f64)| {
-        if let Some((dx, dy, _)) =
+        if let Ok((dx, dy, _)) =
             search_template(aerial, tf, &buf.view, origin, p, phase, &mut buf.search)
         {
             // `dx, dy` move this template's centre; the corner moves with it.

@@ -155,6 +155,17 @@ pub struct AerialRefinement {
     /// Of `tried`: not located because a neighbouring recording shows the template differently (parallax
     /// check, `nadir::parallax_check`).
     pub parallax_rejected: usize,
+    /// Of `tried`: no template could be cut (it leaves the ortho image, touches a masked pixel or is nearly
+    /// flat, `RefineParams::min_template_std`).
+    #[serde(default)]
+    pub unusable_templates: usize,
+    /// Of `tried`: the content was found beyond the search margin (`RefineParams::search_margin_px`) or the
+    /// search window left the aerial image.
+    #[serde(default)]
+    pub beyond_search: usize,
+    /// Of `tried`: the correlation peak stayed below `RefineParams::min_peak`.
+    #[serde(default)]
+    pub weak_peaks: usize,
     /// Of `tried`: located, but dropped because their correction disagrees with the image's other tie points
     /// (`RefineParams::max_shift_spread_px`).
     #[serde(default)]
@@ -181,6 +192,9 @@ impl AerialRefinement {
             aerial_id: aerial_id.to_string(),
             tried: 0,
             parallax_rejected: 0,
+            unusable_templates: 0,
+            beyond_search: 0,
+            weak_peaks: 0,
             shift_inconsistent: 0,
             view_inconsistent: 0,
             point_inconsistent: 0,

@@ -12,7 +12,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("nadir", "6");
+pub const STAGE: StageId = StageId::new("nadir", "7");
 
 /// See the module documentation. Counts, not grades.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -35,6 +35,15 @@ pub struct NadirSummary {
     /// Tie points × aerial images not located because a neighbouring recording shows the template differently
     /// (`nadir::parallax_check`).
     pub parallax_rejected: usize,
+    /// Tie points × aerial images not located: no usable template (masked, outside the ortho, flat).
+    #[serde(default)]
+    pub unusable_templates: usize,
+    /// Tie points × aerial images not located: found beyond the search margin or the window left the image.
+    #[serde(default)]
+    pub beyond_search: usize,
+    /// Tie points × aerial images not located: correlation peak below `RefineParams::min_peak`.
+    #[serde(default)]
+    pub weak_peaks: usize,
     /// Tie points × aerial images located but dropped: their correction disagrees with the other tie points of
     /// the recording in that image (`RefineParams::max_shift_spread_px`).
     pub shift_inconsistent: usize,
@@ -125,6 +134,9 @@ impl NadirSummary {
         for r in refinements {
             s.tie_points += r.matches.len();
             s.parallax_rejected += r.parallax_rejected;
+            s.unusable_templates += r.unusable_templates;
+            s.beyond_search += r.beyond_search;
+            s.weak_peaks += r.weak_peaks;
             s.shift_inconsistent += r.shift_inconsistent;
             s.view_inconsistent += r.view_inconsistent;
             s.point_inconsistent += r.point_inconsistent;
@@ -165,6 +177,9 @@ impl NadirSummary {
             "recordings_with_aerial_fraction": frac,
             "tie_points": self.tie_points,
             "parallax_rejected": self.parallax_rejected,
+            "unusable_templates": self.unusable_templates,
+            "beyond_search": self.beyond_search,
+            "weak_peaks": self.weak_peaks,
             "shift_inconsistent": self.shift_inconsistent,
             "view_inconsistent": self.view_inconsistent,
             "point_inconsistent": self.point_inconsistent,

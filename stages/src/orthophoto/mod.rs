@@ -27,7 +27,7 @@ use crate::params::StageId;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("orthophoto", "8");
+pub const STAGE: StageId = StageId::new("orthophoto", "9");
 
 crate::params! {
     /// Parameters of the orthophoto route (registration, refinement and control points).
