@@ -279,7 +279,10 @@ fn corners_beside_the_mask_are_located_with_a_template_moved_off_centre() {
     let initial = off.compose(&pair.truth);
     let centred = params_at_peak_05();
     let r0 = refine(&pair, &pair.aerial, initial, &centred);
-    assert!(r0.unusable_templates > 0, "some centred templates touch the masked block");
+    assert!(
+        r0.unusable_templates > 0,
+        "some centred templates touch the masked block"
+    );
     assert_eq!(
         r0.tried,
         r0.matches.len() + r0.unusable_templates + r0.beyond_search + r0.weak_peaks
