@@ -147,8 +147,8 @@ fn correction_rows(t: Option<&CsvTable>) -> Option<HashMap<String, CorrectionRow
     Some(out)
 }
 
-/// Per recording id in `wanted`: the number of distinct control points (source, point id) it observes, from
-/// `correspondences.csv` (streamed); `None` without the file.
+/// Per recording id in `wanted`: the number of distinct control points (source, point id) it observes that the
+/// adjustment did not reject or leave out, from `correspondences.csv` (streamed); `None` without the file.
 fn control_counts(
     set_dir: &Path,
     wanted: &HashMap<&str, usize>,
@@ -157,11 +157,12 @@ fn control_counts(
         vec![Default::default(); wanted.len()];
     let mut cols = None;
     let found = for_each_row(&set_dir.join("correspondences.csv"), |c, r| {
-        let [k, i, s, p] = *cols.get_or_insert_with(|| {
-            ["image_kind", "image_id", "source", "point_id"].map(|n| c.col(n).unwrap_or(usize::MAX))
+        let [k, i, s, p, st] = *cols.get_or_insert_with(|| {
+            ["image_kind", "image_id", "source", "point_id", "status"]
+                .map(|n| c.col(n).unwrap_or(usize::MAX))
         });
         let cell = |j: usize| r.get(j).unwrap_or("");
-        if cell(k) != "panorama" {
+        if cell(k) != "panorama" || !super::map_data::counts_as_control(cell(st)) {
             return;
         }
         if let Some(&slot) = wanted.get(cell(i)) {

@@ -138,11 +138,21 @@ impl GeoPoints {
     }
 }
 
-/// Recording image ids with at least one panorama observation of a nadir / oblique control point.
+/// Whether a `correspondences.csv` row's `status` lets its point count as control in the report: every
+/// status except the adjustment's `rejected` and `left_out` (a file without the column counts every row).
+pub fn counts_as_control(status: &str) -> bool {
+    !matches!(status, "rejected" | "left_out")
+}
+
+/// Recording image ids with at least one panorama observation of a nadir / oblique control point that the
+/// adjustment did not reject or leave out ([`counts_as_control`]).
 pub fn correspondence_sets(corr: Option<&CsvTable>) -> (BTreeSet<String>, BTreeSet<String>) {
     let (mut nadir, mut oblique) = (BTreeSet::new(), BTreeSet::new());
     if let Some(t) = corr {
         for r in &t.rows {
+            if !counts_as_control(t.text(r, "status")) {
+                continue;
+            }
             add_correspondence(
                 t.text(r, "image_kind"),
                 t.text(r, "source"),
@@ -178,10 +188,13 @@ fn correspondence_sets_of(path: &Path) -> Result<(BTreeSet<String>, BTreeSet<Str
     let (mut nadir, mut oblique) = (BTreeSet::new(), BTreeSet::new());
     let mut cols = None;
     for_each_row(path, |c, r| {
-        let [k, s, i] = *cols.get_or_insert_with(|| {
-            ["image_kind", "source", "image_id"].map(|n| c.col(n).unwrap_or(usize::MAX))
+        let [k, s, i, st] = *cols.get_or_insert_with(|| {
+            ["image_kind", "source", "image_id", "status"].map(|n| c.col(n).unwrap_or(usize::MAX))
         });
         let cell = |j: usize| r.get(j).unwrap_or("");
+        if !counts_as_control(cell(st)) {
+            return;
+        }
         add_correspondence(cell(k), cell(s), cell(i), (&mut nadir, &mut oblique));
     })?;
     Ok((nadir, oblique))
@@ -515,6 +528,28 @@ mod tests {
         let (n, o) = correspondence_sets(Some(&t));
         assert_eq!(n.into_iter().collect::<Vec<_>>(), vec!["a"]);
         assert_eq!(o.into_iter().collect::<Vec<_>>(), vec!["a", "b"]);
+        // With the adjustment's status: rejected and left-out points are not control.
+        let t = CsvTable::from_cells(
+            &skytie_stages::export::CORRESPONDENCES_CSV_HEADER,
+            &[
+                &["nadir", "p1", "panorama", "a", "1", "2", "", "used"],
+                &["nadir", "p3", "panorama", "c", "1", "2", "", "rejected"],
+                &["oblique", "p2", "panorama", "b", "1", "2", "", "left_out"],
+                &[
+                    "oblique",
+                    "p4",
+                    "panorama",
+                    "d",
+                    "1",
+                    "2",
+                    "",
+                    "not_adjusted",
+                ],
+            ],
+        );
+        let (n, o) = correspondence_sets(Some(&t));
+        assert_eq!(n.into_iter().collect::<Vec<_>>(), vec!["a"]);
+        assert_eq!(o.into_iter().collect::<Vec<_>>(), vec!["d"]);
     }
 
     #[test]
