@@ -11,7 +11,23 @@ use skytie_stages::adjustment::verify::{
 };
 use skytie_stages::adjustment::SyntheticBlockSpec;
 
+/// [`campaign`] without deterioration and with 120 control points instead of 30.
+fn dense_campaign(seed: u64) -> SyntheticCampaign {
+    let mut spec = campaign_spec(0.0, 0.0, 0.5, seed);
+    spec.block.control_points = 120;
+    spec.generate()
+}
+
 fn campaign(systematic_m: f64, random_m: f64, noise_px: f64, seed: u64) -> SyntheticCampaign {
+    campaign_spec(systematic_m, random_m, noise_px, seed).generate()
+}
+
+fn campaign_spec(
+    systematic_m: f64,
+    random_m: f64,
+    noise_px: f64,
+    seed: u64,
+) -> SyntheticCampaignSpec {
     SyntheticCampaignSpec {
         block: SyntheticBlockSpec {
             recordings: 60,
@@ -27,7 +43,6 @@ fn campaign(systematic_m: f64, random_m: f64, noise_px: f64, seed: u64) -> Synth
         single_aerial_every: 5,
         ..SyntheticCampaignSpec::default()
     }
-    .generate()
 }
 
 #[test]
@@ -146,8 +161,9 @@ fn segments_by_length_and_csv_round_trip() {
 }
 
 /// A GNSS outage: the middle segment's recordings drift 1 m east, then 1 m west, so the segment's mean offset is
-/// near zero and proves nothing; its points are each 1 m off, which fails it. One wrong aerial point in an
-/// otherwise exact segment is not enough to fail that segment.
+/// near zero and proves nothing; its points are each 1 m off, which fails it. Wrong aerial points in an
+/// otherwise exact segment do not fail that segment: the points seen from the same recordings outvote them
+/// (each point on its own, two of them would).
 #[test]
 fn a_drifting_segment_fails_on_its_points_and_a_single_wrong_point_does_not() {
     let mut c = campaign(0.0, 0.0, 0.5, 4);
@@ -167,16 +183,46 @@ fn a_drifting_segment_fails_on_its_points_and_a_single_wrong_point_does_not() {
     for s in [&v.segments[0], &v.segments[2]] {
         assert_eq!(s.status, VerifyStatus::Pass, "segment {}", s.index);
     }
-    // One aerial point 2 m wrong in the last segment: counted, but the segment still passes.
-    let first = v.points.iter().find(|p| p.segment == 2).unwrap();
-    let id = first.tie_point_id.clone();
-    let mut wrong = c.control.clone();
-    let cp = wrong.iter_mut().find(|cp| cp.tie_point_id == id).unwrap();
-    let p = cp.point_world.as_mut().unwrap();
-    p[1] += 2.0;
-    let v = verify(&c.recordings, &c.pano_size_px, &wrong, &config).unwrap();
-    assert_eq!(v.segments[2].points_off, 1);
+    // Two aerial points of the last segment 2 m wrong, seen from the same recordings as exact ones (a campaign
+    // with four times the control points, so that each recording sees several).
+    let mut c = dense_campaign(4);
+    for (i, r) in c.recordings.iter_mut().enumerate().take(40).skip(20) {
+        r.x += if i < 30 { 1.0 } else { -1.0 };
+    }
+    let v = verify(&c.recordings, &c.pano_size_px, &c.control, &config).unwrap();
+    assert!(
+        v.segments[2].points_off <= 1,
+        "only a point also seen from recording 39"
+    );
     assert_eq!(v.segments[2].status, VerifyStatus::Pass);
+    let off_before = v.segments[2].points_off;
+    // Two points well inside the segment.
+    let ids: Vec<String> = v
+        .points
+        .iter()
+        .filter(|p| p.segment == 2 && p.observed_from.iter().all(|&r| r >= 45))
+        .take(2)
+        .map(|p| p.tie_point_id.clone())
+        .collect();
+    let mut wrong = c.control.clone();
+    for id in &ids {
+        let cp = wrong.iter_mut().find(|cp| &cp.tie_point_id == id).unwrap();
+        let p = cp.point_world.as_mut().unwrap();
+        p[1] += 2.0;
+    }
+    let each_alone = VerifyConfig {
+        min_neighbours: 0,
+        ..VerifyConfig::default()
+    };
+    assert_eq!(ids.len(), 2);
+    let alone = verify(&c.recordings, &c.pano_size_px, &wrong, &each_alone).unwrap();
+    assert_eq!(alone.segments[2].points_off, off_before + 2);
+    assert_eq!(alone.segments[2].status, VerifyStatus::Fail);
+    let v = verify(&c.recordings, &c.pano_size_px, &wrong, &config).unwrap();
+    assert_eq!(v.segments[2].points_off, off_before);
+    assert_eq!(v.segments[2].status, VerifyStatus::Pass);
+    // The drifted segment still fails: its points' neighbours are off with them.
+    assert_eq!(v.segments[1].status, VerifyStatus::Fail);
 }
 
 /// The middle segment's second half drifts 1 m and has no point of its own: its points, all in the good first

@@ -11,7 +11,8 @@
 //! *significantly* — the horizontal offset minus `confidence_k` σ of it above `tolerance_xy_m`, or (with
 //! `check_height`) |mean Z| minus `confidence_k` σ above `tolerance_z_m` — or when at least
 //! `min_points_off` points each show a horizontal offset beyond `tolerance_xy_m` by more than `confidence_k`
-//! of their own σ: a trajectory that drifts within a segment (a GNSS outage) has a mean that proves nothing,
+//! of their own σ — and the points seen from the same recordings agree (`min_neighbours`: their median offset is
+//! off too): a trajectory that drifts within a segment (a GNSS outage) has a mean that proves nothing,
 //! its spread is the evidence; otherwise `insufficient` with fewer than `min_points` points or when the points
 //! leave a run of at least `max_unobserved_share` of the segment's recordings unobserved (they vouch only for
 //! the recordings they were observed from), `pass` otherwise.
@@ -24,6 +25,7 @@
 use super::id_index::index_by_id;
 use crate::campaign::Recording;
 use crate::correspondence::AerialControlPoint;
+use crate::estimators::median_consensus::median_in_place;
 use crate::geometry::{triangulate_rays, PanoramaCamera};
 use crate::params::{describe, Params, StageId};
 use nalgebra::{Matrix3, Vector3};
@@ -35,7 +37,7 @@ use std::path::Path;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("verify", "7");
+pub const STAGE: StageId = StageId::new("verify", "8");
 
 crate::params! {
     /// Parameters of a verification (the verify node's params).
@@ -59,6 +61,13 @@ crate::params! {
         /// (horizontal offset minus `confidence_k` σ of that point): the recordings near them are off,
         /// whatever the segment's mean says.
         min_points_off: usize = 2, min 1;
+        /// A point counts as off (`min_points_off`) only when the points observed from the same recordings
+        /// agree: with at least `min_neighbours` points sharing one of its recordings (itself included), the
+        /// component-wise median of their offsets must be off as well (beyond `tolerance_xy_m` by more than
+        /// `confidence_k` of the point's σ). A drifted trajectory moves every point seen from the drifted
+        /// recordings; a wrong correspondence moves its own point only (and a window registered at a wrong
+        /// place, the few points of that window). 0 = each point on its own.
+        min_neighbours: usize = 5;
         /// A segment passes only when its points cover it: a run of consecutive recordings from which none of
         /// its compared points was observed, as long as this share of the segment's recordings or longer, gives
         /// `insufficient` instead of `pass` (the points vouch for the part of the segment they lie in, not for
@@ -380,7 +389,7 @@ fn statistics(
     let offset_2d = mean[0].hypot(mean[1]);
     let points_off = points
         .iter()
-        .filter(|p| point_significantly_off(p, config))
+        .filter(|p| point_significantly_off(p, config) && neighbours_agree_off(p, points, config))
         .count();
     let unobserved_run = if recordings == 0 {
         0
@@ -443,8 +452,41 @@ fn longest_unobserved_run(span: RangeInclusive<usize>, points: &[&VerifiedPoint]
 /// True when the point's horizontal offset exceeds `tolerance_xy_m` by more than `confidence_k` of its own
 /// horizontal σ (the root of the two variances, a bound on the σ in any horizontal direction).
 fn point_significantly_off(p: &VerifiedPoint, config: &VerifyConfig) -> bool {
+    significantly_off([p.offset_m[0], p.offset_m[1]], p, config)
+}
+
+/// True when the horizontal offset `offset_xy_m` exceeds `tolerance_xy_m` by more than `confidence_k` of `p`'s
+/// horizontal σ.
+fn significantly_off(offset_xy_m: [f64; 2], p: &VerifiedPoint, config: &VerifyConfig) -> bool {
     let sigma_2d = (p.variance_m2[0] + p.variance_m2[1]).max(0.0).sqrt();
-    p.offset_m[0].hypot(p.offset_m[1]) - config.confidence_k * sigma_2d > config.tolerance_xy_m
+    offset_xy_m[0].hypot(offset_xy_m[1]) - config.confidence_k * sigma_2d > config.tolerance_xy_m
+}
+
+/// With `min_neighbours` > 0: whether the points of `points` that share a recording with `p` (itself included)
+/// are off as a whole — their component-wise median horizontal offset beyond `tolerance_xy_m` by more than
+/// `confidence_k` of `p`'s σ; `true` when fewer than `min_neighbours` share one (too few to outvote it).
+fn neighbours_agree_off(
+    p: &VerifiedPoint,
+    points: &[&VerifiedPoint],
+    config: &VerifyConfig,
+) -> bool {
+    if config.min_neighbours == 0 {
+        return true;
+    }
+    let shares = |q: &VerifiedPoint| q.observed_from.iter().any(|r| p.observed_from.contains(r));
+    let mut xs = Vec::new();
+    let mut ys = Vec::new();
+    for q in points.iter().filter(|q| shares(q)) {
+        xs.push(q.offset_m[0]);
+        ys.push(q.offset_m[1]);
+    }
+    if xs.len() < config.min_neighbours {
+        return true;
+    }
+    let (Some(mx), Some(my)) = (median_in_place(&mut xs), median_in_place(&mut ys)) else {
+        return true;
+    };
+    significantly_off([mx, my], p, config)
 }
 
 /// Column names of `verification.csv`.
