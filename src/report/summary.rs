@@ -210,7 +210,49 @@ fn problems(b: &mut Builder, page: &mut Page, run: &RunOutputs) {
                 ]);
             }
         }
+        const NOT_LOCATED: &str = "nadir tie point (× aerial image) not located";
+        const DROPPED: &str = "nadir tie point (× aerial image) located, dropped";
         for (key, what, reason) in [
+            (
+                "nadir.unusable_templates",
+                NOT_LOCATED,
+                "no usable template (touches the vehicle mask, leaves the ortho, or flat)",
+            ),
+            (
+                "nadir.weak_peaks",
+                NOT_LOCATED,
+                "correlation peak below min_peak",
+            ),
+            (
+                "nadir.beyond_search",
+                NOT_LOCATED,
+                "found beyond the search margin",
+            ),
+            (
+                "nadir.parallax_rejected",
+                NOT_LOCATED,
+                "a neighbouring recording shows the template differently (parallax)",
+            ),
+            (
+                "nadir.point_inconsistent",
+                DROPPED,
+                "departs from its MM object point more than the image's other corners",
+            ),
+            (
+                "nadir.shift_inconsistent",
+                DROPPED,
+                "its correction disagrees with the image's other corners",
+            ),
+            (
+                "nadir.view_inconsistent",
+                DROPPED,
+                "another view of the corner lands elsewhere",
+            ),
+            (
+                "nadir.unconfirmed",
+                DROPPED,
+                "too few located in that image (min_located)",
+            ),
             (
                 "verify.skipped_single_aerial",
                 "verification point skipped",
