@@ -99,6 +99,27 @@ fn report_of_a_tiny_run() {
             );
         }
     }
+    // The rejections table carries the nadir refinement's funnel as metrics.json counts it.
+    let metrics: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("metrics.json")).unwrap()).unwrap();
+    let rejections = std::fs::read_to_string(report.join("tables/summary-rejections.csv")).unwrap();
+    let mut listed = 0;
+    for (key, reason) in [
+        ("unusable_templates", "no usable template"),
+        ("weak_peaks", "correlation peak below min_peak"),
+        ("beyond_search", "found beyond the search margin"),
+    ] {
+        let n = metrics["nadir"][key].as_u64().unwrap();
+        let row = rejections.lines().find(|l| l.contains(reason));
+        if n == 0 {
+            assert!(row.is_none(), "{key} is 0 but listed");
+        } else {
+            let row = row.unwrap_or_else(|| panic!("{key} = {n} not listed"));
+            assert!(row.ends_with(&format!(",{n}")), "{row} vs {key} = {n}");
+            listed += 1;
+        }
+    }
+    assert!(listed > 0, "the tiny run locates every tie point it tries");
     // The run's own log (times, nodes executed / cached) is kept apart from the result tables.
     for id in ["summary-engine", "summary-stages"] {
         assert!(
