@@ -31,6 +31,7 @@ use crate::params::{describe, Params, StageId};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use skytie_util::csv_out::{quote, write_csv};
+use std::collections::BTreeMap;
 use std::io::{self, Write};
 use std::ops::RangeInclusive;
 use std::path::Path;
@@ -387,9 +388,13 @@ fn statistics(
         }
     }
     let offset_2d = mean[0].hypot(mean[1]);
+    let by_recording = points_by_recording(points);
     let points_off = points
         .iter()
-        .filter(|p| point_significantly_off(p, config) && neighbours_agree_off(p, points, config))
+        .filter(|p| {
+            point_significantly_off(p, config)
+                && neighbours_agree_off(p, points, &by_recording, config)
+        })
         .count();
     let unobserved_run = if recordings == 0 {
         0
@@ -462,27 +467,44 @@ fn significantly_off(offset_xy_m: [f64; 2], p: &VerifiedPoint, config: &VerifyCo
     offset_xy_m[0].hypot(offset_xy_m[1]) - config.confidence_k * sigma_2d > config.tolerance_xy_m
 }
 
-/// With `min_neighbours` > 0: whether the points of `points` that share a recording with `p` (itself included)
-/// are off as a whole — their component-wise median horizontal offset beyond `tolerance_xy_m` by more than
-/// `confidence_k` of `p`'s σ; `true` when fewer than `min_neighbours` share one (too few to outvote it).
+/// For each recording index, the positions in `points` of the points observed from it.
+fn points_by_recording(points: &[&VerifiedPoint]) -> BTreeMap<usize, Vec<usize>> {
+    let mut by_recording: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for (k, p) in points.iter().enumerate() {
+        for &r in &p.observed_from {
+            by_recording.entry(r).or_default().push(k);
+        }
+    }
+    by_recording
+}
+
+/// With `min_neighbours` > 0: whether the points of `points` that share a recording with `p` (itself included;
+/// found through `by_recording`, [`points_by_recording`]) are off as a whole — their component-wise median
+/// horizontal offset beyond `tolerance_xy_m` by more than `confidence_k` of `p`'s σ; `true` when fewer than
+/// `min_neighbours` share one (too few to outvote it).
 fn neighbours_agree_off(
     p: &VerifiedPoint,
     points: &[&VerifiedPoint],
+    by_recording: &BTreeMap<usize, Vec<usize>>,
     config: &VerifyConfig,
 ) -> bool {
     if config.min_neighbours == 0 {
         return true;
     }
-    let shares = |q: &VerifiedPoint| q.observed_from.iter().any(|r| p.observed_from.contains(r));
-    let mut xs = Vec::new();
-    let mut ys = Vec::new();
-    for q in points.iter().filter(|q| shares(q)) {
-        xs.push(q.offset_m[0]);
-        ys.push(q.offset_m[1]);
-    }
-    if xs.len() < config.min_neighbours {
+    let mut sharing: Vec<usize> = p
+        .observed_from
+        .iter()
+        .filter_map(|r| by_recording.get(r))
+        .flatten()
+        .copied()
+        .collect();
+    sharing.sort_unstable();
+    sharing.dedup();
+    if sharing.len() < config.min_neighbours {
         return true;
     }
+    let mut xs: Vec<f64> = sharing.iter().map(|&k| points[k].offset_m[0]).collect();
+    let mut ys: Vec<f64> = sharing.iter().map(|&k| points[k].offset_m[1]).collect();
     let (Some(mx), Some(my)) = (median_in_place(&mut xs), median_in_place(&mut ys)) else {
         return true;
     };
