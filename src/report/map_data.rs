@@ -6,6 +6,7 @@
 
 use super::inputs::{for_each_row, read_csv_opt, CsvTable};
 use super::plots::trajectory::{CorrespondenceKind, MapCheckPoint, MapRecording};
+use skytie_stages::export::ControlStatus;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
@@ -138,10 +139,11 @@ impl GeoPoints {
     }
 }
 
-/// Whether a `correspondences.csv` row's `status` lets its point count as control in the report: every
-/// status except the adjustment's `rejected` and `left_out` (a file without the column counts every row).
+/// Whether a `correspondences.csv` row's `status` lets its point count as control in the report: a status
+/// whose point is delivered as ground control ([`ControlStatus::delivered`]); a file without the column (an
+/// empty cell) counts every row.
 pub fn counts_as_control(status: &str) -> bool {
-    !matches!(status, "rejected" | "left_out")
+    ControlStatus::parse(status).is_none_or(ControlStatus::delivered)
 }
 
 /// Recording image ids with at least one panorama observation of a nadir / oblique control point that the

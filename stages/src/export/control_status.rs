@@ -29,6 +29,13 @@ impl ControlStatus {
         }
     }
 
+    /// The status a `status` column's word names (`None` for any other word).
+    pub fn parse(word: &str) -> Option<Self> {
+        [Self::Used, Self::Rejected, Self::LeftOut, Self::NotAdjusted]
+            .into_iter()
+            .find(|s| s.as_str() == word)
+    }
+
     /// Whether the point may be handed to other software as ground control.
     pub fn delivered(self) -> bool {
         matches!(self, Self::Used | Self::NotAdjusted)
@@ -101,6 +108,15 @@ mod tests {
             ],
         );
         let s = ControlStatuses::of(Some(&run));
+        for status in [
+            ControlStatus::Used,
+            ControlStatus::Rejected,
+            ControlStatus::LeftOut,
+            ControlStatus::NotAdjusted,
+        ] {
+            assert_eq!(ControlStatus::parse(status.as_str()), Some(status));
+        }
+        assert_eq!(ControlStatus::parse(""), None);
         assert_eq!(s.get("used"), ControlStatus::Used);
         assert_eq!(s.get("single"), ControlStatus::Used);
         assert_eq!(s.get("rejected"), ControlStatus::Rejected);
