@@ -74,7 +74,8 @@ impl Support {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RecordingSupport {
     pub support: Support,
-    /// Aerial control points the recording observes (used in the adjustment).
+    /// Aerial control points the recording observes and the adjustment kept (a point whose control the
+    /// gross-error test rejected is only a tie point: it does not count).
     pub control_points: usize,
     /// Index of the linked group of recordings (recordings of one group move together).
     pub group: usize,
@@ -149,7 +150,7 @@ pub fn recording_support(run: &AdjustmentRun) -> Vec<RecordingSupport> {
     for p in run
         .points
         .iter()
-        .filter(|p| p.determined && is_control(p.point.kind, run))
+        .filter(|p| p.determined && !p.control_rejected && is_control(p.point.kind, run))
     {
         for &(r, _, _) in &p.point.pano {
             if r < n {
@@ -253,6 +254,17 @@ mod tests {
         let s = recording_support(&r);
         assert_eq!(s[7].support, Support::Controlled);
         assert_eq!(s[6].support, Support::Extrapolated);
+    }
+
+    #[test]
+    fn control_the_adjustment_rejected_does_not_count() {
+        let mut r = run(true);
+        r.points[1].control_rejected = true;
+        let s = recording_support(&r);
+        assert_eq!(s[3].support, Support::Extrapolated);
+        assert_eq!(s[3].control_points, 0);
+        assert_eq!(s[2].support, Support::Extrapolated);
+        assert_eq!(s[1].support, Support::Controlled);
     }
 
     #[test]
