@@ -13,9 +13,11 @@ use crate::nodes::adjust::grade::{AdjustGrade, GradeAdjust};
 use crate::nodes::adjust::verify::{verify_metrics, VerifyStage};
 use crate::nodes::campaign::summary::SummaryParams;
 use crate::nodes::nadir::grade::TRUTH_RECORDINGS;
+use crate::nodes::oblique::consensus::ObliqueOutput;
 use skytie_stages::adjustment::verify::{Verification, VerifyConfig};
 use skytie_stages::adjustment::{AdjustConfig, Sources};
 use skytie_stages::nadir::{OrthoParams, RecordingControl};
+use skytie_stages::oblique::SparseCloud;
 
 /// Handles of the adjustment outputs (for the exports written after the run).
 pub struct AdjustHandles {
@@ -27,12 +29,15 @@ pub struct AdjustHandles {
     /// The nadir control after a second registration pass (`[adjust] passes = 2`): what the adjustment, the
     /// verification of the adjusted trajectory and the exports use; `None` with one pass.
     pub second_pass_control: Option<Vec<Handle<RecordingControl>>>,
+    /// The oblique chain after its second pass (`[adjust] passes = 2`): what the second adjustment and the
+    /// exports use; `None` with one pass.
+    pub second_pass_oblique: Option<ObliqueHandles>,
 }
 
 /// Add `adjust`, `grade_adjust` and `verify` for the variant of `cx` when the workflow enables them. With
 /// `[adjust] passes = 2` the adjustment runs twice: first on the first registration pass's control, then on the
-/// control after a second pass around the first adjustment (`nadir::add_second_pass`); grading, verification
-/// and the exports read the second.
+/// control after a second pass of both chains around the first adjustment (`nadir::add_second_pass`,
+/// `oblique::add_second_pass`); grading, verification and the exports read the second.
 pub fn add_adjust(
     b: &mut DagBuilder,
     cx: &VariantContext<'_>,
@@ -47,6 +52,7 @@ pub fn add_adjust(
         verification: None,
         verification_adjusted: None,
         second_pass_control: None,
+        second_pass_oblique: None,
     };
     if !(on(stage::ADJUST) || on(stage::VERIFY) || on(stage::GRADE_ADJUST)) {
         return Ok(out);
@@ -102,26 +108,50 @@ pub fn add_adjust(
             ..config
         };
         let label = config.sources.label();
-        let add_stage = |b: &mut DagBuilder, label: &str, control: &[Handle<RecordingControl>]| {
-            b.add(
-                AdjustStage,
-                label,
-                config.clone(),
-                (
-                    snap,
-                    pano_images.clone(),
-                    optional_all(&windows),
-                    optional_all(control),
-                    (optional_all(&clouds), optional_all(&oblique_result)),
-                    dtm.clone(),
-                ),
-            )
-        };
-        let mut report = add_stage(b, label, &control)?;
-        if let (2, Some(n)) = (passes, nadir.filter(|_| use_nadir && on(stage::CONTROL))) {
-            let second = super::nadir::add_second_pass(b, cx, ortho, n, report)?;
-            report = add_stage(b, &format!("{label} pass 2"), &second.control)?;
-            out.second_pass_control = Some(second.control);
+        let add_stage =
+            |b: &mut DagBuilder,
+             label: &str,
+             control: &[Handle<RecordingControl>],
+             oblique: (&[Handle<SparseCloud>], &[Handle<ObliqueOutput>])| {
+                b.add(
+                    AdjustStage,
+                    label,
+                    config.clone(),
+                    (
+                        snap,
+                        pano_images.clone(),
+                        optional_all(&windows),
+                        optional_all(control),
+                        (optional_all(oblique.0), optional_all(oblique.1)),
+                        dtm.clone(),
+                    ),
+                )
+            };
+        let mut report = add_stage(b, label, &control, (&clouds, &oblique_result))?;
+        if passes == 2 {
+            let nadir_pass = match nadir.filter(|_| use_nadir && on(stage::CONTROL)) {
+                Some(n) => Some(super::nadir::add_second_pass(b, cx, ortho, n, report)?),
+                None => None,
+            };
+            let oblique_pass = match oblique.filter(|_| use_oblique) {
+                Some(_) => Some(super::oblique::add_second_pass(b, cx, report)?),
+                None => None,
+            };
+            if nadir_pass.is_some() || oblique_pass.is_some() {
+                let control = nadir_pass.as_ref().map_or(&control, |p| &p.control);
+                let (clouds, oblique_result) = match &oblique_pass {
+                    Some(o) => (o.clouds.clone(), o.result.into_iter().collect()),
+                    None => (clouds.clone(), oblique_result.clone()),
+                };
+                report = add_stage(
+                    b,
+                    &format!("{label} pass 2"),
+                    control,
+                    (&clouds, &oblique_result),
+                )?;
+            }
+            out.second_pass_control = nadir_pass.map(|p| p.control);
+            out.second_pass_oblique = oblique_pass;
         }
         b.metrics(report, "adjust", |r: &AdjustReport| r.metrics());
         out.report = Some(report);

@@ -10,6 +10,8 @@
 use super::variant::{RecordingItem, VariantContext};
 use super::{distance_m, missing_upstream, stage};
 use crate::dag::{optional_all, DagBuilder, Handle, PipelineError, RawFile};
+use crate::nodes::adjust::adjustment::AdjustReport;
+use crate::nodes::adjust::second_pass::{PassPriorParams, Shift, TrajectoryPrior};
 use crate::nodes::campaign::aerial::AerialRowNodes;
 use crate::nodes::campaign::ingest::ingest_file;
 use crate::nodes::campaign::summary::SummaryParams;
@@ -70,19 +72,63 @@ pub fn enabled(wf: &Workflow) -> Result<bool, PipelineError> {
     Ok(true)
 }
 
-/// Add the oblique chain for the variant of `cx`.
+/// Add the oblique chain for the variant of `cx`, its `oblique` metrics and, with `truth/`, its grade.
 pub fn add_oblique(
     b: &mut DagBuilder,
     cx: &VariantContext<'_>,
 ) -> Result<ObliqueHandles, PipelineError> {
+    let out = add_chain(b, cx, "")?;
+    add_metrics(b, cx, &out, "oblique")?;
+    Ok(out)
+}
+
+/// The oblique chain searched again around the first adjustment (`[adjust] passes = 2`): every recording's row
+/// shifted by its correction (`pass_trajectory`), then the sparse clouds, façades, patches and consensus of
+/// those rows; metrics and grade under `oblique_pass2`. A recording the adjustment did not move keeps its row,
+/// and every node that reads only such rows is the first pass's.
+pub fn add_second_pass(
+    b: &mut DagBuilder,
+    cx: &VariantContext<'_>,
+    report: Handle<AdjustReport>,
+) -> Result<ObliqueHandles, PipelineError> {
+    let mut items = Vec::with_capacity(cx.items.len());
+    for item in cx.items {
+        let label = format!("rec {} oblique pass 2", item.recording.image_id);
+        let params = PassPriorParams {
+            image_id: item.recording.image_id.clone(),
+        };
+        let shift = b.add(TrajectoryPrior, &label, params, report)?;
+        items.push(RecordingItem {
+            recording: item.recording,
+            row: Shift::add(b, &label, item.row, shift)?,
+            ortho: item.ortho,
+            pano: item.pano.clone(),
+            pano_image: item.pano_image,
+        });
+    }
+    let shifted = VariantContext {
+        items: &items,
+        ..*cx
+    };
+    let out = add_chain(b, &shifted, " pass 2")?;
+    add_metrics(b, &shifted, &out, "oblique_pass2")?;
+    Ok(out)
+}
+
+/// The chain's nodes; `pass` is appended to every item label (the second pass's nodes are distinct items).
+fn add_chain(
+    b: &mut DagBuilder,
+    cx: &VariantContext<'_>,
+    pass: &str,
+) -> Result<ObliqueHandles, PipelineError> {
     let options: ObliqueOptions = cx.params(stage::OBLIQUE)?;
-    let triplets = add_sparse_clouds(b, cx, &options)?;
+    let triplets = add_sparse_clouds(b, cx, &options, pass)?;
     let clouds: Vec<Handle<SparseCloud>> = triplets.iter().map(|(_, c)| *c).collect();
     let FacadesAndPatches {
         facades: all_facades,
         sets,
     } = match cx.on(stage::FACADES) {
-        true => add_facades_and_patches(b, cx, &options, &triplets)?,
+        true => add_facades_and_patches(b, cx, &options, &triplets, pass)?,
         false => FacadesAndPatches::default(),
     };
     let mut out = ObliqueHandles {
@@ -93,20 +139,33 @@ pub fn add_oblique(
         return Ok(out);
     }
     let panos: Vec<RawFile> = cx.items.iter().map(|i| i.pano.clone()).collect();
-    let result = b.add(
+    out.result = Some(b.add(
         ConsensusStage,
-        "",
+        pass.trim_start(),
         options.consensus.clone(),
         (
             cx.snap,
-            panos.clone(),
+            panos,
             optional_all(&clouds),
             optional_all(&all_facades),
             optional_all(&sets),
         ),
-    )?;
-    b.metrics(result, "oblique", |o: &ObliqueOutput| o.summary.metrics());
-    out.result = Some(result);
+    )?);
+    Ok(out)
+}
+
+/// The consensus counts of `out` under `namespace` in `metrics.json` and, on a campaign with `truth/`, its
+/// grade.
+fn add_metrics(
+    b: &mut DagBuilder,
+    cx: &VariantContext<'_>,
+    out: &ObliqueHandles,
+    namespace: &str,
+) -> Result<(), PipelineError> {
+    let Some(result) = out.result else {
+        return Ok(());
+    };
+    b.metrics(result, namespace, |o: &ObliqueOutput| o.summary.metrics());
     if let Some(truth_files) = cx.truth_files(stage::GRADE_OBLIQUE, &[TRUTH_AERIAL_OBLIQUE]) {
         let scene_file = cx.root.join(SCENE_TRUTH_FILE);
         let scene_files: Vec<RawFile> = if scene_file.is_file() {
@@ -114,15 +173,26 @@ pub fn add_oblique(
         } else {
             Vec::new()
         };
+        let panos: Vec<RawFile> = cx.items.iter().map(|i| i.pano.clone()).collect();
         let grade = b.add(
             GradeOblique,
-            "",
+            namespace
+                .strip_prefix("oblique")
+                .unwrap_or(namespace)
+                .trim_start_matches('_'),
             SummaryParams::default(),
-            (cx.snap, truth_files, scene_files, panos, clouds, result),
+            (
+                cx.snap,
+                truth_files,
+                scene_files,
+                panos,
+                out.clouds.clone(),
+                result,
+            ),
         )?;
-        b.metrics(grade, "oblique", GradeOblique::metrics);
+        b.metrics(grade, namespace, GradeOblique::metrics);
     }
-    Ok(out)
+    Ok(())
 }
 
 /// Pass 1 (thesis 4.4.1): the sparse cloud of every triplet of consecutive recordings close enough together,
@@ -131,6 +201,7 @@ fn add_sparse_clouds(
     b: &mut DagBuilder,
     cx: &VariantContext<'_>,
     options: &ObliqueOptions,
+    pass: &str,
 ) -> Result<Vec<(usize, Handle<SparseCloud>)>, PipelineError> {
     let cloud_params: SparseCloudParams = cx.params(stage::SPARSE_CLOUD)?;
     let mut triplets = Vec::new();
@@ -143,7 +214,7 @@ fn add_sparse_clouds(
         }
         let cloud = b.add(
             SparseCloudStage,
-            &format!("rec {}", centre.recording.image_id),
+            &format!("rec {}{pass}", centre.recording.image_id),
             cloud_params.clone(),
             (
                 w.iter().map(|m| m.row).collect::<Vec<_>>(),
@@ -196,6 +267,7 @@ fn add_facades_and_patches(
     cx: &VariantContext<'_>,
     options: &ObliqueOptions,
     triplets: &[(usize, Handle<SparseCloud>)],
+    pass: &str,
 ) -> Result<FacadesAndPatches, PipelineError> {
     let facade_params: FacadeParams = cx.params(stage::FACADES)?;
     let patch_params: PatchParams = cx.params(stage::PATCHES)?;
@@ -212,7 +284,7 @@ fn add_facades_and_patches(
     let mut sets = Vec::new();
     for (t, &(centre_idx, _)) in triplets.iter().enumerate() {
         let centre = &cx.items[centre_idx];
-        let label = format!("rec {}", centre.recording.image_id);
+        let label = format!("rec {}{pass}", centre.recording.image_id);
         let rows: Vec<Handle<Recording>> = cx.items[centre_idx - 1..=centre_idx + 1]
             .iter()
             .map(|m| m.row)
@@ -239,7 +311,7 @@ fn add_facades_and_patches(
         }
         for (a, aerial) in aerials {
             let row = &oblique_rows[a];
-            let pair = format!("rec {} × {}", centre.recording.image_id, row.image_id);
+            let pair = format!("rec {} × {}{pass}", centre.recording.image_id, row.image_id);
             let oblique_image = ingest_file(
                 b,
                 &format!("oblique {}", row.image_id),

@@ -278,12 +278,15 @@ fn add_variant(
         oblique_handles.as_ref(),
         ortho,
     )?;
-    // The exports write the control the adjustment used (after the second registration pass, if any).
+    // The exports write the control the adjustment used (after the second registration passes, if any).
     let nadir_control = match &adjust.second_pass_control {
         Some(c) => c.clone(),
         None => nadir_handles.map(|n| n.control).unwrap_or_default(),
     };
-    let oblique = oblique_handles.and_then(|o| o.result);
+    let oblique = match &adjust.second_pass_oblique {
+        Some(o) => o.result,
+        None => oblique_handles.and_then(|o| o.result),
+    };
     // The exports (correspondences.csv) read these values: request them, or cached runs would not load them.
     for c in &nadir_control {
         b.request(*c);

@@ -2,14 +2,16 @@
 //! (`skytie_stages::adjustment::second_pass`): per recording its shift from the first adjustment
 //! (`pass_prior`), its row, tie-point window and aerial-oriented ortho images translated by it (`pass_row`, `pass_window`, `pass_ortho`), and the counts of both passes
 //! (`registration_passes`). A recording the first pass registered gets a zero shift, so its translated inputs
-//! equal the first pass's and every node below them is found in the cache.
+//! equal the first pass's and every node below them is found in the cache. The oblique chain's second pass
+//! shifts every recording by its whole correction (`pass_trajectory`).
 
 use crate::codec::Artifact;
 use crate::dag::{BuildError, DagBuilder, Handle, InputsOf, NodeCtx, Optional, RunResult, Stage};
 use crate::nodes::adjust::adjustment::{AdjustReport, Verdict};
 use crate::nodes::campaign::summary::SummaryParams;
 use skytie_stages::adjustment::second_pass::{
-    pass_shift, registered, PassShift, RegistrationPasses, Shiftable, PASSES_STAGE, PRIOR_STAGE,
+    pass_shift, registered, trajectory_shift, PassShift, RegistrationPasses, Shiftable,
+    PASSES_STAGE, PRIOR_STAGE, TRAJECTORY_PRIOR_STAGE,
 };
 use skytie_stages::nadir::RecordingControl;
 use std::marker::PhantomData;
@@ -39,6 +41,24 @@ impl Stage for PassPrior {
             &p.image_id,
             &report.run.recordings,
             registered(control.as_deref()),
+            delivered,
+        ))
+    }
+}
+
+/// A recording's shift for the oblique chain's second pass: its whole correction by the first adjustment when
+/// that was delivered. Input: the first adjustment.
+pub struct TrajectoryPrior;
+
+impl Stage for TrajectoryPrior {
+    crate::nodes::stage_types!(TRAJECTORY_PRIOR_STAGE, PassPriorParams => PassShift,
+        inputs: Handle<AdjustReport>);
+
+    fn run(&self, p: &PassPriorParams, report: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
+        let delivered = report.verdict() == Verdict::Corrected;
+        Ok(trajectory_shift(
+            &p.image_id,
+            &report.run.recordings,
             delivered,
         ))
     }

@@ -228,10 +228,11 @@ crate::params! {
         yaw_tie_significance: f64 = 2.0, min 0.0, max 10.0;
         /// Largest number of Levenberg–Marquardt iterations per solve.
         max_iterations: usize = 100, min 1;
-        /// Registration passes (nadir chain): with 2, the recordings that found no aerial control are searched
-        /// again around the first adjustment's positions of them (`adjustment::second_pass`), with the normal
-        /// search windows, and the adjustment runs again on all control; recovers drift larger than the
-        /// windows once the neighbours are corrected (`registration_passes` in `metrics.json`).
+        /// Registration passes: with 2, the nadir chain searches the recordings that found no aerial control
+        /// again around the first adjustment's positions of them, the oblique chain registers every recording
+        /// again from its adjusted position (`adjustment::second_pass`), both with the normal search windows,
+        /// and the adjustment runs again on all control; recovers errors larger than the windows once the
+        /// neighbours are corrected (`registration_passes`, `oblique_pass2` in `metrics.json`).
         passes: usize = 1, min 1, max 2;
     }
 }

@@ -11,8 +11,15 @@
 //! only thing the adjustment reads of them, are unchanged. The neighbours' ortho images that the refinement's
 //! parallax check reads stay the first pass's, with the window's untranslated neighbour views.
 //!
+//! The oblique chain is searched again the same way, for every recording: its patches are predicted from the
+//! sparse cloud and façades of the recordings' poses, so a recording farther off than the patch search radius
+//! (or a pose error that lets a façade patch slide to a wrong place near the prediction) is registered again
+//! from the adjusted trajectory ([`trajectory_shift`], horizontal and vertical: a façade patch depends on the
+//! height too). The matches' panorama and oblique pixels do not depend on the pose they were predicted from,
+//! so the second adjustment reads them with the recorded positions as its priors, like the first.
+//!
 //! The pass is a graph construction of the pipeline; this module holds its pure parts: the shift of one
-//! recording ([`pass_shift`]), the translated inputs, and the counts of the two passes
+//! recording ([`pass_shift`], [`trajectory_shift`]), the translated inputs, and the counts of the two passes
 //! ([`RegistrationPasses`]).
 
 use super::from_correspondences::RunRecording;
@@ -22,7 +29,9 @@ use crate::params::StageId;
 use serde::{Deserialize, Serialize};
 
 /// The identity of the node that derives a recording's shift from the first adjustment.
-pub const PRIOR_STAGE: StageId = StageId::new("pass_prior", "1");
+pub const PRIOR_STAGE: StageId = StageId::new("pass_prior", "2");
+/// The identity of the node that derives a recording's shift for the oblique chain's second pass.
+pub const TRAJECTORY_PRIOR_STAGE: StageId = StageId::new("pass_trajectory", "1");
 /// The identity of the node that translates a recording's tie-point window by its shift.
 pub const SHIFT_WINDOW_STAGE: StageId = StageId::new("pass_window", "1");
 /// The identity of the node that translates a recording's row by its shift.
@@ -38,13 +47,33 @@ pub const PASSES_STAGE: StageId = StageId::new("registration_passes", "1");
 pub struct PassShift {
     pub recording_id: String,
     pub shift_world: [f64; 2],
+    /// Vertical shift, m (zero for the nadir chain, whose ortho images depend only on the position relative
+    /// to the camera).
+    pub shift_z_m: f64,
 }
 
 impl PassShift {
+    /// No shift: the recording is searched where the first pass searched it.
+    pub fn zero(recording_id: &str) -> Self {
+        Self {
+            recording_id: recording_id.to_string(),
+            shift_world: [0.0, 0.0],
+            shift_z_m: 0.0,
+        }
+    }
+
     /// Whether the recording is searched anywhere else than in the first pass.
     pub fn moves(&self) -> bool {
-        self.shift_world != [0.0, 0.0]
+        self.shift_world != [0.0, 0.0] || self.shift_z_m != 0.0
     }
+}
+
+/// The first adjustment's correction (adjusted − recorded) of `recording_id`, world, m; `None` for a recording
+/// the adjustment does not know or whose correction is not finite.
+fn correction(recording_id: &str, adjusted: &[RunRecording]) -> Option<[f64; 3]> {
+    let rec = adjusted.iter().find(|r| r.image_id == recording_id)?;
+    let d: [f64; 3] = std::array::from_fn(|i| rec.adjusted_world[i] - rec.recorded_world[i]);
+    d.iter().all(|v| v.is_finite()).then_some(d)
 }
 
 /// Whether a recording's own control (its window's points located in aerial images) registered it.
@@ -62,26 +91,30 @@ pub fn pass_shift(
     registered_first: bool,
     delivered: bool,
 ) -> PassShift {
-    let zero = PassShift {
-        recording_id: recording_id.to_string(),
-        shift_world: [0.0, 0.0],
-    };
-    if registered_first || !delivered {
-        return zero;
+    match correction(recording_id, adjusted) {
+        Some(d) if delivered && !registered_first => PassShift {
+            shift_world: [d[0], d[1]],
+            ..PassShift::zero(recording_id)
+        },
+        _ => PassShift::zero(recording_id),
     }
-    let Some(rec) = adjusted.iter().find(|r| r.image_id == recording_id) else {
-        return zero;
-    };
-    let shift = [
-        rec.adjusted_world[0] - rec.recorded_world[0],
-        rec.adjusted_world[1] - rec.recorded_world[1],
-    ];
-    if !(shift[0].is_finite() && shift[1].is_finite()) {
-        return zero;
-    }
-    PassShift {
-        shift_world: shift,
-        ..zero
+}
+
+/// The shift of recording `recording_id` for the oblique chain's second pass: the first adjustment's
+/// correction, horizontal and vertical, for every recording when the adjustment was delivered (`delivered`);
+/// zero otherwise, and for a recording the adjustment does not know or whose correction is not finite.
+pub fn trajectory_shift(
+    recording_id: &str,
+    adjusted: &[RunRecording],
+    delivered: bool,
+) -> PassShift {
+    match correction(recording_id, adjusted) {
+        Some(d) if delivered => PassShift {
+            shift_world: [d[0], d[1]],
+            shift_z_m: d[2],
+            ..PassShift::zero(recording_id)
+        },
+        _ => PassShift::zero(recording_id),
     }
 }
 
@@ -122,13 +155,14 @@ impl Shiftable for MmWindowMatch {
     }
 }
 
-/// A recording's row moved by `shift` (its recorded position translated horizontally).
+/// A recording's row moved by `shift` (its recorded position translated).
 impl Shiftable for Recording {
     const STAGE: StageId = SHIFT_ROW_STAGE;
     fn shifted(&self, shift: &PassShift) -> Self {
         let mut out = self.clone();
         out.x += shift.shift_world[0];
         out.y += shift.shift_world[1];
+        out.z += shift.shift_z_m;
         out
     }
 }
@@ -199,6 +233,30 @@ mod tests {
         assert!(!pass_shift("a", &run, false, false).moves());
         assert!(!pass_shift("unknown", &run, false, true).moves());
         assert!(!pass_shift("b", &run, false, true).moves());
+        assert_eq!(pass_shift("a", &run, false, true).shift_z_m, 0.0);
+    }
+
+    #[test]
+    fn the_oblique_pass_shifts_every_recording_by_its_whole_correction() {
+        let run = [
+            recording("a", [100.0, 200.0, 3.0], [101.5, 199.0, 2.5]),
+            recording("b", [110.0, 200.0, 3.0], [110.0, 200.0, 3.0]),
+            recording("c", [120.0, 200.0, 3.0], [f64::NAN, 200.0, 3.0]),
+        ];
+        let s = trajectory_shift("a", &run, true);
+        assert_eq!((s.shift_world, s.shift_z_m), ([1.5, -1.0], -0.5));
+        let row = Recording {
+            x: 100.0,
+            y: 200.0,
+            z: 3.0,
+            ..Recording::default()
+        }
+        .shifted(&s);
+        assert_eq!([row.x, row.y, row.z], [101.5, 199.0, 2.5]);
+        assert!(!trajectory_shift("a", &run, false).moves());
+        assert!(!trajectory_shift("b", &run, true).moves());
+        assert!(!trajectory_shift("c", &run, true).moves());
+        assert!(!trajectory_shift("unknown", &run, true).moves());
     }
 
     #[test]
@@ -219,6 +277,7 @@ mod tests {
         let shift = PassShift {
             recording_id: "a".into(),
             shift_world: [1.7, -2.3],
+            shift_z_m: 0.0,
         };
         let moved = ortho.shifted(&shift);
         let p = Vector3::new(1003.2, 1998.1, 50.0);
@@ -245,6 +304,7 @@ mod tests {
         let shift = PassShift {
             recording_id: "a".into(),
             shift_world: [0.5, -0.25],
+            shift_z_m: 0.0,
         };
         let moved = window.shifted(&shift);
         assert_eq!(moved.ground_world, vec![[1.5, 1.75, 3.0]]);
@@ -273,6 +333,7 @@ mod tests {
         let moved = PassShift {
             recording_id: "b".into(),
             shift_world: [1.0, 0.0],
+            shift_z_m: 0.0,
         };
         let still = PassShift::default();
         let counts = RegistrationPasses::count(
