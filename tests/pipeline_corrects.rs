@@ -88,6 +88,26 @@ fn a_tiny_street_with_road_markings_is_corrected() {
         "only unregistered recordings are searched again: {passes}"
     );
 
+    // The oblique chain's second pass, registered again from the adjusted poses: graded apart from the first
+    // (whose numbers stay the thesis' registration), and what correspondences.csv delivers.
+    let second = &m["oblique_pass2"];
+    assert!(num(second, &["consensus_kept"]) > 0.0, "{second}");
+    assert!(
+        num(second, &["inlier_ratio_after_consensus"]) >= 0.8,
+        "{second}"
+    );
+    let exported = std::fs::read_to_string(out.join("correspondences.csv")).unwrap();
+    let oblique_points: std::collections::BTreeSet<String> = csv_rows(&exported)
+        .into_iter()
+        .filter(|r| r["source"] == "oblique")
+        .map(|r| r["point_id"].clone())
+        .collect();
+    assert_eq!(
+        oblique_points.len() as f64,
+        num(second, &["control_points"]) + num(second, &["single_image_points"]),
+        "correspondences.csv holds the second pass's oblique points: {second}"
+    );
+
     // Adjustment (thesis ch. 5): every recording corrected, the error at least 5× smaller, none left > 0.15 m.
     let a = &m["adjust"]["combined"];
     assert_eq!(a["verdict"].as_str(), Some("corrected"), "{a}");

@@ -160,13 +160,22 @@ fn registration_lines(m: &Value) -> Vec<String> {
             n("nadir.transforms_tried")
         ));
     }
-    if obj_at(m, "oblique").is_some() {
+    // What the adjustment used: the oblique chain's second pass when it ran one.
+    let oblique = ["oblique_pass2", "oblique"]
+        .into_iter()
+        .find(|k| obj_at(m, k).is_some());
+    if let Some(ns) = oblique {
         out.push(format!(
             "oblique (façades): {:.0} recordings with correspondences, {:.0} control points, {:.0} façade \
-             planes",
-            n("oblique.recordings_with_correspondences"),
-            n("oblique.control_points"),
-            n("oblique.planes")
+             planes{}",
+            n(&format!("{ns}.recordings_with_correspondences")),
+            n(&format!("{ns}.control_points")),
+            n(&format!("{ns}.planes")),
+            if ns == "oblique" {
+                ""
+            } else {
+                " (second pass, around the first adjustment)"
+            }
         ));
     }
     out
