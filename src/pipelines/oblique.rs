@@ -1,7 +1,9 @@
 //! The oblique part of the `skytie` pipeline (thesis chapter 4) for one variant: per panorama triplet the
 //! sparse cloud (`sparse_cloud`) and its façades (`facades`), per (triplet centre × candidate oblique image) the
 //! patch registration (`patches`), then the global `oblique` node (median consensus: correspondences, control points,
-//! `oblique.*` counts) and — on synthetic campaigns with `truth/` — the evaluation node `grade_oblique`.
+//! `oblique.*` counts) and — on synthetic campaigns with `truth/` — the evaluation node `grade_oblique`. With
+//! `[adjust] passes = 2` the same chain runs a second time from the first adjustment's poses
+//! ([`add_second_pass`], `oblique_pass2.*`).
 //!
 //! Shared work across a sweep comes from the keys: the sparse cloud's key does not depend on any façade,
 //! patch or consensus parameter, so an 18-variant sweep computes it once; `facades` once per distinct plane
@@ -78,7 +80,7 @@ pub fn add_oblique(
     cx: &VariantContext<'_>,
 ) -> Result<ObliqueHandles, PipelineError> {
     let out = add_chain(b, cx, "")?;
-    add_metrics(b, cx, &out, "oblique")?;
+    add_metrics(b, cx, &out, "oblique", "")?;
     Ok(out)
 }
 
@@ -111,7 +113,7 @@ pub fn add_second_pass(
         ..*cx
     };
     let out = add_chain(b, &shifted, " pass 2")?;
-    add_metrics(b, &shifted, &out, "oblique_pass2")?;
+    add_metrics(b, &shifted, &out, "oblique_pass2", "pass 2")?;
     Ok(out)
 }
 
@@ -155,12 +157,13 @@ fn add_chain(
 }
 
 /// The consensus counts of `out` under `namespace` in `metrics.json` and, on a campaign with `truth/`, its
-/// grade.
+/// grade (a node of item `item`).
 fn add_metrics(
     b: &mut DagBuilder,
     cx: &VariantContext<'_>,
     out: &ObliqueHandles,
     namespace: &str,
+    item: &str,
 ) -> Result<(), PipelineError> {
     let Some(result) = out.result else {
         return Ok(());
@@ -176,10 +179,7 @@ fn add_metrics(
         let panos: Vec<RawFile> = cx.items.iter().map(|i| i.pano.clone()).collect();
         let grade = b.add(
             GradeOblique,
-            namespace
-                .strip_prefix("oblique")
-                .unwrap_or(namespace)
-                .trim_start_matches('_'),
+            item,
             SummaryParams::default(),
             (
                 cx.snap,
