@@ -478,6 +478,7 @@ pub fn add_second_pass(
         let label = format!("rec {} pass 2", item.recording.image_id);
         let params = PassPriorParams {
             image_id: item.recording.image_id.clone(),
+            index_hint: rec.item,
         };
         let shift = b.add(
             PassPrior,

@@ -94,10 +94,11 @@ pub fn add_second_pass(
     report: Handle<AdjustReport>,
 ) -> Result<ObliqueHandles, PipelineError> {
     let mut items = Vec::with_capacity(cx.items.len());
-    for item in cx.items {
+    for (index, item) in cx.items.iter().enumerate() {
         let label = format!("rec {} oblique pass 2", item.recording.image_id);
         let params = PassPriorParams {
             image_id: item.recording.image_id.clone(),
+            index_hint: index,
         };
         let shift = b.add(TrajectoryPrior, &label, params, report)?;
         items.push(RecordingItem {

@@ -10,8 +10,8 @@ use crate::dag::{BuildError, DagBuilder, Handle, InputsOf, NodeCtx, Optional, Ru
 use crate::nodes::adjust::adjustment::{AdjustReport, Verdict};
 use crate::nodes::campaign::summary::SummaryParams;
 use skytie_stages::adjustment::second_pass::{
-    pass_shift, registered, trajectory_shift, PassShift, RegistrationPasses, Shiftable,
-    PASSES_STAGE, PRIOR_STAGE, TRAJECTORY_PRIOR_STAGE,
+    pass_shift, registered, trajectory_shift, PassShift, RecordingRef, RegistrationPasses,
+    Shiftable, PASSES_STAGE, PRIOR_STAGE, TRAJECTORY_PRIOR_STAGE,
 };
 use skytie_stages::nadir::RecordingControl;
 use std::marker::PhantomData;
@@ -23,6 +23,17 @@ skytie_stages::params! {
     pub struct PassPriorParams {
         /// The recording's `image_id`.
         image_id: String = String::new();
+        /// The recording's position in the campaign: where the lookup in the first adjustment starts.
+        index_hint: usize = 0;
+    }
+}
+
+impl PassPriorParams {
+    fn recording(&self) -> RecordingRef<'_> {
+        RecordingRef {
+            image_id: &self.image_id,
+            index_hint: self.index_hint,
+        }
     }
 }
 
@@ -38,7 +49,7 @@ impl Stage for PassPrior {
         let (report, control) = inputs;
         let delivered = report.verdict() == Verdict::Corrected;
         Ok(pass_shift(
-            &p.image_id,
+            p.recording(),
             &report.run.recordings,
             registered(control.as_deref()),
             delivered,
@@ -57,7 +68,7 @@ impl Stage for TrajectoryPrior {
     fn run(&self, p: &PassPriorParams, report: InputsOf<Self>, _: &NodeCtx) -> RunResult<Self> {
         let delivered = report.verdict() == Verdict::Corrected;
         Ok(trajectory_shift(
-            &p.image_id,
+            p.recording(),
             &report.run.recordings,
             delivered,
         ))

@@ -68,10 +68,33 @@ impl PassShift {
     }
 }
 
-/// The first adjustment's correction (adjusted − recorded) of `recording_id`, world, m; `None` for a recording
+/// Where the first adjustment lists a recording: its `image_id` and a hint of its position in the
+/// adjustment's list (the recording's position in the campaign; the adjustment lists the campaign's
+/// recordings in order, without the rows dropped as bad input, so the recording is at the hint or a few
+/// places before it). The lookup goes backwards from the hint, then forwards, so a city-size campaign's
+/// shifts cost O(n · dropped rows), not O(n²); a wrong hint only costs time.
+#[derive(Clone, Copy, Debug)]
+pub struct RecordingRef<'a> {
+    pub image_id: &'a str,
+    pub index_hint: usize,
+}
+
+impl RecordingRef<'_> {
+    fn find<'r>(&self, adjusted: &'r [RunRecording]) -> Option<&'r RunRecording> {
+        let start = self.index_hint.min(adjusted.len().saturating_sub(1));
+        let (before, after) = adjusted.split_at(adjusted.len().min(start + 1));
+        before
+            .iter()
+            .rev()
+            .chain(after)
+            .find(|r| r.image_id == self.image_id)
+    }
+}
+
+/// The first adjustment's correction (adjusted − recorded) of `recording`, world, m; `None` for a recording
 /// the adjustment does not know or whose correction is not finite.
-fn correction(recording_id: &str, adjusted: &[RunRecording]) -> Option<[f64; 3]> {
-    let rec = adjusted.iter().find(|r| r.image_id == recording_id)?;
+fn correction(recording: RecordingRef<'_>, adjusted: &[RunRecording]) -> Option<[f64; 3]> {
+    let rec = recording.find(adjusted)?;
     let d: [f64; 3] = std::array::from_fn(|i| rec.adjusted_world[i] - rec.recorded_world[i]);
     d.iter().all(|v| v.is_finite()).then_some(d)
 }
@@ -81,40 +104,40 @@ pub fn registered(control: Option<&RecordingControl>) -> bool {
     control.is_some_and(|c| !c.points.is_empty())
 }
 
-/// The shift of recording `recording_id` for the second pass: the first adjustment's horizontal correction
+/// The shift of `recording` for the second pass: the first adjustment's horizontal correction
 /// (adjusted − recorded) when the first pass did not register the recording (`registered_first = false`) and
 /// the adjustment was delivered (`delivered`: it corrected something and the check points did not get worse);
 /// zero otherwise, and for a recording the adjustment does not know or whose correction is not finite.
 pub fn pass_shift(
-    recording_id: &str,
+    recording: RecordingRef<'_>,
     adjusted: &[RunRecording],
     registered_first: bool,
     delivered: bool,
 ) -> PassShift {
-    match correction(recording_id, adjusted) {
+    match correction(recording, adjusted) {
         Some(d) if delivered && !registered_first => PassShift {
             shift_world: [d[0], d[1]],
-            ..PassShift::zero(recording_id)
+            ..PassShift::zero(recording.image_id)
         },
-        _ => PassShift::zero(recording_id),
+        _ => PassShift::zero(recording.image_id),
     }
 }
 
-/// The shift of recording `recording_id` for the oblique chain's second pass: the first adjustment's
+/// The shift of `recording` for the oblique chain's second pass: the first adjustment's
 /// correction, horizontal and vertical, for every recording when the adjustment was delivered (`delivered`);
 /// zero otherwise, and for a recording the adjustment does not know or whose correction is not finite.
 pub fn trajectory_shift(
-    recording_id: &str,
+    recording: RecordingRef<'_>,
     adjusted: &[RunRecording],
     delivered: bool,
 ) -> PassShift {
-    match correction(recording_id, adjusted) {
+    match correction(recording, adjusted) {
         Some(d) if delivered => PassShift {
             shift_world: [d[0], d[1]],
             shift_z_m: d[2],
-            ..PassShift::zero(recording_id)
+            ..PassShift::zero(recording.image_id)
         },
-        _ => PassShift::zero(recording_id),
+        _ => PassShift::zero(recording.image_id),
     }
 }
 
@@ -208,6 +231,37 @@ mod tests {
     use crate::nadir::{OrthoGeoref, OrthoParams};
     use nalgebra::Vector3;
 
+    /// `id` with a hint that is wrong for every recording but the second, so the lookup runs both ways.
+    fn at(id: &str) -> RecordingRef<'_> {
+        RecordingRef {
+            image_id: id,
+            index_hint: 1,
+        }
+    }
+
+    #[test]
+    fn a_recording_is_found_whatever_its_hint() {
+        let run: Vec<_> = (0..6)
+            .map(|i| recording(&format!("r{i}"), [0.0; 3], [f64::from(i), 0.0, 0.0]))
+            .collect();
+        for hint in [0, 2, 5, 6, 100] {
+            for i in 0..6 {
+                let id = format!("r{i}");
+                let r = RecordingRef {
+                    image_id: &id,
+                    index_hint: hint,
+                };
+                assert_eq!(r.find(&run).map(|r| r.image_id.as_str()), Some(id.as_str()));
+            }
+            let missing = RecordingRef {
+                image_id: "r9",
+                index_hint: hint,
+            };
+            assert!(missing.find(&run).is_none());
+        }
+        assert!(at("r0").find(&[]).is_none());
+    }
+
     fn recording(id: &str, recorded: [f64; 3], adjusted: [f64; 3]) -> RunRecording {
         RunRecording {
             image_id: id.into(),
@@ -226,14 +280,14 @@ mod tests {
             recording("a", [100.0, 200.0, 3.0], [101.5, 199.0, 2.0]),
             recording("b", [110.0, 200.0, 3.0], [110.0, 200.0, 3.0]),
         ];
-        let s = pass_shift("a", &run, false, true);
+        let s = pass_shift(at("a"), &run, false, true);
         assert_eq!(s.shift_world, [1.5, -1.0]);
         assert!(s.moves());
-        assert!(!pass_shift("a", &run, true, true).moves());
-        assert!(!pass_shift("a", &run, false, false).moves());
-        assert!(!pass_shift("unknown", &run, false, true).moves());
-        assert!(!pass_shift("b", &run, false, true).moves());
-        assert_eq!(pass_shift("a", &run, false, true).shift_z_m, 0.0);
+        assert!(!pass_shift(at("a"), &run, true, true).moves());
+        assert!(!pass_shift(at("a"), &run, false, false).moves());
+        assert!(!pass_shift(at("unknown"), &run, false, true).moves());
+        assert!(!pass_shift(at("b"), &run, false, true).moves());
+        assert_eq!(pass_shift(at("a"), &run, false, true).shift_z_m, 0.0);
     }
 
     #[test]
@@ -243,7 +297,7 @@ mod tests {
             recording("b", [110.0, 200.0, 3.0], [110.0, 200.0, 3.0]),
             recording("c", [120.0, 200.0, 3.0], [f64::NAN, 200.0, 3.0]),
         ];
-        let s = trajectory_shift("a", &run, true);
+        let s = trajectory_shift(at("a"), &run, true);
         assert_eq!((s.shift_world, s.shift_z_m), ([1.5, -1.0], -0.5));
         let row = Recording {
             x: 100.0,
@@ -253,10 +307,10 @@ mod tests {
         }
         .shifted(&s);
         assert_eq!([row.x, row.y, row.z], [101.5, 199.0, 2.5]);
-        assert!(!trajectory_shift("a", &run, false).moves());
-        assert!(!trajectory_shift("b", &run, true).moves());
-        assert!(!trajectory_shift("c", &run, true).moves());
-        assert!(!trajectory_shift("unknown", &run, true).moves());
+        assert!(!trajectory_shift(at("a"), &run, false).moves());
+        assert!(!trajectory_shift(at("b"), &run, true).moves());
+        assert!(!trajectory_shift(at("c"), &run, true).moves());
+        assert!(!trajectory_shift(at("unknown"), &run, true).moves());
     }
 
     #[test]
