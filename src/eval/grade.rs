@@ -1,6 +1,7 @@
 //! The numbers of one evaluation cell, read from its run's output folder and the campaign's `truth/`: nadir
 //! and oblique inlier ratios, recordings and check points before/after the adjustment (RMSE 2D/3D, largest 2D
-//! error), and the verification's flags compared with the true offset of each segment.
+//! error), how many recordings lie beyond the 95 % ellipse of their stated σ, and the verification's flags
+//! compared with the true offset of each segment.
 
 use crate::report::inputs::{num_at, read_csv_opt, RunOutputs};
 use serde_json::Value;
@@ -34,7 +35,7 @@ pub const SEGMENT_OFF_M: f64 = 0.3;
 pub const SEGMENT_GOOD_M: f64 = 0.2;
 
 /// Every metric, in table order.
-pub const METRICS: [MetricDef; 17] = [
+pub const METRICS: [MetricDef; 18] = [
     MetricDef {
         key: "nadir_inlier",
         title: "nadir inlier",
@@ -88,6 +89,12 @@ pub const METRICS: [MetricDef; 17] = [
         title: "rec max 2D",
         better: Better::Lower,
         floor: 0.01,
+    },
+    MetricDef {
+        key: "rec_beyond_sigma95",
+        title: "rec > σ 95 %",
+        better: Better::Lower,
+        floor: 0.03,
     },
     MetricDef {
         key: "cp_2d_before",
@@ -146,6 +153,43 @@ pub type CellMetrics = BTreeMap<String, f64>;
 fn adjust_section(m: &Value) -> Option<&Value> {
     let obj = m.get("adjust")?.as_object()?;
     obj.get("combined").or_else(|| obj.values().next())
+}
+
+/// χ²(2) 95 % quantile: a recording whose squared 2-D error normalised by its stated σ (per axis) exceeds
+/// this lies outside the 95 % ellipse of its stated precision.
+const CHI2_2_95: f64 = 5.991;
+
+/// The share of the delivered recordings (`trajectory_adjusted.csv`, absent when the adjustment was withheld)
+/// whose horizontal error against `truth` lies outside the 95 % ellipse of their stated σ (`sigma_x`,
+/// `sigma_y`): about 0.05 when the stated precision is honest, more when it is optimistic. A recording without
+/// a truth row or a positive finite σ is not counted.
+fn recordings_beyond_sigma95(out: &Path, truth: &[Recording]) -> Result<Option<f64>, String> {
+    let Some(t) = read_csv_opt(&out.join("trajectory_adjusted.csv"))? else {
+        return Ok(None);
+    };
+    let true_of: HashMap<&str, &Recording> =
+        truth.iter().map(|r| (r.image_id.as_str(), r)).collect();
+    let (mut beyond, mut counted) = (0usize, 0usize);
+    for row in &t.rows {
+        let Some(truth) = true_of.get(t.text(row, "image_id")) else {
+            continue;
+        };
+        let (Some(x), Some(y), Some(sx), Some(sy)) = (
+            t.num(row, "x"),
+            t.num(row, "y"),
+            t.num(row, "sigma_x"),
+            t.num(row, "sigma_y"),
+        ) else {
+            continue;
+        };
+        if !(sx > 0.0 && sy > 0.0 && sx.is_finite() && sy.is_finite()) {
+            continue;
+        }
+        let q = ((x - truth.x) / sx).powi(2) + ((y - truth.y) / sy).powi(2);
+        counted += 1;
+        beyond += usize::from(q > CHI2_2_95);
+    }
+    Ok((counted > 0).then(|| beyond as f64 / counted as f64))
 }
 
 /// Largest 2-D error after adjustment in `checkpoints.csv`.
@@ -264,6 +308,11 @@ pub fn grade_cell(out: &Path) -> Result<CellMetrics, String> {
         ));
     }
     if campaign.join("truth/recordings.csv").is_file() {
+        let truth = read_recordings_csv(&campaign.join("truth/recordings.csv")).0;
+        put(
+            "rec_beyond_sigma95",
+            recordings_beyond_sigma95(out, &truth)?,
+        );
         let segments = segment_truth(out, &campaign)?;
         let off: Vec<&str> = segments
             .iter()
@@ -287,4 +336,45 @@ pub fn grade_cell(out: &Path) -> Result<CellMetrics, String> {
         }
     }
     Ok(c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn truth(id: &str, x: f64, y: f64) -> Recording {
+        Recording {
+            image_id: id.into(),
+            x,
+            y,
+            ..Recording::default()
+        }
+    }
+
+    #[test]
+    fn recordings_outside_their_stated_95_percent_ellipse_are_counted() {
+        let d = tempfile::tempdir().unwrap();
+        // a: 0.05 m off with σ 0.02 per axis (q = 6.25 > 5.99, outside); b: 0.04 m off with σ 0.02 (q = 4,
+        // inside); c: 0.30 m off along x with σx 0.20 (inside); d: no truth row; e: no σ (both not counted).
+        std::fs::write(
+            d.path().join("trajectory_adjusted.csv"),
+            "image_id,x,y,z,sigma_x,sigma_y\n\
+             a,100.05,200,1,0.02,0.02\n\
+             b,110,200.04,1,0.02,0.02\n\
+             c,120.30,200,1,0.20,0.01\n\
+             d,130,200,1,0.02,0.02\n\
+             e,140,200,1,,\n",
+        )
+        .unwrap();
+        let t = [
+            truth("a", 100.0, 200.0),
+            truth("b", 110.0, 200.0),
+            truth("c", 120.0, 200.0),
+            truth("e", 140.0, 200.0),
+        ];
+        let share = recordings_beyond_sigma95(d.path(), &t).unwrap().unwrap();
+        assert!((share - 1.0 / 3.0).abs() < 1e-12, "{share}");
+        let empty = tempfile::tempdir().unwrap();
+        assert_eq!(recordings_beyond_sigma95(empty.path(), &t).unwrap(), None);
+    }
 }
