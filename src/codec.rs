@@ -523,6 +523,41 @@ mod tests {
     use serde::Deserialize;
     use std::collections::BTreeMap;
 
+    /// Fields grouped into a nested struct encode as if they were the outer struct's own, in order: an
+    /// artifact can group its counters (e.g. the nadir refinement's misses) without invalidating the cache.
+    #[test]
+    fn a_nested_struct_encodes_as_its_fields_in_sequence() {
+        #[derive(Serialize, Deserialize, Debug, PartialEq)]
+        struct Flat {
+            id: String,
+            a: usize,
+            b: usize,
+            c: Vec<u8>,
+        }
+        #[derive(Serialize, Deserialize, Debug, PartialEq)]
+        struct Counts {
+            a: usize,
+            #[serde(default)]
+            b: usize,
+        }
+        #[derive(Serialize, Deserialize, Debug, PartialEq)]
+        struct Nested {
+            id: String,
+            counts: Counts,
+            c: Vec<u8>,
+        }
+        let flat = Flat {
+            id: "r".into(),
+            a: 3,
+            b: 70_000,
+            c: vec![1, 2],
+        };
+        let bytes = encode_serde(&flat).unwrap();
+        let nested: Nested = decode_serde(&bytes).unwrap();
+        assert_eq!(nested.counts, Counts { a: 3, b: 70_000 });
+        assert_eq!(encode_serde(&nested).unwrap(), bytes);
+    }
+
     /// One- and three-channel rasters shaped like the node layer's images.
     #[derive(Debug, PartialEq)]
     struct GrayImage {

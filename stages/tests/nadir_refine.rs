@@ -280,12 +280,15 @@ fn corners_beside_the_mask_are_located_with_a_template_moved_off_centre() {
     let centred = params_at_peak_05();
     let r0 = refine(&pair, &pair.aerial, initial, &centred);
     assert!(
-        r0.unusable_templates > 0,
+        r0.misses.unusable_templates > 0,
         "some centred templates touch the masked block"
     );
     assert_eq!(
         r0.tried,
-        r0.matches.len() + r0.unusable_templates + r0.beyond_search + r0.weak_peaks
+        r0.matches.len()
+            + r0.misses.unusable_templates
+            + r0.misses.beyond_search
+            + r0.misses.weak_peaks
     );
     let moved = RefineParams {
         template_offset_px: 8,
@@ -297,10 +300,10 @@ fn corners_beside_the_mask_are_located_with_a_template_moved_off_centre() {
         "located {} centred, {} with offsets; unusable {} → {}",
         r0.matches.len(),
         r.matches.len(),
-        r0.unusable_templates,
-        r.unusable_templates
+        r0.misses.unusable_templates,
+        r.misses.unusable_templates
     );
-    assert!(r.unusable_templates < r0.unusable_templates);
+    assert!(r.misses.unusable_templates < r0.misses.unusable_templates);
     assert!(r.matches.len() > r0.matches.len());
     // Every corner located centred is located identically; the corners added are as accurate.
     for m in &r0.matches {
@@ -348,7 +351,7 @@ fn a_tie_point_located_alone_in_an_image_is_not_kept_unless_min_located_is_1() {
     let pair = make_pair(11, 0.01);
     let p = params_at_peak_05();
     let all = refine(&pair, &pair.aerial, pair.truth, &p);
-    assert_eq!(all.unconfirmed, 0);
+    assert_eq!(all.misses.unconfirmed, 0);
     // Keep only the window's first two locatable tie points.
     let keep: Vec<usize> = all
         .matches
@@ -370,11 +373,20 @@ fn a_tie_point_located_alone_in_an_image_is_not_kept_unless_min_located_is_1() {
         )
     };
     let two = run(&keep, 2);
-    assert_eq!((two.tried, two.matches.len(), two.unconfirmed), (2, 2, 0));
+    assert_eq!(
+        (two.tried, two.matches.len(), two.misses.unconfirmed),
+        (2, 2, 0)
+    );
     let one = run(&keep[..1], 2);
-    assert_eq!((one.tried, one.matches.len(), one.unconfirmed), (1, 0, 1));
+    assert_eq!(
+        (one.tried, one.matches.len(), one.misses.unconfirmed),
+        (1, 0, 1)
+    );
     let one_kept = run(&keep[..1], 1);
-    assert_eq!((one_kept.matches.len(), one_kept.unconfirmed), (1, 0));
+    assert_eq!(
+        (one_kept.matches.len(), one_kept.misses.unconfirmed),
+        (1, 0)
+    );
     assert_eq!(
         one_kept.matches[0], two.matches[0],
         "the same location either way"
@@ -419,7 +431,10 @@ fn the_view_check_drops_exactly_the_corner_whose_template_shows_content_at_anoth
         ..params_at_peak_05()
     };
     let clean = refine_window(&pair, &window, &pair.aerial, off, &checked);
-    assert_eq!(clean.view_inconsistent, 0, "every clean corner agrees");
+    assert_eq!(
+        clean.misses.view_inconsistent, 0,
+        "every clean corner agrees"
+    );
     let (rms, _) = errors_px(&pair, &clean);
     assert!(rms < 0.1, "rms {rms}");
     // The first corner with a verdict: the right three quarters of its template now show the ground 4 px further
@@ -457,7 +472,7 @@ fn the_view_check_drops_exactly_the_corner_whose_template_shows_content_at_anoth
     );
     // Exactly the perturbed corner is dropped.
     assert_check_drops_exactly(&pair, &window, off, &checked, &clean, &target, |r| {
-        r.view_inconsistent
+        r.misses.view_inconsistent
     });
 }
 
@@ -473,7 +488,7 @@ fn the_tie_point_consistency_drops_exactly_the_corner_whose_mm_point_is_off() {
     };
     let clean = refine_window(&pair, &window, &pair.aerial, off, &checked);
     assert_eq!(
-        clean.point_inconsistent, 0,
+        clean.misses.point_inconsistent, 0,
         "every consistent corner is kept"
     );
     assert!(clean.matches.len() >= 5, "{}", clean.matches.len());
@@ -488,7 +503,7 @@ fn the_tie_point_consistency_drops_exactly_the_corner_whose_mm_point_is_off() {
     window.tie_points[k].point_world[0] += 0.25;
     // Exactly the inconsistent corner is dropped.
     let r = assert_check_drops_exactly(&pair, &window, off, &checked, &clean, &target, |r| {
-        r.point_inconsistent
+        r.misses.point_inconsistent
     });
     // The locations themselves do not change.
     for m in &r.matches {

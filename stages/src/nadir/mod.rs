@@ -24,6 +24,6 @@ pub mod vehicle_mask;
 pub use ortho::{ortho_project, ortho_project_whole, OrthoGeoref, OrthoImage, OrthoParams};
 pub use registration::{
     AerialMatch, AerialRefinement, InitialTransform, MmWindowMatch, PairMethod, PairReport,
-    RecordingControl, TransformOutcome, ViewGround,
+    RecordingControl, RefinementMisses, TransformOutcome, ViewGround,
 };
 pub use vehicle_mask::VehicleMask;

@@ -548,18 +548,18 @@ pub fn refine_in_image(
             Outcome::NotLocated(miss) => {
                 result.tried += 1;
                 match miss {
-                    Miss::Template => result.unusable_templates += 1,
-                    Miss::Window | Miss::Margin => result.beyond_search += 1,
-                    Miss::Peak => result.weak_peaks += 1,
+                    Miss::Template => result.misses.unusable_templates += 1,
+                    Miss::Window | Miss::Margin => result.misses.beyond_search += 1,
+                    Miss::Peak => result.misses.weak_peaks += 1,
                 }
             }
             Outcome::Parallax => {
                 result.tried += 1;
-                result.parallax_rejected += 1;
+                result.misses.parallax_rejected += 1;
             }
             Outcome::ViewInconsistent => {
                 result.tried += 1;
-                result.view_inconsistent += 1;
+                result.misses.view_inconsistent += 1;
             }
             Outcome::Located(m) => {
                 result.tried += 1;
@@ -583,17 +583,17 @@ pub fn refine_in_image(
             result.matches =
                 consistent_residuals(std::mem::take(&mut result.matches), &residuals, bound_px);
         }
-        result.point_inconsistent = before - result.matches.len();
+        result.misses.point_inconsistent = before - result.matches.len();
     }
     if p.max_shift_spread_px > 0.0 {
         let before = result.matches.len();
         // The spread is in working pixels; corrections are in full-resolution pixels.
         let spread_px = p.max_shift_spread_px * aerial_window.window.scale();
         result.matches = consistent_shifts(std::mem::take(&mut result.matches), spread_px);
-        result.shift_inconsistent = before - result.matches.len();
+        result.misses.shift_inconsistent = before - result.matches.len();
     }
     if result.matches.len() < p.min_located {
-        result.unconfirmed = result.matches.len();
+        result.misses.unconfirmed = result.matches.len();
         result.matches.clear();
     }
     Ok(result)

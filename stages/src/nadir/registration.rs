@@ -145,6 +145,72 @@ impl AerialMatch {
     }
 }
 
+/// Why tie points tried in an aerial image were not kept: the refinement's funnel, per (recording, aerial
+/// image) and summed over a run (`nadir.*` metrics). Encoded as its fields in sequence, so a struct that holds
+/// it encodes as if they were its own.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RefinementMisses {
+    /// Not located because a neighbouring recording shows the template differently (parallax check,
+    /// `nadir::parallax_check`).
+    pub parallax_rejected: usize,
+    /// No template could be cut (it leaves the ortho image, touches a masked pixel or is nearly flat,
+    /// `RefineParams::min_template_std`).
+    #[serde(default)]
+    pub unusable_templates: usize,
+    /// The content was found beyond the search margin (`RefineParams::search_margin_px`) or the search window
+    /// left the aerial image.
+    #[serde(default)]
+    pub beyond_search: usize,
+    /// The correlation peak stayed below `RefineParams::min_peak`.
+    #[serde(default)]
+    pub weak_peaks: usize,
+    /// Located, but dropped because their correction disagrees with the image's other tie points
+    /// (`RefineParams::max_shift_spread_px`).
+    #[serde(default)]
+    pub shift_inconsistent: usize,
+    /// Located, but dropped because a neighbouring recording's view of the same corner lands elsewhere in the
+    /// aerial image (`RefineParams::view_sigma_px`).
+    #[serde(default)]
+    pub view_inconsistent: usize,
+    /// Located, but dropped because the located corner departs from the tie point's MM object point by more
+    /// than the image's other tie points do (`RefineParams::point_sigma_px`).
+    #[serde(default)]
+    pub point_inconsistent: usize,
+    /// Located, but dropped because fewer than `RefineParams::min_located` tie points were located in the
+    /// image (a lone located template has no other to confirm the pair's registration).
+    pub unconfirmed: usize,
+}
+
+impl RefinementMisses {
+    /// Adds `other`'s counts to these.
+    pub fn add(&mut self, other: &RefinementMisses) {
+        self.parallax_rejected += other.parallax_rejected;
+        self.unusable_templates += other.unusable_templates;
+        self.beyond_search += other.beyond_search;
+        self.weak_peaks += other.weak_peaks;
+        self.shift_inconsistent += other.shift_inconsistent;
+        self.view_inconsistent += other.view_inconsistent;
+        self.point_inconsistent += other.point_inconsistent;
+        self.unconfirmed += other.unconfirmed;
+    }
+
+    /// The counts as metrics keys (`parallax_rejected`, `unusable_templates`, …) into `map`.
+    pub fn put_metrics(&self, map: &mut serde_json::Map<String, serde_json::Value>) {
+        for (key, n) in [
+            ("parallax_rejected", self.parallax_rejected),
+            ("unusable_templates", self.unusable_templates),
+            ("beyond_search", self.beyond_search),
+            ("weak_peaks", self.weak_peaks),
+            ("shift_inconsistent", self.shift_inconsistent),
+            ("view_inconsistent", self.view_inconsistent),
+            ("point_inconsistent", self.point_inconsistent),
+            ("unconfirmed", self.unconfirmed),
+        ] {
+            map.insert(key.to_string(), n.into());
+        }
+    }
+}
+
 /// All refined correspondences of one (recording, aerial image).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AerialRefinement {
@@ -152,35 +218,8 @@ pub struct AerialRefinement {
     pub aerial_id: String,
     /// Tie points tried (inside the aerial image) and located (peak accepted).
     pub tried: usize,
-    /// Of `tried`: not located because a neighbouring recording shows the template differently (parallax
-    /// check, `nadir::parallax_check`).
-    pub parallax_rejected: usize,
-    /// Of `tried`: no template could be cut (it leaves the ortho image, touches a masked pixel or is nearly
-    /// flat, `RefineParams::min_template_std`).
-    #[serde(default)]
-    pub unusable_templates: usize,
-    /// Of `tried`: the content was found beyond the search margin (`RefineParams::search_margin_px`) or the
-    /// search window left the aerial image.
-    #[serde(default)]
-    pub beyond_search: usize,
-    /// Of `tried`: the correlation peak stayed below `RefineParams::min_peak`.
-    #[serde(default)]
-    pub weak_peaks: usize,
-    /// Of `tried`: located, but dropped because their correction disagrees with the image's other tie points
-    /// (`RefineParams::max_shift_spread_px`).
-    #[serde(default)]
-    pub shift_inconsistent: usize,
-    /// Of `tried`: located, but dropped because a neighbouring recording's view of the same corner lands
-    /// elsewhere in the aerial image (`RefineParams::view_sigma_px`).
-    #[serde(default)]
-    pub view_inconsistent: usize,
-    /// Of `tried`: located, but dropped because the located corner departs from the tie point's MM object point
-    /// by more than the image's other tie points do (`RefineParams::point_sigma_px`).
-    #[serde(default)]
-    pub point_inconsistent: usize,
-    /// Of `tried`: located, but dropped because fewer than `RefineParams::min_located` tie points were located
-    /// in this image (a lone located template has no other to confirm the pair's registration).
-    pub unconfirmed: usize,
+    /// Of `tried`: why the ones not in `matches` were not kept.
+    pub misses: RefinementMisses,
     pub matches: Vec<AerialMatch>,
 }
 
@@ -191,14 +230,7 @@ impl AerialRefinement {
             recording_id: recording_id.to_string(),
             aerial_id: aerial_id.to_string(),
             tried: 0,
-            parallax_rejected: 0,
-            unusable_templates: 0,
-            beyond_search: 0,
-            weak_peaks: 0,
-            shift_inconsistent: 0,
-            view_inconsistent: 0,
-            point_inconsistent: 0,
-            unconfirmed: 0,
+            misses: RefinementMisses::default(),
             matches: Vec::new(),
         }
     }

@@ -3,7 +3,8 @@
 //! aerial control points. Truth-based grades live in `grading.rs`.
 
 use super::registration::{
-    AerialRefinement, MmWindowMatch, PairMethod, RecordingControl, TransformOutcome,
+    AerialRefinement, MmWindowMatch, PairMethod, RecordingControl, RefinementMisses,
+    TransformOutcome,
 };
 use crate::params::StageId;
 use crate::ratio::ratio_or_zero;
@@ -32,32 +33,8 @@ pub struct NadirSummary {
     pub transforms_rejected: BTreeMap<String, usize>,
     /// MM tie point × aerial image correspondences (as Table 3-1 counts them).
     pub tie_points: usize,
-    /// Tie points × aerial images not located because a neighbouring recording shows the template differently
-    /// (`nadir::parallax_check`).
-    pub parallax_rejected: usize,
-    /// Tie points × aerial images not located: no usable template (masked, outside the ortho, flat).
-    #[serde(default)]
-    pub unusable_templates: usize,
-    /// Tie points × aerial images not located: found beyond the search margin or the window left the image.
-    #[serde(default)]
-    pub beyond_search: usize,
-    /// Tie points × aerial images not located: correlation peak below `RefineParams::min_peak`.
-    #[serde(default)]
-    pub weak_peaks: usize,
-    /// Tie points × aerial images located but dropped: their correction disagrees with the other tie points of
-    /// the recording in that image (`RefineParams::max_shift_spread_px`).
-    pub shift_inconsistent: usize,
-    /// Tie points × aerial images located but dropped: a neighbouring recording's view of the corner lands
-    /// elsewhere in the aerial image (`RefineParams::view_sigma_px`).
-    #[serde(default)]
-    pub view_inconsistent: usize,
-    /// Tie points × aerial images located but dropped: the located corner departs from the tie point's MM
-    /// object point by more than the other tie points of the recording in that image do
-    /// (`RefineParams::point_sigma_px`).
-    #[serde(default)]
-    pub point_inconsistent: usize,
-    /// Tie points × aerial images located but dropped: too few located in that image (`RefineParams::min_located`).
-    pub unconfirmed: usize,
+    /// Tie points × aerial images not located or not kept, by reason.
+    pub misses: RefinementMisses,
     /// Recordings with at least one MM–aerial correspondence.
     pub recordings_with_aerial: usize,
     /// Mean number of distinct aerial images with correspondences per such recording.
@@ -133,14 +110,7 @@ impl NadirSummary {
         let mut images_per_recording: BTreeMap<&str, BTreeSet<&str>> = BTreeMap::new();
         for r in refinements {
             s.tie_points += r.matches.len();
-            s.parallax_rejected += r.parallax_rejected;
-            s.unusable_templates += r.unusable_templates;
-            s.beyond_search += r.beyond_search;
-            s.weak_peaks += r.weak_peaks;
-            s.shift_inconsistent += r.shift_inconsistent;
-            s.view_inconsistent += r.view_inconsistent;
-            s.point_inconsistent += r.point_inconsistent;
-            s.unconfirmed += r.unconfirmed;
+            s.misses.add(&r.misses);
             if !r.matches.is_empty() {
                 images_per_recording
                     .entry(r.recording_id.as_str())
@@ -171,19 +141,11 @@ impl NadirSummary {
     /// The `nadir` metrics section.
     pub fn metrics(&self) -> serde_json::Value {
         let frac = ratio_or_zero(self.recordings_with_aerial, self.recordings);
-        serde_json::json!({
+        let mut m = serde_json::json!({
             "recordings": self.recordings,
             "recordings_with_aerial": self.recordings_with_aerial,
             "recordings_with_aerial_fraction": frac,
             "tie_points": self.tie_points,
-            "parallax_rejected": self.parallax_rejected,
-            "unusable_templates": self.unusable_templates,
-            "beyond_search": self.beyond_search,
-            "weak_peaks": self.weak_peaks,
-            "shift_inconsistent": self.shift_inconsistent,
-            "view_inconsistent": self.view_inconsistent,
-            "point_inconsistent": self.point_inconsistent,
-            "unconfirmed": self.unconfirmed,
             "mean_aerial_images_per_recording": self.mean_aerial_images_per_recording,
             "control_points": self.control_points,
             "single_aerial_points": self.single_aerial_points,
@@ -195,7 +157,11 @@ impl NadirSummary {
             "transforms_tried": self.transforms_tried,
             "transforms_accepted": self.transforms_accepted,
             "transforms_rejected": self.transforms_rejected,
-        })
+        });
+        if let Some(map) = m.as_object_mut() {
+            self.misses.put_metrics(map);
+        }
+        m
     }
 }
 

@@ -82,10 +82,10 @@ fn refine_corroborated(
         p.min_corroborating,
         scale,
     );
-    r.shift_inconsistent += c.weak_dropped;
+    r.misses.shift_inconsistent += c.weak_dropped;
     r.matches = c.kept;
     if r.matches.len() < p.refine.min_located {
-        r.unconfirmed = r.matches.len();
+        r.misses.unconfirmed = r.matches.len();
         r.matches.clear();
     }
     Ok(r)
