@@ -22,7 +22,7 @@ pub use super::block_build::{
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("adjust", "18");
+pub const STAGE: StageId = StageId::new("adjust", "19");
 
 /// One adjusted recording.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

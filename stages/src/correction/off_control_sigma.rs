@@ -17,6 +17,19 @@
 //! first lag (the white noise between neighbours) and grows linearly in `h` beyond the last lag (a random walk).
 //! With too few controlled recordings for a variogram, such a recording's σ is at least its recorded prior σ:
 //! nothing better is known about it.
+//!
+//! The variogram pools the whole campaign, so it describes the typical change of the error; a GNSS outage
+//! drifts by metres where no recording is controlled, and the controlled recordings around it say so only by
+//! their two corrections. A bridged recording (controlled recordings on both sides along the trajectory, its
+//! anchors `a` and `b`, `L` metres apart, the recording `d_a` and `d_b` metres from them) therefore also gets
+//! the local evidence of its anchors, for a trajectory error that wanders like a random walk between them:
+//! the rate per axis estimated from the anchors' difference `Δ = c_b − c_a`, `q = Δ²/L` (horizontally
+//! `|Δ_xy|²/(2L)` per axis), gives the variance of the random walk pinned at both anchors (a Brownian bridge),
+//! `q·d_a·d_b/L`, around the straight interpolation of the anchors' corrections. Where the adjustment put the
+//! recording elsewhere than that interpolation (its own tie points, or the robust loss letting one anchor go
+//! and the stretch keep its recorded shape), the distance between the two adds to the variance per axis: one
+//! of the two is off by about that much, and nothing in the adjustment says which. A bridged recording thus
+//! gets `σ² = σ²_adjustment + max(2·γ(d), q·d_a·d_b/L) + (c − c_interpolated)²` per axis.
 
 use super::support::{recording_support, Support};
 use crate::adjustment::AdjustmentRun;
@@ -52,6 +65,47 @@ pub struct OffControlSigma {
     pub widened: usize,
     /// Recordings whose σ was raised to their recorded prior σ (no variogram).
     pub raised_to_prior: usize,
+    /// Bridged recordings whose σ the local evidence of their two anchors widened beyond the variogram's.
+    pub widened_by_anchors: usize,
+}
+
+/// The local variances per axis (x, y, z; m²) of bridged recording `i` from its anchors `a` < `i` < `b`
+/// (module documentation): the Brownian bridge of the anchors' correction difference, and the squared
+/// distance of its correction from their interpolation. `corr(j)` is recording `j`'s correction, `s_m` the
+/// along-track positions.
+fn anchor_variance(
+    i: usize,
+    (a, b): (usize, usize),
+    s_m: &[f64],
+    corr: impl Fn(usize) -> [f64; 3],
+) -> Option<AnchorVariance> {
+    let length = s_m[b] - s_m[a];
+    let (d_a, d_b) = (s_m[i] - s_m[a], s_m[b] - s_m[i]);
+    if !(length > 0.0 && d_a >= 0.0 && d_b >= 0.0) {
+        return None;
+    }
+    let (ca, cb, ci) = (corr(a), corr(b), corr(i));
+    let delta: [f64; 3] = std::array::from_fn(|k| cb[k] - ca[k]);
+    let rate_xy = (delta[0] * delta[0] + delta[1] * delta[1]) / (2.0 * length);
+    let rate = [rate_xy, rate_xy, delta[2] * delta[2] / length];
+    let pinned = d_a * d_b / length;
+    let out = AnchorVariance {
+        bridge_m2: std::array::from_fn(|k| rate[k] * pinned),
+        off_interpolation_m2: std::array::from_fn(|k| {
+            (ci[k] - (ca[k] + delta[k] * d_a / length)).powi(2)
+        }),
+    };
+    let finite = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
+    (finite(&out.bridge_m2) && finite(&out.off_interpolation_m2)).then_some(out)
+}
+
+/// What a bridged recording's two anchors say of its correction's variance, per axis (x, y, z), m².
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct AnchorVariance {
+    /// The random walk pinned at both anchors, around the interpolation of their corrections.
+    bridge_m2: [f64; 3],
+    /// The squared distance of the adjusted correction from that interpolation.
+    off_interpolation_m2: [f64; 3],
 }
 
 /// Distance along the recorded trajectory (horizontal, m) of every recording from the first.
@@ -169,13 +223,30 @@ pub fn widen_off_control_sigma(
             .filter(|&&c| support[c].group == sup.group)
             .map(|&c| (s_m[c] - s_m[i]).abs())
             .min_by(f64::total_cmp);
+        let anchors = (sup.support == Support::Bridged)
+            .then(|| {
+                let same = |c: &&usize| support[**c].group == sup.group;
+                let before = controlled.iter().filter(same).rev().find(|&&c| c < i)?;
+                let after = controlled.iter().filter(same).find(|&&c| c > i)?;
+                anchor_variance(i, (*before, *after), &s_m, |j| {
+                    let r = &run.recordings[j];
+                    std::array::from_fn(|k| r.adjusted_world[k] - r.recorded_world[k])
+                })
+            })
+            .flatten();
         let sigma = &mut run.recordings[i].sigma_m;
         match nearest_m.and_then(|d| semivariance_at(&variogram, d)) {
             Some((g_xy, g_z)) => {
+                let mut by_anchors = false;
                 for (k, g) in [g_xy, g_xy, g_z].into_iter().enumerate() {
-                    sigma[k] = (sigma[k] * sigma[k] + 2.0 * g).sqrt();
+                    let (bridge, off) =
+                        anchors.map_or((0.0, 0.0), |v| (v.bridge_m2[k], v.off_interpolation_m2[k]));
+                    let added = bridge.max(2.0 * g) + off;
+                    by_anchors |= added > 2.0 * g;
+                    sigma[k] = (sigma[k] * sigma[k] + added).sqrt();
                 }
                 report.widened += 1;
+                report.widened_by_anchors += usize::from(by_anchors);
             }
             None => {
                 let (xy, z) = prior_sigma_m.get(i).copied().unwrap_or((None, None));
@@ -297,5 +368,60 @@ mod tests {
         assert_eq!(report.raised_to_prior, 4);
         assert_eq!(r.recordings[0].sigma_m, [1.0, 1.0, 0.1]);
         assert_eq!(r.recordings[2].sigma_m, [0.1; 3]);
+    }
+    /// A bridged recording midway between anchors whose corrections differ by 2 m in x over 40 m: the random
+    /// walk pinned at both has variance (2²/(2·40))·20·20/40 = 0.5 m² per horizontal axis at the middle, none
+    /// at the anchors; a correction 0.3 m off the interpolation adds 0.09 m² on that axis.
+    #[test]
+    fn a_bridged_recordings_anchors_widen_it_by_their_difference() {
+        let s: Vec<f64> = (0..9).map(|i| 5.0 * i as f64).collect();
+        let corr = |j: usize| match j {
+            0 => [1.0, 0.0, 0.0],
+            8 => [3.0, 0.0, 0.0],
+            4 => [2.3, 0.0, 0.0],
+            _ => [1.0 + 0.25 * j as f64, 0.0, 0.0],
+        };
+        let mid = anchor_variance(4, (0, 8), &s, corr).unwrap();
+        assert!((mid.bridge_m2[0] - 0.5).abs() < 1e-12 && (mid.bridge_m2[1] - 0.5).abs() < 1e-12);
+        assert_eq!(mid.bridge_m2[2], 0.0);
+        assert!((mid.off_interpolation_m2[0] - 0.09).abs() < 1e-12);
+        assert_eq!(mid.off_interpolation_m2[1], 0.0);
+        let near = anchor_variance(1, (0, 8), &s, corr).unwrap();
+        assert!((near.bridge_m2[0] - 0.05 * 5.0 * 35.0 / 40.0).abs() < 1e-12);
+        assert!(near.off_interpolation_m2[0] < 1e-24);
+        assert!(anchor_variance(4, (8, 0), &s, corr).is_none());
+    }
+
+    /// The stretch of a drift between two controlled recordings that the adjustment left on its recorded shape
+    /// (corrections equal to the first anchor's) gets a σ that covers how far it is from the interpolation; a
+    /// recording beyond the last controlled one (extrapolated) is left to the variogram.
+    #[test]
+    fn a_bridge_left_on_its_recorded_shape_is_widened_by_its_anchors() {
+        let n = 30;
+        // Controlled every other recording on 0–10 and 20–29 with the same correction 0.8 m; 11–19 bridged
+        // with the correction of the first anchor although the second anchor's is 2.8 m.
+        let recs = (0..n)
+            .map(|i| {
+                let dx = if i >= 19 { 2.8 } else { 0.8 };
+                recording(i, 5.0 * i as f64, [dx, 0.0, 0.0])
+            })
+            .collect();
+        let points = (0..=10)
+            .step_by(2)
+            .chain((20..n).step_by(2))
+            .map(|i| point(PointKind::Control, &[i]))
+            .collect();
+        let config = AdjustConfig {
+            relative_constraints: true,
+            ..AdjustConfig::default()
+        };
+        let mut r = run(config, recs, points);
+        let report = widen_off_control_sigma(&mut r, &vec![(Some(1.0), Some(0.3)); n]);
+        assert!(report.widened_by_anchors > 0);
+        // Recording 15, midway: 1.0 m from the interpolation in x, plus the pinned random walk.
+        let sx = r.recordings[15].sigma_m[0];
+        assert!(sx > 1.0 && sx < 1.5, "{sx}");
+        // Recording 19 carries the second anchor's correction: close to it, small σ from the anchors.
+        assert!(r.recordings[19].sigma_m[0] < sx);
     }
 }
