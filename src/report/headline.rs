@@ -376,7 +376,7 @@ impl Headline {
         if let Some(v) = &self.verification_after {
             out.push(format!(
                 "Verification of the adjusted trajectory: {} of {} segment(s) pass, {} fail, {} insufficient (too \
-                 few points, or a stretch without any).",
+                 few points, a stretch without any, or a stated σ too large for the tolerance).",
                 v.count("pass"),
                 v.segments.len(),
                 v.count("fail"),

@@ -14,7 +14,7 @@ pub const SIGN_CONVENTION: &str = "Sign convention everywhere: a correction is a
     minus its aerial triangulation: how far the trajectory is off); a check-point error is estimated − surveyed.";
 
 /// Row indices of verification segments, most interesting first, for the page of a long table: the overall
-/// row (label `all`), then failed segments, insufficient ones (too few points, or a stretch without any), passed ones; within each by
+/// row (label `all`), then failed segments, insufficient ones (too few points, a stretch without any, or after adjustment a stated σ too large for the tolerance), passed ones; within each by
 /// decreasing horizontal offset (missing offsets last), ties in table order.
 pub fn rank_segments(rows: &[(&str, &str, Option<f64>)]) -> Vec<usize> {
     let class = |label: &str, status: &str| match (label, status) {
@@ -41,7 +41,7 @@ pub fn rank_segments(rows: &[(&str, &str, Option<f64>)]) -> Vec<usize> {
 
 /// What [`rank_segments`] shows first, for the line under a long table.
 pub const RANKED_SEGMENTS: &str =
-    "failed segments first, then insufficient ones (too few points, or a stretch without any), each by decreasing offset";
+    "failed segments first, then insufficient ones (too few points, a stretch without any, or after adjustment a stated σ too large for the tolerance), each by decreasing offset";
 
 fn segment_table(id: &str, title: &str, segments: &[SegmentLine]) -> Table {
     let mut t = Table::new(

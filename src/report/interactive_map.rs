@@ -453,7 +453,7 @@ pub fn map_section(
          what supports the correction (blue: own aerial control, green: bridged between controlled neighbours, \
          orange: extrapolated, red: not corrected); grey rings: recorded positions; black lines: correction \
          vectors (adjusted − recorded) drawn {}× longer than they are; broad bands: verification per segment \
-         (green pass, red fail, grey insufficient: too few points, or a stretch without any); purple: aerial \
+         (green pass, red fail, grey insufficient: too few points, a stretch without any, or after adjustment a stated σ too large for the tolerance); purple: aerial \
          control points; black squares: check points with their errors before (grey) and after (red), drawn {}× \
          longer.</p>\n\
          <div class=\"mapwrap\"><div id=\"map-{}\" class=\"skymap\"></div><div id=\"panel-{}\" class=\"mappanel\">\

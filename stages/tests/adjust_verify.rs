@@ -2,12 +2,13 @@
 //! and a purely systematic position error, every MM − aerial offset equals that error; a deteriorated campaign
 //! is flagged, an undeteriorated one passes; a segment whose recordings drift with a mean near zero fails on its
 //! points, one wrong point does not fail a segment; a segment whose points leave half of it unobserved does not
-//! pass; `verification.csv` parses back; segments by count and by length.
+//! pass; a segment whose verified poses state a σ too large for the tolerance does not pass;
+//! `verification.csv` parses back; segments by count and by length.
 
 use skytie_stages::adjustment::synthetic_campaign::{SyntheticCampaign, SyntheticCampaignSpec};
 use skytie_stages::adjustment::verify::{
-    render_verification_table, verify, write_verification_csv, VerifyConfig, VerifyStatus,
-    VERIFICATION_CSV_HEADER,
+    render_verification_table, verify, verify_with_detail_levels, write_verification_csv,
+    VerifyConfig, VerifyStatus, VERIFICATION_CSV_HEADER,
 };
 use skytie_stages::adjustment::SyntheticBlockSpec;
 
@@ -148,6 +149,7 @@ fn segments_by_length_and_csv_round_trip() {
         assert_eq!(row[16].parse::<usize>().unwrap(), s.points_off);
         assert_eq!(&row[17], s.status.label());
         assert_eq!(row[18].parse::<usize>().unwrap(), s.unobserved_run);
+        assert_eq!(&row[19], "", "the recorded poses state no σ");
     }
     assert_eq!(&rows[rows.len() - 1][0], "all");
     std::fs::remove_dir_all(&dir).unwrap();
@@ -273,4 +275,67 @@ fn a_segment_whose_points_leave_half_of_it_unobserved_does_not_pass() {
     );
     assert!(middle.unobserved_run >= 10, "run {}", middle.unobserved_run);
     assert_eq!(middle.status, VerifyStatus::Insufficient);
+}
+
+/// The verification of an adjusted trajectory: the same undeteriorated campaign passes when its poses state a
+/// σ of 5 cm, and a segment whose recordings state 0.5 m on half of them (bridged across a drift that the
+/// adjustment could not take out) is `insufficient`, not `pass`: its points vouch for the other half only.
+#[test]
+fn a_segment_whose_stated_sigma_cannot_support_the_tolerance_does_not_pass() {
+    let c = dense_campaign(1);
+    let config = VerifyConfig::default();
+    let n = c.recordings.len();
+    let run = |sigma: &[f64]| {
+        verify_with_detail_levels(
+            &c.recordings,
+            &c.pano_size_px,
+            &[],
+            sigma,
+            &c.control,
+            &config,
+        )
+        .unwrap()
+    };
+    let tight = run(&vec![0.05; n]);
+    assert!(tight.passed(), "{}", render_verification_table(&tight));
+    for s in &tight.segments {
+        assert!((s.stated_sigma_xy_m.unwrap() - 0.05).abs() < 1e-12);
+    }
+    // Segment 1 (recordings 20–39): half of them at 0.5 m → RMS 0.36 m, ×2 beyond 0.20 m.
+    let mut sigma = vec![0.05; n];
+    sigma[25..35].fill(0.5);
+    let loose = run(&sigma);
+    let status: Vec<_> = loose.segments.iter().map(|s| s.status).collect();
+    assert_eq!(
+        status,
+        [
+            VerifyStatus::Pass,
+            VerifyStatus::Insufficient,
+            VerifyStatus::Pass
+        ],
+        "{}",
+        render_verification_table(&loose)
+    );
+    // Evidence of a failure still fails: the deteriorated campaign fails whatever σ its poses state.
+    let bad = campaign(0.8, 0.0, 0.5, 1);
+    let vb = verify_with_detail_levels(
+        &bad.recordings,
+        &bad.pano_size_px,
+        &[],
+        &vec![0.5; n],
+        &bad.control,
+        &config,
+    )
+    .unwrap();
+    assert!(vb.segments.iter().all(|s| s.status == VerifyStatus::Fail));
+    // One σ per recording or none.
+    assert!(verify_with_detail_levels(
+        &c.recordings,
+        &c.pano_size_px,
+        &[],
+        &[0.1],
+        &c.control,
+        &config
+    )
+    .is_err());
 }

@@ -7,6 +7,7 @@ use crate::dag::{Handle, InputsOf, NodeCtx, Optional, RunResult, Stage, StageErr
 use crate::nodes::adjust::adjustment::AdjustReport;
 use crate::nodes::campaign::ingest::IngestedImage;
 use crate::nodes::campaign::load::CampaignSnapshot;
+use skytie_stages::adjustment::block_build::prior_sigmas_m;
 use skytie_stages::adjustment::from_correspondences::RunRecording;
 use skytie_stages::adjustment::verify::{verify_with_detail_levels, Verification, VerifyConfig};
 use skytie_stages::campaign::Recording;
@@ -27,6 +28,7 @@ pub fn verify_metrics(v: &Verification) -> serde_json::Value {
             "offset_2d_m": s.offset_2d_m,
             "points_off": s.points_off,
             "unobserved_run": s.unobserved_run,
+            "stated_sigma_xy_m": s.stated_sigma_xy_m,
             "status": s.status.label(),
         })
     };
@@ -69,18 +71,29 @@ impl Stage for VerifyStage {
             .flatten()
             .flat_map(|r| r.points.iter().cloned())
             .collect();
-        let recordings = match adjusted.first() {
+        let (recordings, stated_sigma) = match adjusted.first() {
             Some(report) => adjusted_recordings(&snap.campaign.recordings, report),
-            None => snap.campaign.recordings.clone(),
+            None => (snap.campaign.recordings.clone(), Vec::new()),
         };
-        verify_with_detail_levels(&recordings, &sizes, &detail_levels, &points, config)
-            .map_err(StageError::new)
+        verify_with_detail_levels(
+            &recordings,
+            &sizes,
+            &detail_levels,
+            &stated_sigma,
+            &points,
+            config,
+        )
+        .map_err(StageError::new)
     }
 }
 
-/// The campaign's recordings at their adjusted poses (position, and yaw where the adjustment estimated it);
-/// recordings the adjustment did not contain keep their recorded pose.
-fn adjusted_recordings(recorded: &[Recording], report: &AdjustReport) -> Vec<Recording> {
+/// The campaign's recordings at their adjusted poses (position, and yaw where the adjustment estimated it),
+/// and each one's stated horizontal σ (the larger of x and y, m); recordings the adjustment did not contain
+/// keep their recorded pose and their prior σ (the adjustment's, from the row's `sigma_xy` or its default).
+fn adjusted_recordings(
+    recorded: &[Recording],
+    report: &AdjustReport,
+) -> (Vec<Recording>, Vec<f64>) {
     let adjusted: HashMap<&str, &RunRecording> = report
         .run
         .recordings
@@ -91,11 +104,15 @@ fn adjusted_recordings(recorded: &[Recording], report: &AdjustReport) -> Vec<Rec
         .iter()
         .map(|rec| {
             let mut rec = rec.clone();
-            if let Some(a) = adjusted.get(rec.image_id.as_str()) {
-                [rec.x, rec.y, rec.z] = a.adjusted_world;
-                rec.yaw_deg += a.yaw_correction_deg;
-            }
-            rec
+            let sigma = match adjusted.get(rec.image_id.as_str()) {
+                Some(a) => {
+                    [rec.x, rec.y, rec.z] = a.adjusted_world;
+                    rec.yaw_deg += a.yaw_correction_deg;
+                    a.sigma_m[0].max(a.sigma_m[1])
+                }
+                None => prior_sigmas_m(&rec, &report.run.config).0,
+            };
+            (rec, sigma)
         })
-        .collect()
+        .unzip()
 }

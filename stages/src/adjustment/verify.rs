@@ -15,7 +15,10 @@
 //! off too): a trajectory that drifts within a segment (a GNSS outage) has a mean that proves nothing,
 //! its spread is the evidence; otherwise `insufficient` with fewer than `min_points` points or when the points
 //! leave a run of at least `max_unobserved_share` of the segment's recordings unobserved (they vouch only for
-//! the recordings they were observed from), `pass` otherwise.
+//! the recordings they were observed from), or when the trajectory's own stated precision cannot support a pass
+//! (the verification of an adjusted trajectory: the RMS of its recordings' stated horizontal σ, times
+//! `confidence_k`, beyond `tolerance_xy_m` — its recordings without control of their own carry a σ that says
+//! how far they may be off, and points elsewhere in the segment do not vouch for them), `pass` otherwise.
 //! One point alone never fails a segment (a single wrong correspondence must not), but two independent
 //! points that both put the recordings significantly off are enough even where `min_points` are needed
 //! for a pass. The height is not tested by default: nadir images from ≈ 4500 m give
@@ -38,7 +41,7 @@ use std::path::Path;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("verify", "8");
+pub const STAGE: StageId = StageId::new("verify", "9");
 
 crate::params! {
     /// Parameters of a verification (the verify node's params).
@@ -143,6 +146,9 @@ pub struct VerificationSegment {
     /// Longest run of consecutive recordings of the segment from which none of its compared points was
     /// observed (`max_unobserved_share`).
     pub unobserved_run: usize,
+    /// RMS over the segment's recordings of their stated horizontal σ (the larger of x and y), metres; `None`
+    /// when the verified poses state none (the recorded trajectory).
+    pub stated_sigma_xy_m: Option<f64>,
     pub status: VerifyStatus,
 }
 
@@ -198,17 +204,20 @@ pub fn verify(
     control: &[AerialControlPoint],
     config: &VerifyConfig,
 ) -> Result<Verification, String> {
-    verify_with_detail_levels(recordings, pano_size_px, &[], control, config)
+    verify_with_detail_levels(recordings, pano_size_px, &[], &[], control, config)
 }
 
 /// [`verify`] with the detail level of each recording's panorama (`pano_detail_level`, one per recording, or
 /// empty for 0 everywhere): a panorama observation's σ is `pano_sigma_px` pixels of that level, i.e.
 /// `pano_sigma_px · 2^level` full-resolution pixels, so a panorama enlarged by pixel repetition weighs its
-/// observations like the panorama it was enlarged from.
+/// observations like the panorama it was enlarged from; and with the stated horizontal σ of each verified
+/// pose (`stated_sigma_xy_m`, m, one per recording, or empty when the poses state none: the recorded
+/// trajectory), which a segment's pass must be able to support (module documentation).
 pub fn verify_with_detail_levels(
     recordings: &[Recording],
     pano_size_px: &[(u32, u32)],
     pano_detail_level: &[usize],
+    stated_sigma_xy_m: &[f64],
     control: &[AerialControlPoint],
     config: &VerifyConfig,
 ) -> Result<Verification, String> {
@@ -222,13 +231,18 @@ pub fn verify_with_detail_levels(
             recordings.len()
         ));
     }
-    if !(pano_detail_level.is_empty() || pano_detail_level.len() == recordings.len()) {
-        return Err(format!(
-            "{} panorama detail levels for {} recordings; pass one per recording, or none",
-            pano_detail_level.len(),
-            recordings.len()
-        ));
+    for (what, len) in [
+        ("panorama detail levels", pano_detail_level.len()),
+        ("stated σ", stated_sigma_xy_m.len()),
+    ] {
+        if !(len == 0 || len == recordings.len()) {
+            return Err(format!(
+                "{len} {what} for {} recordings; pass one per recording, or none",
+                recordings.len()
+            ));
+        }
     }
+    let stated = (!stated_sigma_xy_m.is_empty()).then_some(stated_sigma_xy_m);
     let cameras: Vec<PanoramaCamera> = recordings
         .iter()
         .zip(pano_size_px)
@@ -319,7 +333,16 @@ pub fn verify_with_detail_levels(
                 recordings[a].image_id.clone(),
                 recordings[b].image_id.clone(),
             );
-            Some(statistics(s, n_rec, first, last, a..=b, members, config))
+            Some(statistics(
+                s,
+                n_rec,
+                first,
+                last,
+                a..=b,
+                members,
+                stated,
+                config,
+            ))
         })
         .collect();
     let all: Vec<&VerifiedPoint> = points.iter().collect();
@@ -336,6 +359,7 @@ pub fn verify_with_detail_levels(
             .unwrap_or_default(),
         0..=recordings.len().saturating_sub(1),
         &all,
+        stated,
         config,
     );
     Ok(Verification {
@@ -349,6 +373,7 @@ pub fn verify_with_detail_levels(
 }
 
 /// Table 5-13 statistics of a set of points.
+#[allow(clippy::too_many_arguments)]
 fn statistics(
     index: usize,
     recordings: usize,
@@ -356,6 +381,7 @@ fn statistics(
     last_image_id: String,
     span: RangeInclusive<usize>,
     points: &[&VerifiedPoint],
+    stated_sigma_xy_m: Option<&[f64]>,
     config: &VerifyConfig,
 ) -> VerificationSegment {
     let n = points.len();
@@ -396,6 +422,10 @@ fn statistics(
                 && neighbours_agree_off(p, points, &by_recording, config)
         })
         .count();
+    let stated_sigma_xy_m = stated_sigma_xy_m
+        .and_then(|s| s.get(span.clone()))
+        .filter(|s| !s.is_empty())
+        .map(|s| (s.iter().map(|v| v * v).sum::<f64>() / s.len() as f64).sqrt());
     let unobserved_run = if recordings == 0 {
         0
     } else {
@@ -413,6 +443,9 @@ fn statistics(
             && mean[2].abs() - config.confidence_k * sigma_mean[2] > config.tolerance_z_m)
     {
         VerifyStatus::Fail
+    } else if stated_sigma_xy_m.is_some_and(|s| !(config.confidence_k * s <= config.tolerance_xy_m))
+    {
+        VerifyStatus::Insufficient
     } else {
         VerifyStatus::Pass
     };
@@ -430,6 +463,7 @@ fn statistics(
         offset_2d_m: offset_2d,
         points_off,
         unobserved_run,
+        stated_sigma_xy_m,
         status,
     }
 }
@@ -512,7 +546,7 @@ fn neighbours_agree_off(
 }
 
 /// Column names of `verification.csv`.
-pub const VERIFICATION_CSV_HEADER: [&str; 19] = [
+pub const VERIFICATION_CSV_HEADER: [&str; 20] = [
     "segment",
     "first_image_id",
     "last_image_id",
@@ -532,6 +566,7 @@ pub const VERIFICATION_CSV_HEADER: [&str; 19] = [
     "points_off",
     "status",
     "unobserved_run",
+    "stated_sigma_xy",
 ];
 
 /// `verification.csv`: one row per segment (metres; floats in shortest round-trip form), then a row
@@ -560,7 +595,7 @@ pub fn write_verification_csv(path: &Path, v: &Verification) -> io::Result<()> {
             .map(|x| format!("{x}"));
             writeln!(
                 w,
-                "{label},{},{},{},{},{},{},{},{}",
+                "{label},{},{},{},{},{},{},{},{},{}",
                 quote(&s.first_image_id),
                 quote(&s.last_image_id),
                 s.recordings,
@@ -568,7 +603,9 @@ pub fn write_verification_csv(path: &Path, v: &Verification) -> io::Result<()> {
                 nums.join(","),
                 s.points_off,
                 s.status.label(),
-                s.unobserved_run
+                s.unobserved_run,
+                s.stated_sigma_xy_m
+                    .map_or(String::new(), |v| format!("{v}"))
             )?;
         }
         Ok(())
