@@ -413,26 +413,20 @@ mod tests {
         let c = campaign.path();
         // Segment 0: a drift that starts inside it (offsets 0, 0, 0.5 m: mean 0.17 m, worst 0.5 m);
         // segment 1: every recording within 0.1 m.
-        write_recordings(
-            &c.join("truth/recordings.csv"),
-            &[
-                ("a", 0.0, 0.0),
-                ("b", 5.0, 0.0),
-                ("c", 10.0, 0.0),
-                ("d", 15.0, 0.0),
-                ("e", 20.0, 0.0),
-            ],
-        );
-        write_recordings(
-            &c.join("mm/recordings.csv"),
-            &[
-                ("a", 0.0, 0.0),
-                ("b", 5.0, 0.0),
-                ("c", 10.5, 0.0),
-                ("d", 15.1, 0.0),
-                ("e", 20.0, 0.05),
-            ],
-        );
+        let ids = ["a", "b", "c", "d", "e"];
+        let offsets = [(0.0, 0.0), (0.0, 0.0), (0.5, 0.0), (0.1, 0.0), (0.0, 0.05)];
+        let rows = |with_offsets: bool| -> Vec<(&str, f64, f64)> {
+            ids.iter()
+                .zip(offsets)
+                .enumerate()
+                .map(|(i, (id, (dx, dy)))| {
+                    let k = f64::from(u8::from(with_offsets));
+                    (*id, 5.0 * i as f64 + k * dx, k * dy)
+                })
+                .collect()
+        };
+        write_recordings(&c.join("truth/recordings.csv"), &rows(false));
+        write_recordings(&c.join("mm/recordings.csv"), &rows(true));
         std::fs::write(
             out.path().join("verification.csv"),
             "segment,first_image_id,last_image_id,status\n0,a,c,fail\n1,d,e,fail\nall,a,e,fail\n",

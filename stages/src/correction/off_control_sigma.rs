@@ -218,22 +218,24 @@ pub fn widen_off_control_sigma(
         if !matches!(sup.support, Support::Bridged | Support::Extrapolated) {
             continue;
         }
-        let nearest_m = controlled
-            .iter()
-            .filter(|&&c| support[c].group == sup.group)
-            .map(|&c| (s_m[c] - s_m[i]).abs())
+        // The nearest controlled recordings of its group before and after it (`controlled` is in recording
+        // order, and the along-track position grows with it).
+        let same_group = |c: &usize| support[*c].group == sup.group;
+        let split = controlled.partition_point(|&c| c < i);
+        let before = controlled[..split].iter().rev().copied().find(same_group);
+        let after = controlled[split..].iter().copied().find(same_group);
+        let nearest_m = [before, after]
+            .into_iter()
+            .flatten()
+            .map(|c| (s_m[c] - s_m[i]).abs())
             .min_by(f64::total_cmp);
-        let anchors = (sup.support == Support::Bridged)
-            .then(|| {
-                let same = |c: &&usize| support[**c].group == sup.group;
-                let before = controlled.iter().filter(same).rev().find(|&&c| c < i)?;
-                let after = controlled.iter().filter(same).find(|&&c| c > i)?;
-                anchor_variance(i, (*before, *after), &s_m, |j| {
-                    let r = &run.recordings[j];
-                    std::array::from_fn(|k| r.adjusted_world[k] - r.recorded_world[k])
-                })
-            })
-            .flatten();
+        let anchors = match (sup.support, before, after) {
+            (Support::Bridged, Some(a), Some(b)) => anchor_variance(i, (a, b), &s_m, |j| {
+                let r = &run.recordings[j];
+                std::array::from_fn(|k| r.adjusted_world[k] - r.recorded_world[k])
+            }),
+            _ => None,
+        };
         let sigma = &mut run.recordings[i].sigma_m;
         match nearest_m.and_then(|d| semivariance_at(&variogram, d)) {
             Some((g_xy, g_z)) => {
@@ -242,7 +244,8 @@ pub fn widen_off_control_sigma(
                     let (bridge, off) =
                         anchors.map_or((0.0, 0.0), |v| (v.bridge_m2[k], v.off_interpolation_m2[k]));
                     let added = bridge.max(2.0 * g) + off;
-                    by_anchors |= added > 2.0 * g;
+                    // (More than a millimetre's variance beyond the variogram's counts.)
+                    by_anchors |= added - 2.0 * g > 1e-6;
                     sigma[k] = (sigma[k] * sigma[k] + added).sqrt();
                 }
                 report.widened += 1;
@@ -369,6 +372,7 @@ mod tests {
         assert_eq!(r.recordings[0].sigma_m, [1.0, 1.0, 0.1]);
         assert_eq!(r.recordings[2].sigma_m, [0.1; 3]);
     }
+
     /// A bridged recording midway between anchors whose corrections differ by 2 m in x over 40 m: the random
     /// walk pinned at both has variance (2²/(2·40))·20·20/40 = 0.5 m² per horizontal axis at the middle, none
     /// at the anchors; a correction 0.3 m off the interpolation adds 0.09 m² on that axis.
