@@ -222,13 +222,17 @@ impl SegmentTruth {
     }
 }
 
-/// Per verification segment, its recorded positions' true offsets and the verification's status.
-fn segment_truth(out: &Path, campaign: &Path) -> Result<Vec<SegmentTruth>, String> {
+/// Per verification segment, its recorded positions' (`campaign`'s) true offsets against `truth` and the
+/// verification's status.
+fn segment_truth(
+    out: &Path,
+    campaign: &Path,
+    truth: &[Recording],
+) -> Result<Vec<SegmentTruth>, String> {
     let Some(v) = read_csv_opt(&out.join("verification.csv"))? else {
         return Ok(Vec::new());
     };
-    let read = |rel: &str| -> Vec<Recording> { read_recordings_csv(&campaign.join(rel)).0 };
-    let (mut recorded, truth) = (read("mm/recordings.csv"), read("truth/recordings.csv"));
+    let mut recorded = read_recordings_csv(&campaign.join("mm/recordings.csv")).0;
     recorded.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
     let true_of: BTreeMap<&str, &Recording> =
         truth.iter().map(|t| (t.image_id.as_str(), t)).collect();
@@ -336,7 +340,7 @@ pub fn grade_cell(out: &Path) -> Result<CellMetrics, String> {
             "rec_beyond_sigma95",
             recordings_beyond_sigma95(out, &truth)?,
         );
-        let segments = segment_truth(out, &campaign)?;
+        let segments = segment_truth(out, &campaign, &truth)?;
         let off: Vec<&str> = segments
             .iter()
             .filter(|s| s.mean_off_m > SEGMENT_OFF_M)
@@ -397,6 +401,7 @@ mod tests {
         let empty = tempfile::tempdir().unwrap();
         assert_eq!(recordings_beyond_sigma95(empty.path(), &t).unwrap(), None);
     }
+
     fn write_recordings(path: &Path, rows: &[(&str, f64, f64)]) {
         let mut text = String::from("image_id,file,time,x,y,z,heading,camera_height\n");
         for (i, (id, x, y)) in rows.iter().enumerate() {
@@ -432,7 +437,8 @@ mod tests {
             "segment,first_image_id,last_image_id,status\n0,a,c,fail\n1,d,e,fail\nall,a,e,fail\n",
         )
         .unwrap();
-        let segments = segment_truth(out.path(), c).unwrap();
+        let truth = read_recordings_csv(&c.join("truth/recordings.csv")).0;
+        let segments = segment_truth(out.path(), c, &truth).unwrap();
         assert_eq!(segments.len(), 2);
         assert!((segments[0].mean_off_m - 0.5 / 3.0).abs() < 1e-9);
         assert!((segments[0].max_off_m - 0.5).abs() < 1e-9);
