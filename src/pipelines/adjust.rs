@@ -129,14 +129,14 @@ pub fn add_adjust(
             };
         let mut report = add_stage(b, label, &control, (&clouds, &oblique_result))?;
         if passes == 2 {
-            let nadir_pass = match nadir.filter(|_| use_nadir && on(stage::CONTROL)) {
-                Some(n) => Some(super::nadir::add_second_pass(b, cx, ortho, n, report)?),
-                None => None,
-            };
-            let oblique_pass = match oblique.filter(|_| use_oblique) {
-                Some(_) => Some(super::oblique::add_second_pass(b, cx, report)?),
-                None => None,
-            };
+            let nadir_pass = nadir
+                .filter(|_| use_nadir && on(stage::CONTROL))
+                .map(|n| super::nadir::add_second_pass(b, cx, ortho, n, report))
+                .transpose()?;
+            let oblique_pass = oblique
+                .filter(|_| use_oblique)
+                .map(|_| super::oblique::add_second_pass(b, cx, report))
+                .transpose()?;
             if nadir_pass.is_some() || oblique_pass.is_some() {
                 let control = nadir_pass.as_ref().map_or(&control, |p| &p.control);
                 let (clouds, oblique_result) = match &oblique_pass {
