@@ -174,21 +174,20 @@ pub fn add_adjust(
                 wf.path.display()
             )));
         };
+        // Both verifications compare the same points: the second pass's control where the adjustment ran
+        // two. Its matches are pixels in the panoramas and aerial images, whatever pose found them, and it
+        // reaches recordings whose recorded position was too far off for the first pass's search, so a
+        // drifted stretch is measured by more points.
+        let control = out.second_pass_control.as_ref().unwrap_or(&nadir.control);
         let v = b.add(
             VerifyStage,
             "recorded",
             config.clone(),
-            (
-                snap,
-                pano_images.clone(),
-                optional_all(&nadir.control),
-                Vec::new(),
-            ),
+            (snap, pano_images.clone(), optional_all(control), Vec::new()),
         )?;
         b.metrics(v, "verify", verify_metrics);
         out.verification = Some(v);
         if let Some(report) = out.report {
-            let control = out.second_pass_control.as_ref().unwrap_or(&nadir.control);
             let v = b.add(
                 VerifyStage,
                 "adjusted",

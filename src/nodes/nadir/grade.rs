@@ -36,6 +36,7 @@ pub fn grade_metrics(g: &NadirGrade) -> serde_json::Value {
             "p90": g.correspondence_error_px[1],
             "max": g.correspondence_error_px[2],
         },
+        "correct_mean_offset_px": g.correct_mean_offset_px,
         "wrong_correspondences": g.wrong.iter().map(|w| serde_json::json!({
             "tie_point": w.tie_point_id,
             "aerial_image": w.aerial_id,
@@ -45,6 +46,7 @@ pub fn grade_metrics(g: &NadirGrade) -> serde_json::Value {
         })).collect::<Vec<_>>(),
         "control_point_error_m": {
             "count": c.count,
+            "mean": c.mean_m,
             "median_horizontal": c.median_horizontal_m,
             "rms_horizontal": c.rms_horizontal_m,
             "median_vertical": c.median_vertical_m,

@@ -23,7 +23,7 @@ use std::collections::HashMap;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("grade_nadir", "4");
+pub const STAGE: StageId = StageId::new("grade_nadir", "5");
 
 /// A correspondence is correct within this distance, aerial pixels.
 pub const CORRECT_TOLERANCE_PX: f64 = 1.0;
@@ -43,6 +43,9 @@ pub struct Truth {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ErrorStats {
     pub count: usize,
+    /// Signed mean error (world x, y, z), m: a systematic offset shows here while the medians below stay at
+    /// the noise level.
+    pub mean_m: [f64; 3],
     pub median_horizontal_m: f64,
     pub rms_horizontal_m: f64,
     pub median_vertical_m: f64,
@@ -59,8 +62,10 @@ impl ErrorStats {
         let mut v: Vec<f64> = errors.iter().map(|e| e.z.abs()).collect();
         let rms = |x: &[f64]| (x.iter().map(|a| a * a).sum::<f64>() / x.len() as f64).sqrt();
         let (rh, rv) = (rms(&h), rms(&v));
+        let mean = errors.iter().sum::<Vector3<f64>>() / errors.len() as f64;
         Self {
             count: errors.len(),
+            mean_m: [mean.x, mean.y, mean.z],
             median_horizontal_m: median_in_place(&mut h).unwrap_or(0.0),
             rms_horizontal_m: rh,
             median_vertical_m: median_in_place(&mut v).unwrap_or(0.0),
@@ -88,6 +93,9 @@ pub struct NadirGrade {
     pub delivered_correct: usize,
     /// Error (aerial px) of the graded correspondences: median, 90th percentile, largest.
     pub correspondence_error_px: [f64; 3],
+    /// Signed mean offset (u, v) of the correct correspondences from their true projections, aerial px: a
+    /// matching bias (a half-pixel convention, a template's centre) shows here.
+    pub correct_mean_offset_px: [f64; 2],
     /// The wrong correspondences (error above the tolerance), largest error first, so a user can
     /// look at each one (`skytie tool ortho`, the report's registration views).
     pub wrong: Vec<WrongCorrespondence>,
@@ -184,6 +192,7 @@ pub fn grade_nadir(
         *located_in.entry(m.tie_point_id.as_str()).or_default() += 1;
     }
     let mut errors_px = Vec::new();
+    let mut correct_offset_sum_px = [0.0_f64; 2];
     for r in refinements {
         for m in &r.matches {
             let x = true_points.get(m.tie_point_id.as_str()).copied().flatten();
@@ -196,6 +205,8 @@ pub fn grade_nadir(
                     errors_px.push(e);
                     if e <= tolerance_px {
                         g.correct_tie_points += 1;
+                        correct_offset_sum_px[0] += offset[0];
+                        correct_offset_sum_px[1] += offset[1];
                     } else {
                         g.wrong.push(WrongCorrespondence {
                             tie_point_id: m.tie_point_id.clone(),
@@ -216,6 +227,10 @@ pub fn grade_nadir(
             .then_with(|| a.tie_point_id.cmp(&b.tie_point_id))
             .then_with(|| a.aerial_id.cmp(&b.aerial_id))
     });
+    if g.correct_tie_points > 0 {
+        let n = g.correct_tie_points as f64;
+        g.correct_mean_offset_px = correct_offset_sum_px.map(|s| s / n);
+    }
     if !errors_px.is_empty() {
         let mid = median_in_place(&mut errors_px).unwrap_or(0.0); // sorts
         let at = |q: f64| errors_px[((errors_px.len() - 1) as f64 * q).round() as usize];

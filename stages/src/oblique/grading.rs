@@ -50,7 +50,7 @@ pub use crate::synth::scene_truth::SceneOracle;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("grade_oblique", "4");
+pub const STAGE: StageId = StageId::new("grade_oblique", "5");
 
 /// Largest closest-approach distance of the panorama and oblique rays of a correct correspondence, m.
 pub const CLOSEST_APPROACH_TOLERANCE_M: f64 = 0.15;
@@ -164,6 +164,7 @@ impl ObliqueGrade {
             "control_point_error_m": if cp.count > 0 { json!(error_3d_rms) } else { serde_json::Value::Null },
             "control_point_error": {
                 "count": cp.count,
+                "mean_m": cp.mean_m,
                 "median_horizontal_m": cp.median_horizontal_m,
                 "rms_horizontal_m": cp.rms_horizontal_m,
                 "median_vertical_m": cp.median_vertical_m,
