@@ -37,7 +37,7 @@ pub const SEGMENT_OFF_M: f64 = 0.3;
 pub const SEGMENT_GOOD_M: f64 = 0.2;
 
 /// Every metric, in table order.
-pub const METRICS: [MetricDef; 18] = [
+pub const METRICS: [MetricDef; 19] = [
     MetricDef {
         key: "nadir_inlier",
         title: "nadir inlier",
@@ -123,6 +123,12 @@ pub const METRICS: [MetricDef; 18] = [
         floor: 0.01,
     },
     MetricDef {
+        key: "cp_bias_2d_after",
+        title: "cp bias 2D",
+        better: Better::Lower,
+        floor: 0.005,
+    },
+    MetricDef {
         key: "segments_off",
         title: "seg. off",
         better: Better::Shown,
@@ -194,15 +200,27 @@ fn recordings_beyond_sigma95(out: &Path, truth: &[Recording]) -> Result<Option<f
     Ok((counted > 0).then(|| beyond as f64 / counted as f64))
 }
 
-/// Largest 2-D error after adjustment in `checkpoints.csv`.
-fn checkpoint_max_after(out: &Path) -> Result<Option<f64>, String> {
+/// The check points after adjustment (`checkpoints.csv`): the largest 2-D error, and the length of the mean
+/// horizontal error vector — a systematic offset the RMSE mixes with the noise (both m).
+fn checkpoints_after(out: &Path) -> Result<Option<(f64, f64)>, String> {
     let Some(t) = read_csv_opt(&out.join("checkpoints.csv"))? else {
         return Ok(None);
     };
-    Ok(t.rows
-        .iter()
-        .filter_map(|r| t.num(r, "after_2d"))
-        .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v)))))
+    let (mut max, mut sum, mut n) = (0.0f64, [0.0f64; 2], 0usize);
+    for r in &t.rows {
+        let (Some(d), Some(x), Some(y)) = (
+            t.num(r, "after_2d"),
+            t.num(r, "after_x"),
+            t.num(r, "after_y"),
+        ) else {
+            continue;
+        };
+        max = max.max(d);
+        sum[0] += x;
+        sum[1] += y;
+        n += 1;
+    }
+    Ok((n > 0).then(|| (max, sum[0].hypot(sum[1]) / n as f64)))
 }
 
 /// What the truth says of one verification segment.
@@ -319,7 +337,9 @@ pub fn grade_cell(out: &Path) -> Result<CellMetrics, String> {
         put("cp_2d_after", num_at(a, "checkpoints.after.2d"));
         put("cp_3d_after", num_at(a, "checkpoints.after.3d"));
     }
-    put("cp_max_2d_after", checkpoint_max_after(out)?);
+    let checkpoints = checkpoints_after(out)?;
+    put("cp_max_2d_after", checkpoints.map(|c| c.0));
+    put("cp_bias_2d_after", checkpoints.map(|c| c.1));
     let campaign = run.campaign_dir().ok_or_else(|| {
         format!(
             "{}: provenance.json names no campaign folder",
@@ -400,6 +420,28 @@ mod tests {
         assert!((share - 1.0 / 3.0).abs() < 1e-12, "{share}");
         let empty = tempfile::tempdir().unwrap();
         assert_eq!(recordings_beyond_sigma95(empty.path(), &t).unwrap(), None);
+    }
+
+    #[test]
+    fn check_points_give_their_worst_error_and_their_mean_offset() {
+        let d = tempfile::tempdir().unwrap();
+        // Errors (0.03, 0.04), (0.03, −0.02), (0.03, 0.01): worst 0.05 m, mean (0.03, 0.01); a point without
+        // an "after" (not observed after adjustment) is left out.
+        std::fs::write(
+            d.path().join("checkpoints.csv"),
+            "point_id,after_x,after_y,after_2d
+             a,0.03,0.04,0.05
+             b,0.03,-0.02,0.036
+             c,0.03,0.01,0.0316
+             d,,,
+",
+        )
+        .unwrap();
+        let (max, bias) = checkpoints_after(d.path()).unwrap().unwrap();
+        assert!((max - 0.05).abs() < 1e-12, "{max}");
+        assert!((bias - 0.03f64.hypot(0.01)).abs() < 1e-12, "{bias}");
+        let empty = tempfile::tempdir().unwrap();
+        assert_eq!(checkpoints_after(empty.path()).unwrap(), None);
     }
 
     fn write_recordings(path: &Path, rows: &[(&str, f64, f64)]) {
