@@ -3,7 +3,8 @@
 //! recording to a user campaign re-runs only that recording's nodes, and the shipped full chain
 //! (`workflows/tiny.toml`) runs through registration, adjustment, verification and the exports — with nadir
 //! results that must hold (MM tie points correct against the truth, initial transforms accepted) and the
-//! delivered files following the adjustment's verdict.
+//! delivered files following the adjustment's verdict; with two registration passes, both verifications read
+//! the second pass's control.
 
 #[path = "support/cli.rs"]
 mod cli;
@@ -224,4 +225,57 @@ fn tiny_campaign_end_to_end() {
     }
     let m = run_workflow(&shipped, &cache, &out3);
     assert_eq!(m["engine"]["nodes_executed"].as_u64(), Some(0), "{m}");
+}
+
+/// The `inputs` lines of `skytie explain WF NODE` that name a nadir control node (`control[...]`): the source
+/// identities, in order.
+fn control_inputs(wf: &Path, cache: &Path, node: &str) -> Vec<String> {
+    let text = run_ok(
+        skytie()
+            .arg("explain")
+            .arg(wf)
+            .arg(node)
+            .arg("--cache")
+            .arg(cache),
+    );
+    text.lines()
+        .filter_map(|l| {
+            let source = l.split_whitespace().nth(1)?;
+            let start = l.find(source)?;
+            let identity = l[start..].split(" = ").next()?;
+            identity
+                .starts_with("control[")
+                .then(|| identity.to_string())
+        })
+        .collect()
+}
+
+/// With a second registration pass (`[adjust] passes = 2`), the verification of the recorded trajectory and
+/// that of the adjusted one compare the same points: both read the second pass's nadir control.
+#[test]
+fn both_verifications_read_the_second_pass_control() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("workflows/tiny.toml");
+    let wf = dir.join("two-passes.toml");
+    std::fs::write(
+        &wf,
+        format!(
+            "include = [{:?}]\nname = \"two-passes\"\n[adjust]\npasses = 2\n",
+            shipped.display().to_string()
+        ),
+    )
+    .unwrap();
+    let cache = dir.join("cache");
+    let out = dir.join("out");
+    // The run plans the second phase (the campaign's items); its exit code follows the adjustment's verdict.
+    let _ = cli::run_workflow(&wf, &cache, &out);
+    let recorded = control_inputs(&wf, &cache, "verify[recorded]");
+    let adjusted = control_inputs(&wf, &cache, "verify[adjusted]");
+    assert!(!recorded.is_empty(), "verify[recorded] reads no control");
+    assert!(
+        recorded.iter().all(|c| c.ends_with(" pass 2]")),
+        "{recorded:?}"
+    );
+    assert_eq!(recorded, adjusted);
 }
