@@ -167,16 +167,22 @@ fn adjust_section(m: &Value) -> Option<&Value> {
 /// this lies outside the 95 % ellipse of its stated precision.
 const CHI2_2_95: f64 = 5.991;
 
+/// The true recordings by `image_id`.
+type TrueOf<'a> = HashMap<&'a str, &'a Recording>;
+
+/// [`TrueOf`] of `truth/recordings.csv`'s rows, read once per cell.
+fn true_of(truth: &[Recording]) -> TrueOf<'_> {
+    truth.iter().map(|r| (r.image_id.as_str(), r)).collect()
+}
+
 /// The share of the delivered recordings (`trajectory_adjusted.csv`, absent when the adjustment was withheld)
 /// whose horizontal error against `truth` lies outside the 95 % ellipse of their stated σ (`sigma_x`,
 /// `sigma_y`): about 0.05 when the stated precision is honest, more when it is optimistic. A recording without
 /// a truth row or a positive finite σ is not counted.
-fn recordings_beyond_sigma95(out: &Path, truth: &[Recording]) -> Result<Option<f64>, String> {
+fn recordings_beyond_sigma95(out: &Path, true_of: &TrueOf) -> Result<Option<f64>, String> {
     let Some(t) = read_csv_opt(&out.join("trajectory_adjusted.csv"))? else {
         return Ok(None);
     };
-    let true_of: HashMap<&str, &Recording> =
-        truth.iter().map(|r| (r.image_id.as_str(), r)).collect();
     let (mut beyond, mut counted) = (0usize, 0usize);
     for row in &t.rows {
         let Some(truth) = true_of.get(t.text(row, "image_id")) else {
@@ -245,15 +251,13 @@ impl SegmentTruth {
 fn segment_truth(
     out: &Path,
     campaign: &Path,
-    truth: &[Recording],
+    true_of: &TrueOf,
 ) -> Result<Vec<SegmentTruth>, String> {
     let Some(v) = read_csv_opt(&out.join("verification.csv"))? else {
         return Ok(Vec::new());
     };
     let mut recorded = read_recordings_csv(&campaign.join("mm/recordings.csv")).0;
     recorded.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
-    let true_of: BTreeMap<&str, &Recording> =
-        truth.iter().map(|t| (t.image_id.as_str(), t)).collect();
     let position_of: HashMap<&str, usize> = recorded
         .iter()
         .enumerate()
@@ -356,11 +360,12 @@ pub fn grade_cell(out: &Path) -> Result<CellMetrics, String> {
     }
     if campaign.join("truth/recordings.csv").is_file() {
         let truth = read_recordings_csv(&campaign.join("truth/recordings.csv")).0;
+        let truth_by_id = true_of(&truth);
         put(
             "rec_beyond_sigma95",
-            recordings_beyond_sigma95(out, &truth)?,
+            recordings_beyond_sigma95(out, &truth_by_id)?,
         );
-        let segments = segment_truth(out, &campaign, &truth)?;
+        let segments = segment_truth(out, &campaign, &truth_by_id)?;
         let off: Vec<&str> = segments
             .iter()
             .filter(|s| s.mean_off_m > SEGMENT_OFF_M)
@@ -416,10 +421,15 @@ mod tests {
             truth("c", 120.0, 200.0),
             truth("e", 140.0, 200.0),
         ];
-        let share = recordings_beyond_sigma95(d.path(), &t).unwrap().unwrap();
+        let share = recordings_beyond_sigma95(d.path(), &true_of(&t))
+            .unwrap()
+            .unwrap();
         assert!((share - 1.0 / 3.0).abs() < 1e-12, "{share}");
         let empty = tempfile::tempdir().unwrap();
-        assert_eq!(recordings_beyond_sigma95(empty.path(), &t).unwrap(), None);
+        assert_eq!(
+            recordings_beyond_sigma95(empty.path(), &true_of(&t)).unwrap(),
+            None
+        );
     }
 
     #[test]
@@ -480,7 +490,7 @@ mod tests {
         )
         .unwrap();
         let truth = read_recordings_csv(&c.join("truth/recordings.csv")).0;
-        let segments = segment_truth(out.path(), c, &truth).unwrap();
+        let segments = segment_truth(out.path(), c, &true_of(&truth)).unwrap();
         assert_eq!(segments.len(), 2);
         assert!((segments[0].mean_off_m - 0.5 / 3.0).abs() < 1e-9);
         assert!((segments[0].max_off_m - 0.5).abs() < 1e-9);
