@@ -111,6 +111,7 @@ pub fn add_adjust(
         let add_stage =
             |b: &mut DagBuilder,
              label: &str,
+             config: &AdjustConfig,
              control: &[Handle<RecordingControl>],
              oblique: (&[Handle<SparseCloud>], &[Handle<ObliqueOutput>])| {
                 b.add(
@@ -127,8 +128,20 @@ pub fn add_adjust(
                     ),
                 )
             };
-        let mut report = add_stage(b, label, &control, (&clouds, &oblique_result))?;
-        if passes == 2 {
+        // The first of two passes only says where to search again: every correction counts there, significant
+        // or not (the significance test holds corrections of the delivered adjustment only).
+        let second_pass = passes == 2
+            && ((use_nadir && nadir.is_some() && on(stage::CONTROL))
+                || (use_oblique && oblique.is_some()));
+        let first_pass = match second_pass {
+            true => AdjustConfig {
+                significance_level: None,
+                ..config.clone()
+            },
+            false => config.clone(),
+        };
+        let mut report = add_stage(b, label, &first_pass, &control, (&clouds, &oblique_result))?;
+        if second_pass {
             let nadir_pass = nadir
                 .filter(|_| use_nadir && on(stage::CONTROL))
                 .map(|n| super::nadir::add_second_pass(b, cx, ortho, n, report))
@@ -137,19 +150,19 @@ pub fn add_adjust(
                 .filter(|_| use_oblique)
                 .map(|_| super::oblique::add_second_pass(b, cx, report))
                 .transpose()?;
-            if nadir_pass.is_some() || oblique_pass.is_some() {
-                let control = nadir_pass.as_ref().map_or(&control, |p| &p.control);
-                let (clouds, oblique_result) = match &oblique_pass {
-                    Some(o) => (o.clouds.clone(), o.result.into_iter().collect()),
-                    None => (clouds.clone(), oblique_result.clone()),
-                };
-                report = add_stage(
-                    b,
-                    &format!("{label} pass 2"),
-                    control,
-                    (&clouds, &oblique_result),
-                )?;
-            }
+            // `second_pass` says at least one of the two is there.
+            let control = nadir_pass.as_ref().map_or(&control, |p| &p.control);
+            let (clouds, oblique_result) = match &oblique_pass {
+                Some(o) => (o.clouds.clone(), o.result.into_iter().collect()),
+                None => (clouds.clone(), oblique_result.clone()),
+            };
+            report = add_stage(
+                b,
+                &format!("{label} pass 2"),
+                &config,
+                control,
+                (&clouds, &oblique_result),
+            )?;
             out.second_pass_control = nadir_pass.map(|p| p.control);
             out.second_pass_oblique = oblique_pass;
         }

@@ -133,7 +133,75 @@ pub struct Headline {
     pub verification_after: Option<VerificationSummary>,
     /// What the registration chains found (shown when recordings could not be corrected).
     pub registration: Vec<String>,
+    /// The corrections held at the recorded values because they were not significant (`None` without the
+    /// test).
+    pub held: Option<HeldSummary>,
     pub status: Status,
+}
+
+/// The significance test of the corrections (`adjust.<sources>.significance` in `metrics.json`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeldSummary {
+    /// The test's significance level α.
+    pub level: f64,
+    /// Recordings whose horizontal / height / yaw corrections were held.
+    pub recordings_held: [usize; 3],
+    /// Held stretches per component.
+    pub stretches: [usize; 3],
+    /// Yaw was estimated, so tested.
+    pub yaw_tested: bool,
+    /// Recordings in the run.
+    pub recordings: usize,
+}
+
+impl HeldSummary {
+    fn from_metrics(a: &Value, recordings: usize) -> Option<Self> {
+        let s = a.get("significance").filter(|v| !v.is_null())?;
+        let names = ["horizontal", "height", "yaw"];
+        let mut stretches = [0; 3];
+        for h in s.get("held")?.as_array()? {
+            let component = h.get("component").and_then(Value::as_str);
+            if let Some(k) = names.iter().position(|n| Some(*n) == component) {
+                stretches[k] += 1;
+            }
+        }
+        let held = |k: &str| num_at(s, &format!("held_recordings.{k}")).unwrap_or(0.0) as usize;
+        Some(Self {
+            level: num_at(s, "level")?,
+            recordings_held: names.map(held),
+            stretches,
+            yaw_tested: s.get("yaw_tested").and_then(Value::as_bool) == Some(true),
+            recordings,
+        })
+    }
+
+    /// Nothing was applied anywhere: the output is the recorded trajectory.
+    pub fn everything_held(&self) -> bool {
+        let all = |k: usize| self.recordings_held[k] == self.recordings;
+        self.recordings > 0 && all(0) && all(1) && (!self.yaw_tested || all(2))
+    }
+
+    /// The headline's sentence, `None` when every correction was applied.
+    fn line(&self) -> Option<String> {
+        let names = ["horizontal", "height", "yaw"];
+        let parts: Vec<String> = (0..3)
+            .filter(|&k| self.recordings_held[k] > 0)
+            .map(|k| {
+                format!(
+                    "{} of {} recordings ({}, {} stretch(es))",
+                    self.recordings_held[k], self.recordings, names[k], self.stretches[k]
+                )
+            })
+            .collect();
+        (!parts.is_empty()).then(|| {
+            format!(
+                "Kept at the recorded values, their corrections not significant at α = {}: {} (`held` in \
+                 trajectory_adjusted.csv; σ widened by the correction not applied).",
+                self.level,
+                parts.join("; ")
+            )
+        })
+    }
 }
 
 fn support_index(s: Support) -> usize {
@@ -283,9 +351,13 @@ impl Headline {
         } else {
             Status::Corrected
         };
+        let recordings = num_at(m, "campaign.recordings").map_or(moved.len(), |v| v as usize);
+        let held = adj
+            .as_ref()
+            .and_then(|(_, a)| HeldSummary::from_metrics(a, recordings));
         Self {
             configuration: adj.map(|(k, _)| k),
-            recordings: num_at(m, "campaign.recordings").map_or(moved.len(), |v| v as usize),
+            recordings,
             offset_before_2d_m: offset_before,
             checkpoints_2d_m: checkpoints,
             truth_2d_m: truth,
@@ -295,6 +367,7 @@ impl Headline {
             verification_before,
             verification_after: verification_adjusted.map(VerificationSummary::from_csv),
             registration: registration_lines(m),
+            held,
             status,
         }
     }
@@ -316,6 +389,11 @@ impl Headline {
     pub fn lines(&self) -> Vec<String> {
         let mut out = Vec::new();
         out.push(match &self.status {
+            Status::Corrected if self.held.as_ref().is_some_and(HeldSummary::everything_held) => {
+                "RESULT: recorded trajectory kept: no segment's correction is significant (the aerial evidence \
+                 does not show the recorded positions off; see the σ after)"
+                    .to_string()
+            }
             Status::Corrected if self.unverified() => {
                 "RESULT: trajectory corrected, but not verified: no segment of the adjusted trajectory passes \
                  the verification (its aerial control is too sparse or disagrees; see the σ after and the \
@@ -362,6 +440,9 @@ impl Headline {
                     ""
                 }
             ));
+        }
+        if let Some(line) = self.held.as_ref().and_then(HeldSummary::line) {
+            out.push(line);
         }
         if let Some((_, a, _)) = self.checkpoints_2d_m {
             out.push(format!("Check points after: {a:.3} m RMSE 2D."));
@@ -466,6 +547,66 @@ mod tests {
         assert!(text.contains("Check points after: 0.050 m"), "{text}");
         assert!(!h.unverified());
         assert_eq!(h.lines()[0], "RESULT: trajectory corrected");
+    }
+
+    /// `metrics` with a significance test that held `held` (horizontal, height) of the 3 recordings.
+    fn metrics_with_held(held: [usize; 2]) -> Value {
+        let mut m = metrics(0.05, 0.05);
+        let stretch = |component: &str, n: usize| {
+            serde_json::json!({"component": component, "first_image_id": "a", "last_image_id": "c",
+                "recordings": n, "largest": 1.5})
+        };
+        let mut stretches = Vec::new();
+        for (name, n) in [("horizontal", held[0]), ("height", held[1])] {
+            if n > 0 {
+                stretches.push(stretch(name, n));
+            }
+        }
+        m["adjust"]["combined"]["significance"] = serde_json::json!({
+            "level": 0.05, "window_m": 100.0, "yaw_tested": false,
+            "held_recordings": {"horizontal": held[0], "height": held[1], "yaw": 0},
+            "held": stretches,
+        });
+        m
+    }
+
+    #[test]
+    fn corrections_kept_for_want_of_significance_are_named() {
+        let c = corrections(&[
+            ("recording", 0.0, 0.0, 0.03, "controlled"),
+            ("recording", 0.0, 0.0, 0.03, "controlled"),
+            ("recording", 0.0, 0.0, 0.03, "controlled"),
+        ]);
+        let all = Headline::from_parts(&metrics_with_held([3, 3]), Some(&c), None, None);
+        assert!(all.held.as_ref().unwrap().everything_held());
+        let lines = all.lines();
+        assert!(
+            lines[0].starts_with("RESULT: recorded trajectory kept"),
+            "{lines:?}"
+        );
+        let text = lines.join("\n");
+        assert!(
+            text.contains("α = 0.05: 3 of 3 recordings (horizontal, 1 stretch(es)); 3 of 3 recordings (height"),
+            "{text}"
+        );
+
+        let part = Headline::from_parts(&metrics_with_held([0, 3]), Some(&c), None, None);
+        let lines = part.lines();
+        assert_eq!(lines[0], "RESULT: trajectory corrected");
+        assert!(
+            lines
+                .iter()
+                .any(|l| l.contains("3 of 3 recordings (height")),
+            "{lines:?}"
+        );
+        assert!(
+            !lines.iter().any(|l| l.contains("(horizontal")),
+            "{lines:?}"
+        );
+
+        let none = Headline::from_parts(&metrics(0.8, 0.05), Some(&c), None, None);
+        assert_eq!(none.held, None);
+        assert!(!none.lines().iter().any(|l| l.starts_with("Kept at")));
     }
 
     #[test]

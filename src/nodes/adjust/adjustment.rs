@@ -20,7 +20,9 @@ use skytie_stages::adjustment::from_correspondences::{
 use skytie_stages::adjustment::height_observation::{dtm_height_sigma_m, terrain_heights};
 use skytie_stages::adjustment::tie_point_heights::terrain_under_tie_points;
 use skytie_stages::adjustment::{RmseSummary, ViewSelection};
-use skytie_stages::correction::{widen_off_control_sigma, OffControlSigma};
+use skytie_stages::correction::{
+    hold_insignificant, widen_off_control_sigma, OffControlSigma, Significance,
+};
 use skytie_stages::correspondence::{AerialControlPoint, MmTiePoint};
 use skytie_stages::crs::MapFrame;
 use skytie_stages::export::{checkpoint_rows, recording_support, CheckPointRow, Support};
@@ -68,6 +70,9 @@ pub struct AdjustReport {
     pub two_view: CheckPointSummary,
     /// How the σ of recordings without control of their own was widened (`run`'s σ include it).
     pub off_control_sigma: OffControlSigma,
+    /// The segments' significance tests (`run` holds the insignificant components at their recorded values);
+    /// `None` without `significance_level`.
+    pub significance: Option<Significance>,
 }
 crate::serde_artifact!(AdjustReport);
 
@@ -106,11 +111,26 @@ impl AdjustReport {
                 "sigma_m": r.build.heights.sigma_m,
             })),
             "off_control_sigma": self.off_control_sigma,
+            "significance": self.significance.as_ref().map(significance_metrics),
             "trajectory": recording_metrics(r),
             "yaw_chains": (!r.yaw_chains.is_empty()).then(|| yaw_chain_metrics(r)),
             "verdict": self.verdict().label(),
         }})
     }
+}
+
+/// The significance tests: the level and window, the recordings whose horizontal / height / yaw corrections
+/// were significant and held, and the held stretches.
+fn significance_metrics(s: &Significance) -> serde_json::Value {
+    let [horizontal, height, yaw] = s.held_recordings();
+    serde_json::json!({
+        "level": s.level,
+        "window_m": s.window_m,
+        "yaw_tested": s.yaw_tested,
+        "significant_recordings": {"horizontal": s.significant[0], "height": s.significant[1], "yaw": s.significant[2]},
+        "held_recordings": {"horizontal": horizontal, "height": height, "yaw": yaw},
+        "held": s.held,
+    })
 }
 
 /// Per chain of recordings linked by yaw terms: its first and last recording, how many, the common yaw
@@ -359,6 +379,10 @@ impl Stage for AdjustStage {
             })
             .collect();
         let off_control_sigma = widen_off_control_sigma(&mut result, &priors);
+        // Then the corrections the evidence does not show are taken back, before anything reads them.
+        let significance = config
+            .significance_level
+            .map(|level| hold_insignificant(&mut result, level, config.significance_window_m));
         let compare = |selection| {
             compare_checkpoints(
                 &c.recordings,
@@ -381,6 +405,7 @@ impl Stage for AdjustStage {
             multi_view,
             two_view,
             off_control_sigma,
+            significance,
         })
     }
 }

@@ -226,6 +226,17 @@ crate::params! {
         /// correction is at least this many times its σ (`adjustment::yaw_support`); otherwise each of its
         /// recordings keeps its own yaw prior, as without the tie. 0 = always tied.
         yaw_tie_significance: f64 = 2.0, min 0.0, max 10.0;
+        /// Apply corrections only where they are significant at this level (`correction::significance`): the
+        /// recorded trajectory is the null hypothesis; each component (horizontal position, height, yaw) of a
+        /// recording is tested against the threshold the level gives for the recordings within
+        /// `significance_window_m` (Bonferroni), and a component is applied only within half a window of a
+        /// significant correction that a neighbouring recording's corroborates. Elsewhere the recording keeps
+        /// its recorded value, with σ widened by the correction not applied (`held` in
+        /// `trajectory_adjusted.csv`, `adjust.<sources>.significance` in `metrics.json`). Absent = every
+        /// correction applied.
+        significance_level: Option<f64> = None, above 0.0, max 0.5;
+        /// Length along the recorded track of the window `significance_level` tests in and applies over.
+        significance_window_m: f64 = 100.0, unit "m", above 0.0;
         /// Largest number of Levenberg–Marquardt iterations per solve.
         max_iterations: usize = 100, min 1;
         /// Registration passes: with 2, the nadir chain searches the recordings that found no aerial control

@@ -22,7 +22,7 @@ pub use super::block_build::{
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("adjust", "19");
+pub const STAGE: StageId = StageId::new("adjust", "21");
 
 /// One adjusted recording.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -39,6 +39,34 @@ pub struct RunRecording {
     /// σ of the yaw correction, degrees, scaled like `sigma_m` (0 when yaw is not estimated).
     pub sigma_yaw_deg: f64,
     pub sigma_is_a_posteriori: bool,
+    /// The components of the correction not applied because their segment's corrections were not significant
+    /// (`correction::significance`): the recording keeps its recorded value of them.
+    #[serde(default)]
+    pub held: HeldComponents,
+}
+
+/// Which components of a recording's correction were held at the recorded value.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct HeldComponents {
+    pub horizontal: bool,
+    pub height: bool,
+    pub yaw: bool,
+}
+
+impl HeldComponents {
+    /// The held components as written in the outputs: `xy`, `z`, `yaw` joined by `+`; empty when none is.
+    pub fn label(&self) -> String {
+        [
+            (self.horizontal, "xy"),
+            (self.height, "z"),
+            (self.yaw, "yaw"),
+        ]
+        .iter()
+        .filter(|(held, _)| *held)
+        .map(|(_, name)| *name)
+        .collect::<Vec<_>>()
+        .join("+")
+    }
 }
 
 /// One adjusted tie point.
@@ -129,6 +157,7 @@ pub fn run_in_frame(
                 sigma_m: sigma.into(),
                 sigma_yaw_deg: a.sigma_yaw_a_priori_deg * yaw_scale,
                 sigma_is_a_posteriori: posterior,
+                held: HeldComponents::default(),
             }
         })
         .collect();

@@ -88,7 +88,7 @@ pub use evaluate::{
 };
 pub use from_correspondences::{
     build_block, run, run_in_frame, AdjustInputs, AdjustmentRun, BlockBuild, BlockPoint,
-    BuildCounts, PointKind, RunPoint, RunRecording,
+    BuildCounts, HeldComponents, PointKind, RunPoint, RunRecording,
 };
 pub use problem::{
     AdjustOptions, AerialImageObservation, Block, BlockRecording, ControlPoint, HeightObservation,

@@ -271,6 +271,7 @@ mod tests {
             sigma_m: [0.01; 3],
             sigma_yaw_deg: 0.0,
             sigma_is_a_posteriori: true,
+            held: Default::default(),
         }
     }
 

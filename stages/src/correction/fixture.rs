@@ -15,6 +15,7 @@ pub fn recording(i: usize, x: f64, delta_m: [f64; 3]) -> RunRecording {
         sigma_m: [0.1; 3],
         sigma_yaw_deg: 0.0,
         sigma_is_a_posteriori: true,
+        held: Default::default(),
     }
 }
 

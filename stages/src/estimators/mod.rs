@@ -1,5 +1,6 @@
 //! Robust estimation: the deterministic PRNG of [`crate::rng`], generic RANSAC ([`ransac`](mod@ransac)) and the [`Model`]
-//! implementations of the 2-D transforms of [`crate::geometry`] ([`models`]).
+//! implementations of the 2-D transforms of [`crate::geometry`] ([`models`]), and the quantiles that turn a
+//! significance level into a test's threshold ([`normal_quantile`]).
 
 // `!(x > t)` is used on purpose throughout: it also rejects NaN, which `x <= t` would let through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -7,6 +8,7 @@
 pub mod median_consensus;
 pub mod mlesac;
 pub mod models;
+pub mod normal_quantile;
 pub mod one_plus_one;
 pub mod ransac;
 

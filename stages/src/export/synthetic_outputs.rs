@@ -287,6 +287,7 @@ impl OutputsSpec {
                     sigma_m: [0.03, 0.03, 0.05],
                     sigma_yaw_deg: 0.0,
                     sigma_is_a_posteriori: true,
+                    held: Default::default(),
                 })
                 .collect(),
             points,

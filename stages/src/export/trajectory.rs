@@ -7,9 +7,11 @@
 //! (posterior σ of z), so the file read as a recordings file is the adjusted trajectory with its precision.
 //! Appended: `sigma_x, sigma_y` (and `sigma_z` when the input has none), `yaw` when yaw was estimated and the
 //! input has no such column, then `dx_m, dy_m, dz_m` (adjusted − recorded, metres), `dyaw_deg`,
-//! `sigma_yaw_deg`, and `correction` — what supports the row's correction (`Support` label), or `not_read`
+//! `sigma_yaw_deg`, `correction` — what supports the row's correction (`Support` label), or `not_read`
 //! for a row the campaign reader rejected (written unchanged; its problem was reported when the campaign was
-//! read). An appended name that the input already uses for another column gets the prefix `skytie_`.
+//! read) — and `held`: the components of the correction kept at the recorded values because their segment's
+//! corrections were not significant (`xy`, `z`, `yaw` joined by `+`; empty when all were applied;
+//! `correction::significance`). An appended name that the input already uses for another column gets the prefix `skytie_`.
 //! Comment lines of the input are not copied.
 
 use super::corrections::CorrectionSeries;
@@ -144,6 +146,7 @@ pub fn write_adjusted_trajectory(
             "dyaw_deg",
             "sigma_yaw_deg",
             "correction",
+            "held",
         ]
         .map(|n| cols.fresh(n)),
     );
@@ -160,8 +163,8 @@ pub fn write_adjusted_trajectory(
         let mut cells: Vec<String> = rec.iter().map(str::to_string).collect();
         cells.resize(cols.header.len(), String::new());
         let Some(&i) = rec.get(id_col).and_then(|id| by_id.get(id.trim())) else {
-            cells.extend(std::iter::repeat_n(String::new(), appended - 1));
-            cells.push("not_read".to_string());
+            cells.extend(std::iter::repeat_n(String::new(), appended - 2));
+            cells.extend(["not_read".to_string(), String::new()]);
             counts.not_read += 1;
             w.write_record(&cells).map_err(io::Error::other)?;
             continue;
@@ -197,6 +200,7 @@ pub fn write_adjusted_trajectory(
         cells.push(format!("{}", c.delta_yaw_deg));
         cells.push(format!("{}", c.sigma_yaw_deg));
         cells.push(c.support.label().to_string());
+        cells.push(a.held.label());
         counts.adjusted += 1;
         w.write_record(&cells).map_err(io::Error::other)?;
     }
@@ -251,7 +255,7 @@ mod tests {
         assert_eq!(
             header.join(","),
             "file,operator,image_id,x,y,z,time,heading,camera_height,sigma_z,yaw,\
-             sigma_x,sigma_y,dx_m,dy_m,dz_m,dyaw_deg,sigma_yaw_deg,correction"
+             sigma_x,sigma_y,dx_m,dy_m,dz_m,dyaw_deg,sigma_yaw_deg,correction,held"
         );
         let rows: Vec<csv::StringRecord> = rd.records().map(Result::unwrap).collect();
         for (i, a) in run.recordings.iter().enumerate() {
@@ -266,6 +270,7 @@ mod tests {
             assert_eq!(v(9), a.sigma_m[2], "sigma_z holds the posterior σ");
             assert!((v(10) - (1.5 + a.yaw_correction_deg)).abs() < 1e-12);
             assert_eq!(&r[18], "controlled");
+            assert_eq!(&r[19], "", "every correction applied");
         }
         assert_eq!(&rows[4][2], "bad");
         assert_eq!(&rows[4][3], "1", "a rejected row is copied unchanged");
@@ -282,6 +287,6 @@ mod tests {
         let first = std::fs::read_to_string(d.path().join("trajectory_adjusted.csv")).unwrap();
         let header = first.lines().next().unwrap();
         assert!(header.starts_with("image_id,x,y,z,correction,sigma_x,sigma_y,sigma_z,yaw,"));
-        assert!(header.ends_with(",skytie_correction"), "{header}");
+        assert!(header.ends_with(",skytie_correction,held"), "{header}");
     }
 }
