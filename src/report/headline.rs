@@ -183,22 +183,26 @@ impl HeldSummary {
 
     /// The headline's sentence, `None` when every correction was applied.
     fn line(&self) -> Option<String> {
-        let names = ["horizontal", "height", "yaw"];
+        let names = ["horizontal position", "height", "yaw"];
         let parts: Vec<String> = (0..3)
             .filter(|&k| self.recordings_held[k] > 0)
             .map(|k| {
+                let n = self.stretches[k];
                 format!(
-                    "{} of {} recordings ({}, {} stretch(es))",
-                    self.recordings_held[k], self.recordings, names[k], self.stretches[k]
+                    "{} of {} of {} recordings ({n} {})",
+                    names[k],
+                    self.recordings_held[k],
+                    self.recordings,
+                    if n == 1 { "stretch" } else { "stretches" }
                 )
             })
             .collect();
         (!parts.is_empty()).then(|| {
             format!(
-                "Kept at the recorded values, their corrections not significant at α = {}: {} (`held` in \
-                 trajectory_adjusted.csv; σ widened by the correction not applied).",
+                "Kept at the recorded values (corrections not significant at α = {}): {}; `held` in \
+                 trajectory_adjusted.csv, σ widened by the correction not applied.",
                 self.level,
-                parts.join("; ")
+                parts.join(", ")
             )
         })
     }
@@ -586,7 +590,10 @@ mod tests {
         );
         let text = lines.join("\n");
         assert!(
-            text.contains("α = 0.05: 3 of 3 recordings (horizontal, 1 stretch(es)); 3 of 3 recordings (height"),
+            text.contains(
+                "(corrections not significant at α = 0.05): horizontal position of 3 of 3 recordings (1 \
+                 stretch), height of 3 of 3 recordings (1 stretch);"
+            ),
             "{text}"
         );
 
@@ -596,11 +603,11 @@ mod tests {
         assert!(
             lines
                 .iter()
-                .any(|l| l.contains("3 of 3 recordings (height")),
+                .any(|l| l.contains("height of 3 of 3 recordings")),
             "{lines:?}"
         );
         assert!(
-            !lines.iter().any(|l| l.contains("(horizontal")),
+            !lines.iter().any(|l| l.contains("horizontal position of")),
             "{lines:?}"
         );
 
