@@ -109,7 +109,7 @@ struct AnchorVariance {
 }
 
 /// Distance along the recorded trajectory (horizontal, m) of every recording from the first.
-fn along_track_m(run: &AdjustmentRun) -> Vec<f64> {
+pub(crate) fn along_track_m(run: &AdjustmentRun) -> Vec<f64> {
     let mut s = Vec::with_capacity(run.recordings.len());
     let mut total = 0.0;
     for (i, r) in run.recordings.iter().enumerate() {

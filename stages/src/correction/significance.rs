@@ -26,6 +26,7 @@
 //! `√(σ² + Δ²)`: the recorded value lies `Δ` from the adjustment's estimate, which is itself `σ` from the truth.
 //! The report lists the held stretches (consecutive held recordings) per component.
 
+use super::off_control_sigma::along_track_m;
 use super::support::linked_groups;
 use crate::adjustment::{AdjustmentRun, HeldComponents, RunRecording};
 use crate::estimators::normal_quantile::{chi2_2_quantile, normal_quantile};
@@ -72,20 +73,6 @@ impl Significance {
         }
         out
     }
-}
-
-/// Along-track position of every recording on the recorded track, m.
-fn along_track_m(run: &AdjustmentRun) -> Vec<f64> {
-    let mut total = 0.0;
-    let mut out = Vec::with_capacity(run.recordings.len());
-    for (i, r) in run.recordings.iter().enumerate() {
-        if i > 0 {
-            let p = run.recordings[i - 1].recorded_world;
-            total += (r.recorded_world[0] - p[0]).hypot(r.recorded_world[1] - p[1]);
-        }
-        out.push(total);
-    }
-    out
 }
 
 /// For every recording, its window: the consecutive recordings of its linked group within `half_m` along the
