@@ -1,7 +1,7 @@
 //! Quantiles of the standard normal and of the χ² distribution with two degrees of freedom, for tests whose
 //! thresholds follow from a significance level instead of being picked.
 //!
-//! The normal quantile is Acklam's rational approximation (relative error below 1.2·10⁻⁹ over the whole open
+//! The normal quantile is Acklam's rational approximation (Acklam 2003) (relative error below 1.2·10⁻⁹ over the whole open
 //! interval), which is far below anything a significance level is known to; χ²₂ has the closed form
 //! `−2·ln(1 − p)`.
 
