@@ -1,8 +1,8 @@
 //! Quantiles of the standard normal and of the χ² distribution with two degrees of freedom, for tests whose
 //! thresholds follow from a significance level instead of being picked.
 //!
-//! The normal quantile is Acklam's rational approximation (Acklam 2003) (relative error below 1.2·10⁻⁹ over the whole open
-//! interval), which is far below anything a significance level is known to; χ²₂ has the closed form
+//! The normal quantile is Acklam's rational approximation (Acklam 2003; relative error below 1.2·10⁻⁹ over the
+//! whole open interval), far below anything a significance level is known to; χ²₂ has the closed form
 //! `−2·ln(1 − p)`.
 
 /// The `p` quantile of the standard normal distribution, `Φ⁻¹(p)`; `None` outside the open interval (0, 1).
