@@ -70,8 +70,8 @@ pub struct AdjustReport {
     pub two_view: CheckPointSummary,
     /// How the σ of recordings without control of their own was widened (`run`'s σ include it).
     pub off_control_sigma: OffControlSigma,
-    /// The segments' significance tests (`run` holds the insignificant components at their recorded values);
-    /// `None` without `significance_level`.
+    /// The significance test of the corrections (`run` holds the insignificant components at their recorded
+    /// values); `None` without `significance_level`.
     pub significance: Option<Significance>,
 }
 crate::serde_artifact!(AdjustReport);
