@@ -22,7 +22,7 @@ pub use super::block_build::{
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("adjust", "21");
+pub const STAGE: StageId = StageId::new("adjust", "22");
 
 /// One adjusted recording.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

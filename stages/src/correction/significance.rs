@@ -75,15 +75,19 @@ impl Significance {
     }
 }
 
-/// For every recording, its window: the consecutive recordings of its linked group within `half_m` along the
-/// track (inclusive).
+/// For every recording, its window: the recordings within `half_m` along the track (inclusive) of the run of
+/// consecutive recordings of its linked group that holds it.
 fn windows(s_m: &[f64], groups: &[usize], half_m: f64) -> Vec<Range<usize>> {
     let n = s_m.len();
-    let (mut lo, mut hi) = (0, 0);
+    let (mut lo, mut hi, mut run_start) = (0, 0, 0);
     (0..n)
         .map(|i| {
-            // Both ends only move forward as i does (s grows with i within a group).
-            while lo < i && (groups[lo] != groups[i] || s_m[i] - s_m[lo] > half_m) {
+            if i > 0 && groups[i] != groups[i - 1] {
+                run_start = i;
+            }
+            // Both ends only move forward as i does (s grows with i).
+            lo = lo.max(run_start);
+            while lo < i && s_m[i] - s_m[lo] > half_m {
                 lo += 1;
             }
             hi = hi.max(i + 1);
@@ -279,6 +283,10 @@ mod tests {
         let g = [0, 0, 0, 0, 0, 5, 5];
         let w = windows(&s, &g, 5.0);
         assert_eq!(w, vec![0..2, 0..3, 1..4, 2..5, 3..5, 5..7, 5..7]);
+        // Groups that interleave (a later drive linked to an earlier one): a window never crosses another group.
+        let s = [0.0, 5.0, 10.0, 15.0];
+        let g = [0, 1, 0, 0];
+        assert_eq!(windows(&s, &g, 20.0), vec![0..1, 1..2, 2..4, 2..4]);
     }
 
     #[test]
