@@ -184,12 +184,26 @@ pub fn hold_insignificant(run: &mut AdjustmentRun, level: f64, window_m: f64) ->
             }
         })
         .collect();
+    report.held = held_stretches(run, &groups, &z, &held, components);
+    for (r, h) in run.recordings.iter_mut().zip(held) {
+        hold(r, h);
+    }
+    report
+}
+
+/// The runs of consecutive recordings of one linked group whose component `c` is held, per component, with
+/// their largest normalised correction `z`.
+fn held_stretches(
+    run: &AdjustmentRun,
+    groups: &[usize],
+    z: &[[f64; 3]],
+    held: &[HeldComponents],
+    components: usize,
+) -> Vec<HeldStretch> {
+    let n = held.len();
+    let mut out = Vec::new();
     for c in 0..components {
-        let is_held = |i: usize| match c {
-            0 => held[i].horizontal,
-            1 => held[i].height,
-            _ => held[i].yaw,
-        };
+        let is_held = |i: usize| [held[i].horizontal, held[i].height, held[i].yaw][c];
         let mut i = 0;
         while i < n {
             if !is_held(i) {
@@ -200,7 +214,7 @@ pub fn hold_insignificant(run: &mut AdjustmentRun, level: f64, window_m: f64) ->
             while i + 1 < n && is_held(i + 1) && groups[i + 1] == groups[start] {
                 i += 1;
             }
-            report.held.push(HeldStretch {
+            out.push(HeldStretch {
                 component: COMPONENTS[c].to_string(),
                 first_image_id: run.recordings[start].image_id.clone(),
                 last_image_id: run.recordings[i].image_id.clone(),
@@ -210,10 +224,7 @@ pub fn hold_insignificant(run: &mut AdjustmentRun, level: f64, window_m: f64) ->
             i += 1;
         }
     }
-    for (r, h) in run.recordings.iter_mut().zip(held) {
-        hold(r, h);
-    }
-    report
+    out
 }
 
 /// Puts the `held` components of `r` back to the recorded values and widens their σ by the correction.
