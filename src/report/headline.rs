@@ -14,6 +14,7 @@
 
 use super::inputs::{num_at, obj_at, read_csv_opt, read_csv_where, CsvTable};
 use serde_json::Value;
+use skytie_stages::correction::significance::COMPONENTS;
 use skytie_stages::export::Support;
 use std::path::Path;
 
@@ -157,18 +158,17 @@ pub struct HeldSummary {
 impl HeldSummary {
     fn from_metrics(a: &Value, recordings: usize) -> Option<Self> {
         let s = a.get("significance").filter(|v| !v.is_null())?;
-        let names = ["horizontal", "height", "yaw"];
         let mut stretches = [0; 3];
         for h in s.get("held")?.as_array()? {
             let component = h.get("component").and_then(Value::as_str);
-            if let Some(k) = names.iter().position(|n| Some(*n) == component) {
+            if let Some(k) = COMPONENTS.iter().position(|n| Some(*n) == component) {
                 stretches[k] += 1;
             }
         }
         let held = |k: &str| num_at(s, &format!("held_recordings.{k}")).unwrap_or(0.0) as usize;
         Some(Self {
             level: num_at(s, "level")?,
-            recordings_held: names.map(held),
+            recordings_held: COMPONENTS.map(held),
             stretches,
             yaw_tested: s.get("yaw_tested").and_then(Value::as_bool) == Some(true),
             recordings,
@@ -394,7 +394,7 @@ impl Headline {
         let mut out = Vec::new();
         out.push(match &self.status {
             Status::Corrected if self.held.as_ref().is_some_and(HeldSummary::everything_held) => {
-                "RESULT: recorded trajectory kept: no segment's correction is significant (the aerial evidence \
+                "RESULT: recorded trajectory kept: no correction is significant (the aerial evidence \
                  does not show the recorded positions off; see the σ after)"
                     .to_string()
             }
