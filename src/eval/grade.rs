@@ -6,6 +6,7 @@
 use crate::report::inputs::{num_at, read_csv_opt, RunOutputs};
 use serde_json::Value;
 use skytie_stages::campaign::{read_recordings_csv, Recording};
+use skytie_stages::estimators::normal_quantile::chi2_2_quantile;
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
@@ -163,9 +164,9 @@ fn adjust_section(m: &Value) -> Option<&Value> {
     obj.get("combined").or_else(|| obj.values().next())
 }
 
-/// χ²(2) 95 % quantile: a recording whose squared 2-D error normalised by its stated σ (per axis) exceeds
-/// this lies outside the 95 % ellipse of its stated precision.
-const CHI2_2_95: f64 = 5.991;
+/// The ellipse probability: a recording whose squared 2-D error normalised by its stated σ (per axis) exceeds
+/// the χ²(2) quantile of this lies outside the 95 % ellipse of its stated precision.
+const ELLIPSE_P: f64 = 0.95;
 
 /// The true recordings by `image_id`.
 type TrueOf<'a> = HashMap<&'a str, &'a Recording>;
@@ -183,6 +184,7 @@ fn recordings_beyond_sigma95(out: &Path, true_of: &TrueOf) -> Result<Option<f64>
     let Some(t) = read_csv_opt(&out.join("trajectory_adjusted.csv"))? else {
         return Ok(None);
     };
+    let limit = chi2_2_quantile(ELLIPSE_P).unwrap_or(f64::INFINITY);
     let (mut beyond, mut counted) = (0usize, 0usize);
     for row in &t.rows {
         let Some(truth) = true_of.get(t.text(row, "image_id")) else {
@@ -201,7 +203,7 @@ fn recordings_beyond_sigma95(out: &Path, true_of: &TrueOf) -> Result<Option<f64>
         }
         let q = ((x - truth.x) / sx).powi(2) + ((y - truth.y) / sy).powi(2);
         counted += 1;
-        beyond += usize::from(q > CHI2_2_95);
+        beyond += usize::from(q > limit);
     }
     Ok((counted > 0).then(|| beyond as f64 / counted as f64))
 }

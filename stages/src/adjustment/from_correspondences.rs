@@ -39,7 +39,7 @@ pub struct RunRecording {
     /// σ of the yaw correction, degrees, scaled like `sigma_m` (0 when yaw is not estimated).
     pub sigma_yaw_deg: f64,
     pub sigma_is_a_posteriori: bool,
-    /// The components of the correction not applied because their segment's corrections were not significant
+    /// The components of the correction not applied because no significant correction was near
     /// (`correction::significance`): the recording keeps its recorded value of them.
     #[serde(default)]
     pub held: HeldComponents,
@@ -54,18 +54,20 @@ pub struct HeldComponents {
 }
 
 impl HeldComponents {
+    /// Horizontal, height, yaw: in the order of `correction::significance::COMPONENTS`.
+    pub fn as_array(&self) -> [bool; 3] {
+        [self.horizontal, self.height, self.yaw]
+    }
+
     /// The held components as written in the outputs: `xy`, `z`, `yaw` joined by `+`; empty when none is.
     pub fn label(&self) -> String {
-        [
-            (self.horizontal, "xy"),
-            (self.height, "z"),
-            (self.yaw, "yaw"),
-        ]
-        .iter()
-        .filter(|(held, _)| *held)
-        .map(|(_, name)| *name)
-        .collect::<Vec<_>>()
-        .join("+")
+        self.as_array()
+            .iter()
+            .zip(["xy", "z", "yaw"])
+            .filter(|(held, _)| **held)
+            .map(|(_, name)| name)
+            .collect::<Vec<_>>()
+            .join("+")
     }
 }
 

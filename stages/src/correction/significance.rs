@@ -203,7 +203,7 @@ fn held_stretches(
     let n = held.len();
     let mut out = Vec::new();
     for c in 0..components {
-        let is_held = |i: usize| [held[i].horizontal, held[i].height, held[i].yaw][c];
+        let is_held = |i: usize| held[i].as_array()[c];
         let mut i = 0;
         while i < n {
             if !is_held(i) {
