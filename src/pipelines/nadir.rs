@@ -22,6 +22,7 @@ use crate::nodes::nadir::grade::{grade_metrics, GradeNadir, TRUTH_AERIAL_NADIR};
 use crate::nodes::nadir::mm_match::MmMatch;
 use crate::nodes::nadir::options::{Matcher, NadirOptions};
 use crate::nodes::nadir::ortho_aerial::OrthoForAerial;
+use crate::nodes::nadir::peak_support::PeakSupportStage;
 use crate::nodes::nadir::refine::RefineStage;
 use crate::nodes::nadir::summary::SummarizeNadir;
 use crate::nodes::nadir::transform::InitialTransformStage;
@@ -389,14 +390,38 @@ impl NadirChain<'_, '_> {
                     b.add(BaselineStage, &p.label, params, inputs)?
                 }
             };
-            self.refinements.push(refined);
-            rec_refinements.push(refined);
+            rec_refinements.push((p.label, refined));
             rec_aerials.push(p.aerial);
         }
+        let rec_refinements = self.add_peak_support(b, rec_refinements)?;
+        self.refinements.extend(&rec_refinements);
         Ok(Refined {
             refinements: rec_refinements,
             aerials: rec_aerials,
         })
+    }
+
+    /// The recording's refinements (label, node) without their weak peaks where the recording has strong ones
+    /// (`nadir::peak_support`); unchanged, with no node added, when `[control] strong_peak` is 0.
+    fn add_peak_support(
+        &self,
+        b: &mut DagBuilder,
+        refinements: Vec<(String, Handle<AerialRefinement>)>,
+    ) -> Result<Vec<Handle<AerialRefinement>>, PipelineError> {
+        let all: Vec<Handle<AerialRefinement>> = refinements.iter().map(|(_, r)| *r).collect();
+        if !(self.control_params.strong_peak > 0.0) {
+            return Ok(all);
+        }
+        let mut out = Vec::with_capacity(all.len());
+        for (label, refined) in refinements {
+            out.push(b.add(
+                PeakSupportStage,
+                &label,
+                self.control_params.clone(),
+                (refined, optional_all(&all)),
+            )?);
+        }
+        Ok(out)
     }
 
     /// The global `nadir` summary and, on campaigns with `truth/`, the evaluation node `grade_nadir`.

@@ -7,7 +7,7 @@
 use super::stage;
 
 /// The per-item stages of the `items` phase.
-pub const PER_ITEM_STAGES: [&str; 12] = [
+pub const PER_ITEM_STAGES: [&str; 13] = [
     crate::nodes::campaign::load::RECORDING_STAGE.name,
     stage::ORTHO,
     stage::MM_MATCH,
@@ -16,6 +16,7 @@ pub const PER_ITEM_STAGES: [&str; 12] = [
     skytie_stages::nadir::transform_agreement::STAGE.name,
     stage::REFINE,
     stage::BASELINE,
+    skytie_stages::nadir::peak_support::STAGE.name,
     stage::CONTROL,
     stage::SPARSE_CLOUD,
     stage::FACADES,

@@ -14,6 +14,7 @@ pub mod orthophoto;
 pub mod orthophoto_ortho;
 pub mod orthophoto_points;
 pub mod orthophoto_summary;
+pub mod peak_support;
 pub mod refine;
 pub mod summary;
 pub mod transform;

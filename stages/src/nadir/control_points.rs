@@ -55,6 +55,10 @@ crate::params! {
         mm_height_sigma_m: f64 = 1.0, unit "m", min 0.0, max 1000.0;
         /// Observations with a matching score below this are ignored.
         min_score: f64 = 0.0;
+        /// Weak peaks only where nothing better exists (`nadir::peak_support`): a location whose correlation
+        /// peak is below this is kept only when none of its recording's locations in any nadir image reaches
+        /// it (dropped ones count as `nadir.weak_peaks`). 0 = every peak accepted by `[refine] min_peak` is kept.
+        strong_peak: f64 = 0.0, min 0.0, below 1.0;
     }
     check(p, v) {
         crate::params::check_finite("min_score", &p.min_score, v);

@@ -13,6 +13,7 @@ pub mod neighbour_transform;
 pub mod ortho;
 pub mod ortho_mask;
 pub mod parallax_check;
+pub mod peak_support;
 pub mod refine;
 pub mod registration;
 pub mod summary;

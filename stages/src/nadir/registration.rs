@@ -161,7 +161,8 @@ pub struct RefinementMisses {
     /// left the aerial image.
     #[serde(default)]
     pub beyond_search: usize,
-    /// The correlation peak stayed below `RefineParams::min_peak`.
+    /// The correlation peak stayed below `RefineParams::min_peak`, or below `ControlParams::strong_peak` while
+    /// the recording has a location at or above it (`nadir::peak_support`).
     #[serde(default)]
     pub weak_peaks: usize,
     /// Located, but dropped because their correction disagrees with the image's other tie points
