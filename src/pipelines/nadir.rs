@@ -401,15 +401,17 @@ impl NadirChain<'_, '_> {
         })
     }
 
-    /// The recording's refinements (label, node) without their weak peaks where the recording has strong ones
-    /// (`nadir::peak_support`); unchanged, with no node added, when `[control] strong_peak` is 0.
+    /// The recording's refinements (label, node) without their weak peaks where the recording has strong ones,
+    /// and without tie points located in too few images where it has corroborated ones (`nadir::peak_support`);
+    /// unchanged, with no node added, when `[control] strong_peak` is 0 and `min_aerial_images` 1.
     fn add_peak_support(
         &self,
         b: &mut DagBuilder,
         refinements: Vec<(String, Handle<AerialRefinement>)>,
     ) -> Result<Vec<Handle<AerialRefinement>>, PipelineError> {
         let all: Vec<Handle<AerialRefinement>> = refinements.iter().map(|(_, r)| *r).collect();
-        if !(self.control_params.strong_peak > 0.0) {
+        let p = &self.control_params;
+        if !(p.strong_peak > 0.0) && p.min_aerial_images <= 1 {
             return Ok(all);
         }
         let mut out = Vec::with_capacity(all.len());

@@ -59,6 +59,10 @@ crate::params! {
         /// peak is below this is kept only when none of its recording's locations in any nadir image reaches
         /// it (dropped ones count as `nadir.weak_peaks`). 0 = every peak accepted by `[refine] min_peak` is kept.
         strong_peak: f64 = 0.0, min 0.0, below 1.0;
+        /// Corroborated tie points only where the recording has them (`nadir::peak_support`): a tie point
+        /// located in fewer nadir images than this is left out when another tie point of its recording is
+        /// located in at least this many (dropped ones count as `nadir.unconfirmed`). 1 = no check.
+        min_aerial_images: usize = 1, min 1, max 20;
     }
     check(p, v) {
         crate::params::check_finite("min_score", &p.min_score, v);

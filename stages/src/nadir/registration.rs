@@ -178,7 +178,9 @@ pub struct RefinementMisses {
     #[serde(default)]
     pub point_inconsistent: usize,
     /// Located, but dropped because fewer than `RefineParams::min_located` tie points were located in the
-    /// image (a lone located template has no other to confirm the pair's registration).
+    /// image (a lone located template has no other to confirm the pair's registration), or because the tie
+    /// point was located in fewer than `ControlParams::min_aerial_images` nadir images while others of the
+    /// recording reach that count (`nadir::peak_support`).
     pub unconfirmed: usize,
 }
 
