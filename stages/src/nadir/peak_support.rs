@@ -27,22 +27,12 @@ use std::collections::HashMap;
 /// changes.
 pub const STAGE: StageId = StageId::new("peak_support", "1");
 
-/// `own` without its locations whose peak is below `strong_peak` when any refinement of the same recording in
-/// `recording` (its refinements in all its nadir images; `own` may be among them, other recordings' are
-/// ignored) has a location at or above `strong_peak`; otherwise `own` unchanged. `strong_peak ≤ 0` keeps
-/// everything.
-pub fn keep_supported_peaks(
-    own: &AerialRefinement,
-    recording: &[&AerialRefinement],
-    strong_peak: f64,
-) -> AerialRefinement {
-    keep_supported(own, recording, strong_peak, 1)
-}
-
-/// [`keep_supported_peaks`], then the image-count rule: of the locations left, a tie point located in fewer
-/// than `min_aerial_images` of the recording's nadir images (counting only locations the peak rule keeps) is
-/// dropped from `own` when another tie point of the recording reaches that count; dropped ones count as
-/// `misses.unconfirmed`. `min_aerial_images ≤ 1` disables the rule.
+/// `own` with the two rules of the module applied against `recording` (the recording's refinements in all its
+/// nadir images; `own` may be among them, other recordings' are ignored). The peak rule: when any of them has
+/// a location at or above `strong_peak`, `own`'s locations below it are dropped (`misses.weak_peaks`);
+/// `strong_peak ≤ 0` disables it. The image-count rule, on the locations the peak rule keeps: a tie point
+/// located in fewer than `min_aerial_images` of the recording's nadir images is dropped when another tie point
+/// of the recording reaches that count (`misses.unconfirmed`); `min_aerial_images ≤ 1` disables it.
 pub fn keep_supported(
     own: &AerialRefinement,
     recording: &[&AerialRefinement],
@@ -56,8 +46,11 @@ pub fn keep_supported(
         .filter(|r| r.recording_id == own.recording_id && r.aerial_id != own.aerial_id)
         .collect();
     mine.push(own);
-    let matches = || mine.iter().flat_map(|r| &r.matches);
-    let has_strong = strong_peak > 0.0 && matches().any(|m| m.observation.score >= strong_peak);
+    let has_strong = strong_peak > 0.0
+        && mine
+            .iter()
+            .flat_map(|r| &r.matches)
+            .any(|m| m.observation.score >= strong_peak);
     let kept_peak = |m: &AerialMatch| !has_strong || m.observation.score >= strong_peak;
     let before = out.matches.len();
     out.matches.retain(|m| kept_peak(m));
@@ -121,10 +114,10 @@ mod tests {
     fn weak_peaks_go_when_another_image_of_the_recording_has_a_strong_one() {
         let a = refinement("pano_1", "n1", &[0.71, 0.73]);
         let b = refinement("pano_1", "n2", &[0.72, 0.81]);
-        let kept = keep_supported_peaks(&a, &[&a, &b], 0.75);
+        let kept = keep_supported(&a, &[&a, &b], 0.75, 1);
         assert!(kept.matches.is_empty());
         assert_eq!(kept.misses.weak_peaks, 2);
-        let kept_b = keep_supported_peaks(&b, &[&a, &b], 0.75);
+        let kept_b = keep_supported(&b, &[&a, &b], 0.75, 1);
         assert_eq!(scores(&kept_b), vec![0.81]);
         assert_eq!(kept_b.misses.weak_peaks, 1);
     }
@@ -135,7 +128,7 @@ mod tests {
         let b = refinement("pano_1", "n2", &[0.74]);
         // Another recording's strong peak says nothing about this one.
         let other = refinement("pano_2", "n1", &[0.95]);
-        let kept = keep_supported_peaks(&a, &[&a, &b, &other], 0.75);
+        let kept = keep_supported(&a, &[&a, &b, &other], 0.75, 1);
         assert_eq!(kept, a);
     }
 
@@ -170,7 +163,7 @@ mod tests {
     #[test]
     fn a_peak_exactly_at_the_threshold_is_strong_and_zero_disables() {
         let a = refinement("pano_1", "n1", &[0.75, 0.70]);
-        assert_eq!(scores(&keep_supported_peaks(&a, &[&a], 0.75)), vec![0.75]);
-        assert_eq!(keep_supported_peaks(&a, &[&a], 0.0), a);
+        assert_eq!(scores(&keep_supported(&a, &[&a], 0.75, 1)), vec![0.75]);
+        assert_eq!(keep_supported(&a, &[&a], 0.0, 1), a);
     }
 }
