@@ -9,9 +9,10 @@
 //! input has no such column, then `dx_m, dy_m, dz_m` (adjusted − recorded, metres), `dyaw_deg`,
 //! `sigma_yaw_deg`, `correction` — what supports the row's correction (`Support` label), or `not_read`
 //! for a row the campaign reader rejected (written unchanged; its problem was reported when the campaign was
-//! read) — and `held`: the components of the correction kept at the recorded values because their segment's
-//! corrections were not significant (`xy`, `z`, `yaw` joined by `+`; empty when all were applied;
-//! `correction::significance`). An appended name that the input already uses for another column gets the prefix `skytie_`.
+//! read) — and `held`: the components of the correction kept at the recorded values because no significant
+//! correction was near (`xy`, `z`, `yaw` joined by `+`; empty when all were applied;
+//! `correction::significance`). An appended name that the input already uses for another column gets the
+//! prefix `skytie_`.
 //! Comment lines of the input are not copied.
 
 use super::corrections::CorrectionSeries;
