@@ -161,6 +161,7 @@ fn rows(s: &Scene) -> Rows {
             point_world: Some((*p_map).into()),
             covariance_m2: None,
             map: None,
+            ray_ground: None,
         });
     }
     Rows {

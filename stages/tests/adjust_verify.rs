@@ -57,16 +57,26 @@ fn systematic_error_is_recovered_exactly_and_flagged() {
     let config = VerifyConfig::default();
     let v = verify(&c.recordings, &c.pano_size_px, &c.control, &config).unwrap();
     let singles = c.control.iter().filter(|cp| cp.aerial.len() < 2).count();
-    assert_eq!(v.skipped_single_aerial, singles);
-    assert_eq!(v.points.len() + singles + v.skipped_mm, c.control.len());
+    assert!(singles >= 5, "{singles} single-image points");
+    // Every point is compared: the single-image ones horizontally, at the MM point's height.
+    assert_eq!(v.skipped_single_aerial, 0);
+    assert_eq!(v.points.len() + v.skipped_mm, c.control.len());
+    assert_eq!(
+        v.points.iter().filter(|p| !p.aerial_height).count(),
+        singles
+    );
     assert!(v.points.len() >= 15, "{} points", v.points.len());
     for p in &v.points {
-        for (k, (got, want)) in p.offset_m.iter().zip(&truth_offset).enumerate() {
+        let axes = if p.aerial_height { 3 } else { 2 };
+        for (k, (got, want)) in p.offset_m.iter().zip(&truth_offset).take(axes).enumerate() {
             assert!(
                 (got - want).abs() < 1e-6,
                 "{}: axis {k} offset {got} vs {want}",
                 p.tie_point_id
             );
+        }
+        if !p.aerial_height {
+            assert_eq!((p.offset_m[2], p.variance_m2[2]), (0.0, 0.0));
         }
     }
     assert_eq!(v.segments.len(), 3);
@@ -76,8 +86,18 @@ fn systematic_error_is_recovered_exactly_and_flagged() {
         assert!((s.offset_2d_m - 0.8).abs() < 1e-6);
         assert!(s.sd_m.iter().all(|&x| x < 1e-6));
         assert!((s.mean_3d_m - 0.8).abs() < 1e-6);
+        assert!(s.points_3d < s.points, "segment {}", s.index);
     }
     assert!(!v.passed());
+    // Without them, the single-image points are skipped and counted.
+    let multi_only = VerifyConfig {
+        single_image_points: false,
+        ..VerifyConfig::default()
+    };
+    let m = verify(&c.recordings, &c.pano_size_px, &c.control, &multi_only).unwrap();
+    assert_eq!(m.skipped_single_aerial, singles);
+    assert_eq!(m.points.len() + singles, v.points.len());
+    assert!(m.points.iter().all(|p| p.aerial_height));
     let table = render_verification_table(&v);
     eprintln!("{table}");
     assert!(table.contains("fail") && table.contains("all"));
@@ -202,7 +222,7 @@ fn a_drifting_segment_fails_on_its_points_and_a_single_wrong_point_does_not() {
     let ids: Vec<String> = v
         .points
         .iter()
-        .filter(|p| p.segment == 2 && p.observed_from.iter().all(|&r| r >= 45))
+        .filter(|p| p.segment == 2 && p.aerial_height && p.observed_from.iter().all(|&r| r >= 45))
         .take(2)
         .map(|p| p.tie_point_id.clone())
         .collect();
@@ -217,8 +237,12 @@ fn a_drifting_segment_fails_on_its_points_and_a_single_wrong_point_does_not() {
         ..VerifyConfig::default()
     };
     assert_eq!(ids.len(), 2);
+    let alone_before = verify(&c.recordings, &c.pano_size_px, &c.control, &each_alone).unwrap();
     let alone = verify(&c.recordings, &c.pano_size_px, &wrong, &each_alone).unwrap();
-    assert_eq!(alone.segments[2].points_off, off_before + 2);
+    assert_eq!(
+        alone.segments[2].points_off,
+        alone_before.segments[2].points_off + 2
+    );
     assert_eq!(alone.segments[2].status, VerifyStatus::Fail);
     let v = verify(&c.recordings, &c.pano_size_px, &wrong, &config).unwrap();
     assert_eq!(v.segments[2].points_off, off_before);

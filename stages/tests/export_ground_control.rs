@@ -98,6 +98,7 @@ fn control() -> Vec<AerialControlPoint> {
     vec![
         AerialControlPoint {
             map: None,
+            ray_ground: None,
             tie_point_id: "t 1".into(),
             mm: vec![
                 PanoObservation {
@@ -117,6 +118,7 @@ fn control() -> Vec<AerialControlPoint> {
         },
         AerialControlPoint {
             map: None,
+            ray_ground: None,
             tie_point_id: "t2".into(),
             mm: vec![],
             aerial: vec![aerial("n1", 1.0, 1.0)],

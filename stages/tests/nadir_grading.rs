@@ -112,6 +112,7 @@ fn a_shifted_aerial_observation_is_graded_wrong_and_listed() {
     // The control point keeps only the exact observation (as if the consistency check had dropped the other).
     let control = AerialControlPoint {
         map: None,
+        ray_ground: None,
         tie_point_id: tie_point.id.clone(),
         mm: tie_point.observations.clone(),
         aerial: vec![exact.matches[0].observation.clone()],
@@ -159,6 +160,7 @@ fn a_systematic_offset_shows_in_the_signed_means() {
     let p = sc.point + Vector3::new(0.01, -0.02, 0.5);
     let control = AerialControlPoint {
         map: None,
+        ray_ground: None,
         tie_point_id: sc.tie_point.id.clone(),
         mm: sc.tie_point.observations.clone(),
         aerial: vec![

@@ -181,6 +181,7 @@ fn grade_counts_before_and_after_consensus_per_side() {
     let x = s.points[2];
     let control = vec![AerialControlPoint {
         map: None,
+        ray_ground: None,
         tie_point_id: s.cloud.points[2].tie.id.clone(),
         mm: s.cloud.points[2].tie.observations.clone(),
         aerial: vec![AerialObservation {

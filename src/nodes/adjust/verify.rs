@@ -22,6 +22,7 @@ pub fn verify_metrics(v: &Verification) -> serde_json::Value {
     let seg = |s: &skytie_stages::adjustment::verify::VerificationSegment| {
         serde_json::json!({
             "points": s.points,
+            "points_3d": s.points_3d,
             "mean_m": s.mean_m,
             "sd_m": s.sd_m,
             "sigma_mean_m": s.sigma_mean_m,

@@ -376,6 +376,7 @@ mod tests {
             point_world: None,
             covariance_m2: None,
             map: None,
+            ray_ground: None,
         };
         let with = RecordingControl {
             recording_id: "a".into(),

@@ -8,7 +8,8 @@
 use super::synthetic_block::{SyntheticBlock, SyntheticBlockSpec};
 use crate::campaign::{AerialImage, AerialKind, CheckPoint, Observation, Recording};
 use crate::correspondence::{
-    AerialControlPoint, AerialObservation, MmTiePoint, PanoObservation as CorrPanoObservation,
+    AerialControlPoint, AerialObservation, AerialRayGround, MmTiePoint,
+    PanoObservation as CorrPanoObservation,
 };
 use crate::geometry::{matrix_to_opk, opk_to_matrix, triangulate_rays, FrameCamera};
 use crate::rng::SplitMix64;
@@ -265,8 +266,18 @@ impl SyntheticCampaignSpec {
                     triangulate_rays(&rays, &sigmas).ok()
                 })
                 .flatten();
+            // A point in one image: its ray at the point's height, σ = σ_px × GSD.
+            let ray_ground = match aerial.as_slice() {
+                [a] => AerialRayGround::from_ray(
+                    &cameras[index_of(&nadir, &a.image_id)].pixel_ray(a.u_px, a.v_px),
+                    x.z,
+                    self.aerial_sigma_px * self.aerial_gsd_m,
+                ),
+                _ => None,
+            };
             control.push(AerialControlPoint {
                 map: None,
+                ray_ground,
                 tie_point_id: format!("t{}", cp.point),
                 mm: pano_obs(cp.point),
                 aerial,

@@ -1,7 +1,10 @@
 //! Verification without adjustment (thesis 5.7, Table 5-13): are a campaign's recorded
 //! positions good enough? Each aerial control point triangulated from ≥ 2 aerial images is compared with the
 //! same point triangulated from its MM observations alone with the RECORDED poses; the offset `MM − aerial`
-//! estimates the local trajectory error. Per trajectory segment (a number of recordings or an along-track
+//! estimates the local trajectory error. A point seen in one aerial nadir image has no aerial height, but its
+//! ray is nearly vertical: taken at the MM point's own height it gives a horizontal position
+//! ([`AerialRayGround`]), so it is compared horizontally (`single_image_points`) and left out of the
+//! vertical and 3-D statistics. Per trajectory segment (a number of recordings or an along-track
 //! length): mean and SD of the offsets in X, Y, Z and of their 3-D length (Table 5-13), the uncertainty of the
 //! mean, and pass/fail against a tolerance (horizontal; vertical only with `check_height`).
 //!
@@ -27,7 +30,7 @@
 
 use super::id_index::index_by_id;
 use crate::campaign::Recording;
-use crate::correspondence::AerialControlPoint;
+use crate::correspondence::{AerialControlPoint, AerialRayGround};
 use crate::estimators::median_consensus::median_in_place;
 use crate::geometry::{triangulate_rays, PanoramaCamera};
 use crate::params::{describe, Params, StageId};
@@ -41,7 +44,7 @@ use std::path::Path;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("verify", "9");
+pub const STAGE: StageId = StageId::new("verify", "10");
 
 crate::params! {
     /// Parameters of a verification (the verify node's params).
@@ -84,6 +87,11 @@ crate::params! {
         /// level (`PyramidLayout::detail_level`; full-resolution pixels unless the panorama was enlarged by
         /// pixel repetition), as the adjustment's `pano_sigma_px`.
         pano_sigma_px: f64 = 1.0, unit "px", above 0.0;
+        /// Also compare the points seen in one aerial nadir image, horizontally: their ray taken at the MM
+        /// point's height (a nadir ray is within a degree or two of vertical, so a height error of δz moves it
+        /// by δz · tan(tilt)). They are left out of the vertical and 3-D statistics. Off: only points
+        /// triangulated from ≥ 2 aerial images (or measured in an orthophoto) are compared.
+        single_image_points: bool = true;
     }
 }
 
@@ -120,6 +128,9 @@ pub struct VerifiedPoint {
     /// Diagonal of `C_MM + C_aerial` (a priori), m².
     pub variance_m2: [f64; 3],
     pub mm_views: usize,
+    /// False for a point seen in one aerial image: its offset is horizontal only (`offset_m[2]` and
+    /// `variance_m2[2]` are 0) and it is left out of the vertical and 3-D statistics.
+    pub aerial_height: bool,
 }
 
 /// Table 5-13 statistics of one trajectory segment.
@@ -130,6 +141,9 @@ pub struct VerificationSegment {
     pub last_image_id: String,
     pub recordings: usize,
     pub points: usize,
+    /// The points with an aerial height (≥ 2 aerial images or an orthophoto), the ones the vertical and
+    /// 3-D statistics come from.
+    pub points_3d: usize,
     /// Mean offset X, Y, Z, metres.
     pub mean_m: [f64; 3],
     /// SD of the offsets X, Y, Z, metres (0 with one point).
@@ -159,7 +173,8 @@ pub struct Verification {
     pub points: Vec<VerifiedPoint>,
     /// All points together (index = number of segments, ids of the first and last recording).
     pub overall: VerificationSegment,
-    /// Control points without an aerial triangulation (< 2 aerial images).
+    /// Control points without an aerial position: seen in one aerial image, and not compared
+    /// horizontally (`single_image_points` off, or no ray at the ground).
     pub skipped_single_aerial: usize,
     /// Control points whose MM observations could not be triangulated (< 2 known panoramas, bad geometry).
     pub skipped_mm: usize,
@@ -265,13 +280,19 @@ pub fn verify_with_detail_levels(
     let mut rays = Vec::new();
     let mut sigmas = Vec::new();
     for cp in control {
-        // Triangulated from ≥ 2 aerial images, or measured in the orthophoto.
+        // Triangulated from ≥ 2 aerial images, or measured in the orthophoto; else one image's ray.
         let usable = cp.aerial.len() >= 2 || cp.map.is_some();
-        let (Some(aerial_xyz), true) = (cp.point_world, usable) else {
-            skipped_single_aerial += 1;
-            continue;
+        let aerial = match (cp.point_world, usable, &cp.ray_ground) {
+            (Some(xyz), true, _) => AerialPosition::Point(Vector3::from(xyz)),
+            (_, _, Some(ray)) if config.single_image_points && cp.aerial.len() == 1 => {
+                AerialPosition::Ray(ray)
+            }
+            _ => {
+                skipped_single_aerial += 1;
+                continue;
+            }
         };
-        let aerial = Vector3::from(aerial_xyz);
+        let near = aerial.near_world();
         rays.clear();
         sigmas.clear();
         let mut observed_from = Vec::with_capacity(cp.mm.len());
@@ -281,7 +302,7 @@ pub fn verify_with_detail_levels(
                 rays.push(cameras[r].pixel_ray(o.u_px, o.v_px));
                 sigmas.push(angular_sigma_rad[r]);
                 observed_from.push(r);
-                let d = (cameras[r].center_world - aerial).norm();
+                let d = (cameras[r].center_world - near).norm();
                 if nearest.is_none_or(|(best, _)| d < best) {
                     nearest = Some((d, r));
                 }
@@ -291,19 +312,37 @@ pub fn verify_with_detail_levels(
             skipped_mm += 1;
             continue;
         };
-        let offset = t.point_world - aerial;
-        let aerial_cov = cp
-            .covariance_m2
-            .map(|c| Matrix3::from_fn(|i, j| c[i][j]))
-            .unwrap_or_else(Matrix3::zeros);
-        let cov = t.covariance_m2 + aerial_cov;
+        let mm = &t.point_world;
+        let mm_var = &t.covariance_m2;
+        let (offset_m, variance_m2) = match aerial {
+            AerialPosition::Point(aerial) => {
+                let aerial_cov = cp
+                    .covariance_m2
+                    .map(|c| Matrix3::from_fn(|i, j| c[i][j]))
+                    .unwrap_or_else(Matrix3::zeros);
+                let cov = mm_var + aerial_cov;
+                (
+                    (mm - aerial).into(),
+                    [cov[(0, 0)], cov[(1, 1)], cov[(2, 2)]],
+                )
+            }
+            AerialPosition::Ray(ray) => {
+                let [ax, ay] = ray.xy_at(mm.z);
+                let [vx, vy] = ray.xy_variance_m2(mm_var[(2, 2)]);
+                (
+                    [mm.x - ax, mm.y - ay, 0.0],
+                    [mm_var[(0, 0)] + vx, mm_var[(1, 1)] + vy, 0.0],
+                )
+            }
+        };
         points.push(VerifiedPoint {
             tie_point_id: cp.tie_point_id.clone(),
             segment: segment_of[r],
             observed_from,
-            offset_m: offset.into(),
-            variance_m2: [cov[(0, 0)], cov[(1, 1)], cov[(2, 2)]],
+            offset_m,
+            variance_m2,
             mm_views: rays.len(),
+            aerial_height: matches!(aerial, AerialPosition::Point(_)),
         });
     }
     // Members of every segment in one pass over the recordings and one over the points (in their order).
@@ -372,6 +411,24 @@ pub fn verify_with_detail_levels(
     })
 }
 
+/// Where the aerial data put a compared point.
+enum AerialPosition<'a> {
+    /// Triangulated from ≥ 2 aerial images or measured in an orthophoto (world, m).
+    Point(Vector3<f64>),
+    /// One aerial image's ray, horizontal only.
+    Ray(&'a AerialRayGround),
+}
+
+impl AerialPosition<'_> {
+    /// A world point near the control point (to find the recording that saw it from closest).
+    fn near_world(&self) -> Vector3<f64> {
+        match self {
+            AerialPosition::Point(p) => *p,
+            AerialPosition::Ray(r) => Vector3::from(r.point_world),
+        }
+    }
+}
+
 /// Table 5-13 statistics of a set of points.
 #[allow(clippy::too_many_arguments)]
 fn statistics(
@@ -385,34 +442,28 @@ fn statistics(
     config: &VerifyConfig,
 ) -> VerificationSegment {
     let n = points.len();
-    let nf = n as f64;
+    let with_height: Vec<&VerifiedPoint> =
+        points.iter().copied().filter(|p| p.aerial_height).collect();
     let mut mean = [0.0; 3];
     let mut sd = [0.0; 3];
     let mut sigma_mean = [0.0; 3];
-    let (mut mean_3d, mut sd_3d) = (0.0, 0.0);
-    if n > 0 {
-        for k in 0..3 {
-            mean[k] = points.iter().map(|p| p.offset_m[k]).sum::<f64>() / nf;
-            if n > 1 {
-                let ss: f64 = points
-                    .iter()
-                    .map(|p| (p.offset_m[k] - mean[k]).powi(2))
-                    .sum();
-                sd[k] = (ss / (nf - 1.0)).sqrt();
-            }
-            let propagated = points.iter().map(|p| p.variance_m2[k]).sum::<f64>().sqrt() / nf;
+    for k in 0..3 {
+        // Horizontal axes from every point, the vertical one from those with an aerial height.
+        let axis_points = if k == 2 { &with_height[..] } else { points };
+        (mean[k], sd[k]) = mean_and_sd(axis_points.iter().map(|p| p.offset_m[k]));
+        if !axis_points.is_empty() {
+            let nf = axis_points.len() as f64;
+            let propagated = axis_points
+                .iter()
+                .map(|p| p.variance_m2[k])
+                .sum::<f64>()
+                .sqrt()
+                / nf;
             sigma_mean[k] = (sd[k] / nf.sqrt()).max(propagated);
         }
-        let lengths: Vec<f64> = points
-            .iter()
-            .map(|p| Vector3::from(p.offset_m).norm())
-            .collect();
-        mean_3d = lengths.iter().sum::<f64>() / nf;
-        if n > 1 {
-            sd_3d =
-                (lengths.iter().map(|l| (l - mean_3d).powi(2)).sum::<f64>() / (nf - 1.0)).sqrt();
-        }
     }
+    let (mean_3d, sd_3d) =
+        mean_and_sd(with_height.iter().map(|p| Vector3::from(p.offset_m).norm()));
     let offset_2d = mean[0].hypot(mean[1]);
     let by_recording = points_by_recording(points);
     let points_off = points
@@ -455,6 +506,7 @@ fn statistics(
         last_image_id,
         recordings,
         points: n,
+        points_3d: with_height.len(),
         mean_m: mean,
         sd_m: sd,
         mean_3d_m: mean_3d,
@@ -466,6 +518,22 @@ fn statistics(
         stated_sigma_xy_m,
         status,
     }
+}
+
+/// Mean and sample SD of `values` (0, 0 when empty; SD 0 with one value).
+fn mean_and_sd(values: impl Iterator<Item = f64> + Clone) -> (f64, f64) {
+    let n = values.clone().count();
+    if n == 0 {
+        return (0.0, 0.0);
+    }
+    let nf = n as f64;
+    let mean = values.clone().sum::<f64>() / nf;
+    let sd = if n > 1 {
+        (values.map(|v| (v - mean).powi(2)).sum::<f64>() / (nf - 1.0)).sqrt()
+    } else {
+        0.0
+    };
+    (mean, sd)
 }
 
 /// Longest run of consecutive recordings in `span` (indices into the verified recordings) from which none of
@@ -546,7 +614,7 @@ fn neighbours_agree_off(
 }
 
 /// Column names of `verification.csv`.
-pub const VERIFICATION_CSV_HEADER: [&str; 20] = [
+pub const VERIFICATION_CSV_HEADER: [&str; 21] = [
     "segment",
     "first_image_id",
     "last_image_id",
@@ -567,6 +635,7 @@ pub const VERIFICATION_CSV_HEADER: [&str; 20] = [
     "status",
     "unobserved_run",
     "stated_sigma_xy",
+    "points_3d",
 ];
 
 /// `verification.csv`: one row per segment (metres; floats in shortest round-trip form), then a row
@@ -595,7 +664,7 @@ pub fn write_verification_csv(path: &Path, v: &Verification) -> io::Result<()> {
             .map(|x| format!("{x}"));
             writeln!(
                 w,
-                "{label},{},{},{},{},{},{},{},{},{}",
+                "{label},{},{},{},{},{},{},{},{},{},{}",
                 quote(&s.first_image_id),
                 quote(&s.last_image_id),
                 s.recordings,
@@ -605,7 +674,8 @@ pub fn write_verification_csv(path: &Path, v: &Verification) -> io::Result<()> {
                 s.status.label(),
                 s.unobserved_run,
                 s.stated_sigma_xy_m
-                    .map_or(String::new(), |v| format!("{v}"))
+                    .map_or(String::new(), |v| format!("{v}")),
+                s.points_3d
             )?;
         }
         Ok(())
@@ -667,7 +737,8 @@ pub fn render_verification_table(v: &Verification) -> String {
     }
     if v.skipped_single_aerial + v.skipped_mm > 0 {
         out.push_str(&format!(
-            "skipped: {} control points seen in < 2 aerial images, {} without an MM triangulation\n",
+            "skipped: {} control points seen in one aerial image and not compared, {} without an MM \
+             triangulation\n",
             v.skipped_single_aerial, v.skipped_mm
         ));
     }

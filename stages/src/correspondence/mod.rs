@@ -8,6 +8,9 @@
 use crate::campaign::AerialKind;
 use serde::{Deserialize, Serialize};
 
+mod ray_ground;
+pub use ray_ground::AerialRayGround;
+
 /// Where a point was measured in a panorama (original equirectangular pixel coordinates).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PanoObservation {
@@ -70,6 +73,10 @@ pub struct AerialControlPoint {
     /// was measured and where its height came from. `point_world` and `covariance_m2` are then always set.
     #[serde(default)]
     pub map: Option<MapControl>,
+    /// For a point seen in one aerial nadir image (`point_world` is then `None`): that image's ray where it
+    /// crosses the MM tie point's height, so the point still has a horizontal position to verify against.
+    #[serde(default)]
+    pub ray_ground: Option<AerialRayGround>,
 }
 
 /// Where a height came from.

@@ -78,6 +78,7 @@ mod tests {
     fn one_row_per_observation_panorama_first() {
         let p = AerialControlPoint {
             map: None,
+            ray_ground: None,
             tie_point_id: "pano_1#3".into(),
             mm: vec![
                 PanoObservation {

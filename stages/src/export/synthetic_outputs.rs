@@ -26,7 +26,9 @@ use crate::adjustment::{
 use crate::campaign::{
     format_time_iso, write_recordings_csv, AerialImage, AerialKind, Campaign, CheckPoint, Recording,
 };
-use crate::correspondence::{AerialControlPoint, AerialObservation, PanoObservation};
+use crate::correspondence::{
+    AerialControlPoint, AerialObservation, AerialRayGround, PanoObservation,
+};
 use crate::geometry::{FrameCamera, PanoramaCamera};
 use crate::nadir::footprint_index::FootprintIndex;
 use crate::rng::SplitMix64;
@@ -231,6 +233,14 @@ impl OutputsSpec {
                     [0.0, 0.0, 0.04],
                 ]),
                 map: None,
+                ray_ground: match aerial.as_slice() {
+                    &[(a, u, v)] => AerialRayGround::from_ray(
+                        &nadir_cams[a].pixel_ray(u, v),
+                        point_world.z,
+                        0.05,
+                    ),
+                    _ => None,
+                },
             });
             points.push(RunPoint {
                 point: BlockPoint {

@@ -29,11 +29,12 @@
 //! pixel count.
 //!
 //! Points seen in one aerial image are kept with `point_world: None` (a bundle with fixed aerial orientation
-//! can still use them). Output order: the window's tie-point order; observations sorted by aerial `image_id`.
+//! can still use them) and with their ray where it crosses the MM height (`ray_ground`, map coordinates, σ =
+//! σ_px·GSD): the horizontal position the verification compares with. Output order: the window's tie-point order; observations sorted by aerial `image_id`.
 
 use super::registration::{AerialRefinement, MmWindowMatch};
 use crate::campaign::AerialImage;
-use crate::correspondence::{AerialControlPoint, AerialObservation};
+use crate::correspondence::{AerialControlPoint, AerialObservation, AerialRayGround};
 use crate::crs::MapFrame;
 use crate::geometry::{
     intersect_ray_plane, triangulate_rays, FrameCamera, Plane, Ray, Triangulation,
@@ -44,7 +45,7 @@ use nalgebra::{Matrix3, Vector2, Vector3};
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("control", "4");
+pub const STAGE: StageId = StageId::new("control", "5");
 
 crate::params! {
     /// Parameters of [`aerial_control_points`].
@@ -80,6 +81,8 @@ struct Candidate {
     /// Ray ∩ horizontal plane at the MM height (x, y), m; and that point's horizontal σ, m.
     ground_xy: Vector2<f64>,
     ground_sigma_m: f64,
+    /// The horizontal σ of that point from the observation alone (σ_px · GSD), m.
+    pixel_ground_sigma_m: f64,
 }
 
 fn candidate(
@@ -108,7 +111,8 @@ fn candidate(
     }
     let d = ray.dir_world;
     let tilt_tan = d.x.hypot(d.y) / d.z.abs().max(1e-9);
-    let ground_sigma_m = (sigma_px * gsd_m).hypot(p.mm_height_sigma_m * tilt_tan);
+    let pixel_ground_sigma_m = sigma_px * gsd_m;
+    let ground_sigma_m = pixel_ground_sigma_m.hypot(p.mm_height_sigma_m * tilt_tan);
     Some(Candidate {
         observation: obs.clone(),
         ray,
@@ -117,6 +121,7 @@ fn candidate(
         camera,
         ground_xy: Vector2::new(ground.x, ground.y),
         ground_sigma_m,
+        pixel_ground_sigma_m,
     })
 }
 
@@ -275,6 +280,10 @@ pub fn aerial_control_points_in(
             .filter_map(|(row, obs, level)| candidate(row, (*obs, *level), mm_local.z, p, frame))
             .collect();
         let kept = consistent_subset(candidates, p.k_sigma);
+        let ray_ground = match kept.as_slice() {
+            [single] => ray_ground_in_map(frame, single, mm_local.z),
+            _ => None,
+        };
         let (kept, point) = match kept.len() {
             0 => continue,
             1 => (kept, None),
@@ -302,9 +311,23 @@ pub fn aerial_control_points_in(
                     [c[(2, 0)], c[(2, 1)], c[(2, 2)]],
                 ]
             }),
+            ray_ground,
         });
     }
     out
+}
+
+/// A single observation's ray where it crosses height `z_local` (the MM height, local frame), in map
+/// coordinates (`None` when the frame cannot convert it or the ray is horizontal).
+fn ray_ground_in_map(frame: &MapFrame, c: &Candidate, z_local: f64) -> Option<AerialRayGround> {
+    let local = AerialRayGround::from_ray(&c.ray, z_local, c.pixel_ground_sigma_m)?;
+    let at = Vector3::from(local.point_world);
+    let above = at + Vector3::new(local.xy_per_z[0], local.xy_per_z[1], 1.0);
+    let (at, above) = (
+        frame.point_to_map(&at).ok()?,
+        frame.point_to_map(&above).ok()?,
+    );
+    AerialRayGround::through(&at, &above, c.pixel_ground_sigma_m)
 }
 
 /// The triangulated point and its covariance in map coordinates (`None` when the frame cannot convert it).

@@ -383,6 +383,7 @@ fn control_points(
         }
         out.push(AerialControlPoint {
             map: None,
+            ray_ground: None,
             tie_point_id: point_id.to_string(),
             mm,
             aerial,

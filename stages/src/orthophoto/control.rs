@@ -187,6 +187,7 @@ pub fn orthophoto_control(
                 score: m.observation.score,
                 height,
             }),
+            ray_ground: None,
         });
     }
     Ok(out)
