@@ -97,7 +97,7 @@ fn run_cells(
             );
         }
         rows.push((
-            format!("{}/{}", cell.preset, cell.profile),
+            format!("{}/{}", cell.row, cell.profile),
             cell.seed,
             metrics,
         ));

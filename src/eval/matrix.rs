@@ -27,6 +27,16 @@ pub struct PresetCells {
     pub profiles: Vec<String>,
     /// Workflow of this preset, relative to the matrix file (default: the matrix's `workflow`).
     pub workflow: Option<PathBuf>,
+    /// Name of its rows in the table and of its output folder (default: `name`): one preset rendered two
+    /// ways (another workflow, e.g. with `[synth] panorama_width_px`) needs two labels.
+    pub label: Option<String>,
+}
+
+impl PresetCells {
+    /// The rows' name: `label`, else `name`.
+    pub fn row(&self) -> &str {
+        self.label.as_deref().unwrap_or(&self.name)
+    }
 }
 
 /// The whole matrix.
@@ -46,7 +56,10 @@ pub struct Matrix {
 /// One run of the matrix.
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub struct Cell {
+    /// The synthetic preset rendered (`synth:<preset>`).
     pub preset: String,
+    /// The preset's row name in the table ([`PresetCells::row`]).
+    pub row: String,
     pub profile: String,
     pub seed: u64,
     /// Absolute or working-directory-relative workflow path.
@@ -56,7 +69,7 @@ pub struct Cell {
 impl Cell {
     /// `preset/profile/seedN`, also the cell's output folder below the evaluation's.
     pub fn label(&self) -> String {
-        format!("{}/{}/seed{}", self.preset, self.profile, self.seed)
+        format!("{}/{}/seed{}", self.row, self.profile, self.seed)
     }
 }
 
@@ -74,7 +87,13 @@ impl Matrix {
         if self.presets.is_empty() {
             return Err("no [[preset]]: name at least one preset with seeds and profiles".into());
         }
-        for p in &self.presets {
+        for (i, p) in self.presets.iter().enumerate() {
+            if self.presets[..i].iter().any(|q| q.row() == p.row()) {
+                return Err(format!(
+                    "two [[preset]] entries are labelled '{}': give each a distinct `label`",
+                    p.row()
+                ));
+            }
             if p.seeds.is_empty() || p.profiles.is_empty() {
                 return Err(format!("preset '{}' needs seeds and profiles", p.name));
             }
@@ -90,8 +109,8 @@ impl Matrix {
         Ok(())
     }
 
-    /// Every cell, preset by preset, profile by profile, seed by seed; `only_presets`/`only_profiles` (empty =
-    /// all) and `max_seeds` (0 = all) select a part. Workflow paths are resolved against `matrix_dir`.
+    /// Every cell, preset by preset, profile by profile, seed by seed; `only_presets` (names or labels) and
+    /// `only_profiles` (empty = all) and `max_seeds` (0 = all) select a part. Workflow paths are resolved against `matrix_dir`.
     pub fn cells(
         &self,
         matrix_dir: &Path,
@@ -101,7 +120,9 @@ impl Matrix {
     ) -> Vec<Cell> {
         let mut out = Vec::new();
         for p in &self.presets {
-            if !only_presets.is_empty() && !only_presets.contains(&p.name) {
+            if !only_presets.is_empty()
+                && !only_presets.iter().any(|o| *o == p.name || o == p.row())
+            {
                 continue;
             }
             let workflow = matrix_dir.join(p.workflow.as_ref().unwrap_or(&self.workflow));
@@ -117,6 +138,7 @@ impl Matrix {
                 for &seed in seeds {
                     out.push(Cell {
                         preset: p.name.clone(),
+                        row: p.row().to_string(),
                         profile: profile.clone(),
                         seed,
                         workflow: workflow.clone(),
@@ -164,5 +186,28 @@ mod tests {
         .unwrap();
         let e = bad.check().unwrap_err();
         assert!(e.contains("seed 1") && e.contains("development"), "{e}");
+    }
+
+    #[test]
+    fn a_preset_rendered_two_ways_needs_two_labels() {
+        let two = |label: &str| {
+            format!(
+                "workflow = \"wf.toml\"\n\
+                 [[preset]]\nname = \"demo\"\nseeds = [7]\nprofiles = [\"thesis\"]\n\
+                 [[preset]]\nname = \"demo\"\n{label}seeds = [7]\nprofiles = [\"thesis\"]\nworkflow = \"hi.toml\"\n"
+            )
+        };
+        let same: Matrix = toml::from_str(&two("")).unwrap();
+        let e = same.check().unwrap_err();
+        assert!(e.contains("'demo'") && e.contains("label"), "{e}");
+        let m: Matrix = toml::from_str(&two("label = \"demo-hi\"\n")).unwrap();
+        assert!(m.check().is_ok());
+        let cells = m.cells(Path::new("/m"), &[], &[], 0);
+        assert_eq!(cells[1].label(), "demo-hi/thesis/seed7");
+        assert_eq!((cells[1].preset.as_str(), cells[1].row.as_str()), ("demo", "demo-hi"));
+        assert_eq!(cells[1].workflow, Path::new("/m/hi.toml"));
+        // Selected by name (both) or by label (that one).
+        assert_eq!(m.cells(Path::new("/m"), &["demo".into()], &[], 0).len(), 2);
+        assert_eq!(m.cells(Path::new("/m"), &["demo-hi".into()], &[], 0).len(), 1);
     }
 }

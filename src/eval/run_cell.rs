@@ -86,6 +86,7 @@ mod tests {
         std::fs::write(&base, "name = \"x\"\n").unwrap();
         let cell = Cell {
             preset: "demo".into(),
+            row: "demo".into(),
             profile: "thesis+ins".into(),
             seed: 101,
             workflow: base.clone(),
