@@ -96,11 +96,7 @@ fn run_cells(
                 start.elapsed().as_secs_f64()
             );
         }
-        rows.push((
-            format!("{}/{}", cell.row, cell.profile),
-            cell.seed,
-            metrics,
-        ));
+        rows.push((format!("{}/{}", cell.row, cell.profile), cell.seed, metrics));
     }
     Ok(rows)
 }

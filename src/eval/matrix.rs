@@ -204,10 +204,16 @@ mod tests {
         assert!(m.check().is_ok());
         let cells = m.cells(Path::new("/m"), &[], &[], 0);
         assert_eq!(cells[1].label(), "demo-hi/thesis/seed7");
-        assert_eq!((cells[1].preset.as_str(), cells[1].row.as_str()), ("demo", "demo-hi"));
+        assert_eq!(
+            (cells[1].preset.as_str(), cells[1].row.as_str()),
+            ("demo", "demo-hi")
+        );
         assert_eq!(cells[1].workflow, Path::new("/m/hi.toml"));
         // Selected by name (both) or by label (that one).
         assert_eq!(m.cells(Path::new("/m"), &["demo".into()], &[], 0).len(), 2);
-        assert_eq!(m.cells(Path::new("/m"), &["demo-hi".into()], &[], 0).len(), 1);
+        assert_eq!(
+            m.cells(Path::new("/m"), &["demo-hi".into()], &[], 0).len(),
+            1
+        );
     }
 }
