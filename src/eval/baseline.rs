@@ -187,7 +187,7 @@ mod committed {
             let cells = matrix
                 .presets
                 .iter()
-                .find(|p| p.name == preset)
+                .find(|p| p.row() == preset)
                 .unwrap_or_else(|| panic!("{key}: preset not in the matrix"));
             assert!(cells.profiles.iter().any(|p| p == profile), "{key}");
             assert_eq!(row.seeds, cells.seeds, "{key}");
