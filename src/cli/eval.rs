@@ -30,7 +30,7 @@ pub struct EvalArgs {
     /// Write the table as a new baseline to this file.
     #[arg(long)]
     pub write_baseline: Option<PathBuf>,
-    /// Only these presets (repeatable; default all of the matrix).
+    /// Only these presets, by name or `label` (repeatable; default all of the matrix).
     #[arg(long = "preset")]
     pub presets: Vec<String>,
     /// Only these profiles (repeatable; default all of the matrix).
