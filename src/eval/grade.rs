@@ -1,7 +1,8 @@
 //! The numbers of one evaluation cell, read from its run's output folder and the campaign's `truth/`: nadir
 //! and oblique inlier ratios, recordings and check points before/after the adjustment (RMSE 2D/3D, largest 2D
-//! error), how many recordings lie beyond the 95 % ellipse of their stated σ, and the verification's flags
-//! compared with the true offset of each segment.
+//! error), how many recordings lie beyond the 95 % ellipse of their stated σ, the largest error of the
+//! recordings the output declares controlled by aerial evidence, and the verification's flags compared with the
+//! true offset of each segment.
 
 use crate::report::inputs::{num_at, read_csv_opt, RunOutputs};
 use serde_json::Value;
@@ -38,7 +39,7 @@ pub const SEGMENT_OFF_M: f64 = 0.3;
 pub const SEGMENT_GOOD_M: f64 = 0.2;
 
 /// Every metric, in table order.
-pub const METRICS: [MetricDef; 19] = [
+pub const METRICS: [MetricDef; 20] = [
     MetricDef {
         key: "nadir_inlier",
         title: "nadir inlier",
@@ -90,6 +91,12 @@ pub const METRICS: [MetricDef; 19] = [
     MetricDef {
         key: "rec_max_2d_after",
         title: "rec max 2D",
+        better: Better::Lower,
+        floor: 0.01,
+    },
+    MetricDef {
+        key: "rec_max_2d_controlled",
+        title: "rec max 2D ctrl",
         better: Better::Lower,
         floor: 0.01,
     },
@@ -176,36 +183,55 @@ fn true_of(truth: &[Recording]) -> TrueOf<'_> {
     truth.iter().map(|r| (r.image_id.as_str(), r)).collect()
 }
 
-/// The share of the delivered recordings (`trajectory_adjusted.csv`, absent when the adjustment was withheld)
-/// whose horizontal error against `truth` lies outside the 95 % ellipse of their stated σ (`sigma_x`,
-/// `sigma_y`): about 0.05 when the stated precision is honest, more when it is optimistic. A recording without
-/// a truth row or a positive finite σ is not counted.
-fn recordings_beyond_sigma95(out: &Path, true_of: &TrueOf) -> Result<Option<f64>, String> {
+/// What the truth says of the delivered recordings (`trajectory_adjusted.csv`).
+#[derive(Debug, PartialEq)]
+struct DeliveredRecordings {
+    /// The share whose horizontal error lies outside the 95 % ellipse of their stated σ (`sigma_x`, `sigma_y`):
+    /// about 0.05 when the stated precision is honest, more when it is optimistic. A recording without a
+    /// truth row or a positive finite σ is not counted.
+    beyond_sigma95: Option<f64>,
+    /// The largest horizontal error, m, of the recordings whose `correction` is `controlled` — those the output
+    /// says aerial evidence corrected, as opposed to `bridged` or `extrapolated` ones it only carried along
+    /// (None when there is no such recording).
+    controlled_max_2d_m: Option<f64>,
+}
+
+/// [`DeliveredRecordings`] of the run in `out` (None when the adjustment was withheld and the file is absent).
+fn delivered_recordings(
+    out: &Path,
+    true_of: &TrueOf,
+) -> Result<Option<DeliveredRecordings>, String> {
     let Some(t) = read_csv_opt(&out.join("trajectory_adjusted.csv"))? else {
         return Ok(None);
     };
     let limit = chi2_2_quantile(ELLIPSE_P).unwrap_or(f64::INFINITY);
     let (mut beyond, mut counted) = (0usize, 0usize);
+    let mut controlled_max: Option<f64> = None;
     for row in &t.rows {
         let Some(truth) = true_of.get(t.text(row, "image_id")) else {
             continue;
         };
-        let (Some(x), Some(y), Some(sx), Some(sy)) = (
-            t.num(row, "x"),
-            t.num(row, "y"),
-            t.num(row, "sigma_x"),
-            t.num(row, "sigma_y"),
-        ) else {
+        let (Some(x), Some(y)) = (t.num(row, "x"), t.num(row, "y")) else {
+            continue;
+        };
+        let (ex, ey) = (x - truth.x, y - truth.y);
+        if t.text(row, "correction") == "controlled" {
+            controlled_max = Some(controlled_max.unwrap_or(0.0).max(ex.hypot(ey)));
+        }
+        let (Some(sx), Some(sy)) = (t.num(row, "sigma_x"), t.num(row, "sigma_y")) else {
             continue;
         };
         if !(sx > 0.0 && sy > 0.0 && sx.is_finite() && sy.is_finite()) {
             continue;
         }
-        let q = ((x - truth.x) / sx).powi(2) + ((y - truth.y) / sy).powi(2);
+        let q = (ex / sx).powi(2) + (ey / sy).powi(2);
         counted += 1;
         beyond += usize::from(q > limit);
     }
-    Ok((counted > 0).then(|| beyond as f64 / counted as f64))
+    Ok(Some(DeliveredRecordings {
+        beyond_sigma95: (counted > 0).then(|| beyond as f64 / counted as f64),
+        controlled_max_2d_m: controlled_max,
+    }))
 }
 
 /// The check points after adjustment (`checkpoints.csv`): the largest 2-D error, and the length of the mean
@@ -363,9 +389,14 @@ pub fn grade_cell(out: &Path) -> Result<CellMetrics, String> {
     if campaign.join("truth/recordings.csv").is_file() {
         let truth = read_recordings_csv(&campaign.join("truth/recordings.csv")).0;
         let truth_by_id = true_of(&truth);
+        let delivered = delivered_recordings(out, &truth_by_id)?;
         put(
             "rec_beyond_sigma95",
-            recordings_beyond_sigma95(out, &truth_by_id)?,
+            delivered.as_ref().and_then(|d| d.beyond_sigma95),
+        );
+        put(
+            "rec_max_2d_controlled",
+            delivered.as_ref().and_then(|d| d.controlled_max_2d_m),
         );
         let segments = segment_truth(out, &campaign, &truth_by_id)?;
         let off: Vec<&str> = segments
@@ -407,14 +438,15 @@ mod tests {
         let d = tempfile::tempdir().unwrap();
         // a: 0.05 m off with σ 0.02 per axis (q = 6.25 > 5.99, outside); b: 0.04 m off with σ 0.02 (q = 4,
         // inside); c: 0.30 m off along x with σx 0.20 (inside); d: no truth row; e: no σ (both not counted).
+        // Controlled: a and b (largest error 0.05 m); c, bridged, is not one of them.
         std::fs::write(
             d.path().join("trajectory_adjusted.csv"),
-            "image_id,x,y,z,sigma_x,sigma_y\n\
-             a,100.05,200,1,0.02,0.02\n\
-             b,110,200.04,1,0.02,0.02\n\
-             c,120.30,200,1,0.20,0.01\n\
-             d,130,200,1,0.02,0.02\n\
-             e,140,200,1,,\n",
+            "image_id,x,y,z,sigma_x,sigma_y,correction\n\
+             a,100.05,200,1,0.02,0.02,controlled\n\
+             b,110,200.04,1,0.02,0.02,controlled\n\
+             c,120.30,200,1,0.20,0.01,bridged\n\
+             d,130,200,1,0.02,0.02,controlled\n\
+             e,140,200,1,,,extrapolated\n",
         )
         .unwrap();
         let t = [
@@ -423,13 +455,16 @@ mod tests {
             truth("c", 120.0, 200.0),
             truth("e", 140.0, 200.0),
         ];
-        let share = recordings_beyond_sigma95(d.path(), &true_of(&t))
+        let delivered = delivered_recordings(d.path(), &true_of(&t))
             .unwrap()
             .unwrap();
+        let share = delivered.beyond_sigma95.unwrap();
         assert!((share - 1.0 / 3.0).abs() < 1e-12, "{share}");
+        let controlled = delivered.controlled_max_2d_m.unwrap();
+        assert!((controlled - 0.05).abs() < 1e-9, "{controlled}");
         let empty = tempfile::tempdir().unwrap();
         assert_eq!(
-            recordings_beyond_sigma95(empty.path(), &true_of(&t)).unwrap(),
+            delivered_recordings(empty.path(), &true_of(&t)).unwrap(),
             None
         );
     }
