@@ -225,3 +225,84 @@ fn demo_report() {
         100.0 * meet as f64 / total.max(1) as f64
     );
 }
+
+/// Outer recordings off by decimetres relative to the centre (a GNSS outage between them): the relative
+/// positions measured from the triplet's tracks restore the cloud that the recorded ones lose at the
+/// trifocal check, and the measured baselines point where the true ones do.
+#[test]
+fn relative_positions_off_by_decimetres_are_measured_from_the_tracks() {
+    let f = fixture();
+    let c = &f.campaign;
+    let pano = (c.panoramas[0].width as u32, c.panoramas[0].height as u32);
+    let truth: Vec<Recording> = c
+        .recorded
+        .iter()
+        .map(|r| c.truth[&r.image_id].clone())
+        .collect();
+    let offsets_m = [[0.35, -0.25, 0.0], [0.0, 0.0, 0.0], [-0.30, 0.20, 0.05]];
+    let recorded: Vec<Recording> = truth
+        .iter()
+        .take(3)
+        .zip(offsets_m)
+        .map(|(r, o)| Recording {
+            x: r.x + o[0],
+            y: r.y + o[1],
+            z: r.z + o[2],
+            ..r.clone()
+        })
+        .collect();
+    let levels: Vec<PanoramaLevels> = (0..3)
+        .map(|k| PanoramaLevels::from_image(&c.panoramas[k], 3))
+        .collect();
+    let panos = [&levels[0], &levels[1], &levels[2]];
+    let run = |recs: &[Recording], measured: bool| {
+        let p = SparseCloudParams {
+            relative_pose: measured,
+            ..SparseCloudParams::default()
+        };
+        sparse_cloud([&recs[0], &recs[1], &recs[2]], panos, &p)
+    };
+    let exact = run(&truth, false);
+    let kept = run(&recorded, false);
+    let measured = run(&recorded, true);
+    eprintln!(
+        "points: true poses {}, recorded kept {}, recorded measured {} ({:?})",
+        exact.points.len(),
+        kept.points.len(),
+        measured.points.len(),
+        measured.stats
+    );
+    assert_eq!(measured.stats.pose_corrected, 1);
+    assert!(
+        measured.points.len() as f64 >= 0.8 * exact.points.len() as f64,
+        "{} of {}",
+        measured.points.len(),
+        exact.points.len()
+    );
+    assert!(measured.points.len() >= 2 * kept.points.len().max(1));
+    // The points are right by the truth.
+    let correct = measured
+        .points
+        .iter()
+        .filter(|sp| grade(&sp.tie, measured.centre(), &c.truth, None, pano).0)
+        .count();
+    assert!(correct as f64 >= 0.9 * measured.points.len() as f64);
+    // The measured positions put each outer recording in the true direction from the centre (the triplet's
+    // scale, along the baselines, is what the prior holds): within 0.2° (a third of a view pixel).
+    let corr = measured.stats.pose_corrections_m;
+    let from_centre = |r: &Recording, d: [f64; 3]| {
+        nalgebra::Vector3::new(
+            r.x + d[0] - truth[1].x,
+            r.y + d[1] - truth[1].y,
+            r.z + d[2] - truth[1].z,
+        )
+    };
+    for k in [0, 2] {
+        let tru = from_centre(&truth[k], [0.0; 3]);
+        let angle_deg = |v: nalgebra::Vector3<f64>| v.angle(&tru).to_degrees();
+        let before = angle_deg(from_centre(&recorded[k], [0.0; 3]));
+        let after = angle_deg(from_centre(&recorded[k], corr[k]));
+        eprintln!("recording {k}: baseline direction {before:.2}° off as recorded, {after:.3}° as measured");
+        assert!(after < 0.2, "{k}: {after}°");
+    }
+}

@@ -5,14 +5,21 @@
 //! equirectangular geometry with the same track triangulation as the nadir MM matching
 //! ([`crate::nadir::mm_matching::tie_point::triangulate_track`]).
 //!
+//! Beyond the thesis, the cameras' relative positions are not taken from the recorded poses as they are: a
+//! first, wider matching of both sides gives tracks from which the outer recordings' positions relative to the
+//! centre are measured ([`relative_pose`]; the recorded ones are kept when the tracks do not agree on a
+//! correction), and the matching, the trifocal check and the triangulation then use the measured geometry.
+//!
 //! Deterministic: views and sides run in parallel with ordered results; tracks are sorted by their
 //! view-1/view-2 feature indices; no random sampling is involved (`seed` is kept for future estimators).
 
 pub mod guided;
 mod params;
+pub mod relative_pose;
 
 use guided::epipolar_candidates;
 pub use params::SparseCloudParams;
+use relative_pose::{estimate_relative_pose, PoseTrack, RelativePose, RelativePoseSettings};
 
 use super::types::{SparseCloud, SparseCloudStats, SparsePoint, StreetSide};
 use crate::campaign::Recording;
@@ -34,7 +41,7 @@ use std::collections::HashMap;
 
 /// The stage's identity in cache keys; bump the version whenever its output for the same inputs and parameters
 /// changes.
-pub const STAGE: StageId = StageId::new("sparse_cloud", "2");
+pub const STAGE: StageId = StageId::new("sparse_cloud", "3");
 
 /// Corners of one view with their descriptors (row-major, `len` values each).
 struct ViewFeatures {
@@ -124,14 +131,15 @@ fn view_features(
 }
 
 /// Matches of view `a`'s features (query) with view `b`'s (train): ratio test and mutual check, among the
-/// candidates near each feature's epipolar segment when `epipolar_tolerance_px` is set ([`guided`]).
+/// candidates within `tolerance_px` of each feature's epipolar segment ([`guided`]) when it is set.
 fn match_pair(
     a: &ViewFeatures,
     b: &ViewFeatures,
     len: usize,
+    tolerance_px: Option<f64>,
     p: &SparseCloudParams,
 ) -> Result<Vec<DescriptorMatch>, MatchError> {
-    let Some(tol) = p.epipolar_tolerance_px else {
+    let Some(tol) = tolerance_px else {
         return match_ratio(&a.descriptors, &b.descriptors, len, p.match_ratio, p.mutual);
     };
     let candidates = epipolar_candidates(
@@ -153,17 +161,16 @@ fn match_pair(
     )
 }
 
-/// The points of one side, with its part of the counts.
-fn side_cloud(
+/// The three views of one side with their features (view i from panorama i).
+fn side_features(
     side: StreetSide,
     recs: [&Recording; 3],
     panos: [&PanoramaLevels; 3],
     cams: &[PanoramaCamera; 3],
     p: &SparseCloudParams,
-    stats: &mut SparseCloudStats,
-) -> Vec<SparsePoint> {
+) -> Vec<ViewFeatures> {
     let deviations = p.yaw_deviations_deg(side);
-    let feats: Vec<ViewFeatures> = (0..3)
+    (0..3)
         .into_par_iter()
         .map(|i| {
             let view = PerspectiveView::of_panorama(
@@ -175,24 +182,88 @@ fn side_cloud(
             );
             view_features(view, panos[i], &cams[i], p)
         })
-        .collect();
-    stats.views += 3;
-    stats.corners += feats.iter().map(|f| f.corners).sum::<usize>();
+        .collect()
+}
+
+/// Matches views 1–2 and 2–3 of one side and links them through view 2 into three-view tracks (thesis
+/// 4.4.1), sorted: (matches 1–2, matches 2–3, tracks of feature indices).
+fn side_tracks(
+    feats: &[ViewFeatures],
+    tolerance_px: Option<f64>,
+    p: &SparseCloudParams,
+) -> (usize, usize, Vec<[usize; 3]>) {
     let len = feats[0].len;
-    let pair = |a: usize, b: usize| match_pair(&feats[a], &feats[b], len, p);
+    let pair = |a: usize, b: usize| match_pair(&feats[a], &feats[b], len, tolerance_px, p);
     let (m12, m23) = rayon::join(|| pair(0, 1), || pair(1, 2));
     // Lengths agree by construction; an error can only mean no descriptors at all.
     let (m12, m23) = (m12.unwrap_or_default(), m23.unwrap_or_default());
-    stats.matches_12 += m12.len();
-    stats.matches_23 += m23.len();
-
-    // Link through view 2 (thesis 4.4.1): view-2 feature → its view-3 match.
     let next: HashMap<usize, usize> = m23.iter().map(|m| (m.query, m.train)).collect();
     let mut tracks: Vec<[usize; 3]> = m12
         .iter()
         .filter_map(|m| next.get(&m.train).map(|&k| [m.query, m.train, k]))
         .collect();
     tracks.sort_unstable();
+    (m12.len(), m23.len(), tracks)
+}
+
+/// The outer recordings' positions relative to the centre measured from the tracks of a wide first matching
+/// of both sides ([`relative_pose`]); the corrections of the three centres, or `None` when the recorded
+/// positions are kept (too few agreeing tracks, or a correction beyond `pose_max_correction_m`).
+fn measured_relative_pose(
+    sides: &[Vec<ViewFeatures>],
+    cams: &[PanoramaCamera; 3],
+    p: &SparseCloudParams,
+    stats: &mut SparseCloudStats,
+) -> Option<RelativePose> {
+    let wide = p
+        .epipolar_tolerance_px
+        .map(|_| p.pose_epipolar_tolerance_px);
+    let mut tracks = Vec::new();
+    for feats in sides {
+        let (_, _, t) = side_tracks(feats, wide, p);
+        tracks.extend(t.iter().map(|t| PoseTrack {
+            bearings_world: std::array::from_fn(|v| {
+                let [x, y] = feats[v].points_px[t[v]];
+                feats[v].view.pixel_to_ray_world(x, y)
+            }),
+        }));
+    }
+    stats.pose_tracks += tracks.len();
+    let pixel_rad = sides.first()?.first()?.view.centre_pixel_angle_rad();
+    let mut scales_rad = Vec::new();
+    let mut scale_px = p.pose_epipolar_tolerance_px;
+    while scale_px > p.trifocal_tolerance_px {
+        scales_rad.push(scale_px * pixel_rad);
+        scale_px /= 2.0;
+    }
+    scales_rad.push(p.trifocal_tolerance_px * pixel_rad);
+    let settings = RelativePoseSettings {
+        prior_sigma_m: p.pose_prior_sigma_m,
+        ray_sigma_rad: pixel_rad,
+        scales_rad,
+        min_tracks: p.pose_min_tracks,
+        max_correction_m: p.pose_max_correction_m,
+    };
+    // Centres relative to the middle one (world coordinates are 10⁵ m).
+    let centres: [Vector3<f64>; 3] =
+        std::array::from_fn(|i| cams[i].center_world - cams[1].center_world);
+    estimate_relative_pose(&centres, &tracks, &settings)
+}
+
+/// The points of one side from its views' features, with its part of the counts.
+fn side_cloud(
+    side: StreetSide,
+    recs: [&Recording; 3],
+    feats: &[ViewFeatures],
+    cams: &[PanoramaCamera; 3],
+    p: &SparseCloudParams,
+    stats: &mut SparseCloudStats,
+) -> Vec<SparsePoint> {
+    stats.views += 3;
+    stats.corners += feats.iter().map(|f| f.corners).sum::<usize>();
+    let (m12, m23, tracks) = side_tracks(feats, p.epipolar_tolerance_px, p);
+    stats.matches_12 += m12;
+    stats.matches_23 += m23;
     stats.tracks += tracks.len();
 
     // Trifocal point transfer 1, 2 → 3 in a local frame at the centre recording (world ≈ 10⁵ m).
@@ -268,19 +339,36 @@ pub fn sparse_cloud(
     panos: [&PanoramaLevels; 3],
     p: &SparseCloudParams,
 ) -> SparseCloud {
-    let cams: [PanoramaCamera; 3] = std::array::from_fn(|i| {
+    let mut cams: [PanoramaCamera; 3] = std::array::from_fn(|i| {
         PanoramaCamera::from_recording(recs[i], panos[i].width_px as u32, panos[i].height_px as u32)
     });
+    let mut sides: Vec<Vec<ViewFeatures>> = StreetSide::BOTH
+        .par_iter()
+        .map(|&side| side_features(side, recs, panos, &cams, p))
+        .collect();
+    let mut stats = SparseCloudStats::default();
+    if p.relative_pose {
+        if let Some(pose) = measured_relative_pose(&sides, &cams, p, &mut stats) {
+            for (i, c) in pose.corrections_m.iter().enumerate() {
+                cams[i].center_world += c;
+                for feats in &mut sides {
+                    feats[i].view.center_world += c;
+                }
+            }
+            stats.pose_corrected = 1;
+            stats.pose_corrections_m = pose.corrections_m.map(|c| [c.x, c.y, c.z]);
+        }
+    }
     let per_side: Vec<(Vec<SparsePoint>, SparseCloudStats)> = StreetSide::BOTH
         .par_iter()
-        .map(|&side| {
+        .zip(sides.par_iter())
+        .map(|(&side, feats)| {
             let mut stats = SparseCloudStats::default();
-            let pts = side_cloud(side, recs, panos, &cams, p, &mut stats);
+            let pts = side_cloud(side, recs, feats, &cams, p, &mut stats);
             (pts, stats)
         })
         .collect();
     let mut points = Vec::new();
-    let mut stats = SparseCloudStats::default();
     for (pts, s) in per_side {
         points.extend(pts);
         stats.views += s.views;

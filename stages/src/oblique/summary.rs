@@ -15,6 +15,10 @@ pub struct ObliqueSummary {
     /// Sparse cloud drops: tracks rejected by trifocal transfer and at triangulation.
     pub rejected_trifocal: usize,
     pub rejected_triangulation: usize,
+    /// Triplets whose relative positions were measured from their tracks and used, and the mean of their
+    /// larger outer-position correction, metres.
+    pub relative_pose_corrected: usize,
+    pub relative_pose_correction_mean_m: f64,
     /// Façade planes accepted (4.4.2) and the sides without one, planes occluded, views rejected (4.4.3).
     pub planes: usize,
     pub sides_without_plane: usize,
@@ -55,10 +59,16 @@ impl ObliqueSummary {
             registration_sets: sets.len(),
             ..Default::default()
         };
+        let mut correction_sum_m = 0.0;
         for c in clouds {
             s.sparse_points += c.points.len();
             s.rejected_trifocal += c.stats.rejected_trifocal;
             s.rejected_triangulation += c.stats.rejected_triangulation;
+            s.relative_pose_corrected += c.stats.pose_corrected;
+            correction_sum_m += c.stats.pose_correction_m();
+        }
+        if s.relative_pose_corrected > 0 {
+            s.relative_pose_correction_mean_m = correction_sum_m / s.relative_pose_corrected as f64;
         }
         for f in facades {
             s.planes += f.planes.len();
@@ -91,6 +101,8 @@ impl ObliqueSummary {
         json!({
             "triplets": self.triplets,
             "sparse_points": self.sparse_points,
+            "relative_pose_corrected": self.relative_pose_corrected,
+            "relative_pose_correction_mean_m": self.relative_pose_correction_mean_m,
             "planes": self.planes,
             "registration_sets": self.registration_sets,
             "patches": self.patches,

@@ -54,6 +54,13 @@ pub struct SparseCloudStats {
     pub rejected_triangulation: usize,
     /// Points kept (`SparseCloud::points.len()`).
     pub points: usize,
+    /// Tracks of the wide first matching that measured the relative positions (both sides).
+    pub pose_tracks: usize,
+    /// 1 when the measured relative positions were used, 0 when the recorded ones were kept.
+    pub pose_corrected: usize,
+    /// The position corrections of the three recordings (world x, y, z, metres; the centre's is zero, and all
+    /// are zero when the recorded positions were kept).
+    pub pose_corrections_m: [[f64; 3]; 3],
 }
 
 /// The sparse cloud of one panorama triplet (thesis 4.4.1): recordings i−1, i, i+1 along the trajectory.
@@ -63,6 +70,16 @@ pub struct SparseCloud {
     pub recordings: [String; 3],
     pub points: Vec<SparsePoint>,
     pub stats: SparseCloudStats,
+}
+
+impl SparseCloudStats {
+    /// The larger of the two outer recordings' position corrections, metres.
+    pub fn pose_correction_m(&self) -> f64 {
+        self.pose_corrections_m
+            .iter()
+            .map(|c| c[0].hypot(c[1]).hypot(c[2]))
+            .fold(0.0, f64::max)
+    }
 }
 
 impl SparseCloud {

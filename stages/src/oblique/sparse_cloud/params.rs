@@ -33,6 +33,24 @@ crate::params! {
         min_depth_m: f64 = 2.0, unit "m", above 0.0;
         /// Largest trifocal transfer error (1, 2 → 3) of a kept track.
         trifocal_tolerance_px: f64 = 2.0, unit "px", above 0.0;
+        /// Measure the outer recordings' positions relative to the centre recording from the triplet's own
+        /// tracks before matching for the cloud (`oblique::sparse_cloud::relative_pose`), instead of trusting
+        /// the recorded relative positions: in a GNSS outage consecutive recordings can be off relative to each
+        /// other by decimetres, and the trifocal check then rejects the right tracks.
+        relative_pose: bool = true;
+        /// Epipolar tolerance of the wide first matching whose tracks measure the relative positions (with
+        /// the default 512-px, 90° views 32 px ≈ 5.6°: a relative error of 1 m for a point 10 m away). Without
+        /// `epipolar_tolerance_px` that matching is unguided too.
+        pose_epipolar_tolerance_px: f64 = 32.0, unit "px", above 0.0, max 512.0;
+        /// σ per axis of the prior holding the outer positions at the recorded ones where the tracks say little
+        /// (the triplet's scale; directions the façades leave weak).
+        pose_prior_sigma_m: f64 = 0.5, unit "m", above 0.0;
+        /// Fewest tracks (both sides) that must agree with the measured positions within
+        /// `trifocal_tolerance_px` for them to be used.
+        pose_min_tracks: usize = 12, min 3;
+        /// A measured correction of an outer recording larger than this is not believed; the recorded
+        /// positions are kept.
+        pose_max_correction_m: f64 = 2.0, unit "m", above 0.0;
         /// Smallest maximum ray intersection angle of a kept point.
         min_intersection_angle_deg: f64 = 2.0, unit "deg", min 0.0, below 90.0;
         /// Points farther than this from the centre recording are dropped.
