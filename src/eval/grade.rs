@@ -344,15 +344,24 @@ pub fn grade_cell(out: &Path) -> Result<CellMetrics, String> {
         "nadir_registered",
         num_at(m, "nadir.recordings_with_aerial_fraction"),
     );
-    let oblique =
-        graded("oblique.inliers_after_consensus") || graded("oblique.outliers_after_consensus");
+    // The oblique correspondences the adjustment and the exports use: the second pass's when the workflow runs
+    // two (`[adjust] passes = 2`), else the first's.
+    let ob = if m.get("oblique_pass2").is_some() {
+        "oblique_pass2"
+    } else {
+        "oblique"
+    };
+    let at = |k: &str| num_at(m, &format!("{ob}.{k}"));
+    let oblique = [at("inliers_after_consensus"), at("outliers_after_consensus")]
+        .iter()
+        .any(|n| n.is_some_and(|n| n > 0.0));
     put(
         "oblique_inlier",
-        num_at(m, "oblique.inlier_ratio_after_consensus").filter(|_| oblique),
+        at("inlier_ratio_after_consensus").filter(|_| oblique),
     );
     put(
         "oblique_inlier_nm",
-        num_at(m, "oblique.inlier_ratio_after_consensus_incl_non_matchable").filter(|_| oblique),
+        at("inlier_ratio_after_consensus_incl_non_matchable").filter(|_| oblique),
     );
     if let Some(a) = adjust_section(m) {
         // 1 when the run delivered the adjusted trajectory (verdict `corrected`), 0 when it withheld it.
