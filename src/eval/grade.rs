@@ -352,9 +352,12 @@ pub fn grade_cell(out: &Path) -> Result<CellMetrics, String> {
         "oblique"
     };
     let at = |k: &str| num_at(m, &format!("{ob}.{k}"));
-    let oblique = [at("inliers_after_consensus"), at("outliers_after_consensus")]
-        .iter()
-        .any(|n| n.is_some_and(|n| n > 0.0));
+    let oblique = [
+        at("inliers_after_consensus"),
+        at("outliers_after_consensus"),
+    ]
+    .iter()
+    .any(|n| n.is_some_and(|n| n > 0.0));
     put(
         "oblique_inlier",
         at("inlier_ratio_after_consensus").filter(|_| oblique),
